@@ -1,0 +1,68 @@
+#include "args.h"
+
+#include <charconv>
+#include <cmath>
+
+namespace dressguard::cli {
+
+Args::Args(int argc, char** argv, std::set<std::string> flags) {
+  for (int i = 0; i < argc; ++i) {
+    std::string a = argv[i];
+    if (a.rfind("--", 0) == 0 && a.size() > 2) {
+      std::string name = a.substr(2);
+      if (auto eq = name.find('='); eq != std::string::npos) {
+        values_[name.substr(0, eq)] = name.substr(eq + 1);
+      } else if (flags.count(name)) {
+        flags_set_.insert(name);
+      } else {
+        if (i + 1 >= argc) throw UsageError("option --" + name + " needs a value");
+        values_[name] = argv[++i];
+      }
+    } else {
+      positional_.push_back(a);
+    }
+  }
+}
+
+bool Args::has(const std::string& name) const { return flags_set_.count(name) || values_.count(name); }
+
+std::optional<std::string> Args::get(const std::string& name) const {
+  auto it = values_.find(name);
+  if (it == values_.end()) return std::nullopt;
+  return it->second;
+}
+
+std::string Args::require(const std::string& name) const {
+  auto v = get(name);
+  if (!v) throw UsageError("missing required option --" + name);
+  return *v;
+}
+
+double Args::number(const std::string& name, double fallback) const {
+  auto v = get(name);
+  if (!v) return fallback;
+  double x = 0;
+  auto [p, ec] = std::from_chars(v->data(), v->data() + v->size(), x);
+  if (ec != std::errc() || p != v->data() + v->size() || !std::isfinite(x)) {
+    throw UsageError("option --" + name + ": not a number: '" + *v + "'");
+  }
+  return x;
+}
+
+long Args::integer(const std::string& name, long fallback) const {
+  auto v = get(name);
+  if (!v) return fallback;
+  long x = 0;
+  auto [p, ec] = std::from_chars(v->data(), v->data() + v->size(), x);
+  if (ec != std::errc() || p != v->data() + v->size()) {
+    throw UsageError("option --" + name + ": not an integer: '" + *v + "'");
+  }
+  return x;
+}
+
+void Args::allow_only(const std::set<std::string>& known) const {
+  for (const auto& [k, v] : values_) if (!known.count(k)) throw UsageError("unknown option --" + k);
+  for (const auto& k : flags_set_) if (!known.count(k)) throw UsageError("unknown option --" + k);
+}
+
+}  // namespace dressguard::cli

@@ -1,0 +1,41 @@
+// A small command-line reader shared by the dressguard subcommands.
+//
+// Every subcommand takes "--name value" options and "--flag" switches, answers --help, and on
+// bad input exits non-zero with one line naming what was wrong (UsageError, caught in main).
+#pragma once
+
+#include <map>
+#include <optional>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace dressguard::cli {
+
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class Args {
+ public:
+  // `flags`: names that take no value (e.g. "json", "help"); every other "--name" takes one.
+  Args(int argc, char** argv, std::set<std::string> flags);
+
+  bool has(const std::string& name) const;
+  std::optional<std::string> get(const std::string& name) const;
+  std::string require(const std::string& name) const;  // UsageError when absent
+  double number(const std::string& name, double fallback) const;  // UsageError when not a number
+  long integer(const std::string& name, long fallback) const;
+  const std::vector<std::string>& positional() const { return positional_; }
+  // UsageError naming the first option that is not in `known` (catches typos like --sped).
+  void allow_only(const std::set<std::string>& known) const;
+
+ private:
+  std::map<std::string, std::string> values_;
+  std::set<std::string> flags_set_;
+  std::vector<std::string> positional_;
+};
+
+}  // namespace dressguard::cli

@@ -1,0 +1,18 @@
+// The dressguard subcommands. Each lives in its own cmd_<name>.cpp and is listed once in main.cpp.
+#pragma once
+
+namespace dressguard::cli {
+
+// Every command: argv[0] is the subcommand name; returns the process exit code. Throws
+// UsageError or InputError for bad input (main prints the one-line reason, exits 2).
+using CommandFn = int (*)(int argc, char** argv);
+
+struct Command {
+  const char* name;
+  const char* summary;
+  CommandFn run;
+};
+
+int run_import(int argc, char** argv);
+
+}  // namespace dressguard::cli

@@ -1,0 +1,231 @@
+#include "dataset.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <sstream>
+
+#include "files.h"
+
+namespace dressguard {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::vector<std::string_view> split(std::string_view line, char sep) {
+  std::vector<std::string_view> out;
+  size_t start = 0;
+  while (true) {
+    const size_t pos = line.find(sep, start);
+    out.push_back(line.substr(start, pos == std::string_view::npos ? std::string_view::npos : pos - start));
+    if (pos == std::string_view::npos) break;
+    start = pos + 1;
+  }
+  return out;
+}
+
+std::vector<std::string_view> split_ws(std::string_view line) {
+  std::vector<std::string_view> out;
+  size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+    size_t j = i;
+    while (j < line.size() && line[j] != ' ' && line[j] != '\t') ++j;
+    if (j > i) out.push_back(line.substr(i, j - i));
+    i = j;
+  }
+  return out;
+}
+
+double parse_double(std::string_view s, const fs::path& file, long line, std::string_view column) {
+  double v = 0.0;
+  while (!s.empty() && s.front() == ' ') s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\r')) s.remove_suffix(1);
+  const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || p != s.data() + s.size() || !std::isfinite(v)) {
+    throw_input_error(file, line, "column " + std::string(column) + ": not a finite number: '" + std::string(s) + "'");
+  }
+  return v;
+}
+
+template <typename F>
+void for_each_line(const std::string& text, F&& f) {
+  long lineno = 0;
+  size_t start = 0;
+  while (start < text.size()) {
+    size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    std::string_view line(text.data() + start, end - start);
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    ++lineno;
+    f(line, lineno);
+    start = end + 1;
+  }
+}
+
+constexpr const char* kTrialHeader = "t,travel,f_motion,f_lateral,f_vertical";
+constexpr const char* kManifestHeader = "trial_id,participant,height,speed,label,file";
+
+void check_time_increases(const std::vector<HapticSample>& s, const fs::path& file, long line) {
+  if (s.size() >= 2 && !(s.back().t > s[s.size() - 2].t)) {
+    throw_input_error(file, line, "time does not increase");
+  }
+}
+
+}  // namespace
+
+std::vector<HapticSample> read_trial_csv(const fs::path& path) {
+  const std::string text = read_file(path);
+  std::vector<HapticSample> out;
+  for_each_line(text, [&](std::string_view line, long n) {
+    if (n == 1) {
+      if (line != kTrialHeader) throw_input_error(path, 1, std::string("expected header '") + kTrialHeader + "'");
+      return;
+    }
+    if (line.empty()) return;
+    const auto f = split(line, ',');
+    if (f.size() != 5) throw_input_error(path, n, "expected 5 columns, found " + std::to_string(f.size()));
+    static constexpr const char* names[] = {"t", "travel", "f_motion", "f_lateral", "f_vertical"};
+    double v[5];
+    for (int i = 0; i < 5; ++i) v[i] = parse_double(f[i], path, n, names[i]);
+    out.push_back({v[0], v[1], v[2], v[3], v[4]});
+    check_time_increases(out, path, n);
+  });
+  if (out.empty()) throw_input_error(path, 0, "no samples");
+  return out;
+}
+
+std::string format_trial_csv(const std::vector<HapticSample>& samples) {
+  std::string out = std::string(kTrialHeader) + "\n";
+  char buf[160];
+  for (const auto& s : samples) {
+    // %.9g keeps sub-micronewton resolution and round-trips the study's 6-decimal values.
+    std::snprintf(buf, sizeof buf, "%.9g,%.9g,%.9g,%.9g,%.9g\n", s.t, s.travel, s.f_motion, s.f_lateral, s.f_vertical);
+    out += buf;
+  }
+  return out;
+}
+
+Dataset load_dataset(const fs::path& dir) {
+  const fs::path manifest = dir / "manifest.csv";
+  const std::string text = read_file(manifest);
+  Dataset ds;
+  std::map<std::string, long> seen;
+  for_each_line(text, [&](std::string_view line, long n) {
+    if (n == 1) {
+      if (line != kManifestHeader) throw_input_error(manifest, 1, std::string("expected header '") + kManifestHeader + "'");
+      return;
+    }
+    if (line.empty()) return;
+    const auto f = split(line, ',');
+    if (f.size() != 6) throw_input_error(manifest, n, "expected 6 columns, found " + std::to_string(f.size()));
+    HapticSequence seq;
+    seq.id = std::string(f[0]);
+    if (seq.id.empty()) throw_input_error(manifest, n, "empty trial_id");
+    if (auto [it, fresh] = seen.emplace(seq.id, n); !fresh) {
+      throw_input_error(manifest, n, "trial_id '" + seq.id + "' repeats line " + std::to_string(it->second));
+    }
+    seq.participant = std::string(f[1]);
+    const auto h = parse_arm_height(f[2]);
+    if (!h) throw_input_error(manifest, n, "height must be high, middle or low, not '" + std::string(f[2]) + "'");
+    seq.height = *h;
+    seq.speed = parse_double(f[3], manifest, n, "speed");
+    if (seq.speed <= 0.0) throw_input_error(manifest, n, "speed must be positive");
+    if (!f[4].empty()) {
+      const auto o = parse_outcome(f[4]);
+      if (!o) throw_input_error(manifest, n, "label must be good, missed, caught or empty, not '" + std::string(f[4]) + "'");
+      seq.label = *o;
+    }
+    if (f[5].empty()) throw_input_error(manifest, n, "empty file");
+    seq.samples = read_trial_csv(dir / std::string(f[5]));
+    ds.trials.push_back(std::move(seq));
+  });
+  return ds;
+}
+
+void save_dataset(const Dataset& ds, const fs::path& dir) {
+  fs::create_directories(dir);
+  std::ostringstream m;
+  m << kManifestHeader << '\n';
+  for (const auto& seq : ds.trials) {
+    const std::string file = seq.id + ".csv";
+    write_file_atomic(dir / file, format_trial_csv(seq.samples));
+    char speed[32];
+    std::snprintf(speed, sizeof speed, "%.6g", seq.speed);
+    m << seq.id << ',' << seq.participant << ',' << arm_height_name(seq.height) << ',' << speed << ','
+      << (seq.label ? outcome_name(*seq.label) : std::string_view()) << ',' << file << '\n';
+  }
+  write_file_atomic(dir / "manifest.csv", m.str());
+}
+
+std::vector<HapticSample> read_study_trial(const fs::path& path) {
+  const std::string text = read_file(path);
+  std::vector<HapticSample> out;
+  for_each_line(text, [&](std::string_view line, long n) {
+    const auto f = split_ws(line);
+    if (f.empty()) return;
+    if (f.size() != 5) throw_input_error(path, n, "expected 5 space-separated columns, found " + std::to_string(f.size()));
+    static constexpr const char* names[] = {"t", "position", "F_motion", "F_lateral", "F_vertical"};
+    double v[5];
+    for (int i = 0; i < 5; ++i) v[i] = parse_double(f[i], path, n, names[i]);
+    out.push_back({v[0], v[1], v[2], v[3], v[4]});
+    check_time_increases(out, path, n);
+  });
+  if (out.empty()) throw_input_error(path, 0, "no samples");
+  return out;
+}
+
+double estimate_speed(const std::vector<HapticSample>& s) {
+  // The rig accelerates at 1 m/s^2, so by 0.2 s it cruises; fit the slope over the middle half.
+  if (s.size() < 8) return 0.1;
+  const size_t a = s.size() / 4, b = 3 * s.size() / 4;
+  const double v = (s[b].travel - s[a].travel) / (s[b].t - s[a].t);
+  return std::fabs(v - 0.1) <= std::fabs(v - 0.15) ? 0.1 : 0.15;
+}
+
+Dataset import_study(const fs::path& study) {
+  struct Folder { const char* name; ArmHeight height; Outcome label; const char* tag; };
+  static constexpr Folder folders[] = {
+      {"good", ArmHeight::High, Outcome::Good, "good"},
+      {"caughtmiss", ArmHeight::Middle, Outcome::Missed, "middlemiss"},
+      {"miss", ArmHeight::Low, Outcome::Missed, "miss"},
+  };
+  if (!fs::is_directory(study)) throw_input_error(study, 0, "not a folder");
+  Dataset ds;
+  for (const auto& folder : folders) {
+    const fs::path dir = study / folder.name;
+    if (!fs::is_directory(dir)) throw_input_error(dir, 0, "missing: expected the study's good/, miss/ and caughtmiss/ folders");
+    std::vector<fs::path> files;
+    for (const auto& subj : fs::directory_iterator(dir)) {
+      if (!subj.is_directory()) continue;
+      for (const auto& f : fs::directory_iterator(subj.path())) {
+        if (f.path().extension() == ".txt") files.push_back(f.path());
+      }
+    }
+    std::sort(files.begin(), files.end());
+    for (const auto& f : files) {
+      const std::string subj = f.parent_path().filename().string();
+      if (subj.rfind("subject", 0) != 0) throw_input_error(f.parent_path(), 0, "expected a folder named subject<N>");
+      HapticSequence seq;
+      seq.participant = subj.substr(7);
+      seq.id = "s" + seq.participant + "-" + folder.tag + "-" + f.stem().string();
+      seq.height = folder.height;
+      seq.label = folder.label;
+      seq.samples = read_study_trial(f);
+      seq.speed = estimate_speed(seq.samples);
+      ds.trials.push_back(std::move(seq));
+    }
+  }
+  return ds;
+}
+
+fs::path study_dir() {
+  const fs::path s = shared_dir();
+  if (s.empty()) return {};
+  const fs::path d = s / "data" / "kapusta2016-calibration-trials";
+  return fs::is_directory(d) ? d : fs::path();
+}
+
+}  // namespace dressguard

@@ -1,0 +1,68 @@
+#include "files.h"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <unistd.h>
+
+#ifndef DRESSGUARD_DEFAULT_SHARED_DIR
+#define DRESSGUARD_DEFAULT_SHARED_DIR ""
+#endif
+
+namespace dressguard {
+namespace fs = std::filesystem;
+
+void throw_input_error(const fs::path& file, long line, std::string_view what) {
+  std::ostringstream os;
+  os << file.string();
+  if (line > 0) os << ':' << line;
+  os << ": " << what;
+  throw InputError(os.str());
+}
+
+std::string read_file(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw_input_error(path, 0, std::string("cannot open: ") + std::strerror(errno));
+  std::ostringstream os;
+  os << in.rdbuf();
+  if (in.bad()) throw_input_error(path, 0, "read error");
+  return os.str();
+}
+
+void write_file_atomic(const fs::path& path, std::string_view content) {
+  if (path.has_parent_path()) fs::create_directories(path.parent_path());
+  // Unique per process so that MPI ranks or parallel runs never share a temporary.
+  fs::path tmp = path;
+  tmp += ".tmp." + std::to_string(::getpid());
+  {
+    std::FILE* f = std::fopen(tmp.c_str(), "wb");
+    if (!f) throw_input_error(tmp, 0, std::string("cannot create: ") + std::strerror(errno));
+    const size_t n = std::fwrite(content.data(), 1, content.size(), f);
+    const bool ok = n == content.size() && std::fflush(f) == 0 && ::fsync(fileno(f)) == 0;
+    const int err = errno;
+    std::fclose(f);
+    if (!ok) {
+      fs::remove(tmp);
+      throw_input_error(tmp, 0, std::string("write failed: ") + std::strerror(err));
+    }
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    fs::remove(tmp);
+    throw_input_error(path, 0, "cannot rename temporary into place: " + ec.message());
+  }
+}
+
+fs::path shared_dir() {
+  auto holds_data = [](const fs::path& p) { return !p.empty() && fs::is_directory(p / "data"); };
+  if (const char* env = std::getenv("DRESSGUARD_SHARED_DIR"); env && holds_data(env)) return fs::path(env);
+  if (holds_data(DRESSGUARD_DEFAULT_SHARED_DIR)) return fs::path(DRESSGUARD_DEFAULT_SHARED_DIR);
+  if (holds_data("../shared")) return fs::path("../shared");
+  return {};
+}
+
+}  // namespace dressguard

@@ -1,0 +1,32 @@
+// File handling shared by every offline command: errors that name the file and line, and
+// writes that never leave a half-written file behind.
+#pragma once
+
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+namespace dressguard {
+
+// Bad input: the message names the file (and line, where there is one) and what was wrong.
+class InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// "path:line: what" (line 0 omits the line).
+[[noreturn]] void throw_input_error(const std::filesystem::path& file, long line, std::string_view what);
+
+// Reads a whole file; throws InputError naming the file if it cannot.
+std::string read_file(const std::filesystem::path& path);
+
+// Writes `content` to `path` through a temporary file in the same folder and a rename, so a
+// reader sees either the old file or the whole new one, never a torn one. Creates parent folders.
+void write_file_atomic(const std::filesystem::path& path, std::string_view content);
+
+// The study's shared/ folder: $DRESSGUARD_SHARED_DIR, else the build-time default, else
+// ../shared relative to the working directory. Empty when none of them holds data/.
+std::filesystem::path shared_dir();
+
+}  // namespace dressguard

@@ -1,0 +1,16 @@
+# `dressguard import` on a missing folder exits 2 with one line that names the folder.
+execute_process(COMMAND ${DG} import --study /nonexistent/study --out /tmp/dg_never_written
+                RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+if(NOT rc EQUAL 2)
+  message(FATAL_ERROR "expected exit code 2, got ${rc}")
+endif()
+if(NOT err MATCHES "/nonexistent/study")
+  message(FATAL_ERROR "error does not name the folder: ${err}")
+endif()
+if(EXISTS /tmp/dg_never_written)
+  message(FATAL_ERROR "a failed import wrote its output folder")
+endif()
+execute_process(COMMAND ${DG} import --sped 3 RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "--sped")
+  message(FATAL_ERROR "unknown option not named: rc=${rc} ${err}")
+endif()
