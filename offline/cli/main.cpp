@@ -13,6 +13,7 @@ namespace {
 // One row per subcommand, in the order a user meets them.
 constexpr Command kCommands[] = {
     {"import", "convert the study's measured trials into a dataset", run_import},
+    {"simulate", "simulate one sleeve-pulling trial: haptic CSV, summary, scene for pictures", run_simulate},
 };
 
 void print_usage() {

@@ -25,7 +25,8 @@ inline double distance_constraint(V3& xi, V3& xj, double wi, double wj, double r
     *n_out = {0, 0, 0};
     return 0;
   }
-  const V3 n = (1.0 / len) * d;
+  const double inv_len = 1.0 / len;
+  const V3 n = inv_len * d;
   const double dl = -(len - rest) / denom;
   xi += (wi * dl) * n;
   xj -= (wj * dl) * n;
@@ -42,19 +43,20 @@ inline double distance_constraint(V3& xi, V3& xj, double wi, double wj, double r
 // with compliance alpha = 1 / bending stiffness [1/(N m)]. The rest state is flat (cloth has no
 // rest curvature: a sewn sleeve is flat fabric), and K is constant, so the constraint costs one
 // weighted sum. C vanishes on a flat or cylindrically bent-free stencil; skip when |K x| ~ 0.
-inline double bending_constraint(V3* x0, V3* x1, V3* x2, V3* x3, const double w[4], const double k[4],
-                                 double alpha_t) {
-  V3* xs[4] = {x0, x1, x2, x3};
-  V3 kx{0, 0, 0};
-  for (int a = 0; a < 4; ++a) kx += k[a] * *xs[a];
-  const double c = norm(kx);
-  if (c < 1e-12) return 0;
+inline double bending_constraint(V3& x0, V3& x1, V3& x2, V3& x3, const double w[4], const double k[4],
+                                 double alpha_t, V3* n_out) {
+  const V3 kx = k[0] * x0 + k[1] * x1 + k[2] * x2 + k[3] * x3;
+  const double c2 = dot(kx, kx);
+  if (c2 < 1e-24) return 0;
+  const double c = std::sqrt(c2);
+  const double denom = alpha_t + w[0] * k[0] * k[0] + w[1] * k[1] * k[1] + w[2] * k[2] * k[2] + w[3] * k[3] * k[3];
   const V3 n = (1.0 / c) * kx;
-  double denom = alpha_t;
-  for (int a = 0; a < 4; ++a) denom += w[a] * k[a] * k[a];
-  if (denom <= 0) return 0;
   const double dl = -c / denom;
-  for (int a = 0; a < 4; ++a) *xs[a] += (w[a] * k[a] * dl) * n;
+  x0 += (w[0] * k[0] * dl) * n;
+  x1 += (w[1] * k[1] * dl) * n;
+  x2 += (w[2] * k[2] * dl) * n;
+  x3 += (w[3] * k[3] * dl) * n;
+  *n_out = n;
   return dl;
 }
 

@@ -113,12 +113,12 @@ void detect_self(const GownModel& m, GownState& s) {
   }
 }
 
-void substep(const GownModel& m, GownState& s, V3 grip, V3 grip_accel, bool last_of_sample_unused) {
+// Integration: the grasped vertices follow the gripper, the others move under gravity, the
+// perturbation and velocity damping (symplectic Euler prediction of XPBD).
+void integrate(const GownModel& m, GownState& s, V3 grip) {
   const SceneData& sc = *m.scene;
   const int n = static_cast<int>(s.x.size());
-  const double h = m.h, inv_h = 1.0 / h, inv_h2 = 1.0 / (h * h);
-  const double decay = m.damping_factor;
-  // Integrate: the grasped vertices follow the gripper, the others fall.
+  const double h = m.h, decay = m.damping_factor;
   for (int i = 0; i < n; ++i) {
     s.p[i] = s.x[i];
     if (sc.grasped[i]) {
@@ -130,40 +130,66 @@ void substep(const GownModel& m, GownState& s, V3 grip, V3 grip_accel, bool last
     s.v[i] = v;
     s.x[i] += h * v;
   }
-  V3 force{0, 0, 0};  // of the gown on the gripper, this substep
-  // Stretch and shear: distance constraints.
-  const double at_stretch = m.alpha_stretch * inv_h2, at_shear = m.alpha_shear * inv_h2, at_bend = m.alpha_bend * inv_h2;
-  for (const DistanceLink& l : sc.stretch) {
+}
+
+// Distance constraints in list order (fixed Gauss-Seidel order); the force they exert on
+// grasped vertices is added to `force` (XPBD: f = grad C lambda / h^2).
+void solve_links(const GownModel& m, GownState& s, const std::vector<DistanceLink>& links, double alpha_t,
+                 double inv_h2, V3& force) {
+  const uint8_t* grasped = m.scene->grasped.data();
+  V3* x = s.x.data();
+  const double* w = m.w.data();
+  for (const DistanceLink& l : links) {
     V3 nrm;
-    const double dl = distance_constraint(s.x[l.i], s.x[l.j], m.w[l.i], m.w[l.j], l.rest, at_stretch, &nrm);
-    if (sc.grasped[l.i]) force += (dl * inv_h2) * nrm;
-    if (sc.grasped[l.j]) force -= (dl * inv_h2) * nrm;
-  }
-  for (const DistanceLink& l : sc.shear) {
-    V3 nrm;
-    const double dl = distance_constraint(s.x[l.i], s.x[l.j], m.w[l.i], m.w[l.j], l.rest, at_shear, &nrm);
-    if (sc.grasped[l.i]) force += (dl * inv_h2) * nrm;
-    if (sc.grasped[l.j]) force -= (dl * inv_h2) * nrm;
-  }
-  // Bending.
-  for (const BendStencil& b : sc.bend) {
-    const double w4[4] = {m.w[b.v[0]], m.w[b.v[1]], m.w[b.v[2]], m.w[b.v[3]]};
-    V3 kx{0, 0, 0};
-    const bool touches = sc.grasped[b.v[0]] | sc.grasped[b.v[1]] | sc.grasped[b.v[2]] | sc.grasped[b.v[3]];
-    if (touches)
-      for (int a = 0; a < 4; ++a) kx += b.k[a] * s.x[b.v[a]];
-    const double dl = bending_constraint(&s.x[b.v[0]], &s.x[b.v[1]], &s.x[b.v[2]], &s.x[b.v[3]], w4, b.k, at_bend);
-    if (touches && dl != 0) {
-      const V3 nrm = (1.0 / norm(kx)) * kx;
-      for (int a = 0; a < 4; ++a)
-        if (sc.grasped[b.v[a]]) force += (b.k[a] * dl * inv_h2) * nrm;
+    const double dl = distance_constraint(x[l.i], x[l.j], w[l.i], w[l.j], l.rest, alpha_t, &nrm);
+    if (grasped[l.i] | grasped[l.j]) {
+      if (grasped[l.i]) force += (dl * inv_h2) * nrm;
+      if (grasped[l.j]) force -= (dl * inv_h2) * nrm;
     }
   }
-  // Contacts with the arm (and test planes), friction by the chosen scheme.
+}
+
+void solve_bending(const GownModel& m, GownState& s, double alpha_t, double inv_h2, V3& force) {
+  const uint8_t* grasped = m.scene->grasped.data();
+  V3* x = s.x.data();
+  const double* w = m.w.data();
+  for (const BendStencil& b : m.scene->bend) {
+    const double w4[4] = {w[b.v[0]], w[b.v[1]], w[b.v[2]], w[b.v[3]]};
+    V3 nrm;
+    const double dl = bending_constraint(x[b.v[0]], x[b.v[1]], x[b.v[2]], x[b.v[3]], w4, b.k, alpha_t, &nrm);
+    if (grasped[b.v[0]] | grasped[b.v[1]] | grasped[b.v[2]] | grasped[b.v[3]])
+      for (int a = 0; a < 4; ++a)
+        if (grasped[b.v[a]]) force += (b.k[a] * dl * inv_h2) * nrm;
+  }
+}
+
+// One contact against a static collider with the chosen friction scheme.
+inline void collide_static(const GownModel& m, GownState& s, int i, double phi, V3 nrm) {
+  const double dn = contact_constraint(s.x[i], phi, nrm, m.scene->opt.contact_offset);
+  if (dn <= 0) return;
+  s.contact_n[i] = nrm;
+  s.contact_dn[i] = dn;
+  if (m.scheme == FrictionScheme::Improved) {
+    friction_position(s.x[i], s.p[i], nrm, dn, m.friction);
+  } else if (m.scheme == FrictionScheme::Constraint) {
+    if (!s.anchored[i]) {
+      s.anchor[i] = s.p[i];
+      s.anchored[i] = 1;
+    }
+    friction_anchor(s.x[i], s.anchor[i], nrm, dn, m.friction, m.friction * m.scene->opt.kinetic_ratio);
+  }
+}
+
+// Contacts with the arm's candidate round cones and the test planes; the collision force on
+// each vertex (paper eq. 2: f = m dx_col / h^2) is accumulated for the per-vertex contact map.
+void solve_contacts(const GownModel& m, GownState& s, double inv_h2) {
+  const SceneData& sc = *m.scene;
+  const int n = static_cast<int>(s.x.size());
   const double off = sc.opt.contact_offset;
-  const double mu = m.friction;
+  const bool planes = !sc.planes.empty();
   for (int i = 0; i < n; ++i) {
     s.contact_dn[i] = 0;
+    if (s.cand[i].c[0] < 0 && !planes) continue;
     if (sc.grasped[i]) continue;
     const V3 before = s.x[i];
     for (int k = 0; k < 2; ++k) {
@@ -171,83 +197,60 @@ void substep(const GownModel& m, GownState& s, V3 grip, V3 grip_accel, bool last
       if (c < 0) break;
       V3 nrm;
       const double phi = round_cone_distance(m.arm[c], s.x[i], &nrm);
-      const double dn = contact_constraint(s.x[i], phi, nrm, off);
-      if (dn <= 0) continue;
-      s.contact_n[i] = nrm;
-      s.contact_dn[i] = dn;
-      if (m.scheme == FrictionScheme::Improved) {
-        friction_position(s.x[i], s.p[i], nrm, dn, mu);
-      } else if (m.scheme == FrictionScheme::Constraint) {
-        if (!s.anchored[i]) {
-          s.anchor[i] = s.p[i];
-          s.anchored[i] = 1;
-        }
-        friction_anchor(s.x[i], s.anchor[i], nrm, dn, mu, mu * sc.opt.kinetic_ratio);
-      }
+      collide_static(m, s, i, phi, nrm);
     }
     for (const HalfSpace& pl : sc.planes) {
       const double phi = dot(pl.n, s.x[i]) - pl.d;
-      const double dn = contact_constraint(s.x[i], phi, pl.n, off);
-      if (dn <= 0) {
-        if (phi - off > 1e-3) s.anchored[i] = 0;
-        continue;
-      }
-      s.contact_n[i] = pl.n;
-      s.contact_dn[i] = dn;
-      if (m.scheme == FrictionScheme::Improved) {
-        friction_position(s.x[i], s.p[i], pl.n, dn, mu);
-      } else if (m.scheme == FrictionScheme::Constraint) {
-        if (!s.anchored[i]) {
-          s.anchor[i] = s.p[i];
-          s.anchored[i] = 1;
-        }
-        friction_anchor(s.x[i], s.anchor[i], pl.n, dn, mu, mu * sc.opt.kinetic_ratio);
-      }
+      if (phi - off > 1e-3) s.anchored[i] = 0;
+      collide_static(m, s, i, phi, pl.n);
     }
-    // Paper eq. 2: the collision force on the vertex is m dx_col / h^2.
     if (s.contact_dn[i] > 0) s.contact_acc[i] += (m.mass[i] * inv_h2) * (s.x[i] - before);
   }
-  // Self-collision with self-friction (paper IV-A.3), vertex-vertex at distance ds.
-  if (m.self_collision) {
-    const double ds = sc.opt.self_distance, mus = m.self_friction;
-    for (size_t k = 0; k < s.pair_count; ++k) {
-      const int i = s.pairs[k].i, j = s.pairs[k].j;
-      s.pair_dn[k] = 0;
-      const double wi = m.w[i], wj = m.w[j], wsum = wi + wj;
-      if (wsum <= 0) continue;
-      const V3 d = s.x[i] - s.x[j];
-      const double len = norm(d);
-      if (len >= ds || len < 1e-12) continue;
-      const V3 nrm = (1.0 / len) * d;
-      const double dl = (ds - len) / wsum;
-      s.x[i] += (wi * dl) * nrm;
-      s.x[j] -= (wj * dl) * nrm;
-      s.pair_dn[k] = ds - len;
-      s.pair_n[k] = nrm;
-      if (m.scheme != FrictionScheme::Stock && mus > 0) {
-        // Relative tangential slip this substep, removed up to mus * (normal correction).
-        const V3 u = (s.x[i] - s.p[i]) - (s.x[j] - s.p[j]);
-        const V3 ut = u - dot(u, nrm) * nrm;
-        const double lt = norm(ut);
-        if (lt > 1e-15) {
-          const double f = std::min(1.0, mus * (ds - len) / lt) / wsum;
-          s.x[i] -= (wi * f) * ut;
-          s.x[j] += (wj * f) * ut;
-        }
+}
+
+// Self-collision with self-friction (paper IV-A.3): vertex pairs kept `ds` apart, and their
+// relative tangential slip of this substep removed up to mu_self times the normal correction
+// (the same rule as against the arm; the Stock scheme applies it to velocities only).
+void solve_self(const GownModel& m, GownState& s) {
+  const double ds = m.scene->opt.self_distance, mus = m.self_friction;
+  const bool position_friction = m.scheme != FrictionScheme::Stock && mus > 0;
+  for (size_t k = 0; k < s.pair_count; ++k) {
+    const int i = s.pairs[k].i, j = s.pairs[k].j;
+    s.pair_dn[k] = 0;
+    const double wi = m.w[i], wj = m.w[j], wsum = wi + wj;
+    const V3 d = s.x[i] - s.x[j];
+    const double len2 = dot(d, d);
+    if (len2 >= ds * ds || wsum <= 0 || len2 < 1e-24) continue;
+    const double len = std::sqrt(len2);
+    const V3 nrm = (1.0 / len) * d;
+    const double dl = (ds - len) / wsum;
+    s.x[i] += (wi * dl) * nrm;
+    s.x[j] -= (wj * dl) * nrm;
+    s.pair_dn[k] = ds - len;
+    s.pair_n[k] = nrm;
+    if (position_friction) {
+      const V3 u = (s.x[i] - s.p[i]) - (s.x[j] - s.p[j]);
+      const V3 ut = u - dot(u, nrm) * nrm;
+      const double lt = norm(ut);
+      if (lt > 1e-15) {
+        const double f = std::min(1.0, mus * (ds - len) / lt) / wsum;
+        s.x[i] -= (wi * f) * ut;
+        s.x[j] += (wj * f) * ut;
       }
     }
   }
-  // Velocities from positions.
+}
+
+// v = (x - p) / h; the Stock scheme then applies its velocity-only friction.
+void update_velocities(const GownModel& m, GownState& s) {
+  const int n = static_cast<int>(s.x.size());
+  const double h = m.h, inv_h = 1.0 / h;
+  const bool stock = m.scheme == FrictionScheme::Stock;
   for (int i = 0; i < n; ++i) {
-    if (sc.grasped[i]) {
-      s.v[i] = inv_h * (s.x[i] - s.p[i]);
-      continue;
-    }
     s.v[i] = inv_h * (s.x[i] - s.p[i]);
-    if (m.scheme == FrictionScheme::Stock && s.contact_dn[i] > 0)
-      friction_velocity(s.v[i], s.contact_n[i], s.contact_dn[i], mu, h);
+    if (stock && s.contact_dn[i] > 0) friction_velocity(s.v[i], s.contact_n[i], s.contact_dn[i], m.friction, h);
   }
-  if (m.scheme == FrictionScheme::Stock && m.self_collision && m.self_friction > 0) {
+  if (stock && m.self_collision && m.self_friction > 0) {
     for (size_t k = 0; k < s.pair_count; ++k) {
       if (s.pair_dn[k] <= 0) continue;
       const int i = s.pairs[k].i, j = s.pairs[k].j;
@@ -262,6 +265,19 @@ void substep(const GownModel& m, GownState& s, V3 grip, V3 grip_accel, bool last
       s.v[j] += (wj * f) * ut;
     }
   }
+}
+
+void substep(const GownModel& m, GownState& s, V3 grip, V3 grip_accel) {
+  const SceneData& sc = *m.scene;
+  const double inv_h2 = 1.0 / (m.h * m.h);
+  integrate(m, s, grip);
+  V3 force{0, 0, 0};  // of the gown on the gripper, this substep
+  solve_links(m, s, sc.stretch, m.alpha_stretch * inv_h2, inv_h2, force);
+  solve_links(m, s, sc.shear, m.alpha_shear * inv_h2, inv_h2, force);
+  solve_bending(m, s, m.alpha_bend * inv_h2, inv_h2, force);
+  solve_contacts(m, s, inv_h2);
+  if (m.self_collision) solve_self(m, s);
+  update_velocities(m, s);
   // The grasped vertices' own weight and inertia also load the gripper.
   for (int g : sc.grasp_list) force += m.mass[g] * (m.gravity - grip_accel);
   s.force_acc += force;
@@ -277,7 +293,7 @@ void step(const GownModel& m, GownState& s, V3 grip_from, V3 grip_to, V3 grip_ac
     const double f = static_cast<double>(k + 1) / m.substeps;
     const V3 grip = grip_from + f * (grip_to - grip_from);
     s.grip_offset = grip;
-    substep(m, s, grip, grip_accel, false);
+    substep(m, s, grip, grip_accel);
   }
 }
 

@@ -3,6 +3,7 @@
 #include "trial.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <random>
 
@@ -78,6 +79,7 @@ TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const 
 
   // Perturbation (paper V-A): one random horizontal force, uniform in X and lateral up to 6 N,
   // spread equally over all vertices for 0.5 s (output steps 180-330), then settling.
+  const auto clock0 = std::chrono::steady_clock::now();
   std::mt19937_64 rng(spec.seed);
   const double fx = uniform(rng, -6.0, 6.0), fy = uniform(rng, -6.0, 6.0);
   const int perturb_from = 180, perturb_to = 330;
@@ -109,6 +111,8 @@ TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const 
       if (s.x[v].z <= zmean) lower.push_back(v);
   }
 
+  const auto clock1 = std::chrono::steady_clock::now();
+  r.wall_settle = std::chrono::duration<double>(clock1 - clock0).count();
   const Profile prof{spec.acceleration, spec.speed, spec.max_travel};
   r.seq.height = spec.height;
   r.seq.speed = spec.speed;
@@ -132,6 +136,13 @@ TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const 
     const double travel = prof.travel(t);
     r.seq.samples.push_back({t, travel, f.x, f.y, f.z});
     r.finite = all_finite(s);
+    if (r.contact_t < 0)
+      for (int i = 0; i < n; ++i)
+        if (s.contact_acc[i].x != 0 || s.contact_acc[i].y != 0 || s.contact_acc[i].z != 0) {
+          r.contact_t = t;
+          r.contact_travel = travel;
+          break;
+        }
     if (std::abs(f.x) >= spec.force_limit || std::abs(f.z) >= spec.force_limit) {
       r.stopped_by_force = true;
       break;
@@ -141,6 +152,7 @@ TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const 
       break;
     }
   }
+  r.wall_pull = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock1).count();
   r.travel = prof.travel(t);
   r.self_pairs_dropped = s.pairs_dropped;
   r.d_max = 0;

@@ -95,6 +95,8 @@ struct TrialResult {
   double d_max = 0;                 // [m] paper V-A label distance (NaN-free; 0 when missed)
   bool stopped_by_force = false;
   double travel = 0;                // [m] gripper travel at the stop
+  double contact_t = -1;            // [s] first sample with cloth-arm contact (-1: none)
+  double contact_travel = -1;       // [m] travel then
   double weight = 0;                // [N] gown weight m g
   std::array<double, 3> bias{};     // [N] raw force at the start of the pull, removed from samples
   double area_ratio = 1;            // final triangle area / rest area (explosion check)
@@ -102,6 +104,7 @@ struct TrialResult {
   std::vector<ContactForce> contacts;
   std::vector<Frame> frames;
   long self_pairs_dropped = 0;      // self-collision pairs beyond the preallocated capacity
+  double wall_settle = 0, wall_pull = 0;  // [s] wall time of grasp+settling and of the pull
 };
 
 // The arm (data README; paper IV: capsules, fixed, uniform friction). Spheres fist, wrist,
@@ -139,6 +142,7 @@ struct SceneOptions {
   std::array<double, 3> jaw_half{0.04, 0.06, 0.01};
   std::array<double, 3> grasp_point{0, 0, 0};  // [m] world position of the grasp at travel 0
   bool with_arm = true;
+  bool colour_order = true;       // false: constraints in mesh order (the benchmark's baseline)
 };
 
 struct SceneData;  // model.h
