@@ -34,29 +34,55 @@ inline double distance_constraint(V3& xi, V3& xj, double wi, double wj, double r
   return dl;
 }
 
+// In-plane shear of one triangle (strain based, Mueller et al. 2014 "Strain based dynamics"):
+// with the rest frame (e1 along the first edge, e2 normal to it in the plane) and
+// Dm^-1 = [[a, b], [c, d]], the deformation gradient's columns are
+//   f1 = (x1 - x0) a + (x2 - x0) c,   f2 = (x1 - x0) b + (x2 - x0) d,
+// and the shear strain  C = f1 . f2  (0 at rest: the frame's axes stay perpendicular), with
+//   grad_1 C = a f2 + b f1,  grad_2 C = c f2 + d f1,  grad_0 C = -(grad_1 C + grad_2 C).
+// Energy (1/2) C^2 / alpha per triangle, alpha = 1 / (G A) for shear modulus G [N/m]: the caller
+// passes alpha_t = alpha_shear / (A h^2). Purely in-plane: it neither resists bending nor
+// remembers a curved rest shape (a cross-edge distance would do both).
+inline double shear_constraint(V3& x0, V3& x1, V3& x2, double w0, double w1, double w2, const double dm_inv[4],
+                               double alpha_t, V3 g_out[3]) {
+  const double a = dm_inv[0], b = dm_inv[1], c = dm_inv[2], d = dm_inv[3];
+  const V3 e1 = x1 - x0, e2 = x2 - x0;
+  const V3 f1 = a * e1 + c * e2, f2 = b * e1 + d * e2;
+  const double C = dot(f1, f2);
+  const V3 g1 = a * f2 + b * f1, g2 = c * f2 + d * f1;
+  const V3 g0 = (-1.0) * (g1 + g2);
+  const double denom = w0 * dot(g0, g0) + w1 * dot(g1, g1) + w2 * dot(g2, g2) + alpha_t;
+  if (denom <= 1e-300) return 0;
+  const double dl = -C / denom;
+  x0 += (w0 * dl) * g0;
+  x1 += (w1 * dl) * g1;
+  x2 += (w2 * dl) * g2;
+  g_out[0] = g0;
+  g_out[1] = g1;
+  g_out[2] = g2;
+  return dl;
+}
+
 // Isometric bending (Bergou, Wardetzky, Harmon, Zorin, Grinspun 2006, "A quadratic bending
 // model for inextensible surfaces"): for the edge (x0, x1) with opposite vertices x2, x3 the
 // discrete mean-curvature vector is  K x = sum_i k_i x_i,  k = (c03 + c04, c01 + c02,
 // -(c01 + c03), -(c02 + c04)) with c_ab the cotangents of the rest triangles' angles, scaled by
-// sqrt(3 / (A0 + A1)). Bergou's energy  E = (1/2) (1/alpha) |K x|^2  is XPBD's energy of
-//   C = |K x|,  grad_i C = k_i n,  n = K x / |K x|
-// with compliance alpha = 1 / bending stiffness [1/(N m)]. The rest state is flat (cloth has no
-// rest curvature: a sewn sleeve is flat fabric), and K is constant, so the constraint costs one
-// weighted sum. C vanishes on a flat or cylindrically bent-free stencil; skip when |K x| ~ 0.
-inline double bending_constraint(V3& x0, V3& x1, V3& x2, V3& x3, const double w[4], const double k[4],
-                                 double alpha_t, V3* n_out) {
+// sqrt(3 / (A0 + A1)). Bergou's energy  E = (1/2) (1/alpha) |K x|^2  is the XPBD energy of the
+// *vector* constraint
+//   C = K x = 0 (3 components, linear in x),   grad_i C = k_i I,
+// so one update serves all three components, with no square root and no kink at the flat state
+// (the scalar |K x| has one, and its flipping direction chatters):
+//   dlambda = -(K x) / (sum_i w_i k_i^2 + alpha_t),   dx_i = w_i k_i dlambda.
+// alpha = 1 / bending stiffness [1/(N m)]. The rest state is flat (cloth has no rest curvature:
+// a sewn sleeve is flat fabric), and K is constant. Returns the vector dlambda.
+inline V3 bending_constraint(V3& x0, V3& x1, V3& x2, V3& x3, const double w[4], const double k[4], double alpha_t) {
   const V3 kx = k[0] * x0 + k[1] * x1 + k[2] * x2 + k[3] * x3;
-  const double c2 = dot(kx, kx);
-  if (c2 < 1e-24) return 0;
-  const double c = std::sqrt(c2);
   const double denom = alpha_t + w[0] * k[0] * k[0] + w[1] * k[1] * k[1] + w[2] * k[2] * k[2] + w[3] * k[3] * k[3];
-  const V3 n = (1.0 / c) * kx;
-  const double dl = -c / denom;
-  x0 += (w[0] * k[0] * dl) * n;
-  x1 += (w[1] * k[1] * dl) * n;
-  x2 += (w[2] * k[2] * dl) * n;
-  x3 += (w[3] * k[3] * dl) * n;
-  *n_out = n;
+  const V3 dl = (-1.0 / denom) * kx;
+  x0 += (w[0] * k[0]) * dl;
+  x1 += (w[1] * k[1]) * dl;
+  x2 += (w[2] * k[2]) * dl;
+  x3 += (w[3] * k[3]) * dl;
   return dl;
 }
 

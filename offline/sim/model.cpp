@@ -147,6 +147,17 @@ Scene make_scene(const ClothMesh& mesh, const SceneOptions& opt) {
     const V3 a = d->rest[tr[0]], b = d->rest[tr[1]], c = d->rest[tr[2]];
     const double area = 0.5 * norm(cross(b - a, c - a));
     d->rest_area += area;
+    {
+      // Rest frame: e1 along the first edge, e2 perpendicular in the plane; Dm = [[l1, p], [0, q]].
+      const double l1 = norm(b - a);
+      if (l1 > 1e-12 && area > 1e-14) {
+        const V3 e1 = (1.0 / l1) * (b - a);
+        const double p = dot(c - a, e1);
+        const double q = 2 * area / l1;
+        ShearTri st{{tr[0], tr[1], tr[2]}, {1.0 / l1, -p / (l1 * q), 0.0, 1.0 / q}, area};
+        d->shear.push_back(st);
+      }
+    }
     for (int k = 0; k < 3; ++k) d->vertex_area[tr[k]] += area / 3;
     for (int k = 0; k < 3; ++k) {
       const int32_t u = tr[k], v = tr[(k + 1) % 3], o = tr[(k + 2) % 3];
@@ -161,9 +172,8 @@ Scene make_scene(const ClothMesh& mesh, const SceneOptions& opt) {
     while (e < he.size() && he[e].a == he[k].a && he[e].b == he[k].b) ++e;
     const int32_t i = he[k].a, j = he[k].b;
     d->stretch.push_back({i, j, norm(d->rest[i] - d->rest[j])});
-    if (e - k >= 2) {  // interior edge: shear cross-edge and bending stencil (first two triangles)
+    if (e - k >= 2) {  // interior edge: a bending stencil (first two triangles)
       const int32_t o2 = he[k].opp, o3 = he[k + 1].opp;
-      d->shear.push_back({o2, o3, norm(d->rest[o2] - d->rest[o3])});
       const V3 x0 = d->rest[i], x1 = d->rest[j], x2 = d->rest[o2], x3 = d->rest[o3];
       const V3 e0 = x1 - x0, e1 = x2 - x0, e2 = x3 - x0, e3 = x2 - x1, e4 = x3 - x1;
       const double a0 = 0.5 * norm(cross(e0, e1)), a1 = 0.5 * norm(cross(e0, e2));
@@ -178,7 +188,7 @@ Scene make_scene(const ClothMesh& mesh, const SceneOptions& opt) {
   }
   if (opt.colour_order) {
   colour_order(d->stretch, n, [](const DistanceLink& l) { return std::array<int, 2>{l.i, l.j}; });
-  colour_order(d->shear, n, [](const DistanceLink& l) { return std::array<int, 2>{l.i, l.j}; });
+  colour_order(d->shear, n, [](const ShearTri& t) { return std::array<int, 3>{t.v[0], t.v[1], t.v[2]}; });
   colour_order(d->bend, n, [](const BendStencil& b) { return std::array<int, 4>{b.v[0], b.v[1], b.v[2], b.v[3]}; });
   }
   // Grasp: the given vertices, else those inside the jaw box around the grasp point.
@@ -188,7 +198,7 @@ Scene make_scene(const ClothMesh& mesh, const SceneOptions& opt) {
       if (g < 0 || g >= n) throw std::invalid_argument("make_scene: grasp vertex " + std::to_string(g) + " out of range");
       d->grasped[g] = 1;
     }
-  } else {
+  } else if (opt.require_grasp) {
     const V3 c{opt.grasp_point[0] + opt.jaw_centre[0], opt.grasp_point[1] + opt.jaw_centre[1],
                opt.grasp_point[2] + opt.jaw_centre[2]};
     for (int i = 0; i < n; ++i) {
@@ -199,10 +209,16 @@ Scene make_scene(const ClothMesh& mesh, const SceneOptions& opt) {
   }
   for (int i = 0; i < n; ++i)
     if (d->grasped[i]) d->grasp_list.push_back(i);
-  if (d->grasp_list.empty()) throw std::invalid_argument("make_scene: no vertex of '" + mesh.name + "' is inside the jaw box");
+  if (d->grasp_list.empty() && opt.require_grasp) throw std::invalid_argument("make_scene: no vertex of '" + mesh.name + "' is inside the jaw box");
   for (int v : mesh.sleeve_opening)
     if (v < 0 || v >= n) throw std::invalid_argument("make_scene: sleeve opening vertex " + std::to_string(v) + " out of range");
   d->opening = std::vector<int32_t>(mesh.sleeve_opening.begin(), mesh.sleeve_opening.end());
+  for (const auto& pl : opt.planes) {
+    const V3 nn{pl[0], pl[1], pl[2]};
+    const double l = norm(nn);
+    if (l < 1e-12) throw std::invalid_argument("make_scene: a plane has a zero normal");
+    d->planes.push_back({(1.0 / l) * nn, pl[3] / l});
+  }
   if (opt.with_arm) {
     d->arm = build_arm(opt);
     d->elbow = d->arm[0].a;
@@ -230,7 +246,7 @@ GownModel make_model(const SceneData& s, const ClothParams& p, FrictionScheme sc
   }
   // Ranges documented in trial.h (ClothParams).
   m.alpha_stretch = compliance_of(p.stretch, 1e-2, 1e-7);
-  m.alpha_shear = compliance_of(p.shear, 1e-1, 1e-6);
+  m.alpha_shear = compliance_of(p.shear, 1e0, 1e-5);
   m.alpha_bend = compliance_of(p.bend, 1e7, 1e1);
   m.friction = std::max(0.0, p.friction);
   m.self_friction = std::max(0.0, p.self_friction);
@@ -267,8 +283,6 @@ GownState make_state(const GownModel& m) {
   s.cell_of.assign(n, 0);
   const size_t cap = m.self_collision ? 16 * n : 0;
   s.pairs.resize(cap);
-  s.pair_dn.assign(cap, 0.0);
-  s.pair_n.assign(cap, {});
   return s;
 }
 

@@ -31,10 +31,17 @@ inline double dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 inline V3 cross(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
 inline double norm(V3 a) { return std::sqrt(dot(a, a)); }
 
-// A distance constraint between two vertices (stretch edges and shear cross-edges).
+// A distance constraint between two vertices (the stretch edges).
 struct DistanceLink {
   int32_t i, j;
   double rest;  // [m]
+};
+
+// A triangle's in-plane shear: its vertices, the inverse rest-frame matrix and its rest area.
+struct ShearTri {
+  int32_t v[3];
+  double dm_inv[4];  // [[a, b], [c, d]] row-major
+  double area;       // [m^2]
 };
 
 // An isometric bending stencil (Bergou et al. 2006): edge (v0, v1), opposite vertices v2, v3,
@@ -71,7 +78,7 @@ struct SceneData {
   std::vector<double> vertex_area;   // [m^2] one third of the adjacent triangles' area
   double rest_area = 0;              // [m^2]
   std::vector<DistanceLink> stretch; // every mesh edge
-  std::vector<DistanceLink> shear;   // opposite vertices of each pair of triangles sharing an edge
+  std::vector<ShearTri> shear;       // one per triangle
   std::vector<BendStencil> bend;     // one per interior edge
   std::vector<uint8_t> grasped;      // 1 when held by the gripper (kinematic)
   std::vector<int32_t> grasp_list;
@@ -120,8 +127,8 @@ struct GownState {
   std::vector<V3> anchor;             // Constraint friction: stick point of each arm contact
   std::vector<uint8_t> anchored;
   std::vector<ArmCandidates> cand;
-  std::vector<V3> contact_n;          // last substep's contact normal (Stock friction)
-  std::vector<double> contact_dn;     // last substep's normal correction [m] (0: no contact)
+  std::vector<V3> contact_n;          // last contact normal of the output step (Stock friction)
+  std::vector<double> contact_dn;     // sum of normal corrections over the output step [m]
   std::vector<V3> contact_acc;        // sum over substeps of the contact force on each vertex
   std::vector<V3> ext_force;          // per-vertex external force (the perturbation)
   // Self-collision: spatial hash and pair list, capacities fixed in make_state().
@@ -130,8 +137,6 @@ struct GownState {
   std::vector<SelfPair> pairs;
   size_t pair_count = 0;
   long pairs_dropped = 0;
-  std::vector<double> pair_dn;        // per pair normal correction of the last substep
-  std::vector<V3> pair_n;
   V3 grip_offset;                     // gripper displacement from its start
   V3 grip_accel;                      // gripper acceleration (inertia of the grasped vertices)
   V3 force_acc;                       // sum over substeps of the force of the gown on the gripper

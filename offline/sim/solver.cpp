@@ -149,17 +149,32 @@ void solve_links(const GownModel& m, GownState& s, const std::vector<DistanceLin
   }
 }
 
+// In-plane shear per triangle; alpha_shear / A per triangle (see shear_constraint()).
+void solve_shear(const GownModel& m, GownState& s, double inv_h2, V3& force) {
+  const uint8_t* grasped = m.scene->grasped.data();
+  V3* x = s.x.data();
+  const double* w = m.w.data();
+  const double at = m.alpha_shear * inv_h2;
+  for (const ShearTri& t : m.scene->shear) {
+    V3 g[3];
+    const double dl = shear_constraint(x[t.v[0]], x[t.v[1]], x[t.v[2]], w[t.v[0]], w[t.v[1]], w[t.v[2]], t.dm_inv,
+                                       at / t.area, g);
+    if (grasped[t.v[0]] | grasped[t.v[1]] | grasped[t.v[2]])
+      for (int a = 0; a < 3; ++a)
+        if (grasped[t.v[a]]) force += (dl * inv_h2) * g[a];
+  }
+}
+
 void solve_bending(const GownModel& m, GownState& s, double alpha_t, double inv_h2, V3& force) {
   const uint8_t* grasped = m.scene->grasped.data();
   V3* x = s.x.data();
   const double* w = m.w.data();
   for (const BendStencil& b : m.scene->bend) {
     const double w4[4] = {w[b.v[0]], w[b.v[1]], w[b.v[2]], w[b.v[3]]};
-    V3 nrm;
-    const double dl = bending_constraint(x[b.v[0]], x[b.v[1]], x[b.v[2]], x[b.v[3]], w4, b.k, alpha_t, &nrm);
+    const V3 dl = bending_constraint(x[b.v[0]], x[b.v[1]], x[b.v[2]], x[b.v[3]], w4, b.k, alpha_t);
     if (grasped[b.v[0]] | grasped[b.v[1]] | grasped[b.v[2]] | grasped[b.v[3]])
       for (int a = 0; a < 4; ++a)
-        if (grasped[b.v[a]]) force += (b.k[a] * dl * inv_h2) * nrm;
+        if (grasped[b.v[a]]) force += (b.k[a] * inv_h2) * dl;
   }
 }
 
@@ -168,7 +183,7 @@ inline void collide_static(const GownModel& m, GownState& s, int i, double phi, 
   const double dn = contact_constraint(s.x[i], phi, nrm, m.scene->opt.contact_offset);
   if (dn <= 0) return;
   s.contact_n[i] = nrm;
-  s.contact_dn[i] = dn;
+  s.contact_dn[i] += dn;
   if (m.scheme == FrictionScheme::Improved) {
     friction_position(s.x[i], s.p[i], nrm, dn, m.friction);
   } else if (m.scheme == FrictionScheme::Constraint) {
@@ -188,10 +203,10 @@ void solve_contacts(const GownModel& m, GownState& s, double inv_h2) {
   const double off = sc.opt.contact_offset;
   const bool planes = !sc.planes.empty();
   for (int i = 0; i < n; ++i) {
-    s.contact_dn[i] = 0;
     if (s.cand[i].c[0] < 0 && !planes) continue;
     if (sc.grasped[i]) continue;
     const V3 before = s.x[i];
+    const double dn_before = s.contact_dn[i];
     for (int k = 0; k < 2; ++k) {
       const int c = s.cand[i].c[k];
       if (c < 0) break;
@@ -204,19 +219,18 @@ void solve_contacts(const GownModel& m, GownState& s, double inv_h2) {
       if (phi - off > 1e-3) s.anchored[i] = 0;
       collide_static(m, s, i, phi, pl.n);
     }
-    if (s.contact_dn[i] > 0) s.contact_acc[i] += (m.mass[i] * inv_h2) * (s.x[i] - before);
+    if (s.contact_dn[i] > dn_before) s.contact_acc[i] += (m.mass[i] * inv_h2) * (s.x[i] - before);
   }
 }
 
 // Self-collision with self-friction (paper IV-A.3): vertex pairs kept `ds` apart, and their
 // relative tangential slip of this substep removed up to mu_self times the normal correction
-// (the same rule as against the arm; the Stock scheme applies it to velocities only).
+// (the same rule as against the arm; none in the Stock scheme, as in stock PhysX).
 void solve_self(const GownModel& m, GownState& s) {
   const double ds = m.scene->opt.self_distance, mus = m.self_friction;
   const bool position_friction = m.scheme != FrictionScheme::Stock && mus > 0;
   for (size_t k = 0; k < s.pair_count; ++k) {
     const int i = s.pairs[k].i, j = s.pairs[k].j;
-    s.pair_dn[k] = 0;
     const double wi = m.w[i], wj = m.w[j], wsum = wi + wj;
     const V3 d = s.x[i] - s.x[j];
     const double len2 = dot(d, d);
@@ -226,8 +240,6 @@ void solve_self(const GownModel& m, GownState& s) {
     const double dl = (ds - len) / wsum;
     s.x[i] += (wi * dl) * nrm;
     s.x[j] -= (wj * dl) * nrm;
-    s.pair_dn[k] = ds - len;
-    s.pair_n[k] = nrm;
     if (position_friction) {
       const V3 u = (s.x[i] - s.p[i]) - (s.x[j] - s.p[j]);
       const V3 ut = u - dot(u, nrm) * nrm;
@@ -241,30 +253,19 @@ void solve_self(const GownModel& m, GownState& s) {
   }
 }
 
-// v = (x - p) / h; the Stock scheme then applies its velocity-only friction.
+// v = (x - p) / h.
 void update_velocities(const GownModel& m, GownState& s) {
   const int n = static_cast<int>(s.x.size());
-  const double h = m.h, inv_h = 1.0 / h;
-  const bool stock = m.scheme == FrictionScheme::Stock;
-  for (int i = 0; i < n; ++i) {
-    s.v[i] = inv_h * (s.x[i] - s.p[i]);
-    if (stock && s.contact_dn[i] > 0) friction_velocity(s.v[i], s.contact_n[i], s.contact_dn[i], m.friction, h);
-  }
-  if (stock && m.self_collision && m.self_friction > 0) {
-    for (size_t k = 0; k < s.pair_count; ++k) {
-      if (s.pair_dn[k] <= 0) continue;
-      const int i = s.pairs[k].i, j = s.pairs[k].j;
-      const double wi = m.w[i], wj = m.w[j], wsum = wi + wj;
-      const V3 nrm = s.pair_n[k];
-      const V3 u = s.v[i] - s.v[j];
-      const V3 ut = u - dot(u, nrm) * nrm;
-      const double lt = norm(ut);
-      if (lt < 1e-15) continue;
-      const double f = std::min(1.0, m.self_friction * s.pair_dn[k] / (h * lt)) / wsum;
-      s.v[i] -= (wi * f) * ut;
-      s.v[j] += (wj * f) * ut;
-    }
-  }
+  const double inv_h = 1.0 / m.h;
+  for (int i = 0; i < n; ++i) s.v[i] = inv_h * (s.x[i] - s.p[i]);
+}
+
+// Stock PBD friction, once per output step: the tangential velocity loses at most mu times the
+// step's normal velocity change (sum of the substeps' normal corrections / h).
+void stock_friction(const GownModel& m, GownState& s) {
+  const int n = static_cast<int>(s.x.size());
+  for (int i = 0; i < n; ++i)
+    if (s.contact_dn[i] > 0) friction_velocity(s.v[i], s.contact_n[i], s.contact_dn[i], m.friction, m.h);
 }
 
 void substep(const GownModel& m, GownState& s, V3 grip, V3 grip_accel) {
@@ -273,7 +274,7 @@ void substep(const GownModel& m, GownState& s, V3 grip, V3 grip_accel) {
   integrate(m, s, grip);
   V3 force{0, 0, 0};  // of the gown on the gripper, this substep
   solve_links(m, s, sc.stretch, m.alpha_stretch * inv_h2, inv_h2, force);
-  solve_links(m, s, sc.shear, m.alpha_shear * inv_h2, inv_h2, force);
+  solve_shear(m, s, inv_h2, force);
   solve_bending(m, s, m.alpha_bend * inv_h2, inv_h2, force);
   solve_contacts(m, s, inv_h2);
   if (m.self_collision) solve_self(m, s);
@@ -289,12 +290,14 @@ void substep(const GownModel& m, GownState& s, V3 grip, V3 grip_accel) {
 void step(const GownModel& m, GownState& s, V3 grip_from, V3 grip_to, V3 grip_accel) {
   detect_arm(m, s);
   if (m.self_collision) detect_self(m, s);
+  std::fill(s.contact_dn.begin(), s.contact_dn.end(), 0.0);
   for (int k = 0; k < m.substeps; ++k) {
     const double f = static_cast<double>(k + 1) / m.substeps;
     const V3 grip = grip_from + f * (grip_to - grip_from);
     s.grip_offset = grip;
     substep(m, s, grip, grip_accel);
   }
+  if (m.scheme == FrictionScheme::Stock) stock_friction(m, s);
 }
 
 }  // namespace dressguard::sim

@@ -31,7 +31,7 @@ namespace dressguard::sim {
 // self-friction). The three stiffnesses are dimensionless in [0, 1] and map log-linearly onto
 // XPBD compliances (see compliance_of() in model.h), so that an optimizer can search a box:
 //   stretch: edge distance compliance   1e-2 (k=0) ... 1e-7 m/N (k=1), per metre of rest length
-//   shear:   cross-edge distance compliance, same range as stretch
+//   shear:   in-plane shear compliance per triangle (1 / shear modulus) 1e0 (k=0) ... 1e-5 m/N (k=1)
 //   bend:    isometric bending compliance 1e+2 (k=0) ... 1e-3 1/(N m) (k=1)
 // friction: Coulomb coefficient cloth-arm, [0, 2]; self_friction: cloth-cloth, [0, 2].
 // damping [1/s]: velocity decay rate (v *= exp(-damping h) per substep), fixed by default.
@@ -47,10 +47,13 @@ struct ClothParams {
 };
 
 // Friction of cloth against the arm and itself (paper IV-A.2, the point of the "improved" scheme):
-//  Stock:      PBD as in stock PhysX: the friction impulse changes only the velocity of the next
-//              substep; the tangential slip already made by gravity and internal constraints
-//              stays, so friction is underestimated (the paper's claim, tested).
-//  Improved:   the paper's fix: the same impulse also corrects the current position.
+//  Stock:      PBD as in stock PhysX: contacts push vertices out along the normal in every
+//              substep, and once per output step the friction impulse (bounded by mu times the
+//              step's normal impulse) changes only the velocity; the tangential slip already made
+//              by gravity and internal constraints stays, so friction is underestimated (the
+//              paper's claim, tested). No cloth-cloth friction (stock PhysX has none, paper IV-A.3).
+//  Improved:   the paper's fix: the friction correction is applied to the positions (and so to
+//              the velocities) in every substep that resolves the contact; self-friction likewise.
 //  Constraint: static friction as a positional stick constraint holding each contact at its anchor
 //              while the tangential correction stays within mu times the normal correction, and
 //              dynamic friction bounded by mu times the normal correction otherwise (Macklin et
@@ -143,6 +146,8 @@ struct SceneOptions {
   std::array<double, 3> grasp_point{0, 0, 0};  // [m] world position of the grasp at travel 0
   bool with_arm = true;
   bool colour_order = true;       // false: constraints in mesh order (the benchmark's baseline)
+  bool require_grasp = true;      // false: no jaw box; only ClothMesh::grasp is held (physics tests)
+  std::vector<std::array<double, 4>> planes;  // test colliders {p : n.p >= d} as (n.x, n.y, n.z, d)
 };
 
 struct SceneData;  // model.h
@@ -160,7 +165,7 @@ class Scene {
   std::shared_ptr<const SceneData> d_;
 };
 
-// Builds the constant model: topology, constraint lists (stretch edges, shear cross-edges,
+// Builds the constant model: topology, constraint lists (stretch edges, shear triangles,
 // bending stencils), rest lengths, bending matrices, the arm, the grasp set. Throws
 // std::invalid_argument naming the problem (empty mesh, bad index, no grasped vertex...).
 // Masses are derived from ClothParams::areal_density at trial time.
