@@ -19,6 +19,8 @@
 
 #include <Eigen/Core>
 
+#include "placement.h"
+
 namespace dressguard::gown {
 
 // A triangle mesh of the gown with what the simulator needs to know about it.
@@ -38,7 +40,11 @@ struct GownOptions {
   double scale = 1.679;       // file units -> metres (the paper's simulator)
   int target_triangles = 0;   // 0: full resolution; e.g. 5000 for the reduced gown
   double areal_density = 0.145;
+  PaperScene scene{};         // placement of a file's mesh and the grasp box that picks the sleeve
 };
+
+// shared/data/gown/fullgown.obj when shared/data is present, else empty.
+std::filesystem::path measured_gown_path();
 
 // The gown the simulator runs on: loaded (or generated), reduced if asked, placed in W like the
 // paper's simulator, its boundary loops found and the sleeve opening labelled. Throws InputError
@@ -81,6 +87,14 @@ double total_area(const GownMesh& mesh);  // [m^2]
 double loop_perimeter(const GownMesh& mesh, int loop);            // [m], closed polygon length
 Eigen::Vector3d loop_centroid(const GownMesh& mesh, int loop);    // mean of the loop's vertices
 double mean_edge_length(const GownMesh& mesh);                    // over unique edges [m]
+
+// One-sided distance [m]: the largest distance from a vertex of `from` to the surface of `to`
+// (exact point-triangle distances, triangles found through a uniform grid of `search_radius`
+// cells). Infinity when some vertex has no triangle of `to` within about search_radius.
+double max_distance_to_surface(const GownMesh& from, const GownMesh& to, double search_radius = 0.05);
+
+// The smallest interior angle of any triangle [rad] (slivers have small ones).
+double min_triangle_angle(const GownMesh& mesh);
 
 // The whole mesh as OBJ text (v and f lines, 1-based), for `dressguard gown --out` and frames.
 std::string to_obj(const GownMesh& mesh);

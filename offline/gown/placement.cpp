@@ -27,7 +27,12 @@ void label_sleeve(GownMesh& mesh, const PaperScene& scene) {
     const double d = (loop_centroid(mesh, l) - g).norm();
     if (d < best_d) best_d = d, best = l;
   }
-  mesh.sleeve_loop = best;
+  set_sleeve_loop(mesh, best);
+}
+
+void set_sleeve_loop(GownMesh& mesh, int loop) {
+  mesh.sleeve_loop = loop;
+  const int best = loop;
   // Lower half (paper Fig. 3b): the loop's vertices below its centroid in z_W, i.e. the part of
   // the opening that hangs away from the grip and meets the arm's underside.
   const double zc = loop_centroid(mesh, best).z();

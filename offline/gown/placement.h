@@ -105,6 +105,9 @@ void place_like_paper(GownMesh& mesh, const PaperScene& scene = {});
 // when the mesh has fewer than two boundary loops.
 void label_sleeve(GownMesh& mesh, const PaperScene& scene = {});
 
+// Sets mesh.sleeve_loop = loop and its lower half (the loop's vertices below its centroid in z_W).
+void set_sleeve_loop(GownMesh& mesh, int loop);
+
 // The vertices the gripper holds: vertices_in_box(grasp box).
 std::vector<int> grasp_vertices(const GownMesh& mesh, const PaperScene& scene = {});
 
