@@ -14,5 +14,6 @@ struct Command {
 };
 
 int run_import(int argc, char** argv);
+int run_gown(int argc, char** argv);
 
 }  // namespace dressguard::cli

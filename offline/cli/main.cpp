@@ -13,6 +13,7 @@ namespace {
 // One row per subcommand, in the order a user meets them.
 constexpr Command kCommands[] = {
     {"import", "convert the study's measured trials into a dataset", run_import},
+    {"gown", "load, reduce and place the gown mesh; stats, OBJ and a picture", run_gown},
 };
 
 void print_usage() {

@@ -19,7 +19,8 @@ std::filesystem::path measured_gown_path() {
 }
 
 GownMesh load_gown(const GownOptions& options) {
-  const std::filesystem::path path = options.obj.empty() ? measured_gown_path() : options.obj;
+  const std::filesystem::path path =
+      options.parametric ? std::filesystem::path{} : (options.obj.empty() ? measured_gown_path() : options.obj);
   GownMesh mesh;
   if (path.empty()) {
     mesh = make_parametric_gown();

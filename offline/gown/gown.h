@@ -40,6 +40,7 @@ struct GownOptions {
   double scale = 1.679;       // file units -> metres (the paper's simulator)
   int target_triangles = 0;   // 0: full resolution; e.g. 5000 for the reduced gown
   double areal_density = 0.145;
+  bool parametric = false;    // use the parametric gown even when the measured one is present
   PaperScene scene{};         // placement of a file's mesh and the grasp box that picks the sleeve
 };
 
