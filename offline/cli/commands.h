@@ -17,5 +17,6 @@ int run_import(int argc, char** argv);
 int run_train(int argc, char** argv);
 int run_classify(int argc, char** argv);
 int run_model(int argc, char** argv);
+int run_gown(int argc, char** argv);
 
 }  // namespace dressguard::cli
