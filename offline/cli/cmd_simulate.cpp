@@ -29,7 +29,7 @@ std::vector<double> parse_times(const std::string& s) {
 }  // namespace
 
 int run_simulate(int argc, char** argv) {
-  Args args(argc - 1, argv + 1, {"help", "json", "noise", "no-self-collision"});
+  Args args(argc - 1, argv + 1, {"help", "json", "noise", "no-self-collision", "parametric"});
   if (args.has("help")) {
     std::puts(
         "usage: dressguard simulate --height high|middle|low --out FILE.csv [options]\n"
@@ -41,7 +41,9 @@ int run_simulate(int argc, char** argv) {
         "  --speed V         [m/s] pull speed, 0.1 or 0.15 (default 0.1)\n"
         "  --params FILE     cloth parameters ('name value' lines or flat JSON; see offline/sim/params.h)\n"
         "  --seed S          seed of the perturbation (default 0); --noise turns the perturbation on\n"
-        "  --gown G          full | reduced | coarse (default reduced)\n"
+        "  --gown G          full | reduced | coarse (default reduced): the measured gown at ~20k, 5k,\n"
+        "                    1.5k triangles (the gown module's parametric gown without shared/data)\n"
+        "  --parametric      the gown module's parametric gown even when the measured one is present\n"
         "  --friction F      stock | improved | constraint (default improved)\n"
         "  --no-self-collision\n"
         "  --frames T1,T2,.. [s] since the start of the pull (negative: settling) to keep the gown\n"
@@ -50,7 +52,7 @@ int run_simulate(int argc, char** argv) {
     return 0;
   }
   args.allow_only({"help", "json", "noise", "no-self-collision", "height", "arm-offset", "speed", "params", "seed",
-                   "gown", "friction", "out", "frames"});
+                   "gown", "friction", "out", "frames", "parametric"});
   sim::TrialSpec spec;
   const std::string hs = args.require("height");
   const auto h = parse_arm_height(hs);
@@ -86,7 +88,7 @@ int run_simulate(int argc, char** argv) {
     for (double t = -1.6; t < 12.0; t += 0.25) spec.frame_times.push_back(t);
   }
 
-  const sim::Scene scene = sim::make_default_scene(res);
+  const sim::Scene scene = sim::make_default_scene(res, args.has("parametric"));
   const sim::TrialResult r = sim::simulate_trial(scene, params, spec);
   if (!r.finite) throw std::runtime_error("the simulation diverged (non-finite positions)");
 

@@ -177,7 +177,8 @@ enum class GownResolution { Full = 0, Reduced = 1, Coarse = 2 };
 // The default scene: the measured gown when the gown module and shared/data provide it, else the
 // simulator's own parametric sleeve-and-panel gown (see meshes.h). Coarse is a small version
 // for fast tests.
-Scene make_default_scene(GownResolution res = GownResolution::Reduced);
+// `parametric`: the gown module's parametric gown even when the measured one is present.
+Scene make_default_scene(GownResolution res = GownResolution::Reduced, bool parametric = false);
 
 // One trial: grasp, gravity, settling (with the optional perturbation during output steps
 // 180-330, i.e. 0.5 s), then the pull until max_travel or the force limit. Deterministic: the
