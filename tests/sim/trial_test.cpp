@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "dataset.h"
 #include "files.h"
 #include "model.h"
 #include "objective.h"
@@ -118,4 +119,55 @@ TEST(SimParams, ParseFormats) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("p.txt:2"), std::string::npos) << e.what();
   }
+}
+
+// The three outcomes from the arm height alone (issue 5): sweeping the arm from high to low with
+// the default parameters gives good, then caught, then missed, each at least once, in that order.
+// NOT YET HOLDING (disabled so the suite stays green; run with --gtest_also_run_disabled_tests):
+// on both the measured gown (paper placement: its sleeve opening hangs behind the gripper, facing
+// away from the fist) and the parametric gown (the fist enters the sleeve but the sleeve and the
+// hanging body pull tight at the armhole), every height above the low one ends caught at the 10 N
+// stop at 0.2-0.35 m of travel; see offline/sim/README.md.
+TEST(SimTrial, DISABLED_ThreeOutcomesFromArmHeightAlone) {
+  std::vector<Outcome> seen;
+  for (double dz = 0.05; dz >= -0.30; dz -= 0.05) {
+    TrialSpec spec;
+    spec.height = ArmHeight::High;
+    spec.arm_offset = dz;
+    const Outcome o = simulate_trial(coarse_scene(), ClothParams{}, spec).outcome;
+    if (seen.empty() || seen.back() != o) seen.push_back(o);
+  }
+  const std::vector<Outcome> want = {Outcome::Good, Outcome::Caught, Outcome::Missed};
+  EXPECT_EQ(seen, want);
+}
+
+// Plausibility against the measured trials of participant 4 after a coarse grid over friction and
+// stretch: the best simulated good trial ends at the 10 N stop within 0.1 m of the measured travel,
+// and the missed trial's final drag is within 50% of the measured one. NOT YET HOLDING (see the
+// test above and the grid's output in offline/sim/README.md, from dg_sim_fit).
+TEST(SimTrial, DISABLED_PlausibleAgainstMeasuredParticipant4) {
+  const auto study = study_dir();
+  if (study.empty()) GTEST_SKIP() << "shared/data is not present";
+  const auto good = read_study_trial(study / "good/subject4/3.txt");
+  const auto miss = read_study_trial(study / "miss/subject4/2.txt");
+  double best = 1e300;
+  TrialResult best_g, best_m;
+  for (double friction : {0.1, 0.4})
+    for (double stretch : {0.5, 0.9}) {
+      ClothParams p;
+      p.friction = friction;
+      p.stretch = stretch;
+      TrialSpec sg, sm;
+      sg.height = ArmHeight::High;
+      sm.height = ArmHeight::Low;
+      sg.speed = estimate_speed(good);
+      sm.speed = estimate_speed(miss);
+      TrialResult g = simulate_trial(coarse_scene(), p, sg), m = simulate_trial(coarse_scene(), p, sm);
+      const double l = paper_objective(g.seq.samples, good) + paper_objective(m.seq.samples, miss);
+      if (l < best) best = l, best_g = std::move(g), best_m = std::move(m);
+    }
+  EXPECT_TRUE(best_g.stopped_by_force);
+  EXPECT_NEAR(best_g.travel, good.back().travel, 0.1);
+  EXPECT_EQ(best_m.outcome, Outcome::Missed);
+  EXPECT_NEAR(best_m.seq.samples.back().f_motion, miss.back().f_motion, 0.5 * std::abs(miss.back().f_motion));
 }
