@@ -63,7 +63,9 @@ void detect_self(const GownModel& m, GownState& s) {
   // per output step (1.8 m/s relative at 12 mm, 300 Hz) are caught. It must stay below the mesh
   // edge: vertices nearer than that at rest are mesh neighbours, never self-collision pairs.
   const double r = 1.5 * ds;
-  const double inv = 1.0 / r;
+  // Cells twice the search radius: the neighbours within r of a point lie in the 2 x 2 x 2 block
+  // of cells on the side of its cell that the point is nearer to (8 lookups instead of 27).
+  const double inv = 0.5 / r;
   const uint32_t table = static_cast<uint32_t>(s.cell_start.size() - 1);
   const uint32_t mask = table - 1;
   std::fill(s.cell_start.begin(), s.cell_start.end(), 0);
@@ -83,14 +85,16 @@ void detect_self(const GownModel& m, GownState& s) {
   const size_t cap = s.pairs.size();
   for (int i = 0; i < n; ++i) {
     const V3 q = s.x[i];
-    const int64_t cx = static_cast<int64_t>(std::floor(q.x * inv)), cy = static_cast<int64_t>(std::floor(q.y * inv)),
-                  cz = static_cast<int64_t>(std::floor(q.z * inv));
-    uint32_t seen[27];
+    const double fx = q.x * inv, fy = q.y * inv, fz = q.z * inv;
+    const int64_t cx = static_cast<int64_t>(std::floor(fx)), cy = static_cast<int64_t>(std::floor(fy)),
+                  cz = static_cast<int64_t>(std::floor(fz));
+    const int64_t bx = cx - (fx - cx < 0.5), by = cy - (fy - cy < 0.5), bz = cz - (fz - cz < 0.5);
+    uint32_t seen[8];
     int nseen = 0;
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          const uint32_t h = hash_cell(cx + dx, cy + dy, cz + dz, mask);
+    for (int dx = 0; dx <= 1; ++dx)
+      for (int dy = 0; dy <= 1; ++dy)
+        for (int dz = 0; dz <= 1; ++dz) {
+          const uint32_t h = hash_cell(bx + dx, by + dy, bz + dz, mask);
           bool dup = false;
           for (int k = 0; k < nseen; ++k) dup |= seen[k] == h;
           if (dup) continue;
