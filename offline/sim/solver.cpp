@@ -126,7 +126,7 @@ void integrate(const GownModel& m, GownState& s, V3 grip) {
   for (int i = 0; i < n; ++i) {
     s.p[i] = s.x[i];
     if (sc.grasped[i]) {
-      s.x[i] = sc.rest[i] + grip;
+      s.x[i] = sc.rest[i] + s.jaw_closed * (sc.grasp_target[i] - sc.rest[i]) + grip;
       continue;
     }
     V3 v = decay * s.v[i];
@@ -139,13 +139,13 @@ void integrate(const GownModel& m, GownState& s, V3 grip) {
 // Distance constraints in list order (fixed Gauss-Seidel order); the force they exert on
 // grasped vertices is added to `force` (XPBD: f = grad C lambda / h^2).
 void solve_links(const GownModel& m, GownState& s, const std::vector<DistanceLink>& links, double alpha_t,
-                 double inv_h2, V3& force) {
+                 double alpha_c, double inv_h2, V3& force) {
   const uint8_t* grasped = m.scene->grasped.data();
   V3* x = s.x.data();
   const double* w = m.w.data();
   for (const DistanceLink& l : links) {
     V3 nrm;
-    const double dl = distance_constraint(x[l.i], x[l.j], w[l.i], w[l.j], l.rest, alpha_t, &nrm);
+    const double dl = distance_constraint(x[l.i], x[l.j], w[l.i], w[l.j], l.rest, alpha_t, alpha_c, &nrm);
     if (grasped[l.i] | grasped[l.j]) {
       if (grasped[l.i]) force += (dl * inv_h2) * nrm;
       if (grasped[l.j]) force -= (dl * inv_h2) * nrm;
@@ -277,7 +277,7 @@ void substep(const GownModel& m, GownState& s, V3 grip, V3 grip_accel) {
   const double inv_h2 = 1.0 / (m.h * m.h);
   integrate(m, s, grip);
   V3 force{0, 0, 0};  // of the gown on the gripper, this substep
-  solve_links(m, s, sc.stretch, m.alpha_stretch * inv_h2, inv_h2, force);
+  solve_links(m, s, sc.stretch, m.alpha_stretch * inv_h2, m.alpha_compress * inv_h2, inv_h2, force);
   solve_shear(m, s, inv_h2, force);
   solve_bending(m, s, m.alpha_bend * inv_h2, inv_h2, force);
   solve_contacts(m, s, inv_h2);

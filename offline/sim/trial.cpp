@@ -93,6 +93,8 @@ TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const 
       s.force_acc = zero;
       s.force_count = 0;
     }
+    const int close = sc.opt.jaw_close_steps;
+    s.jaw_closed = close > 0 ? std::min(1.0, (k + 1.0) / close) : 1.0;
     step(m, s, zero, zero, zero);
     maybe_frame((k + 1 - spec.settle_steps) * m.dt, 0.0);
   }

@@ -142,10 +142,15 @@ struct SceneOptions {
   double contact_offset = 0.004;  // [m] cloth thickness kept from the arm
   double self_distance = 0.008;   // [m] self-collision distance (data README: 0.008)
   double kinetic_ratio = 0.8;     // Constraint scheme: dynamic / static friction coefficient
+  double compression_softening = 1000;  // edge compliance in compression / in tension (fabric buckles)
   // Jaw box (centre relative to the grasp point, half extents) used when ClothMesh::grasp is empty.
   std::array<double, 3> jaw_centre{0, 0, 0};
   std::array<double, 3> jaw_half{0.04, 0.06, 0.01};
   std::array<double, 3> grasp_point{0, 0, 0};  // [m] world position of the grasp at travel 0
+  // The jaws close on the grasped vertices: over the first `jaw_close_steps` output steps they
+  // move from their placed positions onto the plane z = grasp_point.z - jaw_half.z (the upper
+  // jaw's lower face), pinched between the jaws as in the paper's simulator. 0: held as placed.
+  int jaw_close_steps = 60;
   bool with_arm = true;
   bool colour_order = true;       // false: constraints in mesh order (the benchmark's baseline)
   bool require_grasp = true;      // false: no jaw box; only ClothMesh::grasp is held (physics tests)
