@@ -124,10 +124,11 @@ TEST(SimParams, ParseFormats) {
 // The three outcomes from the arm height alone (issue 5): sweeping the arm from high to low with
 // the default parameters gives good, then caught, then missed, each at least once, in that order.
 // NOT YET HOLDING (disabled so the suite stays green; run with --gtest_also_run_disabled_tests):
-// on both the measured gown (paper placement: its sleeve opening hangs behind the gripper, facing
-// away from the fist) and the parametric gown (the fist enters the sleeve but the sleeve and the
-// hanging body pull tight at the armhole), every height above the low one ends caught at the 10 N
-// stop at 0.2-0.35 m of travel; see offline/sim/README.md.
+// on the measured gown placed as the gown module reads the paper's code, the jaws hold the
+// sleeve about 0.25 m from its opening, which trails the gripper; the high arm stops at 10 N
+// near the measured good travel (0.62 m) but with the opening's lower half ~0.2 m short of the
+// elbow, so the paper's rule labels it caught; the middle and low arms miss. See
+// offline/sim/README.md.
 TEST(SimTrial, DISABLED_ThreeOutcomesFromArmHeightAlone) {
   std::vector<Outcome> seen;
   for (double dz = 0.05; dz >= -0.30; dz -= 0.05) {
@@ -141,29 +142,34 @@ TEST(SimTrial, DISABLED_ThreeOutcomesFromArmHeightAlone) {
   EXPECT_EQ(seen, want);
 }
 
-// Plausibility against the measured trials of participant 4 after a coarse grid over friction and
-// stretch: the best simulated good trial ends at the 10 N stop within 0.1 m of the measured travel,
-// and the missed trial's final drag is within 50% of the measured one. NOT YET HOLDING (see the
-// test above and the grid's output in offline/sim/README.md, from dg_sim_fit).
-TEST(SimTrial, DISABLED_PlausibleAgainstMeasuredParticipant4) {
+// Plausibility against the measured trials of participant 4 (good/3 at the high arm, miss/2 at
+// the low arm) after a coarse grid over friction and stretch at the paper's arm offset -0.02 m,
+// the point with the smallest objective (eq. 3-5) being kept: its high-arm trial ends at the 10 N
+// stop within 0.1 m of the measured travel, and its low-arm trial runs the full travel (missed)
+// with a final drag within 50% of the measured one (the issue's tolerances). Coarse gown (1.5k
+// triangles) to keep the test short; dg_sim_fit runs the larger grids (offline/sim/README.md).
+TEST(SimTrial, PlausibleAgainstMeasuredParticipant4) {
   const auto study = study_dir();
-  if (study.empty()) GTEST_SKIP() << "shared/data is not present";
+  if (study.empty()) GTEST_SKIP() << "shared/data is not present (needs the study's measured trials)";
   const auto good = read_study_trial(study / "good/subject4/3.txt");
   const auto miss = read_study_trial(study / "miss/subject4/2.txt");
   double best = 1e300;
   TrialResult best_g, best_m;
-  for (double friction : {0.1, 0.4})
-    for (double stretch : {0.5, 0.9}) {
+  for (double friction : {0.2, 0.5})
+    for (double stretch : {0.6, 0.9}) {
       ClothParams p;
       p.friction = friction;
       p.stretch = stretch;
       TrialSpec sg, sm;
       sg.height = ArmHeight::High;
       sm.height = ArmHeight::Low;
+      sg.arm_offset = sm.arm_offset = -0.02;
       sg.speed = estimate_speed(good);
       sm.speed = estimate_speed(miss);
       TrialResult g = simulate_trial(coarse_scene(), p, sg), m = simulate_trial(coarse_scene(), p, sm);
       const double l = paper_objective(g.seq.samples, good) + paper_objective(m.seq.samples, miss);
+      std::printf("friction %.2f stretch %.2f: L %.3f (high: %.3f m, low: %s %.3f m, %.2f N)\n", friction, stretch, l,
+                  g.travel, std::string(outcome_name(m.outcome)).c_str(), m.travel, m.seq.samples.back().f_motion);
       if (l < best) best = l, best_g = std::move(g), best_m = std::move(m);
     }
   EXPECT_TRUE(best_g.stopped_by_force);
