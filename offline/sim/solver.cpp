@@ -230,7 +230,7 @@ void solve_contacts(const GownModel& m, GownState& s, double inv_h2) {
 // Self-collision with self-friction (paper IV-A.3): vertex pairs kept `ds` apart, and their
 // relative tangential slip of this substep removed up to mu_self times the normal correction
 // (the same rule as against the arm; none in the Stock scheme, as in stock PhysX).
-void solve_self(const GownModel& m, GownState& s) {
+void solve_self(const GownModel& m, GownState& s, double inv_h2, V3& force) {
   const double ds = m.scene->opt.self_distance, mus = m.self_friction;
   const bool position_friction = m.scheme != FrictionScheme::Stock && mus > 0;
   for (size_t k = 0; k < s.pair_count; ++k) {
@@ -242,6 +242,7 @@ void solve_self(const GownModel& m, GownState& s) {
     const double len = std::sqrt(len2);
     const V3 nrm = (1.0 / len) * d;
     const double dl = (ds - len) / wsum;
+    const V3 xi0 = s.x[i], xj0 = s.x[j];
     s.x[i] += (wi * dl) * nrm;
     s.x[j] -= (wj * dl) * nrm;
     if (position_friction) {
@@ -254,6 +255,10 @@ void solve_self(const GownModel& m, GownState& s) {
         s.x[j] += (wj * f) * ut;
       }
     }
+    // A grasped (kinematic) vertex pushing a free one: the reaction, -m dx / h^2 of the free
+    // vertex's correction (eq. 2), loads the gripper.
+    if (wi == 0) force -= (m.mass[j] * inv_h2) * (s.x[j] - xj0);
+    if (wj == 0) force -= (m.mass[i] * inv_h2) * (s.x[i] - xi0);
   }
 }
 
@@ -281,7 +286,7 @@ void substep(const GownModel& m, GownState& s, V3 grip, V3 grip_accel) {
   solve_shear(m, s, inv_h2, force);
   solve_bending(m, s, m.alpha_bend * inv_h2, inv_h2, force);
   solve_contacts(m, s, inv_h2);
-  if (m.self_collision) solve_self(m, s);
+  if (m.self_collision) solve_self(m, s, inv_h2, force);
   update_velocities(m, s);
   // The grasped vertices' own weight and inertia also load the gripper.
   for (int g : sc.grasp_list) force += m.mass[g] * (m.gravity - grip_accel);

@@ -71,6 +71,7 @@ struct TrialSpec {
   double acceleration = 1.0;    // [m/s^2] the rig's acceleration up to `speed`
   uint64_t seed = 0;            // drives the perturbation force
   bool gown_noise = false;      // paper V-A: uniform X/lateral force up to 6 N over all vertices
+  bool arm_noise = false;       // paper V-A: arm height + U[-1.5, 1.5] cm (high, low), U[-6, 0] cm (middle)
   double max_travel = 0.85;     // [m] end of the rig's travel
   double force_limit = 10.0;    // [N] stop when |f_motion| or |f_vertical| reaches it
   FrictionScheme friction_scheme = FrictionScheme::Improved;
@@ -95,6 +96,7 @@ struct Frame {
 };
 
 struct TrialResult {
+  double arm_offset = 0;            // [m] the arm offset used (spec.arm_offset plus the arm noise)
   HapticSequence seq;               // samples from the start of the pull; label set
   Outcome outcome = Outcome::Missed;
   double d_max = 0;                 // [m] paper V-A label distance (NaN-free; 0 when missed)
