@@ -30,9 +30,12 @@ namespace dressguard::sim {
 // The cloth's calibrated material (paper IV-B.2: isotropic stretch, shear, bending, friction,
 // self-friction). The three stiffnesses are dimensionless in [0, 1] and map log-linearly onto
 // XPBD compliances (see compliance_of() in model.h), so that an optimizer can search a box:
-//   stretch: edge distance compliance   1e-2 (k=0) ... 1e-7 m/N (k=1), per metre of rest length
+//   stretch: edge distance compliance 1e-2 (k=0) ... 1e-7 m/N (k=1) in tension (a triangulated
+//            membrane's edge stiffness does not depend on the edge length); 1000x softer in
+//            compression (SceneOptions::compression_softening)
 //   shear:   in-plane shear compliance per triangle (1 / shear modulus) 1e0 (k=0) ... 1e-5 m/N (k=1)
-//   bend:    isometric bending compliance 1e+2 (k=0) ... 1e-3 1/(N m) (k=1)
+//   bend:    isometric bending compliance (1 / bending stiffness) 1e7 (k=0) ... 1e1 1/(N m) (k=1);
+//            k = 0.5 is 1e-4 N m, stiff cotton; light gown fabric is nearer 1e-6 (k = 0.17)
 // friction: Coulomb coefficient cloth-arm, [0, 2]; self_friction: cloth-cloth, [0, 2].
 // damping [1/s]: velocity decay rate (v *= exp(-damping h) per substep), fixed by default; 2/s lets
 // the gown settle within the 500 settling steps (1.7 s) as in the paper, and costs the pulled
