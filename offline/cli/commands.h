@@ -14,5 +14,7 @@ struct Command {
 };
 
 int run_import(int argc, char** argv);
+int run_replay(int argc, char** argv);
+int run_export_candump(int argc, char** argv);
 
 }  // namespace dressguard::cli

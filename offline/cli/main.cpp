@@ -13,6 +13,8 @@ namespace {
 // One row per subcommand, in the order a user meets them.
 constexpr Command kCommands[] = {
     {"import", "convert the study's measured trials into a dataset", run_import},
+    {"export-candump", "write trials as candump logs of the CAN protocol (with optional faults)", run_export_candump},
+    {"replay", "run the predictor daemon's code on a candump log: would it stop, when, why", run_replay},
 };
 
 void print_usage() {
