@@ -39,7 +39,7 @@ const char* kHelp =
     "  --mount AXES       sensor axes for the rig's motion/lateral/vertical (default 'x y z'; the\n"
     "                     inverse of the daemon's mount_axes)\n"
     "  Faults, by 0-based sample index in the trial (comma-separated lists):\n"
-    "  --corrupt I,..     flip one payload bit of sample I's force frame (CRC mismatch)\n"
+    "  --corrupt I,..     flip one payload bit in both frames of sample I (CRC mismatch)\n"
     "  --drop I,..        do not send sample I (both frames)\n"
     "  --repeat I,..      send sample I's frames twice\n"
     "  --delay I:D,..     send sample I's frames after sample I+D's\n"
@@ -146,8 +146,11 @@ ExportSummary export_trial(const HapticSequence& trial, uint16_t trial_id, const
     for (int a = 0; a < 3; ++a)
       sensor[a] = proto::to_counts(o.sign_of_sensor[a] * rig[o.axis_of_sensor[a]], proto::kForceCountsPerNewton);
     proto::Frame force = proto::encode(proto::FtForce{c, sensor[0], sensor[1], sensor[2]});
-    const proto::Frame torque = proto::encode(proto::FtTorque{c, 0, 0, 0});
-    if (o.corrupt.count(li)) force.data[5] ^= 0x08;  // one payload bit: only the E2E CRC can tell
+    proto::Frame torque = proto::encode(proto::FtTorque{c, 0, 0, 0});
+    if (o.corrupt.count(li)) {  // one payload bit each: only the E2E CRC can tell
+      force.data[5] ^= 0x08;
+      torque.data[3] ^= 0x40;
+    }
     int64_t t = time_of(i) + gap_shift;
     if (auto d = o.delay.find(li); d != o.delay.end()) {
       const size_t later = std::min(s.size() - 1, i + static_cast<size_t>(d->second));

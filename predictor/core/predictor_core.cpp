@@ -239,9 +239,24 @@ void Predictor::on_frame(const Frame& f, int64_t now_ns) noexcept {
   }
 }
 
+// Trial frames are sporadic: a counter seen again after a long silence is a restarted robot
+// controller, not a duplicate, so their checkers resynchronise after kEventResyncNs.
+void Predictor::resync_events(int64_t now_ns) noexcept {
+  if (last_event_ns_ >= 0 && now_ns - last_event_ns_ > kEventResyncNs) {
+    chk_start_.reset();
+    chk_end_.reset();
+  }
+  last_event_ns_ = now_ns;
+}
+
 void Predictor::on_trial_start(const Frame& f, int64_t now_ns) noexcept {
   uint32_t lost = 0;
+  resync_events(now_ns);
   if (!checked(chk_start_, f, now_ns, lost)) return;
+  // The sample stream resynchronises at a trial start: its first sample is sample 0, and a
+  // counter jump since the previous trial is no loss inside this one.
+  chk_force_.reset();
+  chk_torque_.reset();
   protocol::TrialStart m;
   protocol::decode(f, m);
   decision_ = Decision{};
@@ -265,6 +280,7 @@ void Predictor::on_trial_start(const Frame& f, int64_t now_ns) noexcept {
 
 void Predictor::on_trial_end(const Frame& f, int64_t now_ns) noexcept {
   uint32_t lost = 0;
+  resync_events(now_ns);
   if (!checked(chk_end_, f, now_ns, lost)) return;
   protocol::TrialEnd m;
   protocol::decode(f, m);

@@ -161,6 +161,8 @@ class Predictor {
   void on_force(const Frame& f, int64_t now_ns) noexcept;
   void on_trial_start(const Frame& f, int64_t now_ns) noexcept;
   void on_trial_end(const Frame& f, int64_t now_ns) noexcept;
+  void resync_events(int64_t now_ns) noexcept;
+  static constexpr int64_t kEventResyncNs = 1'000'000'000;
   // E2E check with counting; true when the frame may be used.
   bool checked(protocol::E2EChecker& chk, const Frame& f, int64_t now_ns, uint32_t& lost) noexcept;
   void charge_bad(uint32_t frames, int64_t now_ns) noexcept;
@@ -203,6 +205,7 @@ class Predictor {
   int64_t next_status_ns_ = 0, next_hb_ns_ = 0, next_post_ns_ = 0;
   int64_t start_ns_ = -1;
   uint32_t trials_started_ = 0;
+  int64_t last_event_ns_ = -1;
 };
 
 }  // namespace dressguard::predictor
