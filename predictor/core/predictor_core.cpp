@@ -253,6 +253,7 @@ void Predictor::on_trial_start(const Frame& f, int64_t now_ns) noexcept {
   uint32_t lost = 0;
   resync_events(now_ns);
   if (!checked(chk_start_, f, now_ns, lost)) return;
+  chk_end_.reset();  // this trial's end is the first of its kind
   // The sample stream resynchronises at a trial start: its first sample is sample 0, and a
   // counter jump since the previous trial is no loss inside this one.
   chk_force_.reset();
