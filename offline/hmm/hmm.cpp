@@ -12,6 +12,10 @@ namespace {
 
 constexpr double kLog2Pi = 1.8378770664093454835606594728112;
 constexpr double kNegInf = -std::numeric_limits<double>::infinity();
+// Normalised forward (and scaled backward) probabilities below this are set to 0, as the online
+// filter does (predictor/filter/emission_update.h): states a left-right model has left behind
+// would otherwise decay through the subnormal range, where arithmetic is ~100x slower.
+constexpr double kFlushBelow = 1e-300;
 
 // Per-state constants for the emission log density: mean, inverse covariance [[p q][q r]] and
 // -log(2 pi) - log|S|/2.
@@ -141,7 +145,7 @@ double forward_backward(const ClassHmm& h, const EmissionCache& em, const Band& 
       c += al[j];
     }
     const double inv = 1.0 / c;
-    for (int j = 0; j < n; ++j) al[j] *= inv;
+    for (int j = 0; j < n; ++j) al[j] = al[j] * inv < kFlushBelow ? 0.0 : al[j] * inv;
     w.scale[t] = c;
     ll += std::log(c) + m;
   }
@@ -156,7 +160,7 @@ double forward_backward(const ClassHmm& h, const EmissionCache& em, const Band& 
     for (int i = 0; i < n; ++i) {
       double sum = 0.0;
       for (int j = band.slo[i]; j <= band.shi[i]; ++j) sum += A[i * n + j] * b1[j] * nb[j];
-      cur[i] = sum * ic;
+      cur[i] = sum * ic < kFlushBelow ? 0.0 : sum * ic;
     }
   }
   // Statistics: gamma_t(j) = alpha_t(j) beta_t(j) (sums to 1 per t with this scaling);
@@ -367,7 +371,7 @@ std::vector<double> forward_prefix_log_likelihoods(const ClassHmm& h, const Feat
       alpha[j] = pred[j] > 0.0 ? pred[j] * std::exp(lb[j] - m) : 0.0;
       c += alpha[j];
     }
-    for (int j = 0; j < n; ++j) alpha[j] /= c;
+    for (int j = 0; j < n; ++j) alpha[j] = alpha[j] / c < kFlushBelow ? 0.0 : alpha[j] / c;
     ll += std::log(c) + m;
     out.push_back(ll);
   }

@@ -5,7 +5,10 @@
 // Numerics. Every recursion is scaled (Rabiner 1989, section V-A): at each t the forward vector
 // is normalised to sum 1 and the log of the normaliser accumulates, and the emission densities are
 // shifted by their maximum m_t over reachable states before exponentiation. Nothing is ever a
-// product of T probabilities, so sequences of any length keep finite log-likelihoods.
+// product of T probabilities, so sequences of any length keep finite log-likelihoods. Normalised
+// forward probabilities below 1e-300 are set to 0 (no subnormal arithmetic; the online filter does
+// the same): a state that improbable is dropped, which can matter only when a later sample is so
+// far out that such a state alone explains it.
 //
 // Training (Rabiner eq. 40, 52-54 for the Gaussian case):
 //   initialisation: every sequence split into n equal segments, segment j feeding state j's mean

@@ -8,33 +8,51 @@ namespace dressguard::filter {
 
 namespace {
 constexpr double kLog2Pi = 1.8378770664093454835606594728112;  // log(2 pi)
-}
+int padded(int n) { return (n + 3) & ~3; }
+}  // namespace
 
 ForwardFilter::ForwardFilter(const model::OutcomeModel& m) : features_(m.features) {
   model::validate_model(m, "ForwardFilter model");
   n_classes_ = static_cast<int>(m.classes.size());
-  int total = 0, ttotal = 0;
+  int total = 0;
   for (const auto& h : m.classes) {
-    n_states_.push_back(h.n_states);
+    const int n = h.n_states, np = padded(n);
+    total += kBandPad;  // zeros before the class's first state: alpha_{j-d} for j < d
+    n_states_.push_back(n);
     offset_.push_back(total);
-    toffset_.push_back(ttotal);
     log_prior_.push_back(h.log_prior);
-    total += h.n_states;
-    ttotal += h.n_states * h.n_states;
     // Band width: the largest j - i with A_ij > 0; -1 when some A_ij > 0 has j < i.
     int w = 0;
-    const int n = h.n_states;
     for (int i = 0; i < n && w >= 0; ++i)
       for (int j = 0; j < n; ++j) {
         if (h.transition[i * n + j] <= 0.0) continue;
-        if (j < i) { w = -1; break; }
+        if (j < i) {
+          w = -1;
+          break;
+        }
         if (j - i > w) w = j - i;
       }
     band_.push_back(w);
+    // Band diagonals B_d[j] = A_{j-d,j} (the band path), or the full matrix (the general path).
+    diag_offset_.push_back(static_cast<int>(coef_.size()));
+    if (w >= 0 && w <= kMaxBand) {
+      for (int d = 0; d <= w; ++d)
+        for (int j = 0; j < np; ++j) coef_.push_back(j < n && j - d >= 0 ? h.transition[(j - d) * n + j] : 0.0);
+    } else {
+      coef_.insert(coef_.end(), h.transition.begin(), h.transition.end());
+    }
+    initial_.resize(total, 0.0);
     initial_.insert(initial_.end(), h.initial.begin(), h.initial.end());
-    transition_.insert(transition_.end(), h.transition.begin(), h.transition.end());
-    for (const auto& e : h.emission) {
+    initial_.resize(total + np, 0.0);  // padding states: never reachable
+    for (int j = 0; j < kBandPad; ++j) {
+      mean0_.push_back(0.0), mean1_.push_back(0.0), ip_.push_back(1.0), iq_.push_back(0.0), ir_.push_back(1.0);
+      lconst_.push_back(0.0);
+    }
+    for (int j = 0; j < np; ++j) {
       // S^-1 of [[a b][b d]] is [[d -b][-b a]] / det; log N = -log(2 pi) - log(det)/2 - q/2.
+      // Padding states get the unit Gaussian: finite values that are multiplied by pred = 0.
+      model::GaussianEmission e;
+      if (j < n) e = h.emission[j];
       const double a = e.cov[0][0], b = 0.5 * (e.cov[0][1] + e.cov[1][0]), d = e.cov[1][1];
       const double det = a * d - b * b;
       mean0_.push_back(e.mean[0]);
@@ -44,14 +62,35 @@ ForwardFilter::ForwardFilter(const model::OutcomeModel& m) : features_(m.feature
       ir_.push_back(a / det);
       lconst_.push_back(-kLog2Pi - 0.5 * std::log(det));
     }
+    total += np;
+  }
+  // The constant blocks the per-class update reads (pointers into the arrays above, now final).
+  for (int c = 0; c < n_classes_; ++c) {
+    ClassBlock b;
+    const int o = offset_[c], np = padded(n_states_[c]);
+    b.n_padded = np;
+    b.band = band_[c] <= kMaxBand ? band_[c] : -1;
+    if (b.band >= 0)
+      for (int d = 0; d <= b.band; ++d) b.diag[d] = coef_.data() + diag_offset_[c] + d * np;
+    b.m0 = mean0_.data() + o;
+    b.m1 = mean1_.data() + o;
+    b.ip = ip_.data() + o;
+    b.iq = iq_.data() + o;
+    b.ir = ir_.data() + o;
+    b.lc = lconst_.data() + o;
+    blocks_.push_back(b);
   }
   alpha_.assign(total, 0.0);
   scratch_.assign(total, 0.0);
   logb_.assign(total, 0.0);
   loglik_.assign(n_classes_, 0.0);
   posterior_.assign(n_classes_, 0.0);
+  update_ = class_update_avx2();
+  if (!update_) update_ = class_update_portable;
   reset();
 }
+
+bool ForwardFilter::vectorised() const noexcept { return update_ != class_update_portable; }
 
 void ForwardFilter::reset() noexcept {
   for (int c = 0; c < n_classes_; ++c) {
@@ -78,47 +117,25 @@ void ForwardFilter::step_features(const double x[model::kFeatures]) noexcept {
   const bool first = samples_ == 0;
   double best_score = -std::numeric_limits<double>::infinity();
   for (int c = 0; c < n_classes_; ++c) {
-    const int n = n_states_[c], o = offset_[c], w = band_[c];
-    const double* A = transition_.data() + toffset_[c];
+    const ClassBlock& b = blocks_[c];
+    const int n = n_states_[c], o = offset_[c];
     double* alpha = alpha_.data() + o;
     double* pred = scratch_.data() + o;
-    double* logb = logb_.data() + o;
-    // Predict: pred_j = sum_i alpha_i A_ij, inside the band i in [j-w, j] when left-right.
+    // The first sample predicts pi (alpha holds pi after reset); a general topology predicts
+    // with the full matrix here, O(n^2); a left-right band is predicted inside the update.
+    bool given = first;
     if (first) {
-      for (int j = 0; j < n; ++j) pred[j] = alpha[j];  // alpha_0 = pi
-    } else if (w >= 0) {
-      for (int j = 0; j < n; ++j) {
-        double s = 0.0;
-        const int i0 = j - w > 0 ? j - w : 0;
-        for (int i = i0; i <= j; ++i) s += alpha[i] * A[i * n + j];
-        pred[j] = s;
-      }
-    } else {
+      for (int j = 0; j < n; ++j) pred[j] = alpha[j];
+    } else if (b.band < 0) {
+      const double* A = coef_.data() + diag_offset_[c];
       for (int j = 0; j < n; ++j) {
         double s = 0.0;
         for (int i = 0; i < n; ++i) s += alpha[i] * A[i * n + j];
         pred[j] = s;
       }
+      given = true;
     }
-    // Emission log densities and their maximum m over reachable states.
-    double m = -std::numeric_limits<double>::infinity();
-    for (int j = 0; j < n; ++j) {
-      const int k = o + j;
-      const double d0 = x[0] - mean0_[k], d1 = x[1] - mean1_[k];
-      const double q = ip_[k] * d0 * d0 + 2.0 * iq_[k] * d0 * d1 + ir_[k] * d1 * d1;
-      logb[j] = lconst_[k] - 0.5 * q;
-      if (pred[j] > 0.0 && logb[j] > m) m = logb[j];
-    }
-    // Update and normalise: alpha_j = pred_j exp(logb_j - m) / c.
-    double csum = 0.0;
-    for (int j = 0; j < n; ++j) {
-      const double u = pred[j] > 0.0 ? pred[j] * std::exp(logb[j] - m) : 0.0;
-      alpha[j] = u;
-      csum += u;
-    }
-    const double inv = 1.0 / csum;
-    for (int j = 0; j < n; ++j) alpha[j] *= inv;
-    loglik_[c] += std::log(csum) + m;
+    loglik_[c] += update_(b, given, x[0], x[1], alpha, pred, logb_.data() + o);
     const double score = loglik_[c] + log_prior_[c];
     if (score > best_score) best_score = score;
   }

@@ -11,15 +11,20 @@
 //     P(c | x_1..t) = exp(L_c + log_prior_c) / sum_k exp(L_k + log_prior_k).
 // Left-right models have A_ij = 0 outside i <= j <= i+w: the filter finds the band width w at
 // construction and sums only inside it, O(states * (w+1)) per class per sample; any other topology
-// takes the general O(states^2) sum.
+// takes the general O(states^2) sum. The emission update (Gaussian densities, exp, normalisation)
+// runs four states at a time on CPUs with AVX2+FMA (emission_update.h), else portably.
 //
 // Real-time contract: the constructor allocates everything; reset() and step() allocate nothing,
-// throw nothing, lock nothing and log nothing.
+// throw nothing, lock nothing and log nothing (tests/hmm/filter_alloc_test.cpp counts).
+// Determinism: the same samples give the same bits on one machine. The AVX2 and the portable
+// update differ in the last bits of exp (< 3e-16 relative), so two CPUs may differ in the last
+// digits; both agree with hmm::forward_log_likelihood to 1e-9 relative (tests/hmm/filter_test.cpp).
 #pragma once
 
 #include <vector>
 
 #include "dgm.h"
+#include "emission_update.h"
 
 namespace dressguard::filter {
 
@@ -51,18 +56,23 @@ class ForwardFilter {
   // Samples taken (non-finite samples are skipped, not taken, and counted in rejected()).
   long samples() const noexcept { return samples_; }
   long rejected() const noexcept { return rejected_; }
+  // True when the AVX2+FMA emission update runs (chosen once at construction from the CPU).
+  bool vectorised() const noexcept;
 
  private:
-  // Constant after construction (flat arrays, offset_[c] indexes class c's states).
+  // Constant after construction. Flat arrays: offset_[c] indexes class c's first state, each
+  // class preceded by kBandPad zeros and padded to a multiple of 4 states (emission_update.h);
+  // coef_ holds each class's band diagonals (or full matrix) from diag_offset_[c].
   model::FeatureConvention features_;
   int n_classes_ = 0;
-  std::vector<int> n_states_, offset_, band_;
+  std::vector<int> n_states_, offset_, band_, diag_offset_;
   std::vector<double> log_prior_;
-  std::vector<double> initial_;     // sum of n_states
-  std::vector<double> transition_;  // per class n*n, at toffset_[c]
-  std::vector<int> toffset_;
+  std::vector<double> initial_;  // laid out like alpha_
+  std::vector<double> coef_;
   // Emission j: mean, inverse covariance (p, q, r) = [[p q][q r]], constant -log(2 pi) - log|S|/2.
   std::vector<double> mean0_, mean1_, ip_, iq_, ir_, lconst_;
+  std::vector<ClassBlock> blocks_;
+  ClassUpdateFn update_ = nullptr;
   // Mutable per-trial state.
   std::vector<double> alpha_, scratch_, logb_;
   std::vector<double> loglik_, posterior_;
