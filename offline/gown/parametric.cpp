@@ -22,7 +22,7 @@
 // Placement in W: the right sleeve (pattern X > Wb) is the one the arm enters. Pattern X -> x_W,
 // Y -> z_W, Z -> -y_W (a proper rotation), so the body hangs in the x-z plane behind the sleeve
 // and the cuff faces +x, toward the fist. The cuff sits 1 cm ahead of the grasp box and the
-// sleeve's top seam 1.5 cm above the lower jaw's starting face, so the closing jaws pick up the
+// sleeve's top seam 3 cm above the lower jaw's starting face, so the closing jaws pick up the
 // top of the sleeve (both layers, about 8 cm behind the rim) and lift it to the upper jaw; the
 // opening then hangs open below the jaws, spanning the fist at the high setting (checked by a
 // crude hang in tests/gown/placement_test.cpp). The measured gown is gripped differently (near
@@ -44,7 +44,7 @@ constexpr double kBulge = 0.03;      // half the front-back separation in the bo
 constexpr double kSleeveBulge = 0.0326;  // half-thickness of the sleeve's lens cross-section [m]
 constexpr double kBlend = 0.08;      // sleeve length over which the flat start opens up [m]
 constexpr double kCuffX_W = -0.12;   // x_W of the cuff: 1 cm ahead of the grasp box (x_W -0.21..-0.13) [m]
-constexpr double kTopSeamZ_W = 0.07;  // z_W of the sleeve's top seam: 1.5 cm above the lower jaw's start [m]
+constexpr double kTopSeamZ_W = 0.085;  // z_W of the sleeve's top seam: 3 cm above the lower jaw's start [m]
 
 double smoothstep(double t) {
   t = std::clamp(t, 0.0, 1.0);
