@@ -88,7 +88,7 @@ std::string shell_quote(const std::string& s) {
 }  // namespace
 
 int run_gown(int argc, char** argv) {
-  Args args(argc - 1, argv + 1, {"help", "json", "parametric"});
+  Args args(argc - 1, argv + 1, {"help", "json", "parametric", "hang"});
   if (args.has("help")) {
     std::puts(
         "usage: dressguard gown [--obj FILE] [--scale S] [--parametric] [--reduced N] [--out MESH.obj]\n"
@@ -100,6 +100,8 @@ int run_gown(int argc, char** argv) {
         "  --scale S       file units -> metres (default 1.679, the paper's)\n"
         "  --parametric    use the parametric gown even when the measured one is present\n"
         "  --reduced N     reduce to about N triangles (quadric edge collapse), e.g. 5000\n"
+        "  --hang          let the gown hang 3 s from the jaws in a crude check (edges only, no\n"
+        "                  bending, no collisions; not the simulator) before reporting and drawing\n"
         "  --out MESH.obj  write the placed mesh (atomically)\n"
         "  --dump FILE     write the scene (mesh, grasp, loops, arm, gripper) as JSON for plotting\n"
         "  --picture PNG   draw the placed gown with grasp, sleeve opening and arm (needs python3 +\n"
@@ -107,7 +109,7 @@ int run_gown(int argc, char** argv) {
         "  --json          print a machine-readable summary");
     return 0;
   }
-  args.allow_only({"help", "json", "parametric", "obj", "scale", "reduced", "out", "dump", "picture"});
+  args.allow_only({"help", "json", "parametric", "hang", "obj", "scale", "reduced", "out", "dump", "picture"});
   if (args.has("parametric") && args.has("obj")) throw UsageError("--parametric and --obj exclude each other");
   gown::GownOptions opt;
   opt.scale = args.number("scale", 1.679);
@@ -122,13 +124,14 @@ int run_gown(int argc, char** argv) {
   const fs::path measured = gown::measured_gown_path();
   const std::string source =
       opt.parametric || (opt.obj.empty() && measured.empty()) ? "parametric" : (opt.obj.empty() ? measured : opt.obj).string();
-  const GownMesh mesh = gown::load_gown(opt);
+  GownMesh mesh = gown::load_gown(opt);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   const auto masses = gown::vertex_masses(mesh);
   double mass = 0;
   for (double m : masses) mass += m;
-  const auto grasp = gown::grasp_vertices(mesh, opt.scene);
+  const auto grasp = gown::grasp_vertices(mesh, opt.scene);  // at placement, before any hang
+  if (args.has("hang")) mesh.x = gown::crude_hang(mesh, opt.scene);
   const Eigen::Vector3d sleeve_c = gown::loop_centroid(mesh, mesh.sleeve_loop);
 
   if (auto out = args.get("out")) write_file_atomic(*out, gown::to_obj(mesh));
@@ -151,9 +154,10 @@ int run_gown(int argc, char** argv) {
 
   if (args.has("json")) {
     std::printf("{\"source\": \"%s\", \"vertices\": %zu, \"triangles\": %zu, \"area_m2\": %.5f, \"mass_kg\": %.5f, "
-                "\"mean_edge_m\": %.5f, \"min_angle_deg\": %.2f, \"seconds\": %.3f, \"loops\": [",
+                "\"mean_edge_m\": %.5f, \"min_angle_deg\": %.2f, \"seconds\": %.3f, \"hung\": %s, \"loops\": [",
                 source.c_str(), mesh.x.size(), mesh.triangles.size(), gown::total_area(mesh), mass,
-                gown::mean_edge_length(mesh), gown::min_triangle_angle(mesh) * 180 / M_PI, seconds);
+                gown::mean_edge_length(mesh), gown::min_triangle_angle(mesh) * 180 / M_PI, seconds,
+                args.has("hang") ? "true" : "false");
     for (size_t l = 0; l < mesh.boundary_loops.size(); ++l)
       std::printf("%s{\"vertices\": %zu, \"perimeter_m\": %.5f, \"centroid\": %s}", l ? ", " : "",
                   mesh.boundary_loops[l].size(), gown::loop_perimeter(mesh, static_cast<int>(l)),
@@ -161,7 +165,7 @@ int run_gown(int argc, char** argv) {
     std::printf("], \"sleeve_loop\": %d, \"sleeve_center\": %s, \"sleeve_lower_half\": %zu, \"grasped\": %zu}\n",
                 mesh.sleeve_loop, vec_json(sleeve_c).c_str(), mesh.sleeve_lower_half.size(), grasp.size());
   } else {
-    std::printf("gown: %s\n", source.c_str());
+    std::printf("gown: %s%s\n", source.c_str(), args.has("hang") ? " (after a crude 3 s hang from the jaws)" : "");
     std::printf("  %zu vertices, %zu triangles, area %.4f m^2, mass %.4f kg (%.3f kg/m^2)\n", mesh.x.size(),
                 mesh.triangles.size(), gown::total_area(mesh), mass, mesh.areal_density);
     std::printf("  mean edge %.2f cm, smallest angle %.1f deg, built in %.3f s\n", gown::mean_edge_length(mesh) * 100,
