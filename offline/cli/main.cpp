@@ -17,6 +17,8 @@ constexpr Command kCommands[] = {
     {"classify", "classify a dataset's trials with a model: accuracy, confusion, sweeps", run_classify},
     {"model", "show a model file (model show MODEL.dgm)", run_model},
     {"gown", "load, reduce and place the gown mesh; stats, OBJ and a picture", run_gown},
+    {"export-candump", "write trials as candump logs of the CAN protocol (with optional faults)", run_export_candump},
+    {"replay", "run the predictor daemon's code on a candump log: would it stop, when, why", run_replay},
 };
 
 void print_usage() {
