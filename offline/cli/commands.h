@@ -14,6 +14,7 @@ struct Command {
 };
 
 int run_import(int argc, char** argv);
+int run_simulate(int argc, char** argv);
 int run_train(int argc, char** argv);
 int run_classify(int argc, char** argv);
 int run_model(int argc, char** argv);

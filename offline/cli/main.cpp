@@ -13,6 +13,7 @@ namespace {
 // One row per subcommand, in the order a user meets them.
 constexpr Command kCommands[] = {
     {"import", "convert the study's measured trials into a dataset", run_import},
+    {"simulate", "simulate one sleeve-pulling trial: haptic CSV, summary, scene for pictures", run_simulate},
     {"train", "train the outcome HMMs of a labelled dataset into a model file", run_train},
     {"classify", "classify a dataset's trials with a model: accuracy, confusion, sweeps", run_classify},
     {"model", "show a model file (model show MODEL.dgm)", run_model},
