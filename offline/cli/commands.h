@@ -14,5 +14,8 @@ struct Command {
 };
 
 int run_import(int argc, char** argv);
+int run_calibrate(int argc, char** argv);
+int run_synthesize(int argc, char** argv);
+int run_build_model(int argc, char** argv);
 
 }  // namespace dressguard::cli

@@ -13,6 +13,9 @@ namespace {
 // One row per subcommand, in the order a user meets them.
 constexpr Command kCommands[] = {
     {"import", "convert the study's measured trials into a dataset", run_import},
+    {"calibrate", "fit the simulator to one participant's sequences (CMA-ES)", run_calibrate},
+    {"synthesize", "simulate labelled trials with a calibrated simulator", run_synthesize},
+    {"build-model", "train the simulation-trained classifier (STC) into a model file", run_build_model},
 };
 
 void print_usage() {
