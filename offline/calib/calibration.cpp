@@ -133,7 +133,21 @@ TrialRequest request_for(const HapticSequence& input, const std::array<double, 3
   r.speed = input.speed;
   r.seed = 0;
   r.gown_noise = false;
+  if (!stopped_by_force(input) && !input.samples.empty()) r.max_travel = input.samples.back().travel;
   return r;
+}
+
+bool stopped_by_force(const HapticSequence& s) {
+  if (s.samples.empty()) return false;
+  const HapticSample& last = s.samples.back();
+  return std::abs(last.f_motion) >= 9.5 || std::abs(last.f_vertical) >= 9.5;
+}
+
+double rig_travel_of(const std::vector<HapticSequence>& inputs) {
+  double travel = 0;
+  for (const auto& s : inputs)
+    if (!stopped_by_force(s) && !s.samples.empty()) travel = std::max(travel, s.samples.back().travel);
+  return travel > 0 ? travel : 0.85;
 }
 
 // ---- checkpoint ---------------------------------------------------------------------------------
@@ -339,6 +353,7 @@ Json calibration_to_json(const Calibration& c) {
   }
   j.set("sequences", fits);
   j.set("gown", c.gown);
+  j.set("rig_travel_m", c.rig_travel);
   j.set("provenance", c.provenance);
   return j;
 }
@@ -373,6 +388,8 @@ Calibration calibration_from_json(const Json& j, const std::filesystem::path& so
       c.fits.push_back(f);
     }
     c.gown = j.at("gown").string();
+    c.rig_travel = j.at("rig_travel_m").number();
+    if (!(c.rig_travel > 0.1 && c.rig_travel <= 1.5)) throw std::runtime_error("rig_travel_m outside (0.1, 1.5] m");
     if (j.has("provenance")) c.provenance = j.at("provenance");
   } catch (const InputError&) {
     throw;

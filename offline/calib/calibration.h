@@ -49,6 +49,7 @@ struct TrialRequest {
   double speed = 0.1;        // [m/s]
   std::uint64_t seed = 0;    // the gown perturbation's random stream
   bool gown_noise = false;   // paper V-A perturbation (6 N, 0.5 s) on or off
+  double max_travel = 0.85;  // [m] end of the rig's travel (the paper's 0.85 m; see request_for)
 };
 
 struct SimulatedTrial {
@@ -150,8 +151,19 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
                             const std::function<void(const GenerationProgress&)>& progress = {});
 
 // The request that reproduces a measured input sequence with candidate offsets (no gown noise,
-// fixed seed: calibration compares deterministic simulations).
+// fixed seed: calibration compares deterministic simulations). The travel limit is the measured
+// trial's own when it was not stopped by force: the study's missed trials end at 0.71-0.76 m, not
+// at the 0.85 m the paper states (shared/data: 13 of 14 missed trials), and simulating them to
+// 0.85 m would charge w = 20 on ~0.1 m of travel that the rig never made.
 TrialRequest request_for(const HapticSequence& input, const std::array<double, 3>& offsets);
+
+// True when a measured trial ended at the force threshold (|F| >= 9.5 N on motion or vertical at
+// its last sample; the rig's limit is 10 N, the last sample may sit just under it).
+bool stopped_by_force(const HapticSequence& s);
+
+// The rig's end of travel for a participant: the longest travel among its inputs that were not
+// stopped by force; 0.85 m (the paper) when every input was.
+double rig_travel_of(const std::vector<HapticSequence>& inputs);
 
 // ---- the calibration file ------------------------------------------------------------------------
 
@@ -165,6 +177,7 @@ struct Calibration {
   std::vector<SequenceFit> fits;
   std::string objective_kind = "area";
   std::string gown = "reduced";               // which scene the simulator used
+  double rig_travel = 0.85;                   // [m] end of travel for synthesis (rig_travel_of)
   Json provenance = Json::object();           // dataset, seed, budget, evaluations, timing, tool
 };
 Json calibration_to_json(const Calibration& c);

@@ -30,6 +30,7 @@ TrialSimulator make_cloth_simulator(const std::string& gown) {
     spec.speed = r.speed;
     spec.seed = r.seed;
     spec.gown_noise = r.gown_noise;
+    spec.max_travel = r.max_travel;
     sim::TrialResult res = sim::simulate_trial(*scene, p, spec);
     SimulatedTrial out;
     out.samples = std::move(res.seq.samples);

@@ -28,6 +28,7 @@ TrialRequest synthesis_request(const Calibration& cal, ArmHeight height, int ind
   r.speed = index < o.per_height / 2 ? 0.1 : 0.15;
   r.gown_noise = o.gown_noise;
   r.seed = mix_seed(stream, 1);
+  r.max_travel = cal.rig_travel;  // the calibrated participant's rig (calibration.h, rig_travel_of)
   if (height == ArmHeight::Middle) {
     // Middle: noise on the nominal height, U[-6, 0] cm (the paper's gravity compensation).
     r.arm_offset = o.arm_noise ? kArmNoiseMiddleLow * u : 0.0;

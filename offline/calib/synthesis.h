@@ -8,7 +8,8 @@
 //   arm:   high and low: calibrated offset + U[-1.5, +1.5] cm; middle: U[-6, 0] cm added to the
 //          nominal middle height directly ("not all participants have an optimised middle arm
 //          height", and only negative noise to compensate gravity).
-// Labels come from the simulator (paper V-A rule). Every trial's randomness derives from
+// The pull ends at the calibration's rig travel (the participant's measured end of travel; the
+// paper's 0.85 m when unknown) or at 10 N. Labels come from the simulator (paper V-A rule). Every trial's randomness derives from
 // (seed, height, index) alone, so the dataset is the same whatever the thread or rank count.
 // Resumable: each finished trial is written at once (CSV, then a small ".done" marker holding its
 // label, both atomically); a rerun skips trials whose marker and CSV exist.

@@ -126,6 +126,7 @@ int run_calibrate(int argc, char** argv) {
   cal.fits = r.fits;
   cal.objective_kind = std::string(objective_name(o.objective));
   cal.gown = gown;
+  cal.rig_travel = rig_travel_of(inputs);
   Json prov = Json::object();
   prov.set("tool", "dressguard calibrate");
   prov.set("created", utc_now());

@@ -197,6 +197,7 @@ TEST(Calibration, CalibrationFileRoundTripAndErrors) {
   c.offset_calibrated = {true, false, true};
   c.objective = 0.4567;
   c.fits = {{"s4-good-3", ArmHeight::High, 0.1, 0.22}, {"s4-miss-2", ArmHeight::Low, 0.15, 0.2367}};
+  c.rig_travel = 0.72;
   c.provenance.set("seed", "1");
   const fs::path dir = temp_dir("calfile");
   write_calibration(dir / "cal.json", c);
@@ -207,6 +208,7 @@ TEST(Calibration, CalibrationFileRoundTripAndErrors) {
   EXPECT_FALSE(d.offset_calibrated[1]);
   ASSERT_EQ(d.fits.size(), 2u);
   EXPECT_EQ(d.fits[1].speed, 0.15);
+  EXPECT_EQ(d.rig_travel, 0.72);
   write_file_atomic(dir / "bad.json", "{\"format\": \"dressguard-calibration 1\",\n \"participant\": 4}");
   EXPECT_THROW(read_calibration(dir / "bad.json"), InputError);
   write_file_atomic(dir / "bad2.json", "{\"format\": \n");
@@ -289,6 +291,29 @@ TEST(Synthesis, DatasetIsIndependentOfThreadsAndResumes) {
   EXPECT_THROW(synthesize(cal, testing::fake_simulate, o, b, Comm::world()), InputError);
   fs::remove_all(a);
   fs::remove_all(b);
+}
+
+}  // namespace
+}  // namespace dressguard::calib
+
+namespace dressguard::calib {
+namespace {
+
+// The travel limit of a calibration simulation follows the measured trial: a miss that ended at
+// 0.72 m without reaching 10 N is simulated to 0.72 m; a good trial that stopped at 10 N is
+// simulated to the rig's 0.85 m (the simulation's own force stop ends it).
+TEST(Calibration, TravelLimitFollowsTheMeasuredTrial) {
+  HapticSequence miss;
+  miss.height = ArmHeight::Low;
+  miss.samples = {{0, 0, 0, 0, 0}, {7.2, 0.72, -4.0, 0, -0.6}};
+  HapticSequence good;
+  good.samples = {{0, 0, 0, 0, 0}, {6.1, 0.61, -10.01, 0, -1.1}};
+  EXPECT_FALSE(stopped_by_force(miss));
+  EXPECT_TRUE(stopped_by_force(good));
+  EXPECT_DOUBLE_EQ(request_for(miss, {}).max_travel, 0.72);
+  EXPECT_DOUBLE_EQ(request_for(good, {}).max_travel, 0.85);
+  EXPECT_DOUBLE_EQ(rig_travel_of({good, miss}), 0.72);
+  EXPECT_DOUBLE_EQ(rig_travel_of({good}), 0.85);
 }
 
 }  // namespace

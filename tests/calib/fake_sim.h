@@ -23,7 +23,7 @@ inline SimulatedTrial fake_simulate(const ClothValues& c, const TrialRequest& r)
   const double catchiness = std::max(0.0, 1.0 + 6.0 * arm);  // high arm: the sleeve tightens on the elbow
   for (int i = 0;; ++i) {
     const double t = i * 0.01;
-    const double x = std::min(r.speed * t, 0.85);
+    const double x = std::min(r.speed * t, r.max_travel);
     const double drag = (1.5 * c.friction + 2.0 * c.stretch) * x * (1.0 + 12.0 * catchiness * x * x) +
                         0.6 * c.shear * std::sin(6.0 * x) + noise_amp * std::sin(20.0 * x + r.seed % 7);
     const double vert = (0.5 + 10.0 * arm) * x * (0.5 + c.bend) - 0.8 * c.self_friction * x * x;
@@ -32,7 +32,7 @@ inline SimulatedTrial fake_simulate(const ClothValues& c, const TrialRequest& r)
       out.outcome = arm > -0.05 ? Outcome::Good : Outcome::Caught;
       break;
     }
-    if (x >= 0.85) {
+    if (x >= r.max_travel) {
       out.outcome = Outcome::Missed;
       break;
     }
