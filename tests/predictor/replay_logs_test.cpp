@@ -136,6 +136,30 @@ TEST(ReplayLogs, EveryTestLogHasTheOutcomeInItsName) {
   std::printf("  smallest margin before the 10 N limit: %.2f s\n", min_margin_s);
 }
 
+TEST(ReplayLogs, ModelTrainedByBaumWelchGetsTheCleanOutcomesRight) {
+  // The project's trainer on the same seed-1 trials (`dressguard train`, see CMakeLists.txt).
+  const auto m = model::read_model(DG_TRAINED_MODEL);
+  int checked = 0;
+  for (const auto& entry : fs::directory_iterator(kLogs)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("syn2-", 0) != 0) continue;
+    const auto frames = load(entry.path());
+    const auto r = replay_frames(&m, PredictorConfig{}, frames);
+    ASSERT_EQ(r.trials.size(), 1u) << name;
+    const auto& t = r.trials[0];
+    if (ends_with(name, "-caught.log")) {
+      EXPECT_TRUE(t.stopped && t.reason == protocol::StopReason::Caught) << name;
+      EXPECT_LT(static_cast<long>(t.stop_sample), facts(frames).samples) << name;
+      std::printf("  trained model: %-26s caught at sample %u, %.2f s before the 10 N limit\n", name.c_str(),
+                  t.stop_sample, (facts(frames).samples - static_cast<long>(t.stop_sample)) * 0.01);
+    } else {
+      EXPECT_FALSE(t.stopped) << name << ": " << protocol::stop_reason_name(t.reason) << " at " << t.stop_sample;
+    }
+    ++checked;
+  }
+  EXPECT_EQ(checked, 9);
+}
+
 TEST(ReplayLogs, ModelThatDoesNotLoadStopsEveryTrial) {
   const auto frames = load(kLogs / "syn2-good-0-good.log");
   const auto r = replay_frames(nullptr, PredictorConfig{}, frames);
