@@ -98,7 +98,7 @@ void print_hist(const char* tag, const LatencyHistogram& h) {
   // Coarse log-scale histogram: [2^k, 2^(k+1)) microseconds.
   uint64_t buckets[24] = {};
   for (int b = 0; b < LatencyHistogram::kBins; ++b) {
-    const double us = (b * h.bin_ns()) / 1e3;
+    const double us = ((b + 0.5) * h.bin_ns()) / 1e3;  // the bin's middle
     int k = 0;
     while (k < 23 && us >= (1 << (k + 1))) ++k;
     buckets[k] += h.bins()[static_cast<size_t>(b)];
