@@ -195,6 +195,11 @@ TEST(ReplayCli, JsonReportsTheStop) {
   EXPECT_EQ(WEXITSTATUS(rc), 2);
   EXPECT_NE(bad2.find(tmp.string() + ":2:"), std::string::npos) << bad2;
   fs::remove(tmp);
+  // export-candump: bad input names the problem, exit 2, nothing written.
+  const std::string bad3 = run(std::string(DG_CLI) + " export-candump --trial /nonexistent/t.csv --out /tmp/dg_never.log 2>&1", rc);
+  EXPECT_EQ(WEXITSTATUS(rc), 2);
+  EXPECT_NE(bad3.find("/nonexistent/t.csv"), std::string::npos) << bad3;
+  EXPECT_FALSE(fs::exists("/tmp/dg_never.log"));
 }
 
 TEST(ReplayMeasured, StudyTrialsHitTheHardLimitWhereTheRigStopped) {
