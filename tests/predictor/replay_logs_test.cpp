@@ -160,6 +160,33 @@ TEST(ReplayLogs, ModelTrainedByBaumWelchGetsTheCleanOutcomesRight) {
   EXPECT_EQ(checked, 9);
 }
 
+TEST(ReplayLogs, DefaultModelRunsTheFaultLogsAndReportsTheCleanOnes) {
+  // models/default.dgm is trained on the simulator's trials, not on these synthetic ones: its
+  // outcomes on the clean logs are printed, not asserted. The fail-safes do not depend on the
+  // model: with the caught rule off, each fault log must stop for its reason.
+  const fs::path def = fs::path(DRESSGUARD_SOURCE_DIR) / "models/default.dgm";
+  if (!fs::exists(def)) GTEST_SKIP() << "models/default.dgm not present yet";
+  const auto m = model::read_model(def);
+  for (const auto& entry : fs::directory_iterator(kLogs)) {
+    const std::string name = entry.path().filename().string();
+    const auto frames = load(entry.path());
+    const auto pos = name.find("-expect-");
+    PredictorConfig cfg;
+    if (pos != std::string::npos) cfg.stop_consecutive = 100000;
+    const auto r = replay_frames(&m, cfg, frames);
+    ASSERT_EQ(r.trials.size(), 1u) << name;
+    const auto& t = r.trials[0];
+    if (pos != std::string::npos) {
+      EXPECT_TRUE(t.stopped) << name;
+      EXPECT_EQ(protocol::stop_reason_name(t.reason), name.substr(pos + 8, name.size() - pos - 12)) << name;
+    } else {
+      std::printf("  default model: %-36s %s", name.c_str(), t.stopped ? protocol::stop_reason_name(t.reason) : "no stop");
+      if (t.stopped) std::printf(" at sample %u (F_motion %.2f N)", t.stop_sample, t.f_motion);
+      std::printf("\n");
+    }
+  }
+}
+
 TEST(ReplayLogs, ModelThatDoesNotLoadStopsEveryTrial) {
   const auto frames = load(kLogs / "syn2-good-0-good.log");
   const auto r = replay_frames(nullptr, PredictorConfig{}, frames);
