@@ -122,7 +122,7 @@ def main():
     ap.add_argument("--model", required=True)
     ap.add_argument("--cache", default=None)
     ap.add_argument("--timeout", type=int, default=300)
-    ap.add_argument("--kvm", action="store_true", help="use KVM instead of software emulation (TCG)")
+    ap.add_argument("--kvm", action="store_true", help="use KVM instead of software emulation (TCG); needs working (nested) KVM: on the build VM it hangs")
     ap.add_argument("--keep-console", default=None, help="write the VM's console output here")
     args = ap.parse_args()
     qemu = shutil.which("qemu-system-x86_64")
