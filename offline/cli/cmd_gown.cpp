@@ -35,8 +35,10 @@ std::string ints_json(const std::vector<int>& v) {
 }
 
 // Everything the picture needs: mesh, grasped vertices, loops, arm and gripper (all in W).
-std::string scene_dump(const GownMesh& m, const gown::PaperScene& s, const std::vector<int>& grasp) {
-  std::string out = "{\n\"frame\": \"W: z up, gravity -z, gripper moves +x\",\n\"x\": [";
+std::string scene_dump(const GownMesh& m, const gown::PaperScene& s, const std::vector<int>& grasp, bool hung) {
+  std::string out = "{\n\"frame\": \"W: z up, gravity -z, gripper moves +x\",\n\"state\": \"";
+  out += hung ? "after a crude 3 s hang (edges only, no bending, no collisions)" : "placed, before gravity";
+  out += "\",\n\"x\": [";
   for (size_t i = 0; i < m.x.size(); ++i) {
     char buf[80];
     std::snprintf(buf, sizeof buf, "%s[%.5f,%.5f,%.5f]", i ? "," : "", m.x[i].x(), m.x[i].y(), m.x[i].z());
@@ -140,7 +142,7 @@ int run_gown(int argc, char** argv) {
   if (dump || picture) {
     const fs::path dump_path =
         dump ? fs::path(*dump) : fs::temp_directory_path() / ("dressguard-gown-" + std::to_string(::getpid()) + ".json");
-    write_file_atomic(dump_path, scene_dump(mesh, opt.scene, grasp));
+    write_file_atomic(dump_path, scene_dump(mesh, opt.scene, grasp, args.has("hang")));
     if (picture) {
       const fs::path script = plot_script();
       if (script.empty()) throw std::runtime_error("tools/plot/gown.py not found (set DRESSGUARD_SOURCE_DIR)");

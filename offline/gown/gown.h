@@ -8,6 +8,15 @@
 // The scene constants of that simulator (gripper jaws, arm spheres, gown transform) are in
 // placement.h (`PaperScene`), so that gown and sim use the same numbers.
 //
+// How the simulator uses it:
+//   GownOptions opt;                       // defaults: measured gown if present, scale 1.679
+//   opt.target_triangles = 5000;           // or 0 for the full 20k-triangle mesh
+//   GownMesh g = load_gown(opt);           // placed in W, loops found, sleeve labelled
+//   auto m = vertex_masses(g);             // lumped (the paper's simulator gives every particle
+//                                          // the same mass, total area * density / n)
+//   auto held = grasp_vertices(g, opt.scene);   // then hold them at z = opt.scene.pinch_z_W()
+//   g.sleeve_lower_half                    // for the outcome label (paper V-A)
+//
 // Data: the measured gown is gt-rad/learning-forces, physx_simulation/Mesh/fullgown.obj (read in
 // place from shared/data/gown/, never copied into the project).
 #pragma once
