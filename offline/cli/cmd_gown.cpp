@@ -90,7 +90,7 @@ std::string shell_quote(const std::string& s) {
 }  // namespace
 
 int run_gown(int argc, char** argv) {
-  Args args(argc - 1, argv + 1, {"help", "json", "parametric", "hang"});
+  Args args(argc - 1, argv + 1, {"help", "json", "parametric", "hang", "in-world"});
   if (args.has("help")) {
     std::puts(
         "usage: dressguard gown [--obj FILE] [--scale S] [--parametric] [--reduced N] [--out MESH.obj]\n"
@@ -100,6 +100,7 @@ int run_gown(int argc, char** argv) {
         "  --obj FILE      mesh to load (default: shared/data/gown/fullgown.obj when present,\n"
         "                  else the project's parametric gown)\n"
         "  --scale S       file units -> metres (default 1.679, the paper's)\n"
+        "  --in-world      the OBJ is already placed in W (as --out writes it; use --scale 1)\n"
         "  --parametric    use the parametric gown even when the measured one is present\n"
         "  --reduced N     reduce to about N triangles (quadric edge collapse), e.g. 5000\n"
         "  --hang          let the gown hang 3 s from the jaws in a crude check (edges only, no\n"
@@ -111,7 +112,7 @@ int run_gown(int argc, char** argv) {
         "  --json          print a machine-readable summary");
     return 0;
   }
-  args.allow_only({"help", "json", "parametric", "hang", "obj", "scale", "reduced", "out", "dump", "picture"});
+  args.allow_only({"help", "json", "parametric", "hang", "in-world", "obj", "scale", "reduced", "out", "dump", "picture"});
   if (args.has("parametric") && args.has("obj")) throw UsageError("--parametric and --obj exclude each other");
   gown::GownOptions opt;
   opt.scale = args.number("scale", 1.679);
@@ -123,6 +124,7 @@ int run_gown(int argc, char** argv) {
 
   const auto t0 = std::chrono::steady_clock::now();
   opt.parametric = args.has("parametric");
+  opt.already_in_W = args.has("in-world");
   const fs::path measured = gown::measured_gown_path();
   const std::string source =
       opt.parametric || (opt.obj.empty() && measured.empty()) ? "parametric" : (opt.obj.empty() ? measured : opt.obj).string();

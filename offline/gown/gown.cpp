@@ -26,7 +26,7 @@ GownMesh load_gown(const GownOptions& options) {
     mesh = make_parametric_gown();
   } else {
     mesh = read_obj(path, options.scale);
-    place_like_paper(mesh, options.scene);
+    if (!options.already_in_W) place_like_paper(mesh, options.scene);
   }
   mesh.areal_density = options.areal_density;
   if (mesh.boundary_loops.size() < 2)

@@ -50,6 +50,8 @@ struct GownOptions {
   int target_triangles = 0;   // 0: full resolution; e.g. 5000 for the reduced gown
   double areal_density = 0.145;
   bool parametric = false;    // use the parametric gown even when the measured one is present
+  bool already_in_W = false;  // the file is already placed in W (as `dressguard gown --out` writes
+                              // it, scale 1): skip the paper's transform
   PaperScene scene{};         // placement of a file's mesh and the grasp box that picks the sleeve
 };
 

@@ -18,7 +18,8 @@
 //  - The arm starts 0.1 m further along +x_W and moves to its place during settling steps
 //    200-400 (`arm_approach_x_W`); the numbers below are its final place.
 //  - A crude hanging check (edges only, no bending, no collisions; tests/gown) lets the measured
-//    gown's sleeve opening hang about 0.17 m below the arm axis and 0.08 m behind the gripper:
+//    gown's sleeve opening hang with its centre 0.16 m below the arm axis (its top 0.12 m below)
+//    and 0.08 m behind the jaws, lying nearly flat:
 //    whether the arm enters it at the high setting depends on the bending stiffness and the
 //    settling, i.e. on the simulator, not on this placement.
 //  - The paper's Fig. 3(b) only shows the sleeve hanging toward the fist; the "lower half" of the
