@@ -58,8 +58,8 @@ struct GownOptions {
 // shared/data/gown/fullgown.obj when shared/data is present, else empty.
 std::filesystem::path measured_gown_path();
 
-// The gown the simulator runs on: loaded (or generated), reduced if asked, placed in W like the
-// paper's simulator, its boundary loops found and the sleeve opening labelled. Throws InputError
+// The gown the simulator runs on: loaded (or generated), placed in W like the paper's simulator,
+// reduced if asked (keeping the grasped vertices as they are), its boundary loops found and the sleeve opening labelled. Throws InputError
 // for a malformed file or a mesh without at least one boundary loop near the grasp box.
 GownMesh load_gown(const GownOptions& options);
 
@@ -80,6 +80,9 @@ GownMesh make_parametric_gown();
 // sliver are refused. Deterministic (ties broken by edge index). Loops are found again and the
 // sleeve labelling is carried over (same loop, lower half recomputed) when the input had one.
 GownMesh reduce_gown(const GownMesh& mesh, int target_triangles);
+// The same, with vertices that neither move nor disappear (frozen[v], sized like mesh.x or
+// shorter). load_gown freezes the grasped vertices, so every resolution holds the same patch.
+GownMesh reduce_gown(const GownMesh& mesh, int target_triangles, const std::vector<bool>& frozen);
 
 // Loops of edges used by exactly one triangle, each ordered by walking along the boundary,
 // longest (most vertices) first. A vertex where two loops touch is followed consistently.
