@@ -93,8 +93,8 @@ int run_gown(int argc, char** argv) {
   Args args(argc - 1, argv + 1, {"help", "json", "parametric", "hang", "in-world"});
   if (args.has("help")) {
     std::puts(
-        "usage: dressguard gown [--obj FILE] [--scale S] [--parametric] [--reduced N] [--out MESH.obj]\n"
-        "                       [--dump SCENE.json] [--picture GOWN.png] [--json]\n"
+        "usage: dressguard gown [--obj FILE [--scale S] [--in-world] | --parametric] [--reduced N] [--hang]\n"
+        "                       [--out MESH.obj] [--dump SCENE.json] [--picture GOWN.png] [--json]\n"
         "  Loads the gown the simulator runs on, placed in the world frame W (z up, gripper moves +x)\n"
         "  like the paper's simulator, and prints its statistics.\n"
         "  --obj FILE      mesh to load (default: shared/data/gown/fullgown.obj when present,\n"
