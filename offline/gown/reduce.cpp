@@ -111,8 +111,9 @@ class Reducer {
         boundary_[a] = true;
         loop_of_[a] = static_cast<int>(l);
         // The plane through the boundary edge, perpendicular to its face.
-        const int f = common_faces(a, b).front();
-        const auto& t = tris_[f];
+        const auto faces = common_faces(a, b);
+        if (faces.empty()) continue;
+        const auto& t = tris_[faces.front()];
         const Eigen::Vector3d fn = (x_[t[1]] - x_[t[0]]).cross(x_[t[2]] - x_[t[0]]);
         const Eigen::Vector3d e = x_[b] - x_[a];
         const Eigen::Vector3d pn = e.cross(fn);
