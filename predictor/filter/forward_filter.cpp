@@ -64,22 +64,6 @@ ForwardFilter::ForwardFilter(const model::OutcomeModel& m) : features_(m.feature
     }
     total += np;
   }
-  // The constant blocks the per-class update reads (pointers into the arrays above, now final).
-  for (int c = 0; c < n_classes_; ++c) {
-    ClassBlock b;
-    const int o = offset_[c], np = padded(n_states_[c]);
-    b.n_padded = np;
-    b.band = band_[c] <= kMaxBand ? band_[c] : -1;
-    if (b.band >= 0)
-      for (int d = 0; d <= b.band; ++d) b.diag[d] = coef_.data() + diag_offset_[c] + d * np;
-    b.m0 = mean0_.data() + o;
-    b.m1 = mean1_.data() + o;
-    b.ip = ip_.data() + o;
-    b.iq = iq_.data() + o;
-    b.ir = ir_.data() + o;
-    b.lc = lconst_.data() + o;
-    blocks_.push_back(b);
-  }
   alpha_.assign(total, 0.0);
   scratch_.assign(total, 0.0);
   logb_.assign(total, 0.0);
@@ -88,6 +72,24 @@ ForwardFilter::ForwardFilter(const model::OutcomeModel& m) : features_(m.feature
   update_ = class_update_avx2();
   if (!update_) update_ = class_update_portable;
   reset();
+}
+
+// The constant arrays of class c as the update reads them. Built per step from offsets (a few
+// additions) rather than stored as pointers, so that copies and moves of a filter stay valid.
+ClassBlock ForwardFilter::block(int c) const noexcept {
+  ClassBlock b;
+  const int o = offset_[c], np = padded(n_states_[c]);
+  b.n_padded = np;
+  b.band = band_[c] <= kMaxBand ? band_[c] : -1;
+  if (b.band >= 0)
+    for (int d = 0; d <= b.band; ++d) b.diag[d] = coef_.data() + diag_offset_[c] + d * np;
+  b.m0 = mean0_.data() + o;
+  b.m1 = mean1_.data() + o;
+  b.ip = ip_.data() + o;
+  b.iq = iq_.data() + o;
+  b.ir = ir_.data() + o;
+  b.lc = lconst_.data() + o;
+  return b;
 }
 
 bool ForwardFilter::vectorised() const noexcept { return update_ != class_update_portable; }
@@ -117,7 +119,7 @@ void ForwardFilter::step_features(const double x[model::kFeatures]) noexcept {
   const bool first = samples_ == 0;
   double best_score = -std::numeric_limits<double>::infinity();
   for (int c = 0; c < n_classes_; ++c) {
-    const ClassBlock& b = blocks_[c];
+    const ClassBlock b = block(c);
     const int n = n_states_[c], o = offset_[c];
     double* alpha = alpha_.data() + o;
     double* pred = scratch_.data() + o;

@@ -33,6 +33,7 @@ class ForwardFilter {
   // Copies what it needs from `m` (which may then be destroyed). `m` must be valid (read_model
   // validates); throws model::ModelError otherwise.
   explicit ForwardFilter(const model::OutcomeModel& m);
+  // Copyable and movable (a copy allocates; a copy carries the trial state along).
 
   // Start of a trial: alpha_0 = pi, log-likelihoods 0, posterior = prior.
   void reset() noexcept;
@@ -60,6 +61,7 @@ class ForwardFilter {
   bool vectorised() const noexcept;
 
  private:
+  ClassBlock block(int c) const noexcept;
   // Constant after construction. Flat arrays: offset_[c] indexes class c's first state, each
   // class preceded by kBandPad zeros and padded to a multiple of 4 states (emission_update.h);
   // coef_ holds each class's band diagonals (or full matrix) from diag_offset_[c].
@@ -71,7 +73,6 @@ class ForwardFilter {
   std::vector<double> coef_;
   // Emission j: mean, inverse covariance (p, q, r) = [[p q][q r]], constant -log(2 pi) - log|S|/2.
   std::vector<double> mean0_, mean1_, ip_, iq_, ir_, lconst_;
-  std::vector<ClassBlock> blocks_;
   ClassUpdateFn update_ = nullptr;
   // Mutable per-trial state.
   std::vector<double> alpha_, scratch_, logb_;

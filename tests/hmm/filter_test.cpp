@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
+#include <optional>
 
 #include "fixtures.h"
 #include "forward_filter.h"
@@ -170,4 +172,29 @@ TEST(ForwardFilter, VectorAndPortableUpdatesAgree) {
     for (int j = 0; j < np; ++j)
       ASSERT_NEAR(alpha1[filter::kBandPad + j], alpha2[filter::kBandPad + j], 1e-14) << "trial " << trial << " state " << j;
   }
+}
+
+// A copy (and a move) of a filter is independent of the original: destroying the original and
+// stepping the copy gives the same bits as an untouched filter.
+TEST(ForwardFilter, CopiesAndMovesStayValid) {
+  const Dataset train = fx::synthetic_dataset(8, 200, 300, 38, 5);
+  hmm::ModelOptions opt;
+  opt.hmm.n_states = 5;
+  const auto m = hmm::train_outcome_model(fx::pointers(train), opt);
+  filter::ForwardFilter reference(m);
+  auto original = std::make_unique<filter::ForwardFilter>(m);
+  const auto& tr = train.trials[1].samples;
+  for (int i = 0; i < 20; ++i) {
+    original->step(tr[i].f_motion, tr[i].f_lateral, tr[i].f_vertical);
+    reference.step(tr[i].f_motion, tr[i].f_lateral, tr[i].f_vertical);
+  }
+  filter::ForwardFilter copy(*original);
+  original.reset();
+  std::optional<filter::ForwardFilter> moved;
+  moved.emplace(std::move(copy));
+  for (size_t i = 20; i < tr.size(); ++i) {
+    moved->step(tr[i].f_motion, tr[i].f_lateral, tr[i].f_vertical);
+    reference.step(tr[i].f_motion, tr[i].f_lateral, tr[i].f_vertical);
+  }
+  for (int c = 0; c < reference.classes(); ++c) EXPECT_EQ(moved->log_likelihood(c), reference.log_likelihood(c));
 }
