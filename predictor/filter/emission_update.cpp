@@ -12,7 +12,7 @@
 namespace dressguard::filter {
 
 double class_update_portable(const ClassBlock& b, bool pred_given, double x0, double x1, double* alpha, double* pred,
-                             double* logb) noexcept {
+                             double* logb, double* m_out) noexcept {
   const int n = b.n_padded;
   if (!pred_given) {
     for (int j = 0; j < n; ++j) {
@@ -40,7 +40,8 @@ double class_update_portable(const ClassBlock& b, bool pred_given, double x0, do
     const double a = alpha[j] * inv;
     alpha[j] = a < kFlushBelow ? 0.0 : a;
   }
-  return std::log(c) + m;
+  *m_out = m;
+  return c;
 }
 
 #ifdef DG_HAVE_AVX2_PATH
@@ -82,7 +83,7 @@ __attribute__((target("avx2,fma"))) inline __m256d exp4_nonpositive(__m256d x) {
 
 __attribute__((target("avx2,fma"))) double class_update_avx2_impl(const ClassBlock& b, bool pred_given, double x0,
                                                                   double x1, double* alpha, double* pred,
-                                                                  double* logb) noexcept {
+                                                                  double* logb, double* m_out) noexcept {
   const int n = b.n_padded;
   const __m256d vx0 = _mm256_set1_pd(x0), vx1 = _mm256_set1_pd(x1), half = _mm256_set1_pd(0.5),
                 two = _mm256_set1_pd(2.0), zero = _mm256_setzero_pd(),
@@ -131,7 +132,8 @@ __attribute__((target("avx2,fma"))) double class_update_avx2_impl(const ClassBlo
     const __m256d a = _mm256_mul_pd(_mm256_loadu_pd(alpha + j), inv);
     _mm256_storeu_pd(alpha + j, _mm256_and_pd(a, _mm256_cmp_pd(a, flush, _CMP_GE_OQ)));
   }
-  return std::log(c) + m;
+  *m_out = m;
+  return c;
 }
 
 }  // namespace

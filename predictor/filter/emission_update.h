@@ -3,7 +3,7 @@
 //     logb_j  = lc_j - q_j / 2,   q_j = (x - mu_j)^T S_j^-1 (x - mu_j)     (Gaussian log density)
 //     m       = max { logb_j : pred_j > 0 }
 //     alpha_j = pred_j exp(logb_j - m) / c,   c = sum_j pred_j exp(logb_j - m)   (0 below kFlushBelow)
-// returning log c + m, the sample's log-likelihood increment (see forward_filter.h).
+// returning c and m: the sample's log-likelihood increment is log c + m (see forward_filter.h).
 //
 // Two implementations with one contract: a portable one with std::exp, and one for x86-64 CPUs
 // with AVX2 and FMA that does four states at a time with an inline exp (~1 ulp). ForwardFilter
@@ -38,12 +38,12 @@ struct ClassBlock {
 };
 
 // `pred_given`: pred already holds the prediction (first sample, or a general topology);
-// otherwise it is computed from alpha by the band. Returns log c + m.
+// otherwise it is computed from alpha by the band. Returns c (> 0) and writes m to *m_out.
 using ClassUpdateFn = double (*)(const ClassBlock& b, bool pred_given, double x0, double x1, double* alpha, double* pred,
-                                 double* logb) noexcept;
+                                 double* logb, double* m_out) noexcept;
 
 double class_update_portable(const ClassBlock& b, bool pred_given, double x0, double x1, double* alpha, double* pred,
-                             double* logb) noexcept;
+                             double* logb, double* m_out) noexcept;
 // nullptr when the CPU (or the compiler) lacks AVX2 + FMA.
 ClassUpdateFn class_update_avx2();
 

@@ -2,13 +2,28 @@
 #include "forward_filter.h"
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 
 namespace dressguard::filter {
 
 namespace {
 constexpr double kLog2Pi = 1.8378770664093454835606594728112;  // log(2 pi)
+constexpr double kLn2 = 0.69314718055994530941723212145818;
 int padded(int n) { return (n + 3) & ~3; }
+
+// v = mant 2^k with mant in [0.5, 1): returns mant and adds k to `e` (v normal and > 0, which the
+// product of normalisers c_t stays since it is renormalised every sample). frexp without a call.
+double split_exponent(double v, double& e) noexcept {
+  uint64_t bits;
+  std::memcpy(&bits, &v, sizeof bits);
+  const int k = static_cast<int>((bits >> 52) & 0x7FF) - 1022;
+  bits = (bits & ~(uint64_t{0x7FF} << 52)) | (uint64_t{1022} << 52);
+  std::memcpy(&v, &bits, sizeof v);
+  e += k;
+  return v;
+}
 }  // namespace
 
 ForwardFilter::ForwardFilter(const model::OutcomeModel& m) : features_(m.features) {
@@ -67,7 +82,10 @@ ForwardFilter::ForwardFilter(const model::OutcomeModel& m) : features_(m.feature
   alpha_.assign(total, 0.0);
   scratch_.assign(total, 0.0);
   logb_.assign(total, 0.0);
-  loglik_.assign(n_classes_, 0.0);
+  shift_sum_.assign(n_classes_, 0.0);
+  exp2_.assign(n_classes_, 0.0);
+  mant_.assign(n_classes_, 1.0);
+  score_.assign(n_classes_, 0.0);
   posterior_.assign(n_classes_, 0.0);
   update_ = class_update_avx2();
   if (!update_) update_ = class_update_portable;
@@ -96,7 +114,9 @@ bool ForwardFilter::vectorised() const noexcept { return update_ != class_update
 
 void ForwardFilter::reset() noexcept {
   for (int c = 0; c < n_classes_; ++c) {
-    loglik_[c] = 0.0;
+    shift_sum_[c] = 0.0;
+    exp2_[c] = 0.0;
+    mant_[c] = 1.0;
     posterior_[c] = std::exp(log_prior_[c]);
   }
   for (size_t k = 0; k < alpha_.size(); ++k) alpha_[k] = initial_[k];
@@ -137,19 +157,30 @@ void ForwardFilter::step_features(const double x[model::kFeatures]) noexcept {
       }
       given = true;
     }
-    loglik_[c] += update_(b, given, x[0], x[1], alpha, pred, logb_.data() + o);
-    const double score = loglik_[c] + log_prior_[c];
+    double m = 0.0;
+    const double cs = update_(b, given, x[0], x[1], alpha, pred, logb_.data() + o, &m);
+    // L_c = M_c + E_c ln 2 + log(mant_c): sum the shifts m, multiply the normalisers into the
+    // mantissa and move its binary exponent into E_c (bit operations, no log per sample).
+    shift_sum_[c] += m;
+    mant_[c] = split_exponent(mant_[c] * cs, exp2_[c]);
+    const double score = shift_sum_[c] + exp2_[c] * kLn2 + log_prior_[c];
+    score_[c] = score;
     if (score > best_score) best_score = score;
   }
-  // Posterior: softmax of L_c + log prior_c, shifted by the maximum.
+  // Posterior: P_c proportional to exp(L_c + log prior_c - best) = exp(score_c - best) mant_c,
+  // with mant_c in [0.5, 1): no overflow, and the best class contributes at least 0.5.
   double z = 0.0;
   for (int c = 0; c < n_classes_; ++c) {
-    posterior_[c] = std::exp(loglik_[c] + log_prior_[c] - best_score);
+    posterior_[c] = std::exp(score_[c] - best_score) * mant_[c];
     z += posterior_[c];
   }
   const double iz = 1.0 / z;
   for (int c = 0; c < n_classes_; ++c) posterior_[c] *= iz;
   ++samples_;
+}
+
+double ForwardFilter::log_likelihood(int c) const noexcept {
+  return shift_sum_[c] + exp2_[c] * kLn2 + std::log(mant_[c]);
 }
 
 int ForwardFilter::best() const noexcept {

@@ -5,7 +5,8 @@
 //     pred_j   = sum_i alpha_{t-1}(i) A_ij            (alpha_0 = pi, so pred at t=1 is pi_j)
 //     u_j      = pred_j * exp(log b_j(x_t) - m_t)     (m_t = max log b_j over states with pred_j > 0)
 //     c_t      = sum_j u_j,   alpha_t(j) = u_j / c_t
-//     log p(x_1..t | c) = sum_{s<=t} (log c_s + m_s)
+//     log p(x_1..t | c) = sum_{s<=t} (log c_s + m_s)   (kept as sum m_s + log prod c_s, the product
+//                                                     as mantissa and binary exponent: no log per sample)
 // Shifting by m_t keeps c_t away from underflow however improbable the sample, so sequences of any
 // length keep a finite log-likelihood. The posterior adds the model's log prior:
 //     P(c | x_1..t) = exp(L_c + log_prior_c) / sum_k exp(L_k + log_prior_k).
@@ -46,7 +47,8 @@ class ForwardFilter {
   // P(class c | samples so far), including the model's log prior.
   double posterior(int c) const noexcept { return posterior_[c]; }
   // Running log p(x_1..t | class c) of the feature vectors; 0 before the first sample.
-  double log_likelihood(int c) const noexcept { return loglik_[c]; }
+  // (Kept as sum of shifts + binary exponent + mantissa; this call takes the one log.)
+  double log_likelihood(int c) const noexcept;
   // The normalised state probabilities alpha_t(j) of class c (n_states(c) entries).
   const double* state_probabilities(int c) const noexcept { return alpha_.data() + offset_[c]; }
   int n_states(int c) const noexcept { return n_states_[c]; }
@@ -76,7 +78,9 @@ class ForwardFilter {
   ClassUpdateFn update_ = nullptr;
   // Mutable per-trial state.
   std::vector<double> alpha_, scratch_, logb_;
-  std::vector<double> loglik_, posterior_;
+  // log p(x_1..t | c) = shift_sum_ + exp2_ ln 2 + log(mant_), mant_ in [0.5, 1): the product of
+  // the normalisers c_t is kept as mantissa and exponent, so a sample costs no log.
+  std::vector<double> shift_sum_, exp2_, mant_, score_, posterior_;
   long samples_ = 0, rejected_ = 0;
 };
 
