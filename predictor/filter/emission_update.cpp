@@ -136,8 +136,25 @@ __attribute__((target("avx2,fma"))) double class_update_avx2_impl(const ClassBlo
   return c;
 }
 
+__attribute__((target("avx2,fma"))) void exp8_avx2_impl(const double* x, double* out) noexcept {
+  _mm256_storeu_pd(out, exp4_nonpositive(_mm256_loadu_pd(x)));
+  _mm256_storeu_pd(out + 4, exp4_nonpositive(_mm256_loadu_pd(x + 4)));
+}
+
 }  // namespace
 #endif
+
+void exp8_portable(const double* x, double* out) noexcept {
+  for (int k = 0; k < 8; ++k) out[k] = x[k] < -708.0 ? 0.0 : std::exp(std::min(x[k], 0.0));
+}
+
+Exp8Fn exp8_avx2() {
+#ifdef DG_HAVE_AVX2_PATH
+  __builtin_cpu_init();
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return exp8_avx2_impl;
+#endif
+  return nullptr;
+}
 
 ClassUpdateFn class_update_avx2() {
 #ifdef DG_HAVE_AVX2_PATH

@@ -47,4 +47,10 @@ double class_update_portable(const ClassBlock& b, bool pred_given, double x0, do
 // nullptr when the CPU (or the compiler) lacks AVX2 + FMA.
 ClassUpdateFn class_update_avx2();
 
+// out[k] = exp(x[k]) for k < 8, every x[k] <= 0 (values below -708 give 0): the posterior's
+// softmax over up to kMaxClasses = 8 classes in one call.
+using Exp8Fn = void (*)(const double* x, double* out) noexcept;
+void exp8_portable(const double* x, double* out) noexcept;
+Exp8Fn exp8_avx2();  // nullptr without AVX2 + FMA
+
 }  // namespace dressguard::filter

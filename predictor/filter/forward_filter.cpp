@@ -89,6 +89,8 @@ ForwardFilter::ForwardFilter(const model::OutcomeModel& m) : features_(m.feature
   posterior_.assign(n_classes_, 0.0);
   update_ = class_update_avx2();
   if (!update_) update_ = class_update_portable;
+  exp8_ = exp8_avx2();
+  if (!exp8_) exp8_ = exp8_portable;
   reset();
 }
 
@@ -169,9 +171,12 @@ void ForwardFilter::step_features(const double x[model::kFeatures]) noexcept {
   }
   // Posterior: P_c proportional to exp(L_c + log prior_c - best) = exp(score_c - best) mant_c,
   // with mant_c in [0.5, 1): no overflow, and the best class contributes at least 0.5.
+  double arg[model::kMaxClasses], e[model::kMaxClasses];
+  for (int c = 0; c < model::kMaxClasses; ++c) arg[c] = c < n_classes_ ? score_[c] - best_score : -1000.0;
+  exp8_(arg, e);
   double z = 0.0;
   for (int c = 0; c < n_classes_; ++c) {
-    posterior_[c] = std::exp(score_[c] - best_score) * mant_[c];
+    posterior_[c] = e[c] * mant_[c];
     z += posterior_[c];
   }
   const double iz = 1.0 / z;

@@ -76,6 +76,7 @@ class ForwardFilter {
   // Emission j: mean, inverse covariance (p, q, r) = [[p q][q r]], constant -log(2 pi) - log|S|/2.
   std::vector<double> mean0_, mean1_, ip_, iq_, ir_, lconst_;
   ClassUpdateFn update_ = nullptr;
+  Exp8Fn exp8_ = nullptr;
   // Mutable per-trial state.
   std::vector<double> alpha_, scratch_, logb_;
   // log p(x_1..t | c) = shift_sum_ + exp2_ ln 2 + log(mant_), mant_ in [0.5, 1): the product of
