@@ -53,7 +53,7 @@ struct TrainOptions {
   int band = 1;                // left-right width: A_ij > 0 only for i <= j <= i + band
   double cov_floor = 1e-3;     // minimum covariance eigenvalue, feature units squared
   int max_iterations = 100;
-  double tolerance = 1e-5;     // stop when the log-likelihood gain per sample is below this [nats]
+  double tolerance = 1e-6;     // stop when the log-likelihood gain per sample is below this [nats]
 };
 
 struct TrainResult {
