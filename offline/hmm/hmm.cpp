@@ -1,6 +1,8 @@
 // Outcome HMM training and inference (see hmm.h for the equations and the convergence rule).
 #include "hmm.h"
 
+#include "emission_update.h"  // predictor/filter: the vector exp
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -88,8 +90,47 @@ void floor_covariance(double cov[2][2], double floor) {
 }
 
 // Scratch for one sequence's forward-backward pass, reused across sequences.
+// One HMM laid out for the filter's update kernel: padded structure-of-arrays emissions and the
+// band diagonals B_d[j] = A_{j-d,j} (band -1: the caller predicts with the full matrix).
+struct KernelModel {
+  int np = 0;
+  std::vector<double> diag, m0, m1, ip, iq, ir, lc;
+  filter::ClassBlock block;
+  filter::ClassUpdateFn update = filter::class_update_best();
+  explicit KernelModel(const ClassHmm& h, const Band& band) {
+    const int n = h.n_states;
+    np = (n + 3) & ~3;
+    int w = 0;
+    for (int j = 0; j < n; ++j) {
+      if (band.lo[j] < j - filter::kMaxBand) w = -1;
+      if (w >= 0) w = std::max(w, j - band.lo[j]);
+      if (band.hi[j] > j) w = -1;  // a predecessor after j: not left-right
+    }
+    for (int j = 0; j < np; ++j) {
+      model::GaussianEmission e;
+      if (j < n) e = h.emission[j];
+      const double a = e.cov[0][0], b = 0.5 * (e.cov[0][1] + e.cov[1][0]), d = e.cov[1][1], det = a * d - b * b;
+      m0.push_back(e.mean[0]), m1.push_back(e.mean[1]);
+      ip.push_back(d / det), iq.push_back(-b / det), ir.push_back(a / det);
+      lc.push_back(-kLog2Pi - 0.5 * std::log(det));
+    }
+    if (w >= 0)
+      for (int d = 0; d <= w; ++d)
+        for (int j = 0; j < np; ++j) diag.push_back(j < n && j - d >= 0 ? h.transition[(j - d) * n + j] : 0.0);
+    block.n_padded = np;
+    block.band = w;
+    for (int d = 0; d <= w; ++d) block.diag[d] = diag.data() + d * np;
+    block.m0 = m0.data(), block.m1 = m1.data(), block.ip = ip.data(), block.iq = iq.data(), block.ir = ir.data();
+    block.lc = lc.data();
+  }
+};
+
 struct Workspace {
   std::vector<double> alpha, beta, bs, scale;  // T*n, T*n, T*n (shifted emissions), T
+  KernelModel km;
+  std::vector<double> row, pred, logb, ex;     // one padded row for the kernel
+  Workspace(const ClassHmm& h, const Band& band)
+      : km(h, band), row(filter::kBandPad + km.np, 0.0), pred(km.np, 0.0), logb(km.np, 0.0), ex(km.np, 0.0) {}
   void resize(size_t T, int n) {
     if (alpha.size() < T * n) {
       alpha.resize(T * n);
@@ -118,34 +159,34 @@ double forward_backward(const ClassHmm& h, const EmissionCache& em, const Band& 
   w.resize(T, n);
   const double* A = h.transition.data();
   double ll = 0.0;
+  // Forward with the filter's per-class update (predictor/filter/emission_update.h): band
+  // prediction, log densities, exp and normalisation four states at a time. It works in place on
+  // a padded row (kBandPad zeros, then the states); each alpha_t and its shifted emissions are
+  // copied out to the T x n arrays the backward pass reads.
+  const KernelModel& km = w.km;
+  double* row = w.row.data() + filter::kBandPad;
   for (size_t t = 0; t < T; ++t) {
     double* al = &w.alpha[t * n];
     double* b = &w.bs[t * n];
     const double* x = s.at(t);
-    // pred into al
+    bool given = false;
     if (t == 0) {
-      for (int j = 0; j < n; ++j) al[j] = h.initial[j];
-    } else {
-      const double* prev = &w.alpha[(t - 1) * n];
+      for (int j = 0; j < km.np; ++j) w.pred[j] = j < n ? h.initial[j] : 0.0;
+      given = true;
+    } else if (km.block.band < 0) {
       for (int j = 0; j < n; ++j) {
         double sum = 0.0;
-        for (int i = band.lo[j]; i <= band.hi[j]; ++i) sum += prev[i] * A[i * n + j];
-        al[j] = sum;
+        for (int i = band.lo[j]; i <= band.hi[j]; ++i) sum += row[i] * A[i * n + j];
+        w.pred[j] = sum;
       }
+      given = true;
     }
-    double m = kNegInf;
+    double m = 0.0;
+    const double c = km.update(km.block, given, x[0], x[1], row, w.pred.data(), w.logb.data(), &m, w.ex.data());
     for (int j = 0; j < n; ++j) {
-      b[j] = em.log_density(j, x);
-      if (al[j] > 0.0 && b[j] > m) m = b[j];
+      al[j] = row[j];
+      b[j] = w.ex[j];
     }
-    double c = 0.0;
-    for (int j = 0; j < n; ++j) {
-      b[j] = al[j] > 0.0 ? std::exp(b[j] - m) : 0.0;
-      al[j] *= b[j];
-      c += al[j];
-    }
-    const double inv = 1.0 / c;
-    for (int j = 0; j < n; ++j) al[j] = al[j] * inv < kFlushBelow ? 0.0 : al[j] * inv;
     w.scale[t] = c;
     ll += std::log(c) + m;
   }
@@ -294,7 +335,7 @@ ClassHmm initial_left_right(const std::vector<FeatureSequence>& seqs, const Trai
 double baum_welch_step(const ClassHmm& in, const std::vector<FeatureSequence>& seqs, double cov_floor, ClassHmm& out) {
   const EmissionCache em(in);
   const Band band(in);
-  Workspace w;
+  Workspace w(in, band);
   Accumulators acc(in.n_states);
   double ll = 0.0;
   for (const auto& s : seqs) ll += forward_backward(in, em, band, s, w, acc);

@@ -39,11 +39,14 @@ struct ClassBlock {
 
 // `pred_given`: pred already holds the prediction (first sample, or a general topology);
 // otherwise it is computed from alpha by the band. Returns c (> 0) and writes m to *m_out.
+// e_out (may be null; offline training uses it): exp(logb_j - m) for reachable states, else 0.
 using ClassUpdateFn = double (*)(const ClassBlock& b, bool pred_given, double x0, double x1, double* alpha, double* pred,
-                                 double* logb, double* m_out) noexcept;
+                                 double* logb, double* m_out, double* e_out) noexcept;
 
 double class_update_portable(const ClassBlock& b, bool pred_given, double x0, double x1, double* alpha, double* pred,
-                             double* logb, double* m_out) noexcept;
+                             double* logb, double* m_out, double* e_out) noexcept;
+// The best update this CPU has (AVX2 when available, else portable).
+ClassUpdateFn class_update_best();
 // nullptr when the CPU (or the compiler) lacks AVX2 + FMA.
 ClassUpdateFn class_update_avx2();
 
@@ -52,5 +55,10 @@ ClassUpdateFn class_update_avx2();
 using Exp8Fn = void (*)(const double* x, double* out) noexcept;
 void exp8_portable(const double* x, double* out) noexcept;
 Exp8Fn exp8_avx2();  // nullptr without AVX2 + FMA
+
+// out[k] = exp(x[k]) for k < n, n a multiple of 4, every x[k] <= 0 (below -708: 0), with the
+// best implementation this CPU has (chosen once). For offline loops (hmm training); the filter
+// itself binds its functions at construction.
+void exp_nonpositive_batch(const double* x, double* out, int n) noexcept;
 
 }  // namespace dressguard::filter

@@ -160,7 +160,7 @@ void ForwardFilter::step_features(const double x[model::kFeatures]) noexcept {
       given = true;
     }
     double m = 0.0;
-    const double cs = update_(b, given, x[0], x[1], alpha, pred, logb_.data() + o, &m);
+    const double cs = update_(b, given, x[0], x[1], alpha, pred, logb_.data() + o, &m, nullptr);
     // L_c = M_c + E_c ln 2 + log(mant_c): sum the shifts m, multiply the normalisers into the
     // mantissa and move its binary exponent into E_c (bit operations, no log per sample).
     shift_sum_[c] += m;
