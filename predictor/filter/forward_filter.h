@@ -11,9 +11,10 @@
 // length keep a finite log-likelihood. The posterior adds the model's log prior:
 //     P(c | x_1..t) = exp(L_c + log_prior_c) / sum_k exp(L_k + log_prior_k).
 // Left-right models have A_ij = 0 outside i <= j <= i+w: the filter finds the band width w at
-// construction and sums only inside it, O(states * (w+1)) per class per sample; any other topology
-// takes the general O(states^2) sum. The emission update (Gaussian densities, exp, normalisation)
-// runs four states at a time on CPUs with AVX2+FMA (emission_update.h), else portably.
+// construction and sums only inside it, O(states * (w+1)) per class per sample (w <= 4); any other
+// topology, or a wider band, takes the general O(states^2) sum. The emission update (Gaussian
+// densities, exp, normalisation) runs four states at a time on CPUs with AVX2+FMA
+// (emission_update.h), else portably.
 //
 // Real-time contract: the constructor allocates everything; reset() and step() allocate nothing,
 // throw nothing, lock nothing and log nothing (tests/hmm/filter_alloc_test.cpp counts).
