@@ -126,17 +126,19 @@ struct KernelModel {
 };
 
 struct Workspace {
-  std::vector<double> alpha, beta, bs, scale;  // T*n, T*n, T*n (shifted emissions), T
+  std::vector<double> alpha, beta, bs, scale;  // T*n, 2*n (two rows), T*n (shifted emissions), T
   KernelModel km;
   std::vector<double> row, pred, logb, ex;     // one padded row for the kernel
+  std::vector<double> v;                        // bs * beta / c of the row after
   Workspace(const ClassHmm& h, const Band& band)
-      : km(h, band), row(filter::kBandPad + km.np, 0.0), pred(km.np, 0.0), logb(km.np, 0.0), ex(km.np, 0.0) {}
+      : km(h, band), row(filter::kBandPad + km.np, 0.0), pred(km.np, 0.0), logb(km.np, 0.0), ex(km.np, 0.0),
+        v(h.n_states, 0.0) {}
   void resize(size_t T, int n) {
     if (alpha.size() < T * n) {
       alpha.resize(T * n);
-      beta.resize(T * n);
       bs.resize(T * n);
     }
+    if (beta.size() < static_cast<size_t>(2 * n)) beta.resize(2 * n);
     if (scale.size() < T) scale.resize(T);
   }
 };
@@ -190,29 +192,38 @@ double forward_backward(const ClassHmm& h, const EmissionCache& em, const Band& 
     w.scale[t] = c;
     ll += std::log(c) + m;
   }
-  // Backward: beta_T = 1; beta_t(i) = sum_j A_ij bs_{t+1}(j) beta_{t+1}(j) / c_{t+1}.
-  double* bl = &w.beta[(T - 1) * n];
-  for (int j = 0; j < n; ++j) bl[j] = 1.0;
-  for (size_t t = T - 1; t-- > 0;) {
-    const double* nb = &w.beta[(t + 1) * n];
-    const double* b1 = &w.bs[(t + 1) * n];
-    const double ic = 1.0 / w.scale[t + 1];
-    double* cur = &w.beta[t * n];
-    for (int i = 0; i < n; ++i) {
-      double sum = 0.0;
-      for (int j = band.slo[i]; j <= band.shi[i]; ++j) sum += A[i * n + j] * b1[j] * nb[j];
-      cur[i] = sum * ic < kFlushBelow ? 0.0 : sum * ic;
+  // Backward pass fused with the statistics, t = T-1 down to 0, two beta rows only:
+  //   v_j       = bs_{t+1}(j) beta_{t+1}(j) / c_{t+1}
+  //   beta_t(i) = sum_j A_ij v_j                      (beta_T = 1)
+  //   xi_t(i,j) = alpha_t(i) A_ij v_j                 (each product A_ij v_j serves both)
+  //   gamma_t(j) = alpha_t(j) beta_t(j)               (sums to 1 per t with this scaling)
+  double* nb = w.beta.data();      // beta_{t+1}
+  double* cur = w.beta.data() + n;  // beta_t
+  double* v = w.v.data();
+  for (size_t tt = T; tt-- > 0;) {
+    const double* al = &w.alpha[tt * n];
+    if (tt == T - 1) {
+      for (int j = 0; j < n; ++j) cur[j] = 1.0;
+    } else {
+      const double* b1 = &w.bs[(tt + 1) * n];
+      const double ic = 1.0 / w.scale[tt + 1];
+      for (int j = 0; j < n; ++j) v[j] = b1[j] * nb[j] * ic;
+      for (int i = 0; i < n; ++i) {
+        const double ai = al[i];
+        double sum = 0.0;
+        const double* Ai = A + i * n;
+        double* xi = acc.xi.data() + i * n;
+        for (int j = band.slo[i]; j <= band.shi[i]; ++j) {
+          const double pr = Ai[j] * v[j];
+          sum += pr;
+          xi[j] += ai * pr;
+        }
+        cur[i] = sum < kFlushBelow ? 0.0 : sum;
+      }
     }
-  }
-  // Statistics: gamma_t(j) = alpha_t(j) beta_t(j) (sums to 1 per t with this scaling);
-  // xi_t(i,j) = alpha_t(i) A_ij bs_{t+1}(j) beta_{t+1}(j) / c_{t+1}.
-  for (int j = 0; j < n; ++j) acc.g0[j] += w.alpha[j] * w.beta[j];
-  for (size_t t = 0; t < T; ++t) {
-    const double* al = &w.alpha[t * n];
-    const double* be = &w.beta[t * n];
-    const double* x = s.at(t);
+    const double* x = s.at(tt);
     for (int j = 0; j < n; ++j) {
-      const double gm = al[j] * be[j];
+      const double gm = al[j] * cur[j];
       if (gm == 0.0) continue;
       const double d0 = x[0] - em.m0[j], d1 = x[1] - em.m1[j];
       acc.g[j] += gm;
@@ -222,16 +233,9 @@ double forward_backward(const ClassHmm& h, const EmissionCache& em, const Band& 
       acc.s01[j] += gm * d0 * d1;
       acc.s11[j] += gm * d1 * d1;
     }
-    if (t + 1 < T) {
-      const double* nb = &w.beta[(t + 1) * n];
-      const double* b1 = &w.bs[(t + 1) * n];
-      const double ic = 1.0 / w.scale[t + 1];
-      for (int i = 0; i < n; ++i) {
-        const double ai = al[i] * ic;
-        if (ai == 0.0) continue;
-        for (int j = band.slo[i]; j <= band.shi[i]; ++j) acc.xi[i * n + j] += ai * A[i * n + j] * b1[j] * nb[j];
-      }
-    }
+    if (tt == 0)
+      for (int j = 0; j < n; ++j) acc.g0[j] += al[j] * cur[j];
+    std::swap(nb, cur);
   }
   return ll;
 }
