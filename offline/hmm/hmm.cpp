@@ -25,14 +25,13 @@ struct EmissionCache {
   std::vector<double> m0, m1, p, q, r, c;
   explicit EmissionCache(const ClassHmm& h) {
     for (const auto& e : h.emission) {
-      const double a = e.cov[0][0], b = 0.5 * (e.cov[0][1] + e.cov[1][0]), d = e.cov[1][1];
-      const double det = a * d - b * b;
-      m0.push_back(e.mean[0]);
-      m1.push_back(e.mean[1]);
-      p.push_back(d / det);
-      q.push_back(-b / det);
-      r.push_back(a / det);
-      c.push_back(-kLog2Pi - 0.5 * std::log(det));
+      const model::EmissionTerms t = model::emission_terms(e);
+      m0.push_back(t.mean0);
+      m1.push_back(t.mean1);
+      p.push_back(t.ip);
+      q.push_back(t.iq);
+      r.push_back(t.ir);
+      c.push_back(t.lconst);
     }
   }
   double log_density(int j, const double* x) const {
@@ -109,10 +108,10 @@ struct KernelModel {
     for (int j = 0; j < np; ++j) {
       model::GaussianEmission e;
       if (j < n) e = h.emission[j];
-      const double a = e.cov[0][0], b = 0.5 * (e.cov[0][1] + e.cov[1][0]), d = e.cov[1][1], det = a * d - b * b;
-      m0.push_back(e.mean[0]), m1.push_back(e.mean[1]);
-      ip.push_back(d / det), iq.push_back(-b / det), ir.push_back(a / det);
-      lc.push_back(-kLog2Pi - 0.5 * std::log(det));
+      const model::EmissionTerms t = model::emission_terms(e);
+      m0.push_back(t.mean0), m1.push_back(t.mean1);
+      ip.push_back(t.ip), iq.push_back(t.iq), ir.push_back(t.ir);
+      lc.push_back(t.lconst);
     }
     if (w >= 0)
       for (int d = 0; d <= w; ++d)

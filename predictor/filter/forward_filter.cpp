@@ -9,7 +9,6 @@
 namespace dressguard::filter {
 
 namespace {
-constexpr double kLog2Pi = 1.8378770664093454835606594728112;  // log(2 pi)
 constexpr double kLn2 = 0.69314718055994530941723212145818;
 int padded(int n) { return (n + 3) & ~3; }
 
@@ -68,14 +67,13 @@ ForwardFilter::ForwardFilter(const model::OutcomeModel& m) : features_(m.feature
       // Padding states get the unit Gaussian: finite values that are multiplied by pred = 0.
       model::GaussianEmission e;
       if (j < n) e = h.emission[j];
-      const double a = e.cov[0][0], b = 0.5 * (e.cov[0][1] + e.cov[1][0]), d = e.cov[1][1];
-      const double det = a * d - b * b;
-      mean0_.push_back(e.mean[0]);
-      mean1_.push_back(e.mean[1]);
-      ip_.push_back(d / det);
-      iq_.push_back(-b / det);
-      ir_.push_back(a / det);
-      lconst_.push_back(-kLog2Pi - 0.5 * std::log(det));
+      const model::EmissionTerms t = model::emission_terms(e);
+      mean0_.push_back(t.mean0);
+      mean1_.push_back(t.mean1);
+      ip_.push_back(t.ip);
+      iq_.push_back(t.iq);
+      ir_.push_back(t.ir);
+      lconst_.push_back(t.lconst);
     }
     total += np;
   }
