@@ -45,7 +45,7 @@ int run_train(int argc, char** argv) {
         "  --band W                left-right width: state i may go to i..i+W (default 1)\n"
         "  --cov-floor V           minimum covariance eigenvalue in scaled feature units (default 1e-3)\n"
         "  --max-iter N            Baum-Welch iterations at most (default 100)\n"
-        "  --tolerance T           stop when the gain per sample is below T nats (default 1e-5)\n"
+        "  --tolerance T           stop when the gain per sample is below T nats (default 1e-6)\n"
         "  --uniform-priors        equal class priors instead of the training counts\n"
         "  --exclude-participant P[,Q...]  leave these participants out (leave-one-participant-out)\n"
         "  --stop-threshold X      predictor default: stop when P(caught) > X ... (default 0.9)\n"
@@ -62,7 +62,7 @@ int run_train(int argc, char** argv) {
   opt.hmm.band = static_cast<int>(args.integer("band", 1));
   opt.hmm.cov_floor = args.number("cov-floor", 1e-3);
   opt.hmm.max_iterations = static_cast<int>(args.integer("max-iter", 100));
-  opt.hmm.tolerance = args.number("tolerance", 1e-5);
+  opt.hmm.tolerance = args.number("tolerance", 1e-6);
   opt.uniform_priors = args.has("uniform-priors");
   opt.source_dataset = data;
   if (opt.hmm.n_states < 1 || opt.hmm.n_states > model::kMaxStates)

@@ -14,7 +14,9 @@
 //   initialisation: every sequence split into n equal segments, segment j feeding state j's mean
 //     and covariance; pi = (1, 0, ..., 0); A_ii = 1 - n / mean length, the rest of the row spread
 //     over the band j = i+1..i+w with weights halving per step (the last state absorbs).
-//   E-step: scaled forward-backward per sequence, restricted to the band.
+//   E-step: scaled forward-backward per sequence, restricted to the band; the forward pass runs
+//     through the online filter's vector update (predictor/filter/emission_update.h), so training
+//     and the robot compute the same recursion.
 //   M-step: pi_j = mean gamma_1(j); A_ij = sum_t xi_t(i,j) / sum_t gamma_t(i) (zeros stay zero, so
 //     the left-right band is kept); mu_j = sum gamma x / sum gamma;
 //     Sigma_j = sum gamma (x - mu_j)(x - mu_j)^T / sum gamma, accumulated about the previous mean
@@ -53,7 +55,7 @@ struct TrainOptions {
   int band = 1;                // left-right width: A_ij > 0 only for i <= j <= i + band
   double cov_floor = 1e-3;     // minimum covariance eigenvalue, feature units squared
   int max_iterations = 100;
-  double tolerance = 1e-5;     // stop when the log-likelihood gain per sample is below this [nats]
+  double tolerance = 1e-6;     // stop when the log-likelihood gain per sample is below this [nats]
 };
 
 struct TrainResult {
