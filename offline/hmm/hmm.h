@@ -53,7 +53,12 @@ struct FeatureSequence {
 struct TrainOptions {
   int n_states = 10;           // the paper's 10; the study's code used 5
   int band = 1;                // left-right width: A_ij > 0 only for i <= j <= i + band
-  double cov_floor = 1e-3;     // minimum covariance eigenvalue, feature units squared
+  // Minimum covariance eigenvalue, feature units squared (features are scaled to unit variance).
+  // 0.05 (a standard deviation of 0.22 of the feature's spread): a floor near the sensor noise
+  // lets Baum-Welch shrink states until the online posterior is certain within ~5 samples, and
+  // the predictor then stops good trials at once (measured on the replay logs); 0.05 keeps the
+  // posteriors calibrated enough for the StopPolicy and costs no accuracy on the study.
+  double cov_floor = 0.05;
   int max_iterations = 100;
   double tolerance = 1e-6;     // stop when the log-likelihood gain per sample is below this [nats]
 };
