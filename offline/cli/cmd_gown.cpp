@@ -35,8 +35,10 @@ std::string ints_json(const std::vector<int>& v) {
 }
 
 // Everything the picture needs: mesh, grasped vertices, loops, arm and gripper (all in W).
-std::string scene_dump(const GownMesh& m, const gown::PaperScene& s, const std::vector<int>& grasp) {
-  std::string out = "{\n\"frame\": \"W: z up, gravity -z, gripper moves +x\",\n\"x\": [";
+std::string scene_dump(const GownMesh& m, const gown::PaperScene& s, const std::vector<int>& grasp, bool hung) {
+  std::string out = "{\n\"frame\": \"W: z up, gravity -z, gripper moves +x\",\n\"state\": \"";
+  out += hung ? "after a crude 3 s hang (edges only, no bending, no collisions)" : "placed, before gravity";
+  out += "\",\n\"x\": [";
   for (size_t i = 0; i < m.x.size(); ++i) {
     char buf[80];
     std::snprintf(buf, sizeof buf, "%s[%.5f,%.5f,%.5f]", i ? "," : "", m.x[i].x(), m.x[i].y(), m.x[i].z());
@@ -88,18 +90,21 @@ std::string shell_quote(const std::string& s) {
 }  // namespace
 
 int run_gown(int argc, char** argv) {
-  Args args(argc - 1, argv + 1, {"help", "json", "parametric"});
+  Args args(argc - 1, argv + 1, {"help", "json", "parametric", "hang", "in-world"});
   if (args.has("help")) {
     std::puts(
-        "usage: dressguard gown [--obj FILE] [--scale S] [--parametric] [--reduced N] [--out MESH.obj]\n"
-        "                       [--dump SCENE.json] [--picture GOWN.png] [--json]\n"
+        "usage: dressguard gown [--obj FILE [--scale S] [--in-world] | --parametric] [--reduced N] [--hang]\n"
+        "                       [--out MESH.obj] [--dump SCENE.json] [--picture GOWN.png] [--json]\n"
         "  Loads the gown the simulator runs on, placed in the world frame W (z up, gripper moves +x)\n"
         "  like the paper's simulator, and prints its statistics.\n"
         "  --obj FILE      mesh to load (default: shared/data/gown/fullgown.obj when present,\n"
         "                  else the project's parametric gown)\n"
         "  --scale S       file units -> metres (default 1.679, the paper's)\n"
+        "  --in-world      the OBJ is already placed in W (as --out writes it; use --scale 1)\n"
         "  --parametric    use the parametric gown even when the measured one is present\n"
         "  --reduced N     reduce to about N triangles (quadric edge collapse), e.g. 5000\n"
+        "  --hang          let the gown hang 3 s from the jaws in a crude check (edges only, no\n"
+        "                  bending, no collisions; not the simulator) before reporting and drawing\n"
         "  --out MESH.obj  write the placed mesh (atomically)\n"
         "  --dump FILE     write the scene (mesh, grasp, loops, arm, gripper) as JSON for plotting\n"
         "  --picture PNG   draw the placed gown with grasp, sleeve opening and arm (needs python3 +\n"
@@ -107,7 +112,7 @@ int run_gown(int argc, char** argv) {
         "  --json          print a machine-readable summary");
     return 0;
   }
-  args.allow_only({"help", "json", "parametric", "obj", "scale", "reduced", "out", "dump", "picture"});
+  args.allow_only({"help", "json", "parametric", "hang", "in-world", "obj", "scale", "reduced", "out", "dump", "picture"});
   if (args.has("parametric") && args.has("obj")) throw UsageError("--parametric and --obj exclude each other");
   gown::GownOptions opt;
   opt.scale = args.number("scale", 1.679);
@@ -119,16 +124,18 @@ int run_gown(int argc, char** argv) {
 
   const auto t0 = std::chrono::steady_clock::now();
   opt.parametric = args.has("parametric");
+  opt.already_in_W = args.has("in-world");
   const fs::path measured = gown::measured_gown_path();
   const std::string source =
       opt.parametric || (opt.obj.empty() && measured.empty()) ? "parametric" : (opt.obj.empty() ? measured : opt.obj).string();
-  const GownMesh mesh = gown::load_gown(opt);
+  GownMesh mesh = gown::load_gown(opt);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   const auto masses = gown::vertex_masses(mesh);
   double mass = 0;
   for (double m : masses) mass += m;
-  const auto grasp = gown::grasp_vertices(mesh, opt.scene);
+  const auto grasp = gown::grasp_vertices(mesh, opt.scene);  // at placement, before any hang
+  if (args.has("hang")) mesh.x = gown::crude_hang(mesh, opt.scene);
   const Eigen::Vector3d sleeve_c = gown::loop_centroid(mesh, mesh.sleeve_loop);
 
   if (auto out = args.get("out")) write_file_atomic(*out, gown::to_obj(mesh));
@@ -137,7 +144,7 @@ int run_gown(int argc, char** argv) {
   if (dump || picture) {
     const fs::path dump_path =
         dump ? fs::path(*dump) : fs::temp_directory_path() / ("dressguard-gown-" + std::to_string(::getpid()) + ".json");
-    write_file_atomic(dump_path, scene_dump(mesh, opt.scene, grasp));
+    write_file_atomic(dump_path, scene_dump(mesh, opt.scene, grasp, args.has("hang")));
     if (picture) {
       const fs::path script = plot_script();
       if (script.empty()) throw std::runtime_error("tools/plot/gown.py not found (set DRESSGUARD_SOURCE_DIR)");
@@ -151,9 +158,10 @@ int run_gown(int argc, char** argv) {
 
   if (args.has("json")) {
     std::printf("{\"source\": \"%s\", \"vertices\": %zu, \"triangles\": %zu, \"area_m2\": %.5f, \"mass_kg\": %.5f, "
-                "\"mean_edge_m\": %.5f, \"min_angle_deg\": %.2f, \"seconds\": %.3f, \"loops\": [",
+                "\"mean_edge_m\": %.5f, \"min_angle_deg\": %.2f, \"seconds\": %.3f, \"hung\": %s, \"loops\": [",
                 source.c_str(), mesh.x.size(), mesh.triangles.size(), gown::total_area(mesh), mass,
-                gown::mean_edge_length(mesh), gown::min_triangle_angle(mesh) * 180 / M_PI, seconds);
+                gown::mean_edge_length(mesh), gown::min_triangle_angle(mesh) * 180 / M_PI, seconds,
+                args.has("hang") ? "true" : "false");
     for (size_t l = 0; l < mesh.boundary_loops.size(); ++l)
       std::printf("%s{\"vertices\": %zu, \"perimeter_m\": %.5f, \"centroid\": %s}", l ? ", " : "",
                   mesh.boundary_loops[l].size(), gown::loop_perimeter(mesh, static_cast<int>(l)),
@@ -161,7 +169,7 @@ int run_gown(int argc, char** argv) {
     std::printf("], \"sleeve_loop\": %d, \"sleeve_center\": %s, \"sleeve_lower_half\": %zu, \"grasped\": %zu}\n",
                 mesh.sleeve_loop, vec_json(sleeve_c).c_str(), mesh.sleeve_lower_half.size(), grasp.size());
   } else {
-    std::printf("gown: %s\n", source.c_str());
+    std::printf("gown: %s%s\n", source.c_str(), args.has("hang") ? " (after a crude 3 s hang from the jaws)" : "");
     std::printf("  %zu vertices, %zu triangles, area %.4f m^2, mass %.4f kg (%.3f kg/m^2)\n", mesh.x.size(),
                 mesh.triangles.size(), gown::total_area(mesh), mass, mesh.areal_density);
     std::printf("  mean edge %.2f cm, smallest angle %.1f deg, built in %.3f s\n", gown::mean_edge_length(mesh) * 100,

@@ -19,5 +19,10 @@ int run_train(int argc, char** argv);
 int run_classify(int argc, char** argv);
 int run_model(int argc, char** argv);
 int run_gown(int argc, char** argv);
+int run_replay(int argc, char** argv);
+int run_export_candump(int argc, char** argv);
+int run_calibrate(int argc, char** argv);
+int run_synthesize(int argc, char** argv);
+int run_build_model(int argc, char** argv);
 
 }  // namespace dressguard::cli

@@ -18,6 +18,11 @@ constexpr Command kCommands[] = {
     {"classify", "classify a dataset's trials with a model: accuracy, confusion, sweeps", run_classify},
     {"model", "show a model file (model show MODEL.dgm)", run_model},
     {"gown", "load, reduce and place the gown mesh; stats, OBJ and a picture", run_gown},
+    {"export-candump", "write trials as candump logs of the CAN protocol (with optional faults)", run_export_candump},
+    {"replay", "run the predictor daemon's code on a candump log: would it stop, when, why", run_replay},
+    {"calibrate", "fit the simulator to one participant's sequences (CMA-ES)", run_calibrate},
+    {"synthesize", "simulate labelled trials with a calibrated simulator", run_synthesize},
+    {"build-model", "train the simulation-trained classifier (STC) into a model file", run_build_model},
 };
 
 void print_usage() {

@@ -11,19 +11,22 @@
 // A square grid of spacing s (two triangles per cell, diagonals alternating) meshes the pattern.
 //
 // 3-D shape: the layers bulge apart by up to kBulge in the body (zero on the seams); each sleeve
-// blends from that flat start at the armhole into a round tube whose cross-section at the cuff
-// is a circle of perimeter 2 Ws = 0.47 m (the measured openings: 0.473 and 0.477 m). Both maps
-// keep the cross-sections' lengths, so the area stays close to the pattern's.
+// is a flattened tube hanging from its top seam (as a sleeve held by its top edge hangs), whose
+// layers part from the armhole on into a lens of half-thickness kSleeveBulge; the cuff's
+// perimeter is then 0.47 m (the measured openings: 0.473 and 0.477 m).
 //
-// Dimensions (cells of s = 11.75 mm): Wb = 56 (0.658 m), Hb = 93 (1.093 m), Ws = 20 (0.235 m),
+// Dimensions (cells of s = 11.75 mm): Wb = 56 (0.658 m), Hb = 93 (1.093 m), Ws = 19 (0.223 m),
 // Ls = 17 (0.200 m), neck 22 (0.259 m); area 2 * (Wb Hb + 2 Ls Ws) - slit = 1.60 m^2 (measured
 // 1.614), about 23k triangles, mean edge 1.34 cm (measured 1.4 cm).
 //
 // Placement in W: the right sleeve (pattern X > Wb) is the one the arm enters. Pattern X -> x_W,
 // Y -> z_W, Z -> -y_W (a proper rotation), so the body hangs in the x-z plane behind the sleeve
-// and the cuff faces +x, toward the fist. The cuff sits kCuffX_W ahead of the grasp box and the
-// sleeve's top seam kTopSeamZ_W just below the upper jaw, so the jaws hold the sleeve a few
-// centimetres behind its opening and the fist (high setting) faces the middle of the cuff.
+// and the cuff faces +x, toward the fist. The cuff sits 1 cm ahead of the grasp box and the
+// sleeve's top seam 3 cm above the lower jaw's starting face, so the closing jaws pick up the
+// top of the sleeve (both layers, about 8 cm behind the rim) and lift it to the upper jaw; the
+// opening then hangs open below the jaws, spanning the fist at the high setting (checked by a
+// crude hang in tests/gown/placement_test.cpp). The measured gown is gripped differently (near
+// the sleeve's root, 0.2 m from its rim): this is our choice, not the paper's.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -36,11 +39,12 @@ namespace dressguard::gown {
 namespace {
 
 constexpr double kCell = 0.01175;  // s [m]
-constexpr int kWb = 56, kHb = 93, kWs = 20, kLs = 17, kNeck = 22, kSlit = 2;
+constexpr int kWb = 56, kHb = 93, kWs = 19, kLs = 17, kNeck = 22, kSlit = 2;
 constexpr double kBulge = 0.03;      // half the front-back separation in the body [m]
-constexpr double kBlend = 0.08;      // sleeve length over which the flat start turns round [m]
-constexpr double kCuffX_W = -0.11;   // x_W of the cuff (the grasp box spans -0.21..-0.13) [m]
-constexpr double kTopSeamZ_W = 0.195;  // z_W of the sleeve's top seam (upper jaw bottom at 0.195) [m]
+constexpr double kSleeveBulge = 0.0326;  // half-thickness of the sleeve's lens cross-section [m]
+constexpr double kBlend = 0.08;      // sleeve length over which the flat start opens up [m]
+constexpr double kCuffX_W = -0.12;   // x_W of the cuff: 1 cm ahead of the grasp box (x_W -0.21..-0.13) [m]
+constexpr double kTopSeamZ_W = 0.085;  // z_W of the sleeve's top seam: 3 cm above the lower jaw's start [m]
 
 double smoothstep(double t) {
   t = std::clamp(t, 0.0, 1.0);
@@ -80,16 +84,12 @@ Eigen::Vector3d shape(int i, int j, int sigma) {
   const double xb = std::clamp(x, 0.0, Wb);
   const double z_flat = sigma * kBulge * std::sin(M_PI * xb / Wb) * top;
   if (x >= 0 && x <= Wb) return {x, y, z_flat};
-  // Sleeve: flat start at the armhole, round tube (radius r) from kBlend on.
+  // Sleeve: a flattened tube hanging from its top seam, like a sleeve held up by its top edge:
+  // the layers part as a lens of half-thickness kSleeveBulge (reached kBlend from the armhole).
   const double from_armhole = x < 0 ? -x : x - Wb;
   const double beta = smoothstep(from_armhole / kBlend);
   const double u = (y - (Hb - Ws)) / Ws;  // 0 underarm .. 1 top seam
-  // r so that the cuff polygon (2 kWs segments) has perimeter exactly 2 Ws.
-  const double r = Ws / (kWs * 2.0 * std::sin(M_PI / (2.0 * kWs)));
-  // The top seam stays level at Hb (the sleeve hangs from it); the underarm rises to Hb - 2r.
-  const double y_circ = (Hb - r) - r * std::cos(M_PI * u);
-  const double z_circ = sigma * r * std::sin(M_PI * u);
-  return {x, (1 - beta) * y + beta * y_circ, beta * z_circ};
+  return {x, y, sigma * kSleeveBulge * beta * std::sin(M_PI * u)};
 }
 
 }  // namespace

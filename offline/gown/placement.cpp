@@ -1,6 +1,7 @@
 // Placement of the gown like the paper's public simulator, and the sleeve labelling.
 #include "placement.h"
 
+#include <algorithm>
 #include <limits>
 #include <stdexcept>
 
@@ -43,6 +44,46 @@ void set_sleeve_loop(GownMesh& mesh, int loop) {
 
 std::vector<int> grasp_vertices(const GownMesh& mesh, const PaperScene& scene) {
   return vertices_in_box(mesh, scene.grasp_box_center_W(), scene.grasp_box_half_extent_W());
+}
+
+std::vector<Eigen::Vector3d> crude_hang(const GownMesh& m, const PaperScene& s, double seconds) {
+  std::vector<std::array<int, 2>> edges;
+  for (const auto& t : m.triangles)
+    for (int k = 0; k < 3; ++k) edges.push_back({std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])});
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  std::vector<double> rest(edges.size());
+  for (size_t e = 0; e < edges.size(); ++e) rest[e] = (m.x[edges[e][0]] - m.x[edges[e][1]]).norm();
+  std::vector<double> w(m.x.size(), 1.0);  // inverse masses: uniform, only the shape matters here
+  std::vector<Eigen::Vector3d> x = m.x, v(m.x.size(), Eigen::Vector3d::Zero()), p(m.x.size());
+  for (int g : grasp_vertices(m, s)) w[g] = 0, x[g].z() = s.pinch_z_W();
+  const double dt = 1.0 / 300;
+  const Eigen::Vector3d gravity(0, 0, -9.81);
+  const int steps = static_cast<int>(seconds / dt);
+  for (int step = 0; step < steps; ++step) {
+    for (size_t i = 0; i < x.size(); ++i) {
+      if (w[i] > 0) v[i] = 0.99 * v[i] + dt * gravity;
+      p[i] = x[i] + dt * v[i];
+    }
+    for (int pass = 0; pass < 20; ++pass)
+      for (size_t e = 0; e < edges.size(); ++e) {
+        // C = |p_a - p_b| - L;  dp_a = -w_a C n / (w_a + w_b),  dp_b = +w_b C n / (w_a + w_b).
+        const int a = edges[e][0], b = edges[e][1];
+        const double ws = w[a] + w[b];
+        if (ws == 0) continue;
+        const Eigen::Vector3d d = p[a] - p[b];
+        const double len = d.norm();
+        if (len == 0) continue;
+        const Eigen::Vector3d c = (len - rest[e]) / (len * ws) * d;
+        p[a] -= w[a] * c;
+        p[b] += w[b] * c;
+      }
+    for (size_t i = 0; i < x.size(); ++i) {
+      if (w[i] > 0) v[i] = (p[i] - x[i]) / dt;
+      x[i] = p[i];
+    }
+  }
+  return x;
 }
 
 }  // namespace dressguard::gown

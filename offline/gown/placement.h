@@ -6,14 +6,24 @@
 //   x_W = -x_P,  y_W = z_P,  z_W = y_P      (a proper rotation, det = +1)
 //
 // Where this placement is uncertain (read from that code, never checked by running it):
-//  - PhysX boxes take half extents; shared/data/README.md gives the jaws as "boxes of
-//    0.08 x 0.01 x 0.12 m", which we read as full sizes. If they were half extents the jaws
-//    (and the grasped patch) would be twice as large in x and y.
+//  - The jaws are PxBoxGeometry(0.04, 0.005, 0.06) (half extents) in that code, so the full
+//    sizes 0.08 x 0.01 x 0.12 m (P) are right.
 //  - The gown rotation angles are rounded (1.57, -1.2, -3.14 rad), so the gown is not exactly
 //    axis-aligned; we apply them as given, not as pi/2 and pi.
-//  - Which particles the lower jaw pinches depends on PhysX's contact offsets; we take every
-//    vertex inside the volume the lower jaw sweeps from z = 0.06 up to the upper jaw
-//    (`grasp_box_*`), before gravity is switched on.
+//  - That code grips the particles inside both jaws' bounds once the lower jaw has closed (it
+//    pushes the cloth it meets up against the upper jaw, with gravity off). We take every vertex
+//    inside the volume the lower jaw sweeps from z = 0.06 up to the upper jaw (`grasp_box_*`), at
+//    placement; the simulator should then hold them at z = pinch_z_W() (between the jaws).
+//    PhysX contact offsets may add or drop a row of particles at the box's faces.
+//  - The arm starts 0.1 m further along +x_W and moves to its place during settling steps
+//    200-400 (`arm_approach_x_W`); the numbers below are its final place.
+//  - A crude hanging check (crude_hang: edges only, no bending, no collisions) lets the measured
+//    gown's sleeve opening (reduced gown) hang with its centre about 0.15 m below the arm axis
+//    (its top 0.11 m below) and 0.05 m behind the jaws, lying nearly flat: placed, the paper's
+//    grip is on the sleeve's root, 0.2 m from the rim. Whether the arm enters the opening at the
+//    high setting then depends on the bending stiffness and the settling, i.e. on the simulator.
+//  - Also in that code, not here: every particle gets the same mass (total / n; we lump by area)
+//    and the grasped particles' masses are scaled up (grip_massscale).
 //  - The paper's Fig. 3(b) only shows the sleeve hanging toward the fist; the "lower half" of the
 //    opening is our reading: the half of the loop that lies below its centroid (z_W).
 #pragma once
@@ -50,6 +60,10 @@ struct PaperScene {
   Eigen::Vector3d upper_jaw_center_W{-0.17, 0.0, 0.20};  // P: (-F + 0.48, 0.20, 0)
   Eigen::Vector3d jaw_size_W{0.08, 0.12, 0.01};          // full box sizes x, y, z [m]
   double lower_jaw_start_z_W = 0.06;                     // the lower jaw's centre before it closes [m]
+  double arm_approach_x_W = 0.1;  // the arm starts this far along +x_W and moves in while settling [m]
+
+  // Height at which the closed jaws hold the grasped vertices: the upper jaw's lower face.
+  double pinch_z_W() const { return upper_jaw_center_W.z() - 0.5 * jaw_size_W.z(); }
 
   // --- arm (W); all sphere centres at the same height, the high ("good") setting ---------------
   double r_fist = 0.05, r_wrist = 0.0365, r_elbow = 0.05, r_shoulder = 0.075;  // [m]
@@ -110,5 +124,12 @@ void set_sleeve_loop(GownMesh& mesh, int loop);
 
 // The vertices the gripper holds: vertices_in_box(grasp box).
 std::vector<int> grasp_vertices(const GownMesh& mesh, const PaperScene& scene = {});
+
+// A crude hang to check a placement, NOT the simulator: position-based dynamics with the mesh
+// edges as inextensible distance constraints, the grasped vertices moved to the closed jaws
+// (z = pinch_z_W) and fixed, gravity, 1% velocity damping per step, 300 Hz, 20 Gauss-Seidel
+// passes, no bending, no collisions, `seconds` of simulated time. Returns the hung positions.
+// Run it on the reduced gown (about 1 s for 3 s on 5k triangles).
+std::vector<Eigen::Vector3d> crude_hang(const GownMesh& mesh, const PaperScene& scene = {}, double seconds = 3.0);
 
 }  // namespace dressguard::gown

@@ -1,0 +1,430 @@
+// Simulator calibration, see calibration.h.
+#include "calibration.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <sstream>
+
+#include "cmaes.h"
+#include "files.h"
+
+namespace dressguard::calib {
+
+double cloth_value(const ClothValues& c, int i) {
+  switch (i) {
+    case 0: return c.stretch;
+    case 1: return c.shear;
+    case 2: return c.bend;
+    case 3: return c.friction;
+    default: return c.self_friction;
+  }
+}
+
+void set_cloth_value(ClothValues& c, int i, double v) {
+  switch (i) {
+    case 0: c.stretch = v; break;
+    case 1: c.shear = v; break;
+    case 2: c.bend = v; break;
+    case 3: c.friction = v; break;
+    default: c.self_friction = v; break;
+  }
+}
+
+Bounds default_bounds() {
+  Bounds b;
+  b.cloth[0] = {0.0, 1.0, 0.8};  // stretch
+  b.cloth[1] = {0.0, 1.0, 0.5};  // shear
+  b.cloth[2] = {0.0, 1.0, 0.5};  // bend
+  b.cloth[3] = {0.0, 2.0, 0.5};  // friction
+  b.cloth[4] = {0.0, 2.0, 0.2};  // self_friction
+  b.arm_offset = {-0.06, 0.06, 0.0};
+  return b;
+}
+
+Bounds read_bounds(const std::filesystem::path& path) {
+  Bounds b = default_bounds();
+  std::istringstream in(read_file(path));
+  std::string line;
+  long n = 0;
+  while (std::getline(in, line)) {
+    ++n;
+    if (const auto hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+    std::istringstream row(line);
+    std::string name;
+    if (!(row >> name)) continue;  // blank or comment
+    ParamBound pb;
+    if (!(row >> pb.lower >> pb.upper)) throw_input_error(path, n, "expected 'name lower upper [initial]'");
+    if (!(pb.lower < pb.upper)) throw_input_error(path, n, "lower bound must be below upper bound for " + name);
+    double initial = 0;
+    pb.initial = (row >> initial) ? initial : 0.5 * (pb.lower + pb.upper);
+    std::string extra;
+    if (row >> extra) throw_input_error(path, n, "unexpected '" + extra + "' after the bounds of " + name);
+    if (pb.initial < pb.lower || pb.initial > pb.upper)
+      throw_input_error(path, n, "initial value of " + name + " is outside its bounds");
+    ParamBound* target = nullptr;
+    for (int i = 0; i < kClothParams; ++i)
+      if (name == kClothParamNames[i]) target = &b.cloth[i];
+    if (name == "arm_offset") target = &b.arm_offset;
+    if (!target)
+      throw_input_error(path, n,
+                        "unknown parameter '" + name +
+                            "' (expected stretch, shear, bend, friction, self_friction or arm_offset)");
+    *target = pb;
+  }
+  return b;
+}
+
+namespace {
+double to_unit(const ParamBound& b, double v) { return (v - b.lower) / (b.upper - b.lower); }
+double from_unit(const ParamBound& b, double u) { return b.lower + u * (b.upper - b.lower); }
+}  // namespace
+
+Eigen::VectorXd ParameterSpace::initial_unit() const {
+  Eigen::VectorXd x(dimension());
+  for (int i = 0; i < kClothParams; ++i) x[i] = to_unit(bounds.cloth[i], bounds.cloth[i].initial);
+  for (std::size_t k = 0; k < offset_heights.size(); ++k)
+    x[kClothParams + static_cast<long>(k)] = to_unit(bounds.arm_offset, bounds.arm_offset.initial);
+  return x;
+}
+
+ClothValues ParameterSpace::cloth(const Eigen::VectorXd& unit) const {
+  ClothValues c;
+  for (int i = 0; i < kClothParams; ++i) set_cloth_value(c, i, from_unit(bounds.cloth[i], unit[i]));
+  return c;
+}
+
+std::array<double, 3> ParameterSpace::offsets(const Eigen::VectorXd& unit) const {
+  std::array<double, 3> o{};
+  for (std::size_t k = 0; k < offset_heights.size(); ++k)
+    o[static_cast<int>(offset_heights[k])] = from_unit(bounds.arm_offset, unit[kClothParams + static_cast<long>(k)]);
+  return o;
+}
+
+std::vector<std::string> ParameterSpace::names() const {
+  std::vector<std::string> n(kClothParamNames.begin(), kClothParamNames.end());
+  for (ArmHeight h : offset_heights) n.push_back("arm_offset_" + std::string(arm_height_name(h)));
+  return n;
+}
+
+std::vector<HapticSequence> select_inputs(const Dataset& ds, const std::string& participant, std::uint64_t seed) {
+  std::vector<HapticSequence> out;
+  for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
+    std::vector<const HapticSequence*> pool;
+    for (const auto& t : ds.trials)
+      if (t.participant == participant && t.height == h && t.label && *t.label != Outcome::Caught) pool.push_back(&t);
+    if (pool.empty()) continue;  // e.g. a middle height with only caught trials: 2 sequences
+    std::sort(pool.begin(), pool.end(), [](auto* a, auto* b) { return a->id < b->id; });
+    const std::uint64_t pick = mix_seed(seed, 100 + static_cast<std::uint64_t>(h)) % pool.size();
+    out.push_back(*pool[pick]);
+  }
+  if (out.empty())
+    throw InputError("participant '" + participant + "' has no labelled good or missed trial in the dataset");
+  return out;
+}
+
+TrialRequest request_for(const HapticSequence& input, const std::array<double, 3>& offsets) {
+  TrialRequest r;
+  r.height = input.height;
+  r.arm_offset = offsets[static_cast<int>(input.height)];
+  r.speed = input.speed;
+  r.seed = 0;
+  r.gown_noise = false;
+  if (!stopped_by_force(input) && !input.samples.empty()) r.max_travel = input.samples.back().travel;
+  return r;
+}
+
+bool stopped_by_force(const HapticSequence& s) {
+  if (s.samples.empty()) return false;
+  const HapticSample& last = s.samples.back();
+  return std::abs(last.f_motion) >= 9.5 || std::abs(last.f_vertical) >= 9.5;
+}
+
+double rig_travel_of(const std::vector<HapticSequence>& inputs) {
+  double travel = 0;
+  for (const auto& s : inputs)
+    if (!stopped_by_force(s) && !s.samples.empty()) travel = std::max(travel, s.samples.back().travel);
+  return travel > 0 ? travel : 0.85;
+}
+
+// ---- checkpoint ---------------------------------------------------------------------------------
+
+namespace {
+
+constexpr const char* kCheckpointMagic = "dressguard-calibration-checkpoint";
+
+std::string hexd(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%a", v);
+  return buf;
+}
+
+// What must match for a checkpoint to continue this run.
+std::string fingerprint(const std::vector<HapticSequence>& inputs, const ParameterSpace& space,
+                        const CalibrationOptions& o) {
+  std::ostringstream f;
+  f << "seed=" << o.seed << ";population=" << o.population << ";generations=" << o.generations
+    << ";sigma0=" << hexd(o.sigma0) << ";objective=" << objective_name(o.objective) << ";names=";
+  for (const auto& n : space.names()) f << n << ',';
+  f << ";bounds=";
+  for (const auto& b : space.bounds.cloth) f << hexd(b.lower) << ',' << hexd(b.upper) << ',' << hexd(b.initial) << ',';
+  f << hexd(space.bounds.arm_offset.lower) << ',' << hexd(space.bounds.arm_offset.upper) << ','
+    << hexd(space.bounds.arm_offset.initial) << ";inputs=";
+  for (const auto& s : inputs) f << s.id << '/' << s.samples.size() << ',';
+  return f.str();
+}
+
+struct Checkpoint {
+  std::string fingerprint;
+  int generations_done = 0;
+  std::vector<double> best_fits;
+  std::string cmaes_state;
+};
+
+std::string encode_checkpoint(const Checkpoint& c) {
+  std::ostringstream o;
+  o << kCheckpointMagic << " 1\n" << "fingerprint " << c.fingerprint << "\n"
+    << "generations_done " << c.generations_done << "\n" << "best_fits " << c.best_fits.size();
+  for (double v : c.best_fits) o << ' ' << hexd(v);
+  o << "\ncmaes\n" << c.cmaes_state;
+  return o.str();
+}
+
+Checkpoint decode_checkpoint(const std::string& text, const std::filesystem::path& path) {
+  std::istringstream in(text);
+  Checkpoint c;
+  std::string word;
+  int version = 0;
+  if (!(in >> word >> version) || word != kCheckpointMagic || version != 1)
+    throw_input_error(path, 1, "not a dressguard calibration checkpoint (version 1)");
+  if (!(in >> word) || word != "fingerprint") throw_input_error(path, 2, "expected 'fingerprint'");
+  in.get();
+  std::getline(in, c.fingerprint);
+  std::size_t nfits = 0;
+  if (!(in >> word >> c.generations_done) || word != "generations_done") throw_input_error(path, 3, "expected 'generations_done'");
+  if (!(in >> word >> nfits) || word != "best_fits" || nfits > 16) throw_input_error(path, 4, "expected 'best_fits'");
+  c.best_fits.resize(nfits);
+  for (auto& v : c.best_fits) {
+    if (!(in >> word)) throw_input_error(path, 4, "truncated best_fits");
+    v = std::strtod(word.c_str(), nullptr);
+  }
+  if (!(in >> word) || word != "cmaes") throw_input_error(path, 5, "expected 'cmaes'");
+  in.get();
+  std::ostringstream rest;
+  rest << in.rdbuf();
+  c.cmaes_state = rest.str();
+  return c;
+}
+
+}  // namespace
+
+CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const ParameterSpace& space,
+                            const TrialSimulator& sim, const CalibrationOptions& options, const Comm& comm,
+                            const std::function<void(const GenerationProgress&)>& progress) {
+  if (inputs.empty()) throw std::invalid_argument("calibrate: no input sequences");
+  if (options.generations < 1 || options.population < 2)
+    throw std::invalid_argument("calibrate: need at least 1 generation and a population of 2");
+  const auto t0 = std::chrono::steady_clock::now();
+  const int K = static_cast<int>(inputs.size());
+
+  CmaesSettings cs;
+  cs.x0 = space.initial_unit();
+  cs.sigma0 = options.sigma0;
+  cs.lambda = options.population;
+  cs.seed = options.seed;
+  cs.lower = Eigen::VectorXd::Zero(space.dimension());
+  cs.upper = Eigen::VectorXd::Ones(space.dimension());
+  cs.max_generations = options.generations;
+  Cmaes es(cs);
+
+  const std::string fp = fingerprint(inputs, space, options);
+  std::vector<double> best_fits(static_cast<std::size_t>(K), 0.0);
+  int done = 0;
+  bool resumed = false;
+  // Resume: every rank reads rank 0's checkpoint text (broadcast), so all start from one state.
+  if (!options.checkpoint.empty()) {
+    std::string text;
+    if (comm.is_root() && std::filesystem::exists(options.checkpoint)) text = read_file(options.checkpoint);
+    comm.broadcast(text);
+    if (!text.empty()) {
+      const Checkpoint c = decode_checkpoint(text, options.checkpoint);
+      if (c.fingerprint != fp)
+        throw_input_error(options.checkpoint, 2,
+                          "checkpoint belongs to a different calibration (inputs, seed, budget, bounds or "
+                          "objective differ); remove it or choose another --checkpoint");
+      if (static_cast<int>(c.best_fits.size()) != K) throw_input_error(options.checkpoint, 4, "wrong number of fits");
+      try {
+        es.restore_state(c.cmaes_state);
+      } catch (const std::runtime_error& e) {
+        throw_input_error(options.checkpoint, 6, e.what());
+      }
+      best_fits = c.best_fits;
+      done = c.generations_done;
+      resumed = true;
+    }
+  }
+
+  int done_here = 0;
+  while (!es.stopped()) {
+    if (options.stop_after_generations > 0 && done_here >= options.stop_after_generations) break;
+    const std::vector<Eigen::VectorXd> xs = es.ask();
+    const int lambda = static_cast<int>(xs.size());
+    // One task per (candidate, sequence): finer grains keep all cores busy with 2-3 sequences.
+    const std::vector<double> per = run_batch(lambda * K, 1, thread_count(options.threads), comm, [&](int t, double* out) {
+      const int c = t / K, k = t % K;
+      const SimulatedTrial st = sim(space.cloth(xs[c]), request_for(inputs[k], space.offsets(xs[c])));
+      double v = std::numeric_limits<double>::infinity();
+      if (st.finite && !st.samples.empty()) v = sequence_objective(options.objective, st.samples, inputs[k].samples);
+      out[0] = std::isfinite(v) ? v : std::numeric_limits<double>::infinity();
+    });
+    std::vector<double> f(static_cast<std::size_t>(lambda), 0.0);
+    for (int c = 0; c < lambda; ++c)
+      for (int k = 0; k < K; ++k) f[c] += per[static_cast<std::size_t>(c) * K + k];  // fixed order: same bits
+    const double best_before = es.best_f();
+    const int arg = static_cast<int>(std::min_element(f.begin(), f.end()) - f.begin());
+    es.tell(f);
+    if (f[arg] < best_before)
+      for (int k = 0; k < K; ++k) best_fits[k] = per[static_cast<std::size_t>(arg) * K + k];
+    ++done;
+    ++done_here;
+    if (comm.is_root()) {
+      if (!options.checkpoint.empty()) {
+        Checkpoint c{fp, done, best_fits, es.save_state()};
+        write_file_atomic(options.checkpoint, encode_checkpoint(c));
+      }
+      if (progress) {
+        GenerationProgress p;
+        p.generation = done;
+        p.generations = options.generations;
+        p.best = es.best_f();
+        p.generation_best = f[arg];
+        p.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        p.eta_s = p.elapsed_s / done_here * std::max(0, options.generations - done);
+        p.resumed = resumed;
+        progress(p);
+      }
+    }
+  }
+
+  CalibrationResult r;
+  r.complete = es.stopped();
+  r.generations_done = done;
+  r.evaluations = es.state().evaluations;
+  r.objective = es.best_f();
+  r.best_unit = es.best_x();
+  r.cloth = space.cloth(r.best_unit);
+  r.offsets = space.offsets(r.best_unit);
+  for (int k = 0; k < K; ++k)
+    r.fits.push_back({inputs[k].id, inputs[k].height, inputs[k].speed, best_fits[k]});
+  r.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+// ---- the calibration file -------------------------------------------------------------------------
+
+Json calibration_to_json(const Calibration& c) {
+  Json j = Json::object();
+  j.set("format", "dressguard-calibration 1");
+  j.set("participant", c.participant);
+  Json cloth = Json::object();
+  for (int i = 0; i < kClothParams; ++i) cloth.set(kClothParamNames[i], cloth_value(c.cloth, i));
+  j.set("cloth", cloth);
+  Json off = Json::object();
+  for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
+    Json e = Json::object();
+    e.set("offset_m", c.offsets[static_cast<int>(h)]);
+    e.set("calibrated", c.offset_calibrated[static_cast<int>(h)]);
+    off.set(std::string(arm_height_name(h)), e);
+  }
+  j.set("arm_offsets", off);
+  j.set("objective_kind", c.objective_kind);
+  j.set("objective", c.objective);
+  Json fits = Json::array();
+  for (const auto& f : c.fits) {
+    Json e = Json::object();
+    e.set("trial_id", f.trial_id);
+    e.set("height", std::string(arm_height_name(f.height)));
+    e.set("speed", f.speed);
+    e.set("objective", f.objective);
+    fits.push(e);
+  }
+  j.set("sequences", fits);
+  j.set("gown", c.gown);
+  j.set("rig_travel_m", c.rig_travel);
+  j.set("provenance", c.provenance);
+  return j;
+}
+
+Calibration calibration_from_json(const Json& j, const std::filesystem::path& source) {
+  Calibration c;
+  try {
+    if (!j.has("format") || j.at("format").string() != "dressguard-calibration 1")
+      throw std::runtime_error("not a dressguard calibration file (format \"dressguard-calibration 1\")");
+    c.participant = j.at("participant").string();
+    for (int i = 0; i < kClothParams; ++i) {
+      const double v = j.at("cloth").at(kClothParamNames[i]).number();
+      if (!std::isfinite(v)) throw std::runtime_error(std::string("cloth.") + kClothParamNames[i] + " is not finite");
+      set_cloth_value(c.cloth, i, v);
+    }
+    for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
+      const Json& e = j.at("arm_offsets").at(std::string(arm_height_name(h)));
+      c.offsets[static_cast<int>(h)] = e.at("offset_m").number();
+      c.offset_calibrated[static_cast<int>(h)] = e.at("calibrated").boolean();
+      if (std::abs(c.offsets[static_cast<int>(h)]) > 0.5) throw std::runtime_error("arm offset beyond 0.5 m");
+    }
+    c.objective_kind = j.at("objective_kind").string();
+    c.objective = j.at("objective").number();
+    for (const Json& e : j.at("sequences").items()) {
+      SequenceFit f;
+      f.trial_id = e.at("trial_id").string();
+      const auto h = parse_arm_height(e.at("height").string());
+      if (!h) throw std::runtime_error("bad height \"" + e.at("height").string() + "\"");
+      f.height = *h;
+      f.speed = e.at("speed").number();
+      f.objective = e.at("objective").number();
+      c.fits.push_back(f);
+    }
+    c.gown = j.at("gown").string();
+    c.rig_travel = j.at("rig_travel_m").number();
+    if (!(c.rig_travel > 0.1 && c.rig_travel <= 1.5)) throw std::runtime_error("rig_travel_m outside (0.1, 1.5] m");
+    if (j.has("provenance")) c.provenance = j.at("provenance");
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw_input_error(source, 0, e.what());
+  }
+  return c;
+}
+
+void write_calibration(const std::filesystem::path& path, const Calibration& c) {
+  write_file_atomic(path, calibration_to_json(c).dump() + "\n");
+}
+
+Calibration read_calibration(const std::filesystem::path& path) {
+  return calibration_from_json(Json::parse(read_file(path), path), path);
+}
+
+std::string overlay_csv(const std::vector<HapticSequence>& inputs, const std::vector<SimulatedTrial>& simulated,
+                        const std::string& label) {
+  std::ostringstream o;
+  o << "trial_id,height,source,travel,f_motion,f_vertical\n";
+  char buf[160];
+  for (std::size_t k = 0; k < inputs.size(); ++k) {
+    const std::string h(arm_height_name(inputs[k].height));
+    for (const auto& s : inputs[k].samples) {
+      std::snprintf(buf, sizeof buf, ",%.6g,%.6g,%.6g\n", s.travel, s.f_motion, s.f_vertical);
+      o << inputs[k].id << ',' << h << ",measured" << buf;
+    }
+    if (k < simulated.size())
+      for (const auto& s : simulated[k].samples) {
+        std::snprintf(buf, sizeof buf, ",%.6g,%.6g,%.6g\n", s.travel, s.f_motion, s.f_vertical);
+        o << inputs[k].id << ',' << h << ',' << label << buf;
+      }
+  }
+  return o.str();
+}
+
+}  // namespace dressguard::calib

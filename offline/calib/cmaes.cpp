@@ -1,0 +1,513 @@
+// CMA-ES, see cmaes.h. Equation numbers: Hansen, arXiv:1604.00772.
+#include "cmaes.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <numeric>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+namespace dressguard::calib {
+namespace {
+
+// SplitMix64 (Steele, Lea, Flood 2014): decorrelates the generator seeds of neighbouring
+// generations, so that seeding by (seed, restart, generation) gives independent streams.
+std::uint64_t splitmix(std::uint64_t x) {
+  x += 0x9E3779B97F4A7C15ull;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+  return x ^ (x >> 31);
+}
+
+// The generator of one generation's samples: std::mt19937_64 is specified bit-exactly by the
+// standard; the normal deviates are our own Box-Muller (std::normal_distribution is not
+// specified bit-exactly across standard libraries).
+class Normal {
+ public:
+  explicit Normal(std::uint64_t seed) : gen_(seed) {}
+  double uniform() {  // in (0, 1): 53 random bits, never 0
+    return (static_cast<double>(gen_() >> 11) + 0.5) * 0x1.0p-53;
+  }
+  double operator()() {
+    if (has_spare_) {
+      has_spare_ = false;
+      return spare_;
+    }
+    const double r = std::sqrt(-2.0 * std::log(uniform()));
+    const double phi = 2.0 * M_PI * uniform();
+    spare_ = r * std::sin(phi);
+    has_spare_ = true;
+    return r * std::cos(phi);
+  }
+
+ private:
+  std::mt19937_64 gen_;
+  double spare_ = 0.0;
+  bool has_spare_ = false;
+};
+
+std::uint64_t stream_seed(std::uint64_t seed, int restart, long generation) {
+  return splitmix(splitmix(splitmix(seed) ^ static_cast<std::uint64_t>(restart + 1)) ^
+                  static_cast<std::uint64_t>(generation + 2));
+}
+
+}  // namespace
+
+const char* stop_reason_name(StopReason r) {
+  switch (r) {
+    case StopReason::None: return "none";
+    case StopReason::TargetReached: return "target-reached";
+    case StopReason::MaxEvaluations: return "max-evaluations";
+    case StopReason::MaxGenerations: return "max-generations";
+    case StopReason::TolFun: return "tolfun";
+    case StopReason::TolX: return "tolx";
+    case StopReason::ConditionCov: return "condition-cov";
+    case StopReason::NoEffectAxis: return "no-effect-axis";
+    case StopReason::NoEffectCoord: return "no-effect-coord";
+    case StopReason::Stagnation: return "stagnation";
+  }
+  return "?";
+}
+
+int Cmaes::default_lambda(int n) {
+  return 4 + static_cast<int>(std::floor(3.0 * std::log(static_cast<double>(n))));  // eq. 48
+}
+
+Cmaes::Cmaes(CmaesSettings settings) : settings_(std::move(settings)) {
+  const long n = settings_.x0.size();
+  if (n < 1) throw std::invalid_argument("cmaes: x0 must have at least one coordinate");
+  if (!(settings_.sigma0 > 0.0)) throw std::invalid_argument("cmaes: sigma0 must be positive");
+  if (settings_.lower.has_value() != settings_.upper.has_value())
+    throw std::invalid_argument("cmaes: give both lower and upper bounds or neither");
+  if (settings_.lower) {
+    if (settings_.lower->size() != n || settings_.upper->size() != n)
+      throw std::invalid_argument("cmaes: bounds must have the size of x0");
+    for (long i = 0; i < n; ++i) {
+      if (!((*settings_.lower)[i] < (*settings_.upper)[i]))
+        throw std::invalid_argument("cmaes: lower bound must be below upper bound in every coordinate");
+      settings_.x0[i] = std::clamp(settings_.x0[i], (*settings_.lower)[i], (*settings_.upper)[i]);
+    }
+  }
+  state_.n = static_cast<int>(n);
+  state_.best_x = settings_.x0;
+  const int lambda = settings_.lambda > 0 ? settings_.lambda : default_lambda(state_.n);
+  if (lambda < 2) throw std::invalid_argument("cmaes: lambda must be at least 2");
+  start_restart(lambda, settings_.sigma0, /*reset_mean=*/false);
+}
+
+// Weights and learning rates for the current lambda: tutorial Table 1 / Appendix A.
+void Cmaes::derive_strategy() {
+  const int n = state_.n;
+  const int lambda = state_.lambda;
+  const double nd = n;
+  mu_ = lambda / 2;  // eq. 49: mu = floor(lambda / 2)
+  // eq. 49: w'_i = ln((lambda + 1) / 2) - ln i, i = 1..lambda (negative for i > mu).
+  Eigen::VectorXd wp(lambda);
+  for (int i = 0; i < lambda; ++i) wp[i] = std::log((lambda + 1) / 2.0) - std::log(i + 1.0);
+  double sum_pos = 0, sum_pos2 = 0, sum_neg = 0, sum_neg2 = 0;
+  for (int i = 0; i < lambda; ++i) {
+    if (wp[i] >= 0) {
+      sum_pos += wp[i];
+      sum_pos2 += wp[i] * wp[i];
+    } else {
+      sum_neg += -wp[i];
+      sum_neg2 += wp[i] * wp[i];
+    }
+  }
+  mu_eff_ = sum_pos * sum_pos / sum_pos2;                         // mu_eff, below eq. 49
+  const double mu_eff_neg = sum_neg2 > 0 ? sum_neg * sum_neg / sum_neg2 : 0.0;
+  // eq. 57 (alpha_cov = 2): rank-one and rank-mu learning rates.
+  const double alpha_cov = 2.0;
+  c_1_ = alpha_cov / ((nd + 1.3) * (nd + 1.3) + mu_eff_);
+  c_mu_ = std::min(1.0 - c_1_, alpha_cov * (0.25 + mu_eff_ + 1.0 / mu_eff_ - 2.0) /
+                                   ((nd + 2.0) * (nd + 2.0) + alpha_cov * mu_eff_ / 2.0));
+  // eq. 50-52: the three bounds on the sum of the negative weights.
+  const double alpha_mu_neg = 1.0 + c_1_ / c_mu_;
+  const double alpha_mueff_neg = 1.0 + 2.0 * mu_eff_neg / (mu_eff_ + 2.0);
+  const double alpha_posdef_neg = (1.0 - c_1_ - c_mu_) / (nd * c_mu_);
+  const double neg_scale = std::min({alpha_mu_neg, alpha_mueff_neg, alpha_posdef_neg});
+  // eq. 53: positive weights sum to one, negative ones to -neg_scale.
+  weights_.resize(lambda);
+  for (int i = 0; i < lambda; ++i)
+    weights_[i] = wp[i] >= 0 ? wp[i] / sum_pos : (sum_neg > 0 ? neg_scale * wp[i] / sum_neg : 0.0);
+  // eq. 55: step-size control.
+  c_sigma_ = (mu_eff_ + 2.0) / (nd + mu_eff_ + 5.0);
+  d_sigma_ = 1.0 + 2.0 * std::max(0.0, std::sqrt((mu_eff_ - 1.0) / (nd + 1.0)) - 1.0) + c_sigma_;
+  // eq. 56: cumulation for the rank-one update.
+  c_c_ = (4.0 + mu_eff_ / nd) / (nd + 4.0 + 2.0 * mu_eff_ / nd);
+  // E||N(0, I)||, the approximation below eq. 44.
+  chi_n_ = std::sqrt(nd) * (1.0 - 1.0 / (4.0 * nd) + 1.0 / (21.0 * nd * nd));
+}
+
+void Cmaes::start_restart(int lambda, double sigma, bool reset_mean) {
+  const int n = state_.n;
+  state_.lambda = lambda;
+  state_.generation = 0;
+  state_.sigma = sigma;
+  state_.sigma_this_restart = sigma;
+  if (reset_mean && settings_.lower) {
+    // A new start drawn uniformly in the box: the restarts explore other basins.
+    Normal rng(stream_seed(settings_.seed, state_.restart, -1));
+    state_.mean.resize(n);
+    for (int i = 0; i < n; ++i)
+      state_.mean[i] = (*settings_.lower)[i] + rng.uniform() * ((*settings_.upper)[i] - (*settings_.lower)[i]);
+  } else {
+    state_.mean = settings_.x0;
+  }
+  state_.pc = Eigen::VectorXd::Zero(n);
+  state_.ps = Eigen::VectorXd::Zero(n);
+  state_.C = Eigen::MatrixXd::Identity(n, n);
+  state_.best_history.clear();
+  state_.median_history.clear();
+  derive_strategy();
+  update_eigen();
+  asked_ = false;
+}
+
+void Cmaes::update_eigen() {
+  // Enforce symmetry (rounding), then C = B D^2 B^T (tutorial eq. 10-12).
+  Eigen::MatrixXd C = 0.5 * (state_.C + state_.C.transpose());
+  state_.C = C;
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(C);
+  B_ = es.eigenvectors();
+  D_ = es.eigenvalues().cwiseMax(1e-300).cwiseSqrt();
+}
+
+std::vector<Eigen::VectorXd> Cmaes::ask() {
+  if (stopped()) throw std::logic_error("cmaes: ask() after the run stopped");
+  const int n = state_.n;
+  Normal rng(stream_seed(settings_.seed, state_.restart, state_.generation));
+  y_.assign(state_.lambda, Eigen::VectorXd(n));
+  x_unrepaired_.assign(state_.lambda, Eigen::VectorXd(n));
+  x_repaired_.assign(state_.lambda, Eigen::VectorXd(n));
+  Eigen::VectorXd z(n);
+  for (int k = 0; k < state_.lambda; ++k) {
+    for (int i = 0; i < n; ++i) z[i] = rng();
+    y_[k] = B_ * D_.cwiseProduct(z);                   // eq. 38-39: y_k ~ N(0, C)
+    x_unrepaired_[k] = state_.mean + state_.sigma * y_[k];  // eq. 40: x_k ~ m + sigma N(0, C)
+    x_repaired_[k] = x_unrepaired_[k];
+    if (settings_.lower)  // repair: projection onto the box (Appendix B.5)
+      x_repaired_[k] = x_repaired_[k].cwiseMax(*settings_.lower).cwiseMin(*settings_.upper);
+  }
+  asked_ = true;
+  return x_repaired_;
+}
+
+void Cmaes::tell(const std::vector<double>& f_in) {
+  if (!asked_) throw std::logic_error("cmaes: tell() without a matching ask()");
+  const int n = state_.n;
+  const int lambda = state_.lambda;
+  if (static_cast<int>(f_in.size()) != lambda) throw std::invalid_argument("cmaes: tell() needs lambda values");
+  asked_ = false;
+  std::vector<double> f(f_in);
+  for (double& v : f)
+    if (!std::isfinite(v)) v = std::numeric_limits<double>::max();  // failures rank last
+  state_.evaluations += lambda;
+  state_.generations_total += 1;
+  for (int k = 0; k < lambda; ++k) {
+    if (f[k] < state_.best_f) {
+      state_.best_f = f[k];
+      state_.best_x = x_repaired_[k];
+    }
+  }
+  // Ranking values: the repaired point's value plus the boundary penalty (cmaes.h, Appendix B.5).
+  std::vector<double> rank_f(f);
+  if (settings_.lower) {
+    std::vector<double> sorted(f);
+    std::sort(sorted.begin(), sorted.end());
+    const double iqr = sorted[(3 * (lambda - 1)) / 4] - sorted[(lambda - 1) / 4];
+    const double gamma = std::max(iqr, 1e-12);
+    for (int k = 0; k < lambda; ++k) {
+      const double d2 = (x_unrepaired_[k] - x_repaired_[k]).squaredNorm();
+      if (d2 > 0) rank_f[k] = f[k] + gamma * d2 / (state_.sigma * state_.sigma);
+    }
+  }
+  std::vector<int> order(lambda);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return rank_f[a] < rank_f[b]; });
+
+  // eq. 41: <y>_w = sum_{i<=mu} w_i y_{i:lambda}; eq. 42: m <- m + c_m sigma <y>_w (c_m = 1).
+  Eigen::VectorXd y_w = Eigen::VectorXd::Zero(n);
+  for (int i = 0; i < mu_; ++i) y_w += weights_[i] * y_[order[i]];
+  state_.mean += state_.sigma * y_w;
+
+  // C^{-1/2} = B D^{-1} B^T.
+  const Eigen::MatrixXd C_invsqrt = B_ * D_.cwiseInverse().asDiagonal() * B_.transpose();
+  // eq. 43: cumulation for sigma.
+  state_.ps = (1.0 - c_sigma_) * state_.ps + std::sqrt(c_sigma_ * (2.0 - c_sigma_) * mu_eff_) * (C_invsqrt * y_w);
+  // h_sigma (Appendix A, below eq. 45): stalls p_c when ||p_sigma|| is large.
+  const double g1 = static_cast<double>(state_.generation + 1);
+  const double ps_norm = state_.ps.norm();
+  const bool h_sigma =
+      ps_norm / std::sqrt(1.0 - std::pow(1.0 - c_sigma_, 2.0 * g1)) < (1.4 + 2.0 / (n + 1.0)) * chi_n_;
+  // eq. 45: cumulation for the rank-one update.
+  state_.pc = (1.0 - c_c_) * state_.pc + (h_sigma ? std::sqrt(c_c_ * (2.0 - c_c_) * mu_eff_) : 0.0) * y_w;
+  // eq. 46: w°_i = w_i for w_i >= 0, else w_i n / ||C^{-1/2} y_{i:lambda}||^2.
+  // eq. 47: C <- (1 + c_1 delta(h_sigma) - c_1 - c_mu sum w_j) C + c_1 p_c p_c^T + c_mu sum w°_i y y^T.
+  const double delta_h = h_sigma ? 0.0 : c_c_ * (2.0 - c_c_);  // delta(h_sigma) = (1 - h_sigma) c_c (2 - c_c)
+  Eigen::MatrixXd rank_mu = Eigen::MatrixXd::Zero(n, n);
+  for (int i = 0; i < lambda; ++i) {
+    const Eigen::VectorXd& y = y_[order[i]];
+    double w = weights_[i];
+    if (w < 0) {
+      const double q = (C_invsqrt * y).squaredNorm();
+      w *= q > 0 ? n / q : 0.0;
+    }
+    rank_mu.noalias() += w * (y * y.transpose());
+  }
+  const double sum_w = weights_.sum();
+  state_.C = (1.0 + c_1_ * delta_h - c_1_ - c_mu_ * sum_w) * state_.C +
+             c_1_ * (state_.pc * state_.pc.transpose()) + c_mu_ * rank_mu;
+  // eq. 44: step-size update.
+  // The exponent is capped at 1 (as purecma does) so one wild generation cannot blow sigma up.
+  state_.sigma *= std::exp(std::min(1.0, (c_sigma_ / d_sigma_) * (ps_norm / chi_n_ - 1.0)));
+  update_eigen();
+
+  // Histories for TolFun and stagnation.
+  std::vector<double> sorted(f);
+  std::sort(sorted.begin(), sorted.end());
+  state_.best_history.push_back(sorted.front());
+  state_.median_history.push_back(sorted[lambda / 2]);
+  state_.generation += 1;
+
+  // Global stops first, then local ones (which may restart).
+  if (state_.best_f <= settings_.target_f) {
+    state_.stopped = StopReason::TargetReached;
+    return;
+  }
+  if (settings_.max_evaluations > 0 && state_.evaluations >= settings_.max_evaluations) {
+    state_.stopped = StopReason::MaxEvaluations;
+    return;
+  }
+  if (settings_.max_generations > 0 && state_.generations_total >= settings_.max_generations) {
+    state_.stopped = StopReason::MaxGenerations;
+    return;
+  }
+  const StopReason local = local_stop();
+  if (local != StopReason::None) {
+    // Range of this generation for TolFun uses the repaired values; fine for a stop test.
+    on_local_stop(local);
+  }
+}
+
+// Termination criteria of Appendix B.3 that end one restart.
+StopReason Cmaes::local_stop() const {
+  const int n = state_.n;
+  const auto& bh = state_.best_history;
+  // TolFun: range of the best values of the last 10 + ceil(30 n / lambda) generations below tol_fun.
+  const std::size_t window = 10 + static_cast<std::size_t>(std::ceil(30.0 * n / state_.lambda));
+  if (bh.size() >= window) {
+    const auto [lo, hi] = std::minmax_element(bh.end() - window, bh.end());
+    if (*hi - *lo < settings_.tol_fun) return StopReason::TolFun;
+  }
+  // TolX: sigma * max(|p_c,i|, sqrt(C_ii)) < tol_x * sigma0 for all i.
+  bool all_small = true;
+  for (int i = 0; i < n; ++i) {
+    const double s = state_.sigma * std::max(std::abs(state_.pc[i]), std::sqrt(state_.C(i, i)));
+    if (!(s < settings_.tol_x * settings_.sigma0)) all_small = false;
+  }
+  if (all_small) return StopReason::TolX;
+  // ConditionCov: cond(C) > 1e14.
+  const double dmax = D_.maxCoeff(), dmin = D_.minCoeff();
+  if (dmax * dmax > 1e14 * dmin * dmin) return StopReason::ConditionCov;
+  // NoEffectAxis: m + 0.1 sigma d_i b_i == m for the axis i = g mod n.
+  {
+    const int i = static_cast<int>(state_.generation % n);
+    const Eigen::VectorXd moved = state_.mean + 0.1 * state_.sigma * D_[i] * B_.col(i);
+    if (moved == state_.mean) return StopReason::NoEffectAxis;
+  }
+  // NoEffectCoord: m_i + 0.2 sigma sqrt(C_ii) == m_i for some i.
+  for (int i = 0; i < n; ++i)
+    if (state_.mean[i] + 0.2 * state_.sigma * std::sqrt(state_.C(i, i)) == state_.mean[i])
+      return StopReason::NoEffectCoord;
+  // Stagnation: after 120 + 30 n / lambda generations, neither the best nor the median of the
+  // last 20% of the history improved on the first 20% of the last 20 000 generations... here: the
+  // medians of the newest and the oldest 30% of the history (Hansen's cmaes.m "stagnation").
+  const std::size_t min_gen = 120 + static_cast<std::size_t>(30.0 * n / state_.lambda);
+  if (bh.size() >= min_gen) {
+    const std::size_t k = bh.size() * 3 / 10;
+    auto median_of = [](std::vector<double> v) {
+      std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+      return v[v.size() / 2];
+    };
+    const auto& mh = state_.median_history;
+    const double old_best = median_of({bh.begin(), bh.begin() + k});
+    const double new_best = median_of({bh.end() - k, bh.end()});
+    const double old_med = median_of({mh.begin(), mh.begin() + k});
+    const double new_med = median_of({mh.end() - k, mh.end()});
+    if (new_best >= old_best && new_med >= old_med) return StopReason::Stagnation;
+  }
+  return StopReason::None;
+}
+
+void Cmaes::on_local_stop(StopReason r) {
+  if (settings_.restarts == Restarts::None || state_.restart >= settings_.max_restarts) {
+    state_.stopped = r;
+    return;
+  }
+  const int lambda_default = settings_.lambda > 0 ? settings_.lambda : default_lambda(state_.n);
+  const long spent = static_cast<long>(state_.lambda) * state_.generation;
+  state_.restart += 1;
+  if (settings_.restarts == Restarts::Ipop) {
+    // IPOP: double the population, same sigma0 (Auger & Hansen 2005).
+    start_restart(state_.lambda * 2, settings_.sigma0, /*reset_mean=*/true);
+    return;
+  }
+  // BIPOP (Hansen 2009): account the finished run to its regime, then run the regime that has
+  // used fewer evaluations. Large regime: lambda = 2^k lambda_default, sigma0. Small regime:
+  // lambda = floor(lambda_default (lambda_large / (2 lambda_default))^(u^2)), sigma0 10^(-2u).
+  (state_.bipop_small_regime ? state_.bipop_small_evals : state_.bipop_large_evals) += spent;
+  Normal rng(stream_seed(settings_.seed, state_.restart, -2));
+  if (state_.bipop_small_evals < state_.bipop_large_evals) {
+    const double u1 = rng.uniform(), u2 = rng.uniform();
+    const double lambda_large = std::ldexp(static_cast<double>(lambda_default), state_.bipop_large_restarts);
+    const int lambda_s = std::max(
+        2, static_cast<int>(std::floor(lambda_default * std::pow(0.5 * lambda_large / lambda_default, u1 * u1))));
+    start_restart(lambda_s, settings_.sigma0 * std::pow(10.0, -2.0 * u2), /*reset_mean=*/true);
+    state_.bipop_small_regime = true;
+  } else {
+    state_.bipop_large_restarts += 1;
+    state_.bipop_small_regime = false;
+    start_restart(lambda_default << state_.bipop_large_restarts, settings_.sigma0, /*reset_mean=*/true);
+  }
+}
+
+// ---- exact serialisation ----------------------------------------------------------------------
+
+namespace {
+void put(std::ostringstream& o, const char* key, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%a", v);
+  o << key << ' ' << buf << '\n';
+}
+void put_vec(std::ostringstream& o, const char* key, const Eigen::VectorXd& v) {
+  o << key << ' ' << v.size();
+  char buf[64];
+  for (long i = 0; i < v.size(); ++i) {
+    std::snprintf(buf, sizeof buf, " %a", v[i]);
+    o << buf;
+  }
+  o << '\n';
+}
+void put_list(std::ostringstream& o, const char* key, const std::vector<double>& v) {
+  put_vec(o, key, Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<long>(v.size())));
+}
+}  // namespace
+
+std::string Cmaes::save_state() const {
+  std::ostringstream o;
+  o << "cmaes-state 1\n";
+  o << "n " << state_.n << "\nlambda " << state_.lambda << "\nrestart " << state_.restart
+    << "\ngeneration " << state_.generation << "\ngenerations_total " << state_.generations_total
+    << "\nevaluations " << state_.evaluations << "\nbipop_large_evals " << state_.bipop_large_evals
+    << "\nbipop_small_evals " << state_.bipop_small_evals << "\nbipop_large_restarts "
+    << state_.bipop_large_restarts << "\nbipop_small_regime " << state_.bipop_small_regime << "\nstopped " << static_cast<int>(state_.stopped) << '\n';
+  put(o, "sigma", state_.sigma);
+  put(o, "sigma_this_restart", state_.sigma_this_restart);
+  put(o, "best_f", state_.best_f);
+  put_vec(o, "mean", state_.mean);
+  put_vec(o, "pc", state_.pc);
+  put_vec(o, "ps", state_.ps);
+  put_vec(o, "best_x", state_.best_x);
+  put_vec(o, "C", Eigen::Map<const Eigen::VectorXd>(state_.C.data(), state_.C.size()));
+  put_list(o, "best_history", state_.best_history);
+  put_list(o, "median_history", state_.median_history);
+  o << "end\n";
+  return o.str();
+}
+
+void Cmaes::restore_state(const std::string& text) {
+  std::istringstream in(text);
+  std::string key;
+  CmaesState s;
+  auto fail = [](const std::string& what) { throw std::runtime_error("cmaes state: " + what); };
+  auto read_double = [&](double& v) {
+    std::string tok;
+    if (!(in >> tok)) fail("truncated");
+    char* end = nullptr;
+    v = std::strtod(tok.c_str(), &end);
+    if (end == tok.c_str() || *end) fail("bad number '" + tok + "'");
+  };
+  auto read_vec = [&](Eigen::VectorXd& v) {
+    long size = 0;
+    if (!(in >> size) || size < 0 || size > 1000000) fail("bad vector size");
+    v.resize(size);
+    for (long i = 0; i < size; ++i) read_double(v[i]);
+  };
+  auto read_list = [&](std::vector<double>& v) {
+    Eigen::VectorXd e;
+    read_vec(e);
+    v.assign(e.data(), e.data() + e.size());
+  };
+  int version = 0;
+  if (!(in >> key >> version) || key != "cmaes-state" || version != 1) fail("not a cmaes state (version 1)");
+  bool ended = false;
+  Eigen::VectorXd cflat;
+  while (in >> key) {
+    if (key == "end") {
+      ended = true;
+      break;
+    }
+    if (key == "n") in >> s.n;
+    else if (key == "lambda") in >> s.lambda;
+    else if (key == "restart") in >> s.restart;
+    else if (key == "generation") in >> s.generation;
+    else if (key == "generations_total") in >> s.generations_total;
+    else if (key == "evaluations") in >> s.evaluations;
+    else if (key == "bipop_large_evals") in >> s.bipop_large_evals;
+    else if (key == "bipop_small_evals") in >> s.bipop_small_evals;
+    else if (key == "bipop_large_restarts") in >> s.bipop_large_restarts;
+    else if (key == "bipop_small_regime") in >> s.bipop_small_regime;
+    else if (key == "stopped") {
+      int v = 0;
+      in >> v;
+      s.stopped = static_cast<StopReason>(v);
+    } else if (key == "sigma") read_double(s.sigma);
+    else if (key == "sigma_this_restart") read_double(s.sigma_this_restart);
+    else if (key == "best_f") read_double(s.best_f);
+    else if (key == "mean") read_vec(s.mean);
+    else if (key == "pc") read_vec(s.pc);
+    else if (key == "ps") read_vec(s.ps);
+    else if (key == "best_x") read_vec(s.best_x);
+    else if (key == "C") read_vec(cflat);
+    else if (key == "best_history") read_list(s.best_history);
+    else if (key == "median_history") read_list(s.median_history);
+    else fail("unknown key '" + key + "'");
+    if (!in) fail("bad value for '" + key + "'");
+  }
+  if (!ended) fail("missing 'end' (truncated file)");
+  if (s.n != state_.n) fail("dimension " + std::to_string(s.n) + " does not match " + std::to_string(state_.n));
+  if (s.mean.size() != s.n || s.pc.size() != s.n || s.ps.size() != s.n || s.best_x.size() != s.n ||
+      cflat.size() != static_cast<long>(s.n) * s.n || s.lambda < 2)
+    fail("inconsistent sizes");
+  s.C = Eigen::Map<Eigen::MatrixXd>(cflat.data(), s.n, s.n);
+  state_ = std::move(s);
+  derive_strategy();
+  update_eigen();
+  asked_ = false;
+}
+
+// ---- benchmark functions ------------------------------------------------------------------------
+
+double sphere(const Eigen::VectorXd& x) { return x.squaredNorm(); }
+
+double ellipsoid(const Eigen::VectorXd& x) {
+  const long n = x.size();
+  double f = 0;
+  for (long i = 0; i < n; ++i) f += std::pow(1e6, n > 1 ? static_cast<double>(i) / (n - 1) : 0.0) * x[i] * x[i];
+  return f;
+}
+
+double rosenbrock(const Eigen::VectorXd& x) {
+  double f = 0;
+  for (long i = 0; i + 1 < x.size(); ++i) {
+    const double a = x[i] * x[i] - x[i + 1], b = x[i] - 1.0;
+    f += 100.0 * a * a + b * b;
+  }
+  return f;
+}
+
+}  // namespace dressguard::calib

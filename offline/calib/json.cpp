@@ -1,0 +1,241 @@
+// Minimal JSON, see json.h.
+#include "json.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <stdexcept>
+
+#include "files.h"
+
+namespace dressguard::calib {
+
+double Json::number() const {
+  if (type_ != Type::Number) throw std::runtime_error("json: expected a number");
+  return num_;
+}
+const std::string& Json::string() const {
+  if (type_ != Type::String) throw std::runtime_error("json: expected a string");
+  return str_;
+}
+bool Json::boolean() const {
+  if (type_ != Type::Bool) throw std::runtime_error("json: expected true or false");
+  return bool_;
+}
+const std::vector<Json>& Json::items() const {
+  if (type_ != Type::Array) throw std::runtime_error("json: expected an array");
+  return arr_;
+}
+const std::vector<std::pair<std::string, Json>>& Json::members() const {
+  if (type_ != Type::Object) throw std::runtime_error("json: expected an object");
+  return obj_;
+}
+bool Json::has(const std::string& key) const {
+  if (type_ != Type::Object) return false;
+  for (const auto& [k, v] : obj_)
+    if (k == key) return true;
+  return false;
+}
+const Json& Json::at(const std::string& key) const {
+  for (const auto& [k, v] : members())
+    if (k == key) return v;
+  throw std::runtime_error("json: missing key \"" + key + "\"");
+}
+Json& Json::push(Json v) {
+  if (type_ != Type::Array) throw std::runtime_error("json: push on a non-array");
+  arr_.push_back(std::move(v));
+  return arr_.back();
+}
+Json& Json::set(const std::string& key, Json v) {
+  if (type_ != Type::Object) throw std::runtime_error("json: set on a non-object");
+  for (auto& [k, old] : obj_)
+    if (k == key) return old = std::move(v);
+  obj_.emplace_back(key, std::move(v));
+  return obj_.back().second;
+}
+
+namespace {
+void escape(std::string& out, const std::string& s) {
+  out += '"';
+  for (char c : s) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      case '\r': out += "\\r"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", c);
+          out += buf;
+        } else {
+          out += c;
+        }
+    }
+  }
+  out += '"';
+}
+}  // namespace
+
+void Json::dump_to(std::string& out, int indent, int depth) const {
+  auto newline = [&](int d) {
+    if (indent <= 0) return;
+    out += '\n';
+    out.append(static_cast<std::size_t>(indent * d), ' ');
+  };
+  switch (type_) {
+    case Type::Null: out += "null"; break;
+    case Type::Bool: out += bool_ ? "true" : "false"; break;
+    case Type::Number: {
+      if (!std::isfinite(num_)) {
+        out += "null";  // JSON has no inf/NaN
+        break;
+      }
+      char buf[40];
+      std::snprintf(buf, sizeof buf, "%.17g", num_);
+      out += buf;
+      break;
+    }
+    case Type::String: escape(out, str_); break;
+    case Type::Array: {
+      // Arrays of numbers stay on one line (curves, parameter vectors).
+      bool flat = true;
+      for (const auto& v : arr_) flat = flat && (v.type_ != Type::Array && v.type_ != Type::Object);
+      out += '[';
+      for (std::size_t i = 0; i < arr_.size(); ++i) {
+        if (i) out += flat ? ", " : ",";
+        if (!flat) newline(depth + 1);
+        arr_[i].dump_to(out, indent, depth + 1);
+      }
+      if (!flat && !arr_.empty()) newline(depth);
+      out += ']';
+      break;
+    }
+    case Type::Object: {
+      out += '{';
+      for (std::size_t i = 0; i < obj_.size(); ++i) {
+        if (i) out += ',';
+        newline(depth + 1);
+        escape(out, obj_[i].first);
+        out += indent > 0 ? ": " : ":";
+        obj_[i].second.dump_to(out, indent, depth + 1);
+      }
+      if (!obj_.empty()) newline(depth);
+      out += '}';
+      break;
+    }
+  }
+}
+
+std::string Json::dump(int indent) const {
+  std::string out;
+  dump_to(out, indent, 0);
+  return out;
+}
+
+namespace {
+struct Parser {
+  const std::string& s;
+  const std::filesystem::path& source;
+  std::size_t i = 0;
+
+  [[noreturn]] void fail(const std::string& what) const {
+    long line = 1;
+    for (std::size_t k = 0; k < i && k < s.size(); ++k) line += s[k] == '\n';
+    throw_input_error(source, line, "JSON: " + what);
+  }
+  void ws() {
+    while (i < s.size() && (s[i] == ' ' || s[i] == '\n' || s[i] == '\t' || s[i] == '\r')) ++i;
+  }
+  bool eat(char c) {
+    ws();
+    if (i < s.size() && s[i] == c) {
+      ++i;
+      return true;
+    }
+    return false;
+  }
+  void expect(char c) {
+    if (!eat(c)) fail(std::string("expected '") + c + "'");
+  }
+  std::string str() {
+    expect('"');
+    std::string out;
+    while (i < s.size() && s[i] != '"') {
+      char c = s[i++];
+      if (c == '\\') {
+        if (i >= s.size()) fail("unterminated escape");
+        char e = s[i++];
+        switch (e) {
+          case 'n': out += '\n'; break;
+          case 't': out += '\t'; break;
+          case 'r': out += '\r'; break;
+          case 'b': out += '\b'; break;
+          case 'f': out += '\f'; break;
+          case 'u': {
+            if (i + 4 > s.size()) fail("bad \\u escape");
+            const long code = std::strtol(s.substr(i, 4).c_str(), nullptr, 16);
+            i += 4;
+            if (code > 0x7f) fail("non-ASCII \\u escape not supported");
+            out += static_cast<char>(code);
+            break;
+          }
+          default: out += e;
+        }
+      } else {
+        out += c;
+      }
+    }
+    if (i >= s.size()) fail("unterminated string");
+    ++i;
+    return out;
+  }
+  Json value() {
+    ws();
+    if (i >= s.size()) fail("unexpected end");
+    const char c = s[i];
+    if (c == '{') {
+      ++i;
+      Json o = Json::object();
+      if (eat('}')) return o;
+      do {
+        ws();
+        std::string k = str();
+        expect(':');
+        o.set(k, value());
+      } while (eat(','));
+      expect('}');
+      return o;
+    }
+    if (c == '[') {
+      ++i;
+      Json a = Json::array();
+      if (eat(']')) return a;
+      do a.push(value());
+      while (eat(','));
+      expect(']');
+      return a;
+    }
+    if (c == '"') return Json(str());
+    if (s.compare(i, 4, "true") == 0) { i += 4; return Json(true); }
+    if (s.compare(i, 5, "false") == 0) { i += 5; return Json(false); }
+    if (s.compare(i, 4, "null") == 0) { i += 4; return Json(); }
+    char* end = nullptr;
+    const double v = std::strtod(s.c_str() + i, &end);
+    if (end == s.c_str() + i) fail(std::string("unexpected character '") + c + "'");
+    i = static_cast<std::size_t>(end - s.c_str());
+    return Json(v);
+  }
+};
+}  // namespace
+
+Json Json::parse(const std::string& text, const std::filesystem::path& source) {
+  Parser p{text, source};
+  Json v = p.value();
+  p.ws();
+  if (p.i != text.size()) p.fail("trailing characters after the value");
+  return v;
+}
+
+}  // namespace dressguard::calib

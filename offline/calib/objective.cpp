@@ -1,0 +1,109 @@
+// The calibration objective, see objective.h (paper eq. 3-5).
+#include "objective.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace dressguard::calib {
+
+std::string_view objective_name(ObjectiveKind k) {
+  return k == ObjectiveKind::Area ? "area" : "position-weighted";
+}
+
+std::optional<ObjectiveKind> parse_objective(std::string_view s) {
+  if (s == "area") return ObjectiveKind::Area;
+  if (s == "position-weighted") return ObjectiveKind::PositionWeighted;
+  return std::nullopt;
+}
+
+namespace {
+
+double force(const HapticSample& s, ForceAxis a) { return a == ForceAxis::Motion ? s.f_motion : s.f_vertical; }
+
+// |x_i - x_{i-1}|: the travel between two frames (never negative, even if the stamp jitters).
+double step(const std::vector<HapticSample>& seq, std::size_t i) {
+  return std::abs(seq[i].travel - seq[i - 1].travel);
+}
+
+void require_samples(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured) {
+  if (sim.empty() || measured.empty()) throw std::invalid_argument("objective: a sequence has no samples");
+}
+
+// Linear interpolation of a sequence's force at travel x (clamped to its ends). Travel is
+// non-decreasing in both measured and simulated sequences; equal travels take the later sample.
+double force_at(const std::vector<HapticSample>& seq, double x, ForceAxis a) {
+  if (x <= seq.front().travel) return force(seq.front(), a);
+  if (x >= seq.back().travel) return force(seq.back(), a);
+  const auto it = std::upper_bound(seq.begin(), seq.end(), x,
+                                   [](double v, const HapticSample& s) { return v < s.travel; });
+  const HapticSample& hi = *it;
+  const HapticSample& lo = *(it - 1);
+  const double span = hi.travel - lo.travel;
+  if (span <= 1e-12) return force(hi, a);
+  const double t = (x - lo.travel) / span;
+  return (1.0 - t) * force(lo, a) + t * force(hi, a);
+}
+
+}  // namespace
+
+double area_error(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured, ForceAxis axis,
+                  double w) {
+  require_samples(sim, measured);
+  const std::size_t m = sim.size() - 1, n = measured.size() - 1;  // last indices, as in eq. 4
+  double e = 0.0;
+  // i = 0 has no travel before it: d = 0. Both running: dx |s_i - r_i| with the measured dx.
+  for (std::size_t i = 1; i <= std::min(m, n); ++i)
+    e += step(measured, i) * std::abs(force(sim[i], axis) - force(measured[i], axis));
+  // Simulation longer: w dx |s_i - r_n|, dx the simulation's travel.
+  for (std::size_t i = n + 1; i <= m; ++i)
+    e += w * step(sim, i) * std::abs(force(sim[i], axis) - force(measured[n], axis));
+  // Measurement longer: w dx |s_m - r_i|, dx the measurement's travel.
+  for (std::size_t i = m + 1; i <= n; ++i)
+    e += w * step(measured, i) * std::abs(force(sim[m], axis) - force(measured[i], axis));
+  return e;
+}
+
+double area_objective(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured, double w) {
+  return area_error(sim, measured, ForceAxis::Vertical, w) + area_error(sim, measured, ForceAxis::Motion, w);
+}
+
+double position_weighted_objective(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured) {
+  require_samples(sim, measured);
+  const double x_sim_end = sim.back().travel;
+  const double x_meas_end = measured.back().travel;
+  auto both = [](double dm, double dv) { return std::abs(dm) + std::abs(dv); };
+  double score = 0.0;
+  for (std::size_t i = 1; i < measured.size(); ++i) {
+    const HapticSample& r = measured[i];
+    const double dx = r.travel - measured[i - 1].travel;
+    if (r.travel > x_sim_end) {
+      // Measurement beyond the simulation's end: 1.5 exp(x_i + x_S) |r_i - s_end|.
+      const double diff = both(r.f_motion - sim.back().f_motion, r.f_vertical - sim.back().f_vertical);
+      score += 1.5 * std::exp(r.travel + x_sim_end) * diff * dx;
+    } else {
+      // Inside: exp(x_i) |r_i - s(x_i)|, s interpolated on the simulated travel.
+      const double diff = both(r.f_motion - force_at(sim, r.travel, ForceAxis::Motion),
+                               r.f_vertical - force_at(sim, r.travel, ForceAxis::Vertical));
+      score += std::exp(r.travel) * diff * dx;
+    }
+  }
+  if (x_meas_end < x_sim_end) {
+    // Simulation beyond the measurement's end: 1.5 exp(x_j - x_R) |s_j - r_end| dx_j, from the
+    // first simulated sample at or after x_R.
+    const auto first = std::lower_bound(sim.begin(), sim.end(), x_meas_end,
+                                        [](const HapticSample& s, double v) { return s.travel < v; });
+    for (auto it = std::max(first, sim.begin() + 1); it != sim.end(); ++it) {
+      const double diff = both(it->f_motion - measured.back().f_motion, it->f_vertical - measured.back().f_vertical);
+      score += 1.5 * std::exp(it->travel - x_meas_end) * diff * (it->travel - (it - 1)->travel);
+    }
+  }
+  return score;
+}
+
+double sequence_objective(ObjectiveKind kind, const std::vector<HapticSample>& sim,
+                          const std::vector<HapticSample>& measured) {
+  return kind == ObjectiveKind::Area ? area_objective(sim, measured) : position_weighted_objective(sim, measured);
+}
+
+}  // namespace dressguard::calib

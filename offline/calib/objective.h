@@ -1,0 +1,63 @@
+// The calibration objective: how far a simulated force sequence is from a measured one.
+//
+// Paper section IV-B.3, eq. 3-5. For one force axis, with simulated samples s_0..s_m and measured
+// samples r_0..r_n (both at the sensor's 100 Hz, paired by index):
+//
+//   e(S, R) = sum_{i=1}^{max(n,m)} d(s_i, r_i)                                         (eq. 3)
+//   d(s_i, r_i) =   dx_i |s_i - r_i|        i <= m and i <= n   (both sequences still running)
+//                 w dx_i |s_i - r_n|        i <= m and i > n    (simulation ran longer)   (eq. 4)
+//                 w dx_i |s_m - r_i|        i > m and i <= n    (measurement ran longer)
+//   L(R, theta) = sum_k e(S_k^Y, R_k^Y) + e(S_k^X, R_k^X)                               (eq. 5)
+//
+// with w = 20 and dx_i the end effector's travel between frames i-1 and i. The paper does not
+// say whose travel; we take the measured sequence's while both run (the measurement is the
+// reference the simulation is scored against) and the longer sequence's beyond the shorter one.
+// Between two measured repeats the choice changes L by < 0.001 (tests/calib/objective_test.cpp).
+// X is F_motion and Y is F_vertical (rig convention, haptic.h). e is an approximation of the
+// unsigned area between the two curves over travel [N m], plus a w-weighted penalty for a
+// different length (a trial that stops at 10 N too early or too late).
+//
+// PositionWeighted: the variant in the paper's public code (gt-rad/learning-forces,
+// physx_simulation CMAES HapticObjective, evalObj), described here in our own words as we read
+// it: walk the *measured* samples; at each measured travel x_i the simulated force is linearly
+// interpolated on the simulated travel; the absolute differences of both axes are summed and
+// weighted by exp(x_i) [x in m, so the end of the pull weighs e^0.85 = 2.3 times the start] and by
+// the measured travel step. Where the measurement runs beyond the simulation's final travel x_S,
+// the difference to the simulation's last sample is weighted 1.5 exp(x_i + x_S); where the
+// simulation runs beyond the measurement's final travel x_R, each further simulated sample's
+// difference to the last measured one is weighted 1.5 exp(x_j - x_R) times its own travel step.
+// Both axes are summed inside, so it is a whole-sequence error (no per-axis split).
+#pragma once
+
+#include <string_view>
+#include <optional>
+#include <vector>
+
+#include "haptic.h"
+
+namespace dressguard::calib {
+
+enum class ObjectiveKind { Area = 0, PositionWeighted = 1 };
+std::string_view objective_name(ObjectiveKind k);           // "area", "position-weighted"
+std::optional<ObjectiveKind> parse_objective(std::string_view s);
+
+enum class ForceAxis { Motion, Vertical };
+
+inline constexpr double kLengthPenaltyWeight = 20.0;  // w of eq. 4
+
+// eq. 3-4 for one axis. `sim` and `measured` need at least one sample each.
+double area_error(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured, ForceAxis axis,
+                  double w = kLengthPenaltyWeight);
+
+// Both axes of eq. 5 for one sequence pair: e(S^Y, R^Y) + e(S^X, R^X).
+double area_objective(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured,
+                      double w = kLengthPenaltyWeight);
+
+// The public code's position-weighted error (see above), both axes.
+double position_weighted_objective(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured);
+
+// The chosen objective for one pair.
+double sequence_objective(ObjectiveKind kind, const std::vector<HapticSample>& sim,
+                          const std::vector<HapticSample>& measured);
+
+}  // namespace dressguard::calib

@@ -1,0 +1,43 @@
+// dg_sim behind the calibration's TrialSimulator, see sim_bridge.h.
+#include "sim_bridge.h"
+
+#include <memory>
+#include <stdexcept>
+
+#include "trial.h"
+
+namespace dressguard::calib {
+
+bool cloth_simulator_available() { return true; }
+
+TrialSimulator make_cloth_simulator(const std::string& gown) {
+  sim::GownResolution res;
+  if (gown == "full") res = sim::GownResolution::Full;
+  else if (gown == "reduced") res = sim::GownResolution::Reduced;
+  else if (gown == "coarse") res = sim::GownResolution::Coarse;
+  else throw std::invalid_argument("unknown gown '" + gown + "' (expected full, reduced or coarse)");
+  auto scene = std::make_shared<const sim::Scene>(sim::make_default_scene(res));
+  return [scene](const ClothValues& c, const TrialRequest& r) {
+    sim::ClothParams p;  // damping and density keep the simulator's defaults (not calibrated, paper IV-B.2)
+    p.stretch = c.stretch;
+    p.shear = c.shear;
+    p.bend = c.bend;
+    p.friction = c.friction;
+    p.self_friction = c.self_friction;
+    sim::TrialSpec spec;
+    spec.height = r.height;
+    spec.arm_offset = r.arm_offset;
+    spec.speed = r.speed;
+    spec.seed = r.seed;
+    spec.gown_noise = r.gown_noise;
+    spec.max_travel = r.max_travel;
+    sim::TrialResult res = sim::simulate_trial(*scene, p, spec);
+    SimulatedTrial out;
+    out.samples = std::move(res.seq.samples);
+    out.outcome = res.outcome;
+    out.finite = res.finite;
+    return out;
+  };
+}
+
+}  // namespace dressguard::calib

@@ -1,0 +1,23 @@
+// The simulation-trained classifier, see stc.h.
+#include "stc.h"
+
+#include "hmm.h"
+
+namespace dressguard::calib {
+
+model::OutcomeModel build_outcome_model(const std::vector<const HapticSequence*>& trials, const StcOptions& o) {
+  hmm::ModelOptions mo;
+  mo.hmm.n_states = o.states;
+  mo.uniform_priors = o.uniform_priors;
+  mo.source_dataset = o.source;
+  return hmm::train_outcome_model(trials, mo);
+}
+
+double accuracy(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials, double truncate_at,
+                int* counted) {
+  const hmm::Evaluation e = hmm::evaluate(m, trials, truncate_at);
+  if (counted) *counted = e.total;
+  return e.accuracy();
+}
+
+}  // namespace dressguard::calib

@@ -1,0 +1,29 @@
+// The simulation-trained classifier (STC, paper section V-B and VI): one left-right HMM per
+// outcome, trained on a synthesized dataset with the HMM module (dg_hmm), written as a .dgm model.
+// Built only when dg_hmm is (DRESSGUARD_HAVE_HMM).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "dataset.h"
+#include "dgm.h"
+
+namespace dressguard::calib {
+
+struct StcOptions {
+  int states = 10;             // paper VI: bivariate HMMs with 10 hidden states
+  bool uniform_priors = true;  // paper V-B: the class whose HMM has the highest likelihood
+  std::string source;          // written into the model's metadata
+};
+
+// Trains the HMMs of every outcome present among the labelled trials.
+model::OutcomeModel build_outcome_model(const std::vector<const HapticSequence*>& trials, const StcOptions& o);
+
+// The fraction of `trials` whose label the model predicts, with every trial cut after
+// `truncate_at` metres of travel (infinity: whole). Trials whose label is not a class of the
+// model are skipped.
+double accuracy(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials,
+                double truncate_at, int* counted = nullptr);
+
+}  // namespace dressguard::calib

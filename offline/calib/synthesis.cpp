@@ -1,0 +1,148 @@
+// Haptic data synthesis, see synthesis.h (paper section V-A).
+#include "synthesis.h"
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <mutex>
+
+#include "files.h"
+
+namespace dressguard::calib {
+
+namespace fs = std::filesystem;
+
+std::string synthesis_trial_id(ArmHeight height, int index) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "sim-%s-%03d", std::string(arm_height_name(height)).c_str(), index);
+  return buf;
+}
+
+TrialRequest synthesis_request(const Calibration& cal, ArmHeight height, int index, const SynthesisOptions& o) {
+  const std::uint64_t key = static_cast<std::uint64_t>(height) * 1000003ull + static_cast<std::uint64_t>(index);
+  const std::uint64_t stream = mix_seed(o.seed, key);
+  const double u = static_cast<double>(stream >> 11) * 0x1.0p-53;  // U[0, 1)
+  TrialRequest r;
+  r.height = height;
+  // The study's protocol: half the trials at 0.1 m/s, half at 0.15 m/s.
+  r.speed = index < o.per_height / 2 ? 0.1 : 0.15;
+  r.gown_noise = o.gown_noise;
+  r.seed = mix_seed(stream, 1);
+  r.max_travel = cal.rig_travel;  // the calibrated participant's rig (calibration.h, rig_travel_of)
+  if (height == ArmHeight::Middle) {
+    // Middle: noise on the nominal height, U[-6, 0] cm (the paper's gravity compensation).
+    r.arm_offset = o.arm_noise ? kArmNoiseMiddleLow * u : 0.0;
+  } else {
+    // High and low: calibrated offset + U[-1.5, 1.5] cm.
+    r.arm_offset = cal.offsets[static_cast<int>(height)] + (o.arm_noise ? kArmNoiseHighLow * (2.0 * u - 1.0) : 0.0);
+  }
+  return r;
+}
+
+namespace {
+
+std::string settings_record(const Calibration& cal, const SynthesisOptions& o) {
+  Json j = Json::object();
+  j.set("format", "dressguard-synthesis 1");
+  j.set("calibration", calibration_to_json(cal));
+  j.set("per_height", o.per_height);
+  j.set("gown_noise", o.gown_noise);
+  j.set("arm_noise", o.arm_noise);
+  j.set("seed", std::to_string(o.seed));
+  return j.dump() + "\n";
+}
+
+fs::path marker_path(const fs::path& out, const std::string& id) { return out / ".synth" / (id + ".done"); }
+
+}  // namespace
+
+SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, const SynthesisOptions& options,
+                            const fs::path& out, const Comm& comm,
+                            const std::function<void(const SynthesisProgress&)>& progress) {
+  if (options.per_height < 1) throw std::invalid_argument("synthesize: per_height must be at least 1");
+  const auto t0 = std::chrono::steady_clock::now();
+  // A folder holds one synthesis: resuming with other settings would mix two datasets.
+  const std::string record = settings_record(cal, options);
+  const fs::path record_path = out / "synthesis.json";
+  if (fs::exists(record_path) && read_file(record_path) != record)
+    throw_input_error(record_path, 0,
+                      "this folder holds a synthesis with other settings (calibration, count, noise or seed); "
+                      "choose another --out or remove it");
+  comm.barrier();
+  if (comm.is_root()) write_file_atomic(record_path, record);
+  comm.barrier();
+
+  const ArmHeight heights[3] = {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low};
+  const int total = 3 * options.per_height;
+  std::atomic<int> done{0}, skipped{0};
+  std::mutex progress_mutex;
+  const int mine = (total - comm.rank() + comm.size() - 1) / comm.size();
+  // Result block per trial: label code, resumed flag.
+  const std::vector<double> res =
+      run_batch(total, 2, thread_count(options.threads), comm, [&](int t, double* r) {
+        const ArmHeight h = heights[t / options.per_height];
+        const int index = t % options.per_height;
+        const std::string id = synthesis_trial_id(h, index);
+        const fs::path csv = out / (id + ".csv");
+        const fs::path marker = marker_path(out, id);
+        bool resumed = false;
+        if (fs::exists(marker) && fs::exists(csv)) {
+          const std::string text = read_file(marker);
+          const auto label = parse_outcome(text.substr(0, text.find('\n')));
+          if (label) {
+            r[0] = static_cast<double>(*label);
+            resumed = true;
+          }
+        }
+        if (!resumed) {
+          const SimulatedTrial st = sim(cal.cloth, synthesis_request(cal, h, index, options));
+          if (!st.finite || st.samples.empty())
+            throw std::runtime_error("simulation of " + id + " did not stay finite; check the calibration");
+          write_file_atomic(csv, format_trial_csv(st.samples));
+          write_file_atomic(marker, std::string(outcome_name(st.outcome)) + "\n");
+          r[0] = static_cast<double>(st.outcome);
+        }
+        r[1] = resumed ? 1.0 : 0.0;
+        const int d = ++done;
+        if (resumed) ++skipped;
+        if (progress && comm.is_root()) {
+          std::lock_guard<std::mutex> lock(progress_mutex);
+          SynthesisProgress p;
+          p.done = d;
+          p.total = mine;
+          p.skipped = skipped;
+          p.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+          const int simulated = d - skipped;
+          p.eta_s = simulated > 0 ? p.elapsed_s / simulated * (mine - d) : 0.0;
+          progress(p);
+        }
+      });
+
+  SynthesisSummary s;
+  s.trials = total;
+  for (int t = 0; t < total; ++t) {
+    s.per_label[static_cast<int>(res[2 * t])]++;
+    s.resumed += res[2 * t + 1] > 0.5;
+  }
+  if (comm.is_root()) {
+    Dataset ds;
+    for (int t = 0; t < total; ++t) {
+      HapticSequence seq;
+      const ArmHeight h = heights[t / options.per_height];
+      const int index = t % options.per_height;
+      seq.id = synthesis_trial_id(h, index);
+      seq.participant = "";
+      seq.height = h;
+      seq.speed = synthesis_request(cal, h, index, options).speed;
+      seq.label = static_cast<Outcome>(static_cast<int>(res[2 * t]));
+      seq.samples = read_trial_csv(out / (seq.id + ".csv"));
+      ds.trials.push_back(std::move(seq));
+    }
+    save_dataset(ds, out);
+  }
+  comm.barrier();
+  s.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return s;
+}
+
+}  // namespace dressguard::calib

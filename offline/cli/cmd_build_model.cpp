@@ -1,0 +1,77 @@
+// dressguard build-model: the simulation-trained classifier (STC) from a calibration (synthesize,
+// then train three HMMs) or from an existing dataset (paper V-B).
+#include <cstdio>
+
+#include "args.h"
+#include "calibration.h"
+#include "commands.h"
+#include "dataset.h"
+#include "files.h"
+#include "synthesis.h"
+#ifdef DRESSGUARD_HAVE_HMM
+#include "stc.h"
+#endif
+
+namespace dressguard::cli {
+
+using namespace dressguard::calib;
+
+SynthesisOptions synthesis_options_from(const Args& args);
+SynthesisSummary run_synthesis(const Calibration& cal, const std::string& gown, const SynthesisOptions& o,
+                               const std::string& out);
+
+int run_build_model(int argc, char** argv) {
+  Args args(argc - 1, argv + 1, {"help", "json", "no-gown-noise", "no-arm-noise"});
+  if (args.has("help")) {
+    std::puts(
+        "usage: dressguard build-model (--calibration CAL.json | --data DATASET) --out MODEL.dgm [options]\n"
+        "  With --calibration: synthesizes the training data first (into --synth-dir, default\n"
+        "  MODEL.dgm.synth/, resumable; the synthesize options apply), then trains one 10-state\n"
+        "  left-right bivariate HMM per outcome (paper V-B) and writes the model file.\n"
+        "  With --data: trains on the labelled trials of an existing dataset.\n"
+        "  --states N   hidden states per HMM (default 10, paper VI)\n"
+        "  --per-height N --no-gown-noise --no-arm-noise --seed S --threads N --gown G  (synthesis)\n"
+        "  --json       machine-readable summary");
+    return 0;
+  }
+  args.allow_only({"help", "json", "no-gown-noise", "no-arm-noise", "calibration", "data", "out", "synth-dir",
+                   "states", "per-height", "seed", "gown", "threads"});
+  const std::string out = args.require("out");
+  if (args.has("calibration") == args.has("data")) throw UsageError("give exactly one of --calibration and --data");
+  const int states = static_cast<int>(args.integer("states", 10));
+  if (states < 1 || states > 32) throw UsageError("--states must be in 1..32");
+  std::string data;
+  if (args.has("calibration")) {
+    const Calibration cal = read_calibration(*args.get("calibration"));
+    data = args.get("synth-dir").value_or(out + ".synth");
+    run_synthesis(cal, args.get("gown").value_or(cal.gown), synthesis_options_from(args), data);
+  } else {
+    data = *args.get("data");
+  }
+  if (!Comm::world().is_root()) return 0;  // training is one process's job (seconds)
+#ifndef DRESSGUARD_HAVE_HMM
+  throw UsageError("this dressguard was built without the HMM module (offline/hmm); build-model needs it");
+#else
+  const Dataset ds = load_dataset(data);
+  std::vector<const HapticSequence*> trials;
+  for (const auto& t : ds.trials) trials.push_back(&t);
+  StcOptions so;
+  so.states = states;
+  so.source = data;
+  const model::OutcomeModel m = build_outcome_model(trials, so);
+  model::write_model(out, m);
+  const double acc = accuracy(m, trials, std::numeric_limits<double>::infinity());
+  if (args.has("json")) {
+    std::printf("{\"model\": \"%s\", \"classes\": %zu, \"training_trials\": %zu, \"training_accuracy\": %.4f}\n",
+                out.c_str(), m.classes.size(), trials.size(), acc);
+  } else {
+    std::printf("wrote %s: %zu classes (", out.c_str(), m.classes.size());
+    for (std::size_t i = 0; i < m.classes.size(); ++i) std::printf("%s%s", i ? ", " : "", m.classes[i].name.c_str());
+    std::printf(") from %zu trials of %s; accuracy on its own training data %.1f%%\n", trials.size(), data.c_str(),
+                100 * acc);
+  }
+  return 0;
+#endif
+}
+
+}  // namespace dressguard::cli

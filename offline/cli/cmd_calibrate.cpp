@@ -1,0 +1,175 @@
+// dressguard calibrate: fit the simulator's cloth parameters and arm offsets to one participant's
+// measured sequences with CMA-ES (paper section IV-B). See offline/calib/README.md.
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+
+#include "args.h"
+#include "calibration.h"
+#include "commands.h"
+#include "dataset.h"
+#include "files.h"
+#ifdef DRESSGUARD_HAVE_SIM
+#include "sim_bridge.h"
+#endif
+
+namespace dressguard::cli {
+
+using namespace dressguard::calib;
+
+namespace {
+
+[[maybe_unused]] std::string utc_now() {
+  const std::time_t t = std::time(nullptr);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+  return buf;
+}
+
+[[maybe_unused]] std::string minutes(double s) {
+  char buf[32];
+  if (s < 120) std::snprintf(buf, sizeof buf, "%.0f s", s);
+  else std::snprintf(buf, sizeof buf, "%.1f min", s / 60);
+  return buf;
+}
+
+}  // namespace
+
+int run_calibrate(int argc, char** argv) {
+  Args args(argc - 1, argv + 1, {"help", "json", "no-arm-offset"});
+  if (args.has("help")) {
+    std::puts(
+        "usage: dressguard calibrate --data DATASET --participant P --out CAL.json [options]\n"
+        "  Fits stretch, shear, bend, friction, self-friction and one arm-height offset per height\n"
+        "  to one measured sequence per arm height of participant P (caught excluded; paper IV-B)\n"
+        "  with CMA-ES, minimising the area between force curves (eq. 3-5).\n"
+        "  --profile default|quick   default: 50 generations x 32 (the paper); quick: 6 x 8 (tests)\n"
+        "  --generations N --population N   override the profile\n"
+        "  --bounds FILE       'name lower upper [initial]' lines (offline/calib/README.md)\n"
+        "  --seed S            input selection and CMA-ES (default 1); same seed, same result\n"
+        "  --objective area|position-weighted   (default area: paper eq. 3-5)\n"
+        "  --no-arm-offset     do not optimise the arm offsets (paper Fig. 9 comparison)\n"
+        "  --gown full|reduced|coarse   simulator gown (default reduced)\n"
+        "  --threads N         threads per process (default: all cores)\n"
+        "  --checkpoint FILE   default CAL.json.ckpt; an existing one is resumed\n"
+        "  --stop-after-generations K   stop after K generations in this process (resume later)\n"
+        "  --json              machine-readable summary on stdout\n"
+        "  Writes CAL.json and CAL.json.curves.csv (measured and simulated curves; plot them with\n"
+        "  tools/plot/calib_overlay.py). Under mpirun every rank runs a share of each generation.");
+    return 0;
+  }
+  args.allow_only({"help", "json", "no-arm-offset", "data", "participant", "profile", "bounds", "seed", "out",
+                   "checkpoint", "objective", "gown", "threads", "generations", "population",
+                   "stop-after-generations"});
+  const std::string data = args.require("data");
+  const std::string participant = args.require("participant");
+  const std::string out = args.require("out");
+  const std::string profile = args.get("profile").value_or("default");
+  if (profile != "default" && profile != "quick") throw UsageError("--profile must be default or quick");
+  CalibrationOptions o;
+  o.generations = profile == "quick" ? 6 : 50;
+  o.population = profile == "quick" ? 8 : 32;
+  o.generations = static_cast<int>(args.integer("generations", o.generations));
+  o.population = static_cast<int>(args.integer("population", o.population));
+  if (o.generations < 1 || o.population < 4) throw UsageError("need --generations >= 1 and --population >= 4");
+  const long seed = args.integer("seed", 1);
+  if (seed < 0) throw UsageError("--seed must be non-negative");
+  o.seed = static_cast<std::uint64_t>(seed);
+  const auto kind = parse_objective(args.get("objective").value_or("area"));
+  if (!kind) throw UsageError("--objective must be area or position-weighted");
+  o.objective = *kind;
+  o.threads = static_cast<int>(args.integer("threads", 0));
+  o.checkpoint = args.get("checkpoint").value_or(out + ".ckpt");
+  o.stop_after_generations = static_cast<int>(args.integer("stop-after-generations", 0));
+  const std::string gown = args.get("gown").value_or("reduced");
+  if (gown != "full" && gown != "reduced" && gown != "coarse") throw UsageError("--gown must be full, reduced or coarse");
+
+  const Dataset ds = load_dataset(data);
+  const std::vector<HapticSequence> inputs = select_inputs(ds, participant, o.seed);
+  ParameterSpace space;
+  space.bounds = args.get("bounds") ? read_bounds(*args.get("bounds")) : default_bounds();
+  if (!args.has("no-arm-offset"))
+    for (const auto& s : inputs) space.offset_heights.push_back(s.height);
+
+#ifndef DRESSGUARD_HAVE_SIM
+  throw UsageError("this dressguard was built without the cloth simulator (offline/sim); calibrate needs it");
+#else
+  const Comm& comm = Comm::world();
+  const TrialSimulator sim = make_cloth_simulator(gown);
+  if (comm.is_root()) {
+    std::fprintf(stderr, "calibrate: participant %s, %zu sequences (", participant.c_str(), inputs.size());
+    for (std::size_t k = 0; k < inputs.size(); ++k) std::fprintf(stderr, "%s%s", k ? ", " : "", inputs[k].id.c_str());
+    std::fprintf(stderr, "), %d parameters, %d x %d, %d rank(s) x %d thread(s), gown %s\n", space.dimension(),
+                 o.generations, o.population, comm.size(), thread_count(o.threads), gown.c_str());
+  }
+  const CalibrationResult r = calibrate(inputs, space, sim, o, comm, [&](const GenerationProgress& p) {
+    std::fprintf(stderr, "generation %d/%d  best L %.4f  (this generation %.4f)  elapsed %s  ETA %s\n", p.generation,
+                 p.generations, p.best, p.generation_best, minutes(p.elapsed_s).c_str(), minutes(p.eta_s).c_str());
+  });
+  if (!r.complete) {
+    if (comm.is_root()) {
+      if (args.has("json"))
+        std::printf("{\"complete\": false, \"generations_done\": %d, \"checkpoint\": \"%s\"}\n", r.generations_done,
+                    o.checkpoint.c_str());
+      else
+        std::printf("stopped after %d generations; run the same command again to resume from %s\n",
+                    r.generations_done, o.checkpoint.c_str());
+    }
+    return 0;
+  }
+  Calibration cal;
+  cal.participant = participant;
+  cal.cloth = r.cloth;
+  cal.offsets = r.offsets;
+  for (ArmHeight h : space.offset_heights) cal.offset_calibrated[static_cast<int>(h)] = true;
+  cal.objective = r.objective;
+  cal.fits = r.fits;
+  cal.objective_kind = std::string(objective_name(o.objective));
+  cal.gown = gown;
+  cal.rig_travel = rig_travel_of(inputs);
+  Json prov = Json::object();
+  prov.set("tool", "dressguard calibrate");
+  prov.set("created", utc_now());
+  prov.set("dataset", data);
+  prov.set("seed", std::to_string(o.seed));
+  prov.set("profile", profile);
+  prov.set("generations", r.generations_done);
+  prov.set("population", o.population);
+  prov.set("evaluations", r.evaluations);
+  prov.set("simulations", r.evaluations * static_cast<long>(inputs.size()));
+  prov.set("ranks", comm.size());
+  prov.set("threads_per_rank", thread_count(o.threads));
+  prov.set("elapsed_s_last_process", r.elapsed_s);
+  Json names = Json::array();
+  for (const auto& n : space.names()) names.push(n);
+  prov.set("parameters", names);
+  Json unit = Json::array();
+  for (long i = 0; i < r.best_unit.size(); ++i) unit.push(r.best_unit[i]);
+  prov.set("best_unit_vector", unit);
+  cal.provenance = prov;
+  // The best candidate's curves, simulated again (deterministic: the same as during the search).
+  std::vector<SimulatedTrial> curves(inputs.size());
+  if (comm.is_root()) {
+    for (std::size_t k = 0; k < inputs.size(); ++k) curves[k] = sim(r.cloth, request_for(inputs[k], r.offsets));
+    write_calibration(out, cal);
+    write_file_atomic(out + ".curves.csv",
+                      overlay_csv(inputs, curves, args.has("no-arm-offset") ? "simulated-no-offset" : "simulated"));
+    std::filesystem::remove(o.checkpoint);  // done: a rerun starts afresh
+    if (args.has("json")) {
+      std::printf("%s\n", calibration_to_json(cal).dump(0).c_str());
+    } else {
+      std::printf("participant %s: L = %.4f after %d generations (%ld evaluations, %s)\n", participant.c_str(),
+                  r.objective, r.generations_done, r.evaluations, minutes(r.elapsed_s).c_str());
+      for (const auto& f : r.fits) std::printf("  %-18s %-6s L = %.4f\n", f.trial_id.c_str(),
+                                               std::string(arm_height_name(f.height)).c_str(), f.objective);
+      for (int i = 0; i < kClothParams; ++i) std::printf("  %-13s %.4f\n", kClothParamNames[i], cloth_value(r.cloth, i));
+      for (ArmHeight h : space.offset_heights)
+        std::printf("  arm offset %-6s %+.4f m\n", std::string(arm_height_name(h)).c_str(), r.offsets[static_cast<int>(h)]);
+      std::printf("wrote %s and %s.curves.csv\n", out.c_str(), out.c_str());
+    }
+  }
+  return 0;
+#endif
+}
+
+}  // namespace dressguard::cli

@@ -1,0 +1,320 @@
+// The calibration and synthesis drivers with the analytic stand-in simulator (fake_sim.h):
+// recovery of known parameters, independence of the thread count, checkpoint and resume,
+// bounds files, input selection on the measured data, the calibration file.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include <unistd.h>
+
+#include "calibration.h"
+#include "fake_sim.h"
+#include "files.h"
+#include "synthesis.h"
+
+namespace dressguard::calib {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path temp_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("dg_calib_test_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+// "Measured" sequences made by the stand-in at known parameters and offsets.
+struct Truth {
+  ClothValues cloth{0.6, 0.3, 0.7, 0.9, 0.4};
+  std::array<double, 3> offsets{0.02, 0.0, -0.03};
+};
+
+std::vector<HapticSequence> fake_inputs(const Truth& truth) {
+  std::vector<HapticSequence> v;
+  for (ArmHeight h : {ArmHeight::High, ArmHeight::Low}) {
+    HapticSequence s;
+    s.id = std::string("fake-") + std::string(arm_height_name(h));
+    s.participant = "9";
+    s.height = h;
+    s.speed = 0.1;
+    s.label = h == ArmHeight::High ? Outcome::Good : Outcome::Missed;
+    TrialRequest r;
+    r.height = h;
+    r.arm_offset = truth.offsets[static_cast<int>(h)];
+    r.speed = 0.1;
+    s.samples = testing::fake_simulate(truth.cloth, r).samples;
+    v.push_back(s);
+  }
+  return v;
+}
+
+ParameterSpace space_for(const std::vector<HapticSequence>& inputs) {
+  ParameterSpace sp;
+  sp.bounds = default_bounds();
+  for (const auto& s : inputs) sp.offset_heights.push_back(s.height);
+  return sp;
+}
+
+CalibrationOptions quick(int gens, int threads) {
+  CalibrationOptions o;
+  o.generations = gens;
+  o.population = 16;
+  o.seed = 11;
+  o.threads = threads;
+  return o;
+}
+
+// The initial guess is far from the truth; after 60 generations x 16 the objective must be below
+// 2% of the initial one (the stand-in is smooth, so CMA-ES converges; 2% leaves room for the
+// seed) and the offsets within 5 mm of the truth (they set the vertical slope directly).
+TEST(Calibration, RecoversKnownParametersOfTheStandIn) {
+  const Truth truth;
+  const auto inputs = fake_inputs(truth);
+  const auto space = space_for(inputs);
+  double initial = 0;
+  for (const auto& s : inputs)
+    initial += area_objective(
+        testing::fake_simulate(space.cloth(space.initial_unit()), request_for(s, space.offsets(space.initial_unit())))
+            .samples,
+        s.samples);
+  const auto r = calibrate(inputs, space, testing::fake_simulate, quick(60, 2), Comm::world());
+  std::printf("  initial L %.4f -> calibrated L %.6f after %ld evaluations\n", initial, r.objective, r.evaluations);
+  EXPECT_TRUE(r.complete);
+  EXPECT_EQ(r.generations_done, 60);
+  EXPECT_EQ(r.evaluations, 60 * 16);
+  EXPECT_LT(r.objective, 0.02 * initial);
+  EXPECT_NEAR(r.offsets[0], truth.offsets[0], 0.005);
+  EXPECT_NEAR(r.offsets[2], truth.offsets[2], 0.005);
+  EXPECT_EQ(r.offsets[1], 0.0);  // no middle input: no middle offset
+  ASSERT_EQ(r.fits.size(), 2u);
+  EXPECT_NEAR(r.fits[0].objective + r.fits[1].objective, r.objective, 1e-12);
+}
+
+TEST(Calibration, ResultDoesNotDependOnThreadCount) {
+  const auto inputs = fake_inputs(Truth{});
+  const auto space = space_for(inputs);
+  const auto a = calibrate(inputs, space, testing::fake_simulate, quick(12, 1), Comm::world());
+  const auto b = calibrate(inputs, space, testing::fake_simulate, quick(12, 3), Comm::world());
+  EXPECT_EQ(a.objective, b.objective);  // bitwise
+  EXPECT_TRUE(a.best_unit == b.best_unit);
+}
+
+// Interrupt after 5 generations (as a kill after the 5th checkpoint would), resume: the final
+// result equals an uninterrupted run's, bit for bit.
+TEST(Calibration, ResumeFromCheckpointGivesTheUninterruptedResult) {
+  const auto inputs = fake_inputs(Truth{});
+  const auto space = space_for(inputs);
+  const auto full = calibrate(inputs, space, testing::fake_simulate, quick(15, 2), Comm::world());
+  const fs::path dir = temp_dir("resume");
+  auto o = quick(15, 2);
+  o.checkpoint = dir / "run.ckpt";
+  o.stop_after_generations = 5;
+  const auto part = calibrate(inputs, space, testing::fake_simulate, o, Comm::world());
+  EXPECT_FALSE(part.complete);
+  EXPECT_EQ(part.generations_done, 5);
+  ASSERT_TRUE(fs::exists(o.checkpoint));
+  o.stop_after_generations = 0;
+  int first_reported = 0;
+  const auto resumed = calibrate(inputs, space, testing::fake_simulate, o, Comm::world(),
+                                 [&](const GenerationProgress& p) {
+                                   if (!first_reported) first_reported = p.generation;
+                                   EXPECT_TRUE(p.resumed);
+                                 });
+  EXPECT_EQ(first_reported, 6);  // continued with generation 6, not from scratch
+  EXPECT_TRUE(resumed.complete);
+  EXPECT_EQ(resumed.generations_done, 15);
+  EXPECT_EQ(resumed.evaluations, full.evaluations);
+  EXPECT_EQ(resumed.objective, full.objective);
+  EXPECT_TRUE(resumed.best_unit == full.best_unit);
+  for (std::size_t k = 0; k < full.fits.size(); ++k) EXPECT_EQ(resumed.fits[k].objective, full.fits[k].objective);
+  fs::remove_all(dir);
+}
+
+TEST(Calibration, CheckpointOfAnotherRunIsRefused) {
+  const auto inputs = fake_inputs(Truth{});
+  const auto space = space_for(inputs);
+  const fs::path dir = temp_dir("mismatch");
+  auto o = quick(3, 1);
+  o.checkpoint = dir / "run.ckpt";
+  calibrate(inputs, space, testing::fake_simulate, o, Comm::world());
+  o.seed = 12;  // another run
+  EXPECT_THROW(calibrate(inputs, space, testing::fake_simulate, o, Comm::world()), InputError);
+  write_file_atomic(o.checkpoint, "garbage\n");
+  EXPECT_THROW(calibrate(inputs, space, testing::fake_simulate, o, Comm::world()), InputError);
+  fs::remove_all(dir);
+}
+
+TEST(Calibration, BoundsFileParsesAndNamesBadLines) {
+  const fs::path dir = temp_dir("bounds");
+  const fs::path ok = dir / "ok.txt";
+  write_file_atomic(ok, "# cloth box\nfriction 0.1 1.5 0.6\n\narm_offset -0.03 0.03\n");
+  const Bounds b = read_bounds(ok);
+  EXPECT_EQ(b.cloth[3].lower, 0.1);
+  EXPECT_EQ(b.cloth[3].upper, 1.5);
+  EXPECT_EQ(b.cloth[3].initial, 0.6);
+  EXPECT_EQ(b.arm_offset.initial, 0.0);           // midpoint when not given
+  EXPECT_EQ(b.cloth[0].upper, default_bounds().cloth[0].upper);  // untouched default
+  auto error_of = [&](const std::string& text) {
+    write_file_atomic(dir / "bad.txt", text);
+    try {
+      read_bounds(dir / "bad.txt");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(error_of("stretch 0 1\nstiffness 0 1\n").find("bad.txt:2: unknown parameter 'stiffness'"), std::string::npos);
+  EXPECT_NE(error_of("bend 1 0\n").find("bad.txt:1:"), std::string::npos);
+  EXPECT_NE(error_of("bend 0 1 2\n").find("outside"), std::string::npos);
+  EXPECT_NE(error_of("bend 0\n").find("expected"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+// Paper IV-B.1 on the measured data: one sequence per height, caught never chosen (the study
+// folder holds none), two sequences when a participant has no middle-height miss.
+TEST(Calibration, InputSelectionOnMeasuredData) {
+  const auto dir = study_dir();
+  if (dir.empty()) GTEST_SKIP() << "shared/data/kapusta2016-calibration-trials not present";
+  const Dataset ds = import_study(dir);
+  const auto s1 = select_inputs(ds, "1", 1);  // subject 1: good and miss only
+  ASSERT_EQ(s1.size(), 2u);
+  EXPECT_EQ(s1[0].height, ArmHeight::High);
+  EXPECT_EQ(s1[1].height, ArmHeight::Low);
+  const auto s2 = select_inputs(ds, "2", 1);  // subject 2: all three heights
+  ASSERT_EQ(s2.size(), 3u);
+  for (const auto& s : s2) EXPECT_NE(*s.label, Outcome::Caught);
+  EXPECT_EQ(select_inputs(ds, "2", 5)[0].id, select_inputs(ds, "2", 5)[0].id);  // deterministic
+  EXPECT_THROW(select_inputs(ds, "42", 1), InputError);
+}
+
+TEST(Calibration, CalibrationFileRoundTripAndErrors) {
+  Calibration c;
+  c.participant = "4";
+  c.cloth = {0.1, 0.2, 0.3, 0.4, 0.5};
+  c.offsets = {-0.02, 0.0, 0.011};
+  c.offset_calibrated = {true, false, true};
+  c.objective = 0.4567;
+  c.fits = {{"s4-good-3", ArmHeight::High, 0.1, 0.22}, {"s4-miss-2", ArmHeight::Low, 0.15, 0.2367}};
+  c.rig_travel = 0.72;
+  c.provenance.set("seed", "1");
+  const fs::path dir = temp_dir("calfile");
+  write_calibration(dir / "cal.json", c);
+  const Calibration d = read_calibration(dir / "cal.json");
+  EXPECT_EQ(d.participant, "4");
+  EXPECT_EQ(d.cloth.self_friction, 0.5);
+  EXPECT_EQ(d.offsets[2], 0.011);
+  EXPECT_FALSE(d.offset_calibrated[1]);
+  ASSERT_EQ(d.fits.size(), 2u);
+  EXPECT_EQ(d.fits[1].speed, 0.15);
+  EXPECT_EQ(d.rig_travel, 0.72);
+  write_file_atomic(dir / "bad.json", "{\"format\": \"dressguard-calibration 1\",\n \"participant\": 4}");
+  EXPECT_THROW(read_calibration(dir / "bad.json"), InputError);
+  write_file_atomic(dir / "bad2.json", "{\"format\": \n");
+  try {
+    read_calibration(dir / "bad2.json");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad2.json:2:"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+}
+
+// Synthesis with the stand-in: counts, speeds and noise ranges of paper V-A, labels from the
+// simulator, independence of the thread count, resume after a partial run, switches.
+TEST(Synthesis, CountsSpeedsNoiseRangesAndLabels) {
+  Calibration cal;
+  cal.offsets = {0.01, 0.0, -0.02};
+  SynthesisOptions o;
+  o.per_height = 100;
+  for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
+    int slow = 0;
+    double lo = 1, hi = -1;
+    for (int i = 0; i < o.per_height; ++i) {
+      const auto r = synthesis_request(cal, h, i, o);
+      slow += r.speed == 0.1;
+      EXPECT_TRUE(r.speed == 0.1 || r.speed == 0.15);
+      EXPECT_TRUE(r.gown_noise);
+      lo = std::min(lo, r.arm_offset);
+      hi = std::max(hi, r.arm_offset);
+    }
+    EXPECT_EQ(slow, 50);
+    if (h == ArmHeight::Middle) {
+      EXPECT_GE(lo, -0.06);
+      EXPECT_LE(hi, 0.0);
+      EXPECT_LT(lo, -0.05);  // 100 uniform draws fill the range (a gap > 1 cm has probability < 1e-7)
+    } else {
+      const double base = cal.offsets[static_cast<int>(h)];
+      EXPECT_GE(lo, base - 0.015);
+      EXPECT_LE(hi, base + 0.015);
+      EXPECT_LT(lo, base - 0.01);
+      EXPECT_GT(hi, base + 0.01);
+    }
+  }
+  SynthesisOptions off = o;
+  off.arm_noise = false;
+  off.gown_noise = false;
+  EXPECT_EQ(synthesis_request(cal, ArmHeight::Low, 3, off).arm_offset, -0.02);
+  EXPECT_EQ(synthesis_request(cal, ArmHeight::Middle, 3, off).arm_offset, 0.0);
+  EXPECT_FALSE(synthesis_request(cal, ArmHeight::Low, 3, off).gown_noise);
+}
+
+TEST(Synthesis, DatasetIsIndependentOfThreadsAndResumes) {
+  Calibration cal;
+  SynthesisOptions o;
+  o.per_height = 10;
+  const fs::path a = temp_dir("synth_a"), b = temp_dir("synth_b");
+  o.threads = 1;
+  const auto sa = synthesize(cal, testing::fake_simulate, o, a, Comm::world());
+  EXPECT_EQ(sa.trials, 30);
+  EXPECT_EQ(sa.per_label[0] + sa.per_label[1] + sa.per_label[2], 30);
+  EXPECT_GT(sa.per_label[static_cast<int>(Outcome::Missed)], 0);  // the low arm misses
+  EXPECT_GT(sa.per_label[static_cast<int>(Outcome::Good)], 0);    // the high arm goes in
+  // Partial run in b: simulate everything, then delete a third of the trials as a kill would
+  // have left them missing; the rerun simulates only those.
+  o.threads = 3;
+  synthesize(cal, testing::fake_simulate, o, b, Comm::world());
+  for (int i = 0; i < 10; ++i) fs::remove(b / ".synth" / (synthesis_trial_id(ArmHeight::Middle, i) + ".done"));
+  const auto sb = synthesize(cal, testing::fake_simulate, o, b, Comm::world());
+  EXPECT_EQ(sb.resumed, 20);
+  const Dataset da = load_dataset(a), db = load_dataset(b);
+  ASSERT_EQ(da.trials.size(), 30u);
+  ASSERT_EQ(db.trials.size(), 30u);
+  for (std::size_t i = 0; i < 30; ++i) {
+    EXPECT_EQ(da.trials[i].id, db.trials[i].id);
+    EXPECT_EQ(da.trials[i].label, db.trials[i].label);
+    EXPECT_EQ(read_file(a / (da.trials[i].id + ".csv")), read_file(b / (db.trials[i].id + ".csv")));
+  }
+  // Other settings into the same folder are refused.
+  o.seed = 2;
+  EXPECT_THROW(synthesize(cal, testing::fake_simulate, o, b, Comm::world()), InputError);
+  fs::remove_all(a);
+  fs::remove_all(b);
+}
+
+}  // namespace
+}  // namespace dressguard::calib
+
+namespace dressguard::calib {
+namespace {
+
+// The travel limit of a calibration simulation follows the measured trial: a miss that ended at
+// 0.72 m without reaching 10 N is simulated to 0.72 m; a good trial that stopped at 10 N is
+// simulated to the rig's 0.85 m (the simulation's own force stop ends it).
+TEST(Calibration, TravelLimitFollowsTheMeasuredTrial) {
+  HapticSequence miss;
+  miss.height = ArmHeight::Low;
+  miss.samples = {{0, 0, 0, 0, 0}, {7.2, 0.72, -4.0, 0, -0.6}};
+  HapticSequence good;
+  good.samples = {{0, 0, 0, 0, 0}, {6.1, 0.61, -10.01, 0, -1.1}};
+  EXPECT_FALSE(stopped_by_force(miss));
+  EXPECT_TRUE(stopped_by_force(good));
+  EXPECT_DOUBLE_EQ(request_for(miss, {}).max_travel, 0.72);
+  EXPECT_DOUBLE_EQ(request_for(good, {}).max_travel, 0.85);
+  EXPECT_DOUBLE_EQ(rig_travel_of({good, miss}), 0.72);
+  EXPECT_DOUBLE_EQ(rig_travel_of({good}), 0.85);
+}
+
+}  // namespace
+}  // namespace dressguard::calib

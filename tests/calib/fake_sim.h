@@ -1,0 +1,43 @@
+// A cheap analytic stand-in for the cloth simulator, for unit tests of the calibration and
+// synthesis drivers only (the real simulator is tested with them in sim_calibration_test.cpp).
+//
+// It has the shape of a sleeve pull: the drag grows with travel at a rate set by friction and
+// stretch, with a bump set by shear; the vertical force's slope depends on the arm height and its
+// offset (bend and self-friction shift it); the pull stops at 10 N or 0.85 m like the rig. Every
+// parameter changes the curves, so a calibration against curves made at known parameters must
+// find a near-zero objective. The gown noise adds a seeded, smooth disturbance. Deterministic
+// and thread-safe (no state).
+#pragma once
+
+#include <cmath>
+
+#include "calibration.h"
+
+namespace dressguard::calib::testing {
+
+inline SimulatedTrial fake_simulate(const ClothValues& c, const TrialRequest& r) {
+  SimulatedTrial out;
+  const double h = r.height == ArmHeight::High ? 0.0 : (r.height == ArmHeight::Middle ? -0.123 : -0.205);
+  const double arm = h + r.arm_offset;  // [m] relative to the high setting
+  const double noise_amp = r.gown_noise ? 0.3 * static_cast<double>(mix_seed(r.seed, 7) >> 11) * 0x1.0p-53 : 0.0;
+  const double catchiness = std::max(0.0, 1.0 + 6.0 * arm);  // high arm: the sleeve tightens on the elbow
+  for (int i = 0;; ++i) {
+    const double t = i * 0.01;
+    const double x = std::min(r.speed * t, r.max_travel);
+    const double drag = (1.5 * c.friction + 2.0 * c.stretch) * x * (1.0 + 12.0 * catchiness * x * x) +
+                        0.6 * c.shear * std::sin(6.0 * x) + noise_amp * std::sin(20.0 * x + r.seed % 7);
+    const double vert = (0.5 + 10.0 * arm) * x * (0.5 + c.bend) - 0.8 * c.self_friction * x * x;
+    out.samples.push_back({t, x, -drag, 0.0, vert});
+    if (drag >= 10.0 || std::abs(vert) >= 10.0) {
+      out.outcome = arm > -0.05 ? Outcome::Good : Outcome::Caught;
+      break;
+    }
+    if (x >= r.max_travel) {
+      out.outcome = Outcome::Missed;
+      break;
+    }
+  }
+  return out;
+}
+
+}  // namespace dressguard::calib::testing

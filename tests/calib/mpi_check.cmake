@@ -1,0 +1,23 @@
+# Runs calib_mpi_check as one process and as two MPI ranks and requires identical digests.
+# -DCHECK=<binary> -DMPIEXEC=<mpiexec> -DWORK=<dir>
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK}/one ${WORK}/two)
+execute_process(COMMAND ${CHECK} ${WORK}/one RESULT_VARIABLE rc1 OUTPUT_VARIABLE out1 ERROR_VARIABLE err1)
+if(NOT rc1 EQUAL 0)
+  message(FATAL_ERROR "single process failed (${rc1}): ${err1}")
+endif()
+execute_process(COMMAND ${MPIEXEC} --allow-run-as-root --oversubscribe -n 2 ${CHECK} ${WORK}/two
+                RESULT_VARIABLE rc2 OUTPUT_VARIABLE out2 ERROR_VARIABLE err2)
+if(NOT rc2 EQUAL 0)
+  message(FATAL_ERROR "mpirun -n 2 failed (${rc2}): ${err2}")
+endif()
+string(REGEX REPLACE "^ranks [0-9]+\n" "" d1 "${out1}")
+string(REGEX REPLACE "^ranks [0-9]+\n" "" d2 "${out2}")
+if(NOT out2 MATCHES "^ranks 2\n")
+  message(FATAL_ERROR "the MPI run did not have 2 ranks:\n${out2}\n${err2}")
+endif()
+if(NOT d1 STREQUAL d2)
+  message(FATAL_ERROR "results differ between 1 process and 2 ranks:\n--- 1 ---\n${out1}\n--- 2 ---\n${out2}")
+endif()
+message(STATUS "identical digests:\n${d1}")
+file(REMOVE_RECURSE ${WORK})

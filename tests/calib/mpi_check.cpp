@@ -1,0 +1,62 @@
+// Runs a calibration and a synthesis with the analytic stand-in simulator and prints a digest of
+// the results (exact hex floats, labels, file contents' sizes). tests/calib/mpi_check.cmake runs
+// it once as one process and once under `mpirun -n 2` and requires identical digests: the MPI
+// spreading of generations and trials must not change a single bit.
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+#include "calibration.h"
+#include "fake_sim.h"
+#include "files.h"
+#include "synthesis.h"
+
+using namespace dressguard;
+using namespace dressguard::calib;
+
+int main(int argc, char** argv) {
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: calib_mpi_check WORKDIR\n");
+    return 2;
+  }
+  const std::filesystem::path dir = argv[1];
+  const Comm& comm = Comm::world();
+  std::vector<HapticSequence> inputs;
+  for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
+    HapticSequence s;
+    s.id = std::string("m-") + std::string(arm_height_name(h));
+    s.height = h;
+    TrialRequest r;
+    r.height = h;
+    r.arm_offset = h == ArmHeight::High ? 0.01 : -0.02;
+    s.samples = testing::fake_simulate(ClothValues{0.4, 0.6, 0.3, 1.1, 0.5}, r).samples;
+    inputs.push_back(s);
+  }
+  ParameterSpace space;
+  space.bounds = default_bounds();
+  for (const auto& s : inputs) space.offset_heights.push_back(s.height);
+  CalibrationOptions o;
+  o.generations = 10;
+  o.population = 12;
+  o.seed = 5;
+  o.threads = 2;
+  const CalibrationResult r = calibrate(inputs, space, testing::fake_simulate, o, comm);
+  Calibration cal;
+  cal.cloth = r.cloth;
+  cal.offsets = r.offsets;
+  SynthesisOptions so;
+  so.per_height = 8;
+  so.threads = 2;
+  const SynthesisSummary s = synthesize(cal, testing::fake_simulate, so, dir / "synth", comm);
+  if (comm.is_root()) {
+    std::printf("ranks %d\n", comm.size());  // not part of the compared digest (first line)
+    std::printf("objective %a evaluations %ld\n", r.objective, r.evaluations);
+    for (long i = 0; i < r.best_unit.size(); ++i) std::printf("x%ld %a\n", i, r.best_unit[i]);
+    std::printf("labels %d %d %d\n", s.per_label[0], s.per_label[1], s.per_label[2]);
+    const Dataset ds = load_dataset(dir / "synth");
+    std::size_t bytes = 0;
+    for (const auto& t : ds.trials) bytes += read_file(dir / "synth" / (t.id + ".csv")).size();
+    std::printf("trials %zu bytes %zu manifest %zu\n", ds.trials.size(), bytes, read_file(dir / "synth" / "manifest.csv").size());
+  }
+  return 0;
+}

@@ -1,0 +1,145 @@
+// The calibration objective (paper eq. 3-5): closed-form cases, and the issue's yardstick on the
+// measured repeats of one person's trial.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "dataset.h"
+#include "objective.h"
+
+namespace dressguard::calib {
+namespace {
+
+// A pull at constant speed: travel i*h, forces constant.
+std::vector<HapticSample> constant_curve(int samples, double h, double f_motion, double f_vertical) {
+  std::vector<HapticSample> s(samples);
+  for (int i = 0; i < samples; ++i) s[i] = {i * 0.01, i * h, f_motion, 0.0, f_vertical};
+  return s;
+}
+
+// Two curves of equal length offset by c (motion) and d (vertical): the area between them is
+// (|c| + |d|) times the distance travelled, exactly (eq. 3-4 with no length mismatch).
+TEST(Objective, ConstantOffsetGivesOffsetTimesDistance) {
+  const int n = 501;
+  const double h = 0.001;  // 0.5 m of travel
+  const auto r = constant_curve(n, h, -2.0, 0.5);
+  const auto s = constant_curve(n, h, -2.3, 0.4);
+  const double distance = (n - 1) * h;
+  EXPECT_NEAR(area_error(s, r, ForceAxis::Motion), 0.3 * distance, 1e-12);
+  EXPECT_NEAR(area_error(s, r, ForceAxis::Vertical), 0.1 * distance, 1e-12);
+  EXPECT_NEAR(area_objective(s, r), 0.4 * distance, 1e-12);
+  EXPECT_DOUBLE_EQ(area_objective(r, r), 0.0);
+}
+
+// A simulation that runs k samples longer than the measurement, with force s_extra there:
+// eq. 4's second case adds w * k * h * |s_extra - r_n| per axis.
+TEST(Objective, LengthMismatchIsPenalisedWithW) {
+  const double h = 0.001;
+  const auto r = constant_curve(301, h, -1.0, 0.0);
+  auto s = constant_curve(301, h, -1.0, 0.0);
+  for (int i = 301; i < 351; ++i) s.push_back({i * 0.01, i * h, -4.0, 0.0, 0.0});  // 50 more samples at -4 N
+  const double expected = kLengthPenaltyWeight * 50 * h * 3.0;  // w k h |-4 - (-1)|
+  EXPECT_NEAR(area_objective(s, r), expected, 1e-12);
+  // The third case (measurement longer) is the mirror image: the same value with roles swapped.
+  EXPECT_NEAR(area_objective(r, s), expected, 1e-12);
+  EXPECT_NEAR(area_objective(s, r, /*w=*/1.0), expected / kLengthPenaltyWeight, 1e-12);
+}
+
+// Position-weighted (the public code's variant): identical curves give 0; a constant offset c on
+// travel [0, X] gives sum exp(x_i) c h -> c (e^X - 1) as h -> 0 (right Riemann sum: relative
+// error about h/2, 5e-4 here, so 1e-3 relative tolerance).
+TEST(Objective, PositionWeightedClosedForm) {
+  const double h = 0.001;
+  const auto r = constant_curve(801, h, -2.0, 0.0);
+  EXPECT_DOUBLE_EQ(position_weighted_objective(r, r), 0.0);
+  const auto s = constant_curve(801, h, -2.5, 0.0);
+  const double expected = 0.5 * (std::exp(0.8) - 1.0);
+  EXPECT_NEAR(position_weighted_objective(s, r), expected, 1e-3 * expected);
+  // Simulation that stops early at 0.4 m with the same force: nothing to penalise.
+  EXPECT_DOUBLE_EQ(position_weighted_objective(constant_curve(401, h, -2.0, 0.0), r), 0.0);
+  // ... and 1 N off: inside exp(x) * 1 N * h, beyond 0.4 m 1.5 exp(x + 0.4) * 1 N * h.
+  auto early_off = constant_curve(401, h, -1.0, 0.0);
+  double tail2 = 0, inside = 0;
+  for (int i = 1; i < 801; ++i) {
+    const double x = i * h;
+    if (x > 0.4 + 1e-12) tail2 += 1.5 * std::exp(x + 0.4) * 1.0 * h;
+    else inside += std::exp(x) * 1.0 * h;
+  }
+  EXPECT_NEAR(position_weighted_objective(early_off, r), inside + tail2, 1e-9);
+}
+
+TEST(Objective, ParseNames) {
+  EXPECT_EQ(parse_objective("area"), ObjectiveKind::Area);
+  EXPECT_EQ(parse_objective("position-weighted"), ObjectiveKind::PositionWeighted);
+  EXPECT_FALSE(parse_objective("mse").has_value());
+}
+
+const HapticSequence& trial(const Dataset& ds, const std::string& id) {
+  for (const auto& t : ds.trials)
+    if (t.id == id) return t;
+  throw std::runtime_error("no trial " + id);
+}
+
+// The issue's yardstick: L between two repeats of one person's trial (w = 20).
+//   good   s1 1 vs 3: stated 0.09; ours 0.108.
+//   missed s1 1 vs 4: stated 0.22; ours 0.222.
+//   middle missed, s2 1 vs 7 and s7 1 vs 3: stated 0.26 = their median; ours 0.137 and 0.378,
+//   median 0.257.
+// The good pair differs only in the length term: the two trials stop at the 10 N threshold 4
+// samples (3.3 mm) apart while the force climbs at ~1 N/cm, and w = 20 on those 4 samples adds
+// 0.025 to the 0.083 of the overlapping part. The stated 0.09 is what w = 5 gives (0.089); with
+// w = 20 and either choice of dx (measured, simulated or their mean) we get 0.107-0.108, so we
+// keep w = 20 as the paper says and accept 0.02 on the good figure. The others agree to 0.005.
+TEST(Objective, YardstickOnMeasuredRepeats) {
+  const auto dir = study_dir();
+  if (dir.empty()) GTEST_SKIP() << "shared/data/kapusta2016-calibration-trials not present";
+  const Dataset ds = import_study(dir);
+  auto L = [&](const std::string& a, const std::string& b) {
+    return area_objective(trial(ds, a).samples, trial(ds, b).samples);
+  };
+  const double good = L("s1-good-1", "s1-good-3");
+  const double missed = L("s1-miss-1", "s1-miss-4");
+  const double mid_a = L("s2-middlemiss-1", "s2-middlemiss-7");
+  const double mid_b = L("s7-middlemiss-1", "s7-middlemiss-3");
+  std::printf("  L good %.4f  missed %.4f  middle %.4f / %.4f (median %.4f)\n", good, missed, mid_a, mid_b,
+              0.5 * (mid_a + mid_b));
+  EXPECT_NEAR(good, 0.09, 0.02);
+  EXPECT_NEAR(area_objective(trial(ds, "s1-good-1").samples, trial(ds, "s1-good-3").samples, 5.0), 0.09, 0.005);
+  EXPECT_NEAR(missed, 0.22, 0.005);
+  EXPECT_NEAR(0.5 * (mid_a + mid_b), 0.26, 0.005);
+  // Symmetry between repeats: swapping the roles moves L by less than 0.001 (dx choice).
+  EXPECT_NEAR(L("s1-good-3", "s1-good-1"), good, 1e-3);
+  EXPECT_NEAR(L("s1-miss-4", "s1-miss-1"), missed, 1e-3);
+}
+
+// Across people (same class, different participants): the issue states medians 0.57 (good),
+// 0.55 (missed), 0.86 (middle). For missed we get 0.543. For good and middle our medians are far
+// larger (1.65, 1.51): across people the trials stop at different travel (good ends at
+// 0.62 +- 0.03 m), and w = 20 multiplies the whole unmatched tail; the stated figures are not
+// reproduced by any single w (w = 1 gives 0.47 / 0.34 / 0.53). We assert the missed figure and
+// that good and middle are above it (the penalty dominates), and print all three.
+TEST(Objective, YardstickAcrossPeople) {
+  const auto dir = study_dir();
+  if (dir.empty()) GTEST_SKIP() << "shared/data/kapusta2016-calibration-trials not present";
+  const Dataset ds = import_study(dir);
+  std::map<std::string, std::vector<const HapticSequence*>> by_class;
+  for (const auto& t : ds.trials) by_class[std::string(arm_height_name(t.height))].push_back(&t);
+  std::map<std::string, double> median;
+  for (auto& [cls, v] : by_class) {
+    std::vector<double> l;
+    for (std::size_t a = 0; a < v.size(); ++a)
+      for (std::size_t b = a + 1; b < v.size(); ++b)
+        if (v[a]->participant != v[b]->participant) l.push_back(area_objective(v[a]->samples, v[b]->samples));
+    std::nth_element(l.begin(), l.begin() + l.size() / 2, l.end());
+    median[cls] = l.size() % 2 ? l[l.size() / 2] : 0.5 * (l[l.size() / 2] + *std::max_element(l.begin(), l.begin() + l.size() / 2));
+    std::printf("  across people %-6s median L %.3f over %zu pairs\n", cls.c_str(), median[cls], l.size());
+  }
+  EXPECT_NEAR(median["low"], 0.55, 0.02);
+  EXPECT_GT(median["high"], median["low"]);
+  EXPECT_GT(median["middle"], median["low"]);
+}
+
+}  // namespace
+}  // namespace dressguard::calib

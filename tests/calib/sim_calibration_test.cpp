@@ -1,0 +1,59 @@
+// The calibration with the real cloth simulator (dg_sim), on the measured data. Built only when
+// dg_sim is. Kept small (coarse gown, one generation of 4): each simulation costs seconds.
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "calibration.h"
+#include "sim_bridge.h"
+
+namespace dressguard::calib {
+namespace {
+
+// The bridge is deterministic and thread-safe: the same trial simulated on two threads at once
+// and once more on this thread gives the same samples, bit for bit (calibration's independence
+// of the thread count rests on this).
+TEST(SimCalibration, BridgeIsDeterministicAcrossThreads) {
+  const TrialSimulator sim = make_cloth_simulator("coarse");
+  TrialRequest r;
+  r.height = ArmHeight::Low;
+  r.max_travel = 0.3;  // short: this test checks identity, not physics
+  SimulatedTrial a, b;
+  std::thread ta([&] { a = sim(ClothValues{}, r); });
+  std::thread tb([&] { b = sim(ClothValues{}, r); });
+  ta.join();
+  tb.join();
+  const SimulatedTrial c = sim(ClothValues{}, r);
+  ASSERT_FALSE(a.samples.empty());
+  ASSERT_EQ(a.samples.size(), b.samples.size());
+  ASSERT_EQ(a.samples.size(), c.samples.size());
+  for (std::size_t i = 0; i < a.samples.size(); ++i) {
+    EXPECT_EQ(a.samples[i].f_motion, b.samples[i].f_motion);
+    EXPECT_EQ(a.samples[i].f_vertical, c.samples[i].f_vertical);
+  }
+  EXPECT_NEAR(a.samples.back().travel, 0.3, 0.002);  // the travel limit reaches the simulator
+}
+
+// One generation on participant 4's sequences (the paper's public code calibrated on the same
+// person): every candidate's objective is finite and the per-sequence fits add up to L.
+TEST(SimCalibration, OneGenerationOnParticipant4) {
+  const auto dir = study_dir();
+  if (dir.empty()) GTEST_SKIP() << "shared/data/kapusta2016-calibration-trials not present";
+  const Dataset ds = import_study(dir);
+  const auto inputs = select_inputs(ds, "4", 1);
+  ParameterSpace space;
+  space.bounds = default_bounds();
+  for (const auto& s : inputs) space.offset_heights.push_back(s.height);
+  CalibrationOptions o;
+  o.generations = 1;
+  o.population = 4;
+  const auto r = calibrate(inputs, space, make_cloth_simulator("coarse"), o, Comm::world());
+  std::printf("  participant 4, one generation of 4 on the coarse gown: L = %.4f\n", r.objective);
+  EXPECT_TRUE(std::isfinite(r.objective));
+  double sum = 0;
+  for (const auto& f : r.fits) sum += f.objective;
+  EXPECT_NEAR(sum, r.objective, 1e-9 * std::max(1.0, r.objective));
+}
+
+}  // namespace
+}  // namespace dressguard::calib

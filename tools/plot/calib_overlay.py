@@ -1,0 +1,114 @@
+#!/usr/bin/python3
+"""Overlay plots of measured and simulated force curves (paper Fig. 7-9).
+
+Two modes:
+  fit:      calib_overlay.py fit CAL.json.curves.csv [--compare CAL0.json.curves.csv] --out fit.png
+            One row per calibration input, F_motion and F_vertical over travel: measured (red,
+            solid), simulated with the calibrated arm offsets (green, dashed) and, with --compare,
+            the simulator calibrated without arm offsets (blue, dotted), as in Fig. 9.
+  dataset:  calib_overlay.py dataset SYNTH_DIR --measured STUDY_DIR --participant P --out data.png
+            All synthesized trials per outcome (thin) with the participant's measured trials (bold),
+            as in Fig. 7 and 8.
+Reads only the CSVs that dressguard writes (calibrate's curves file; dataset folders).
+"""
+import argparse
+import csv
+import collections
+import os
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def read_curves(path):
+    curves = collections.OrderedDict()
+    with open(path, newline="") as f:
+        for row in csv.DictReader(f):
+            key = (row["trial_id"], row["height"])
+            curves.setdefault(key, collections.defaultdict(list))
+            curves[key][row["source"]].append(
+                (float(row["travel"]), float(row["f_motion"]), float(row["f_vertical"])))
+    return curves
+
+
+def plot_fit(args):
+    curves = read_curves(args.curves)
+    other = read_curves(args.compare) if args.compare else {}
+    fig, axes = plt.subplots(len(curves), 2, figsize=(10, 3 * len(curves)), squeeze=False)
+    styles = {"measured": ("tab:red", "-", "measured"),
+              "simulated": ("tab:green", "--", "simulated, with arm offset"),
+              "simulated-no-offset": ("tab:blue", ":", "simulated, without arm offset")}
+    for row, (key, sources) in enumerate(curves.items()):
+        merged = dict(sources)
+        for src, pts in other.get(key, {}).items():
+            if src != "measured":
+                merged[src] = pts
+        for col, (idx, name) in enumerate([(1, "F_motion [N]"), (2, "F_vertical [N]")]):
+            ax = axes[row][col]
+            for src, pts in merged.items():
+                color, ls, label = styles.get(src, ("gray", "-", src))
+                ax.plot([p[0] for p in pts], [p[idx] for p in pts], color=color, ls=ls, lw=1.5, label=label)
+            ax.set_title(f"{key[0]} ({key[1]} arm)")
+            ax.set_xlabel("travel [m]")
+            ax.set_ylabel(name)
+            ax.grid(alpha=0.3)
+    axes[0][0].legend(loc="lower left", fontsize=8)
+    fig.tight_layout()
+    fig.savefig(args.out, dpi=110)
+
+
+def read_dataset(folder):
+    trials = []
+    with open(os.path.join(folder, "manifest.csv"), newline="") as f:
+        for row in csv.DictReader(f):
+            pts = []
+            with open(os.path.join(folder, row["file"]), newline="") as g:
+                for r in csv.DictReader(g):
+                    pts.append((float(r["travel"]), float(r["f_motion"]), float(r["f_vertical"])))
+            trials.append((row, pts))
+    return trials
+
+
+def plot_dataset(args):
+    synth = read_dataset(args.dataset)
+    measured = [t for t in read_dataset(args.measured) if t[0]["participant"] == args.participant]
+    colors = {"good": "tab:green", "missed": "tab:blue", "caught": "tab:orange"}
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+    for col, (idx, name) in enumerate([(1, "F_motion [N]"), (2, "F_vertical [N]")]):
+        ax = axes[col]
+        for row, pts in synth:
+            ax.plot([p[0] for p in pts], [p[idx] for p in pts], color=colors.get(row["label"], "gray"),
+                    lw=0.5, alpha=0.25)
+        for row, pts in measured:
+            ax.plot([p[0] for p in pts], [p[idx] for p in pts], color=colors.get(row["label"], "k"), lw=2.2,
+                    ls="--" if row["label"] == "caught" else "-")
+        ax.set_xlabel("travel [m]")
+        ax.set_ylabel(name)
+        ax.grid(alpha=0.3)
+    handles = [plt.Line2D([], [], color=c, label=f"{k} (thin: simulated, bold: measured)") for k, c in colors.items()]
+    axes[0].legend(handles=handles, fontsize=8, loc="lower left")
+    fig.suptitle(f"participant {args.participant}: synthesized data and measured trials")
+    fig.tight_layout()
+    fig.savefig(args.out, dpi=110)
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = p.add_subparsers(dest="mode", required=True)
+    f = sub.add_parser("fit")
+    f.add_argument("curves")
+    f.add_argument("--compare")
+    f.add_argument("--out", required=True)
+    d = sub.add_parser("dataset")
+    d.add_argument("dataset")
+    d.add_argument("--measured", required=True)
+    d.add_argument("--participant", required=True)
+    d.add_argument("--out", required=True)
+    args = p.parse_args()
+    (plot_fit if args.mode == "fit" else plot_dataset)(args)
+
+
+if __name__ == "__main__":
+    main()
