@@ -14,6 +14,13 @@ struct Command {
 };
 
 int run_import(int argc, char** argv);
+int run_simulate(int argc, char** argv);
+int run_train(int argc, char** argv);
+int run_classify(int argc, char** argv);
+int run_model(int argc, char** argv);
+int run_gown(int argc, char** argv);
+int run_replay(int argc, char** argv);
+int run_export_candump(int argc, char** argv);
 int run_calibrate(int argc, char** argv);
 int run_synthesize(int argc, char** argv);
 int run_build_model(int argc, char** argv);

@@ -13,6 +13,13 @@ namespace {
 // One row per subcommand, in the order a user meets them.
 constexpr Command kCommands[] = {
     {"import", "convert the study's measured trials into a dataset", run_import},
+    {"simulate", "simulate one sleeve-pulling trial: haptic CSV, summary, scene for pictures", run_simulate},
+    {"train", "train the outcome HMMs of a labelled dataset into a model file", run_train},
+    {"classify", "classify a dataset's trials with a model: accuracy, confusion, sweeps", run_classify},
+    {"model", "show a model file (model show MODEL.dgm)", run_model},
+    {"gown", "load, reduce and place the gown mesh; stats, OBJ and a picture", run_gown},
+    {"export-candump", "write trials as candump logs of the CAN protocol (with optional faults)", run_export_candump},
+    {"replay", "run the predictor daemon's code on a candump log: would it stop, when, why", run_replay},
     {"calibrate", "fit the simulator to one participant's sequences (CMA-ES)", run_calibrate},
     {"synthesize", "simulate labelled trials with a calibrated simulator", run_synthesize},
     {"build-model", "train the simulation-trained classifier (STC) into a model file", run_build_model},

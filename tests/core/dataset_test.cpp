@@ -14,12 +14,16 @@ using namespace dressguard;
 
 namespace {
 
-fs::path fresh_dir(const std::string& name) {
-  fs::path d = fs::temp_directory_path() / ("dg_core_test_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+// A temporary folder removed when the test ends.
+struct TempDir {
+  fs::path path;
+  explicit TempDir(const std::string& name)
+      : path(fs::temp_directory_path() / ("dg_core_test_" + name + "_" + std::to_string(::getpid()))) {
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TempDir() { fs::remove_all(path); }
+};
 
 void write_text(const fs::path& p, const std::string& s) { std::ofstream(p) << s; }
 
@@ -37,7 +41,8 @@ TEST(Dataset, RoundTripKeepsEverySampleAndLabel) {
     for (int i = 0; i < 50; ++i) s.samples.push_back({0.01 * i, 0.001 * i * i, -0.123456 * i, 1e-7 * i, 0.5 - i});
     ds.trials.push_back(s);
   }
-  const fs::path dir = fresh_dir("roundtrip");
+  const TempDir tmp("roundtrip");
+  const fs::path& dir = tmp.path;
   save_dataset(ds, dir);
   const Dataset back = load_dataset(dir);
   ASSERT_EQ(back.trials.size(), 3u);
@@ -58,7 +63,8 @@ TEST(Dataset, RoundTripKeepsEverySampleAndLabel) {
 }
 
 TEST(Dataset, MalformedRowNamesFileAndLine) {
-  const fs::path dir = fresh_dir("malformed");
+  const TempDir tmp("malformed");
+  const fs::path& dir = tmp.path;
   write_text(dir / "manifest.csv", "trial_id,participant,height,speed,label,file\na,1,high,0.1,good,a.csv\n");
   write_text(dir / "a.csv", "t,travel,f_motion,f_lateral,f_vertical\n0,0,0,0,0\n0.01,0.001,abc,0,0\n");
   try {
@@ -79,7 +85,8 @@ TEST(Dataset, MalformedRowNamesFileAndLine) {
 }
 
 TEST(Files, AtomicWriteReplacesWholeOrNothing) {
-  const fs::path dir = fresh_dir("atomic");
+  const TempDir tmp("atomic");
+  const fs::path& dir = tmp.path;
   const fs::path p = dir / "x.txt";
   write_file_atomic(p, "first");
   EXPECT_EQ(read_file(p), "first");

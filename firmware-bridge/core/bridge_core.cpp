@@ -1,0 +1,92 @@
+// The firmware bridge's portable core (see bridge_core.h). Freestanding: no heap, no OS calls.
+#include "bridge_core.h"
+
+namespace dressguard::bridge {
+
+void bridge_init(BridgeCore& c, const BridgeConfig& cfg, uint32_t now_ms) {
+  c = BridgeCore{};
+  c.cfg = cfg;
+  c.start_ms = now_ms;
+  c.next_heartbeat_ms = now_ms;
+  c.last_predictor_ms = now_ms;
+}
+
+int bridge_on_reading(BridgeCore& c, const FtReading& r, uint32_t, Frame out[2]) {
+  const uint8_t n = c.sample_counter.next();
+  out[0] = protocol::encode(protocol::FtForce{n, r.force[0], r.force[1], r.force[2]});
+  out[1] = protocol::encode(protocol::FtTorque{n, r.torque[0], r.torque[1], r.torque[2]});
+  ++c.readings;
+  if (c.state == protocol::BridgeState::SensorLost) c.state = protocol::BridgeState::Ok;
+  if (c.stop_cause != StopCause::None) c.state = protocol::BridgeState::StopLatched;
+  return 2;
+}
+
+void bridge_on_sensor_error(BridgeCore& c, uint32_t) {
+  if (c.sensor_errors < 255) ++c.sensor_errors;
+  if (c.stop_cause == StopCause::None) c.state = protocol::BridgeState::SensorLost;
+}
+
+void bridge_on_reconnect(BridgeCore& c) {
+  if (c.reconnects < 0xFFFF) ++c.reconnects;
+}
+
+BridgeAction bridge_on_frame(BridgeCore& c, const Frame& f, uint32_t now_ms) {
+  uint32_t lost = 0;
+  switch (f.id) {
+    case protocol::id_of(protocol::MsgId::Stop): {
+      if (!protocol::accepted(c.stop_checker.check(f, lost))) {
+        // A repeated stop is still a stop request; only a corrupted one is ignored.
+        protocol::Stop s;
+        if (protocol::e2e_crc(protocol::data_id_of(protocol::MsgId::Stop), f.data) != f.data[0] || !protocol::decode(f, s)) {
+          ++c.bad_frames;
+          return BridgeAction::None;
+        }
+      }
+      protocol::Stop s;
+      protocol::decode(f, s);
+      c.last_stop_reason = s.reason;
+      if (c.stop_cause != StopCause::None) return BridgeAction::None;  // already latched
+      c.stop_cause = StopCause::StopFrame;
+      c.state = protocol::BridgeState::StopLatched;
+      return BridgeAction::StopRobot;
+    }
+    case protocol::id_of(protocol::MsgId::TrialStart):
+      if (!protocol::accepted(c.trial_checker.check(f, lost))) {
+        ++c.bad_frames;
+        return BridgeAction::None;
+      }
+      // A new trial releases the latch (the robot controller restarts the motion itself).
+      c.stop_cause = StopCause::None;
+      c.last_stop_reason = protocol::StopReason::None;
+      if (c.state == protocol::BridgeState::StopLatched) c.state = protocol::BridgeState::Ok;
+      return BridgeAction::None;
+    case protocol::id_of(protocol::MsgId::HeartbeatPredictor):
+      if (!protocol::accepted(c.predictor_hb_checker.check(f, lost))) {
+        ++c.bad_frames;
+        return BridgeAction::None;
+      }
+      c.predictor_seen = true;
+      c.last_predictor_ms = now_ms;
+      return BridgeAction::None;
+    default: return BridgeAction::None;
+  }
+}
+
+int bridge_on_tick(BridgeCore& c, uint32_t now_ms, Frame* out, BridgeAction* action) {
+  *action = BridgeAction::None;
+  if (c.cfg.predictor_timeout_ms > 0 && c.stop_cause == StopCause::None &&
+      static_cast<uint32_t>(now_ms - c.last_predictor_ms) > c.cfg.predictor_timeout_ms) {
+    c.stop_cause = StopCause::PredictorSilent;
+    c.state = protocol::BridgeState::StopLatched;
+    *action = BridgeAction::StopRobot;
+  }
+  // Wrap-safe comparison of millisecond ticks.
+  if (static_cast<int32_t>(now_ms - c.next_heartbeat_ms) < 0) return 0;
+  c.next_heartbeat_ms = now_ms + c.cfg.heartbeat_period_ms;
+  const uint32_t up = (now_ms - c.start_ms) / 1000;
+  *out = protocol::encode(protocol::HeartbeatBridge{c.heartbeat_counter.next(), c.state, c.sensor_errors, c.reconnects,
+                                                    static_cast<uint16_t>(up > 0xFFFF ? 0xFFFF : up)});
+  return 1;
+}
+
+}  // namespace dressguard::bridge

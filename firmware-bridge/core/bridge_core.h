@@ -1,0 +1,82 @@
+// The firmware bridge's portable core: turns force-torque readings into protocol frames and
+// watches the stop line. No heap, no OS calls, no exceptions, no globals: everything lives in a
+// BridgeCore context the port passes in (as SOEM passes its context), and time comes in as a
+// millisecond tick from the port. A microcontroller port calls the same functions as the Linux
+// host port (firmware-bridge/linux/).
+//
+// Rules it enforces:
+//   - a reading becomes exactly one FtForce and one FtTorque frame with the same alive counter;
+//     a failed read produces no frame at all (never stale data: the predictor's deadline then
+//     stops the robot), and the heartbeat says "sensor lost";
+//   - a valid Stop frame (E2E-checked) latches a stop: the port must stop the robot and keeps
+//     the latch until the next TrialStart frame on the bus;
+//   - optionally, a predictor whose heartbeat is silent for predictor_timeout_ms is itself a
+//     reason to stop (the robot must not run unguarded).
+#pragma once
+
+#include <cstdint>
+
+#include "dg_protocol.h"
+
+namespace dressguard::bridge {
+
+using protocol::Frame;
+
+// One sensor reading in protocol counts (a Robotiq FT 300 register already is: F x 100, M x 1000).
+struct FtReading {
+  int16_t force[3];   // 0.01 N
+  int16_t torque[3];  // 0.001 Nm
+};
+
+struct BridgeConfig {
+  uint32_t heartbeat_period_ms = 100;
+  uint32_t predictor_timeout_ms = 0;  // 0: a silent predictor is not a stop reason
+};
+
+enum class BridgeAction : uint8_t {
+  None = 0,
+  StopRobot = 1,     // newly latched: write the stop to the robot controller now
+};
+
+enum class StopCause : uint8_t { None = 0, StopFrame = 1, PredictorSilent = 2 };
+
+struct BridgeCore {
+  BridgeConfig cfg;
+  protocol::AliveCounter sample_counter;
+  protocol::AliveCounter heartbeat_counter;
+  protocol::E2EChecker stop_checker{protocol::MsgId::Stop, 255};
+  protocol::E2EChecker trial_checker{protocol::MsgId::TrialStart, 255};
+  protocol::E2EChecker predictor_hb_checker{protocol::MsgId::HeartbeatPredictor, 255};
+  protocol::BridgeState state = protocol::BridgeState::SensorLost;  // until the first reading
+  StopCause stop_cause = StopCause::None;
+  protocol::StopReason last_stop_reason = protocol::StopReason::None;
+  uint8_t sensor_errors = 0;     // saturating
+  uint16_t reconnects = 0;
+  uint32_t readings = 0;
+  uint32_t bad_frames = 0;       // stop/trial/heartbeat frames that failed their E2E check
+  uint32_t start_ms = 0;
+  uint32_t next_heartbeat_ms = 0;
+  uint32_t last_predictor_ms = 0;
+  bool predictor_seen = false;
+};
+
+void bridge_init(BridgeCore& c, const BridgeConfig& cfg, uint32_t now_ms);
+
+// A reading arrived: writes the two sample frames to out[0..1] and returns 2.
+int bridge_on_reading(BridgeCore& c, const FtReading& r, uint32_t now_ms, Frame out[2]);
+
+// The sensor could not be read (timeout, exception, connection lost): no frames.
+void bridge_on_sensor_error(BridgeCore& c, uint32_t now_ms);
+// The port reconnected to the sensor.
+void bridge_on_reconnect(BridgeCore& c);
+
+// A frame received from the bus (Stop, TrialStart, HeartbeatPredictor; others are ignored).
+BridgeAction bridge_on_frame(BridgeCore& c, const Frame& f, uint32_t now_ms);
+
+// The periodic tick: writes a heartbeat frame to *out when one is due (returns 1, else 0);
+// *action becomes StopRobot when the predictor's heartbeat timed out.
+int bridge_on_tick(BridgeCore& c, uint32_t now_ms, Frame* out, BridgeAction* action);
+
+inline bool bridge_stop_latched(const BridgeCore& c) { return c.stop_cause != StopCause::None; }
+
+}  // namespace dressguard::bridge

@@ -1,0 +1,158 @@
+// The bridge's Linux event loop.
+#include "bridge_app.h"
+
+#include <sys/epoll.h>
+#include <sys/eventfd.h>
+#include <sys/timerfd.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <system_error>
+
+namespace dressguard::bridge {
+namespace {
+
+uint32_t now_ms() {
+  timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<uint32_t>(static_cast<uint64_t>(ts.tv_sec) * 1000 + ts.tv_nsec / 1000000);
+}
+
+constexpr uint64_t kTimer = 1, kCan = 2, kShutdown = 3;
+
+bool due(uint32_t now, uint32_t t) { return static_cast<int32_t>(now - t) >= 0; }
+
+}  // namespace
+
+BridgeApp::BridgeApp(const BridgeAppConfig& cfg, ModbusSensor& sensor, RobotStopWriter* robot, can::CanPort& port)
+    : cfg_(cfg), sensor_(sensor), robot_(robot), port_(port) {
+  bridge_init(core_, cfg.core, now_ms());
+  epoll_fd_ = epoll_create1(EPOLL_CLOEXEC);
+  timer_fd_ = timerfd_create(CLOCK_MONOTONIC, TFD_NONBLOCK | TFD_CLOEXEC);
+  shutdown_fd_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+  if (epoll_fd_ < 0 || timer_fd_ < 0 || shutdown_fd_ < 0) throw std::system_error(errno, std::generic_category(), "epoll/timerfd/eventfd");
+  for (auto [fd, tag] : {std::pair{timer_fd_, kTimer}, std::pair{port_.fd(), kCan}, std::pair{shutdown_fd_, kShutdown}}) {
+    epoll_event ev{};
+    ev.events = EPOLLIN;
+    ev.data.u64 = tag;
+    if (epoll_ctl(epoll_fd_, EPOLL_CTL_ADD, fd, &ev) < 0) throw std::system_error(errno, std::generic_category(), "epoll_ctl");
+  }
+  itimerspec its{};
+  its.it_interval.tv_sec = cfg_.sample_period_ms / 1000;
+  its.it_interval.tv_nsec = (cfg_.sample_period_ms % 1000) * 1000000L;
+  its.it_value = its.it_interval;
+  timerfd_settime(timer_fd_, 0, &its, nullptr);
+}
+
+BridgeApp::~BridgeApp() {
+  for (int fd : {epoll_fd_, timer_fd_, shutdown_fd_})
+    if (fd >= 0) ::close(fd);
+}
+
+void BridgeApp::request_shutdown() noexcept {
+  const uint64_t one = 1;
+  [[maybe_unused]] ssize_t n = ::write(shutdown_fd_, &one, sizeof one);
+}
+
+std::string BridgeApp::last_error() const { return sensor_.link().last_error(); }
+
+void BridgeApp::send(const Frame& f) {
+  // A full transmit queue drops this frame (the next sample supersedes it); counted, never blocked on.
+  if (port_.send(f) == can::SendResult::Ok) ++stats_.frames_sent;
+  else ++stats_.send_failures;
+}
+
+void BridgeApp::try_stop(uint32_t t) {
+  if (!stop_pending_ || !due(t, next_stop_try_ms_)) return;
+  if (!robot_) {
+    stop_pending_ = false;
+    return;
+  }
+  if (robot_->write_stop()) {
+    stop_pending_ = false;
+    ++stats_.stops_written;
+  } else {
+    ++stats_.stop_write_failures;
+    next_stop_try_ms_ = t + static_cast<uint32_t>(cfg_.stop_retry_ms);
+  }
+}
+
+void BridgeApp::on_timer(uint32_t t) {
+  // The sensor: reconnect with exponential backoff, else read one sample.
+  if (!sensor_.link().connected()) {
+    if (due(t, next_connect_ms_)) {
+      if (sensor_.link().connect()) {
+        backoff_ms_ = 0;
+        bridge_on_reconnect(core_);
+        ++stats_.reconnects;
+      } else {
+        ++stats_.connect_failures;
+        backoff_ms_ = backoff_ms_ == 0 ? cfg_.backoff_min_ms : std::min(2 * backoff_ms_, cfg_.backoff_max_ms);
+        next_connect_ms_ = t + static_cast<uint32_t>(backoff_ms_);
+      }
+    }
+  }
+  if (sensor_.link().connected()) {
+    FtReading r;
+    const ReadResult rr = sensor_.read(r);
+    if (rr == ReadResult::Ok) {
+      Frame frames[2];
+      const int n = bridge_on_reading(core_, r, t, frames);
+      for (int i = 0; i < n; ++i) send(frames[i]);
+      ++stats_.readings;
+    } else {
+      bridge_on_sensor_error(core_, t);
+      ++stats_.sensor_errors;
+      if (rr == ReadResult::Disconnected) next_connect_ms_ = t + static_cast<uint32_t>(cfg_.backoff_min_ms);
+    }
+  } else {
+    bridge_on_sensor_error(core_, t);
+  }
+  Frame hb;
+  BridgeAction a;
+  if (bridge_on_tick(core_, t, &hb, &a)) send(hb);
+  if (a == BridgeAction::StopRobot) {
+    stop_pending_ = true;
+    next_stop_try_ms_ = t;
+  }
+  try_stop(t);
+}
+
+void BridgeApp::drain_can(uint32_t t) {
+  Frame f;
+  can::RxInfo info;
+  for (int n = 0; n < 64 && port_.receive(f, info) == 1; ++n) {
+    if (info.error_frame || info.own_echo) continue;
+    if (bridge_on_frame(core_, f, t) == BridgeAction::StopRobot) {
+      stop_pending_ = true;
+      next_stop_try_ms_ = t;
+    }
+  }
+  try_stop(t);  // in the same wakeup as the stop frame
+}
+
+int BridgeApp::run() {
+  epoll_event evs[4];
+  for (;;) {
+    const int n = epoll_wait(epoll_fd_, evs, 4, -1);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return 1;
+    }
+    const uint32_t t = now_ms();
+    for (int i = 0; i < n; ++i) {
+      if (evs[i].data.u64 == kShutdown) return 0;
+      if (evs[i].data.u64 == kCan) drain_can(t);
+      if (evs[i].data.u64 == kTimer) {
+        uint64_t exp;
+        [[maybe_unused]] ssize_t r = ::read(timer_fd_, &exp, sizeof exp);
+        on_timer(t);
+      }
+    }
+  }
+}
+
+}  // namespace dressguard::bridge

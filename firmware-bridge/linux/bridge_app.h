@@ -1,0 +1,61 @@
+// The bridge's Linux host port: one event loop (epoll on a timerfd at the sensor rate, the CAN
+// port, a shutdown eventfd) around the portable core. Reads the sensor over Modbus each period,
+// publishes the frames, and on a stop writes the stop to the robot controller; reconnects to a
+// lost sensor with exponential backoff (no frames meanwhile: never stale data).
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "bridge_core.h"
+#include "can_port.h"
+#include "modbus_link.h"
+
+namespace dressguard::bridge {
+
+struct BridgeAppConfig {
+  BridgeConfig core;
+  int sample_period_ms = 10;       // 100 Hz, the study's rate
+  int backoff_min_ms = 50;         // first reconnect delay, doubled per failure ...
+  int backoff_max_ms = 2000;       // ... up to this
+  int stop_retry_ms = 10;          // an unacknowledged stop write is retried this often
+};
+
+struct BridgeStats {
+  std::atomic<uint64_t> readings{0}, frames_sent{0}, send_failures{0}, sensor_errors{0}, reconnects{0},
+      connect_failures{0}, stops_written{0}, stop_write_failures{0};
+};
+
+class BridgeApp {
+ public:
+  // `robot` may be null (no robot controller: stops are only logged).
+  BridgeApp(const BridgeAppConfig& cfg, ModbusSensor& sensor, RobotStopWriter* robot, can::CanPort& port);
+  ~BridgeApp();
+  int run();                        // until request_shutdown(); 0 = clean
+  void request_shutdown() noexcept; // async-signal-safe
+  const BridgeStats& stats() const { return stats_; }
+  const BridgeCore& core() const { return core_; }  // read only from the loop's thread or after run()
+  std::string last_error() const;
+
+ private:
+  void on_timer(uint32_t now_ms);
+  void drain_can(uint32_t now_ms);
+  void send(const Frame& f);
+  void try_stop(uint32_t now_ms);
+
+  BridgeAppConfig cfg_;
+  ModbusSensor& sensor_;
+  RobotStopWriter* robot_;
+  can::CanPort& port_;
+  BridgeCore core_;
+  BridgeStats stats_;
+  int epoll_fd_ = -1, timer_fd_ = -1, shutdown_fd_ = -1;
+  int backoff_ms_ = 0;
+  uint32_t next_connect_ms_ = 0;
+  bool stop_pending_ = false;
+  uint32_t next_stop_try_ms_ = 0;
+};
+
+}  // namespace dressguard::bridge

@@ -1,0 +1,142 @@
+// dressguard-bridge: Modbus force-torque sensor -> CAN, and CAN stop -> robot controller.
+#include <signal.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+#include "bridge_app.h"
+
+using namespace dressguard;
+using namespace dressguard::bridge;
+
+namespace {
+
+BridgeApp* g_app = nullptr;
+void on_signal(int) {
+  if (g_app) g_app->request_shutdown();
+}
+
+const char* kUsage =
+    "usage: dressguard-bridge [options]\n"
+    "  Reads a force-torque sensor over Modbus (default: a Robotiq FT 300, holding registers\n"
+    "  180-185, int16, F x 100 and M x 1000, slave 9) at a fixed rate and publishes each reading as\n"
+    "  the protocol's FtForce + FtTorque frames on SocketCAN (firmware-bridge/PROTOCOL.md). On a\n"
+    "  Stop frame it writes a stop to the robot controller over Modbus. A lost sensor is reconnected\n"
+    "  with exponential backoff; meanwhile no sample frames are sent (the predictor's deadline stops\n"
+    "  the robot).\n"
+    "  --interface IF          SocketCAN interface (default can0)\n"
+    "  --sensor SPEC           tcp:HOST:PORT or rtu:DEVICE:BAUD[:PARITY] (default rtu:/dev/ttyUSB0:19200:N)\n"
+    "  --sensor-slave N        Modbus unit id (default 9)\n"
+    "  --sensor-register N     first of the six registers (default 180)\n"
+    "  --input-registers       read with FC04 instead of FC03\n"
+    "  --force-scale S         sensor counts -> 0.01 N counts (default 1, the FT 300's)\n"
+    "  --torque-scale S        sensor counts -> 0.001 Nm counts (default 1)\n"
+    "  --timeout-ms N          Modbus response timeout (default 20)\n"
+    "  --period-ms N           sampling period (default 10: 100 Hz)\n"
+    "  --robot SPEC            robot controller, tcp:HOST:PORT or rtu:...; none: stops are only logged\n"
+    "  --robot-slave N         its unit id (default 1)\n"
+    "  --stop-coil ADDR        write the stop as coil ADDR = ON (default: coil 0)\n"
+    "  --stop-register ADDR=V  write the stop as holding register ADDR = V instead\n"
+    "  --predictor-timeout-ms N  stop the robot when the predictor's heartbeat is silent this long (0: off)\n"
+    "  --help                  this text\n"
+    "Exit codes: 0 clean shutdown (SIGTERM/SIGINT), 1 runtime error, 2 bad arguments.";
+
+int bad(const std::string& why) {
+  std::fprintf(stderr, "dressguard-bridge: %s (see --help)\n", why.c_str());
+  return 2;
+}
+
+bool to_int(const std::string& s, long& v) {
+  char* end = nullptr;
+  v = std::strtol(s.c_str(), &end, 10);
+  return !s.empty() && end && *end == '\0';
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string iface = "can0", robot_spec;
+  ModbusEndpoint sensor_ep, robot_ep;
+  robot_ep.slave = 1;
+  robot_ep.response_timeout_ms = 100;
+  SensorMap map;
+  StopTarget target;
+  BridgeAppConfig cfg;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--help" || a == "-h") {
+      std::puts(kUsage);
+      return 0;
+    }
+    if (a == "--input-registers") {
+      map.input_registers = true;
+      continue;
+    }
+    if (i + 1 >= argc) return bad(a + " needs a value");
+    const std::string v = argv[++i];
+    long n = 0;
+    const bool is_int = to_int(v, n);
+    if (a == "--interface") iface = v;
+    else if (a == "--sensor") sensor_ep.spec = v;
+    else if (a == "--robot") robot_spec = v;
+    else if (a == "--force-scale" || a == "--torque-scale") {
+      char* end = nullptr;
+      const double d = std::strtod(v.c_str(), &end);
+      if (!end || *end || !(d > 0)) return bad(a + ": '" + v + "' is not a positive number");
+      (a == "--force-scale" ? map.force_scale : map.torque_scale) = d;
+    } else if (a == "--stop-register") {
+      const auto eq = v.find('=');
+      long addr = 0, val = 0;
+      if (eq == std::string::npos || !to_int(v.substr(0, eq), addr) || !to_int(v.substr(eq + 1), val) || addr < 0 ||
+          val < 0 || val > 65535)
+        return bad("--stop-register: '" + v + "' is not ADDR=VALUE");
+      target = {false, static_cast<int>(addr), static_cast<int>(val)};
+    } else if (!is_int || n < 0) {
+      return bad(a + ": '" + v + "' is not a non-negative integer (or unknown option)");
+    } else if (a == "--sensor-slave") sensor_ep.slave = static_cast<int>(n);
+    else if (a == "--sensor-register") map.first_register = static_cast<int>(n);
+    else if (a == "--timeout-ms") sensor_ep.response_timeout_ms = static_cast<int>(n);
+    else if (a == "--period-ms") cfg.sample_period_ms = static_cast<int>(n);
+    else if (a == "--robot-slave") robot_ep.slave = static_cast<int>(n);
+    else if (a == "--stop-coil") target = {true, static_cast<int>(n), 1};
+    else if (a == "--predictor-timeout-ms") cfg.core.predictor_timeout_ms = static_cast<uint32_t>(n);
+    else return bad("unknown option '" + a + "'");
+  }
+  if (cfg.sample_period_ms < 1) return bad("--period-ms must be >= 1");
+  try {
+    can::PortOptions opt;
+    opt.ids = {protocol::id_of(protocol::MsgId::Stop), protocol::id_of(protocol::MsgId::TrialStart),
+               protocol::id_of(protocol::MsgId::HeartbeatPredictor)};
+    auto port = can::open_socketcan(iface, opt);
+    ModbusSensor sensor(sensor_ep, map);
+    std::unique_ptr<RobotStopWriter> robot;
+    if (!robot_spec.empty()) {
+      robot_ep.spec = robot_spec;
+      robot = std::make_unique<RobotStopWriter>(robot_ep, target);
+    }
+    BridgeApp app(cfg, sensor, robot.get(), *port);
+    g_app = &app;
+    struct sigaction sa{};
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGTERM, &sa, nullptr);
+    sigaction(SIGINT, &sa, nullptr);
+    std::fprintf(stderr, "dressguard-bridge: %s -> %s every %d ms\n", sensor_ep.spec.c_str(), iface.c_str(), cfg.sample_period_ms);
+    const int rc = app.run();
+    g_app = nullptr;
+    const auto& s = app.stats();
+    std::fprintf(stderr,
+                 "dressguard-bridge: readings=%llu frames=%llu send_failures=%llu sensor_errors=%llu reconnects=%llu "
+                 "stops_written=%llu stop_write_failures=%llu\n",
+                 (unsigned long long)s.readings.load(), (unsigned long long)s.frames_sent.load(),
+                 (unsigned long long)s.send_failures.load(), (unsigned long long)s.sensor_errors.load(),
+                 (unsigned long long)s.reconnects.load(), (unsigned long long)s.stops_written.load(),
+                 (unsigned long long)s.stop_write_failures.load());
+    return rc;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "dressguard-bridge: %s\n", e.what());
+    return 1;
+  }
+}

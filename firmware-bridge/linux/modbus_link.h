@@ -1,0 +1,90 @@
+// Modbus connections of the bridge's Linux port (libmodbus): the F/T sensor it reads and the
+// robot controller it writes a stop to. Failures follow libmodbus: the call fails, errno says
+// why (libmodbus's own codes for exceptions, e.g. EMBXSFAIL), modbus_strerror names it.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "bridge_core.h"
+
+typedef struct _modbus modbus_t;
+
+namespace dressguard::bridge {
+
+// Where a Modbus device is: "tcp:HOST:PORT" or "rtu:/dev/ttyUSB0:BAUD[:PARITY]" (parity N/E/O,
+// 8 data bits, 1 stop bit; the FT 300's default is rtu:...:19200:N).
+struct ModbusEndpoint {
+  std::string spec = "rtu:/dev/ttyUSB0:19200:N";
+  int slave = 9;
+  int response_timeout_ms = 20;
+};
+
+enum class ReadResult : uint8_t { Ok = 0, Timeout = 1, Exception = 2, Disconnected = 3, BadData = 4 };
+const char* read_result_name(ReadResult r);
+
+// A Modbus connection that knows how to (re)open itself.
+class ModbusLink {
+ public:
+  explicit ModbusLink(ModbusEndpoint ep);
+  ~ModbusLink();
+  ModbusLink(const ModbusLink&) = delete;
+  ModbusLink& operator=(const ModbusLink&) = delete;
+  // Opens (or reopens) the connection; false with last_error() set when it fails.
+  bool connect();
+  void close();
+  bool connected() const { return ctx_ != nullptr; }
+  const std::string& last_error() const { return error_; }
+  modbus_t* ctx() { return ctx_; }
+  // Classifies the errno of a failed libmodbus call, closing the link when it is gone.
+  ReadResult classify_failure();
+  const ModbusEndpoint& endpoint() const { return ep_; }
+
+ private:
+  ModbusEndpoint ep_;
+  modbus_t* ctx_ = nullptr;
+  std::string error_;
+};
+
+// The F/T sensor's register map. Default: Robotiq FT 300 (holding registers 180-185: Fx Fy Fz
+// in 0.01 N, Mx My Mz in 0.001 Nm, int16). `force_scale`/`torque_scale` convert other sensors'
+// counts to the protocol's (1.0 for the FT 300).
+struct SensorMap {
+  int first_register = 180;
+  bool input_registers = false;  // FC04 instead of FC03
+  double force_scale = 1.0;
+  double torque_scale = 1.0;
+};
+
+class ModbusSensor {
+ public:
+  ModbusSensor(ModbusEndpoint ep, SensorMap map) : link_(std::move(ep)), map_(map) {}
+  ModbusLink& link() { return link_; }
+  // One reading (six registers in one request); on failure nothing is written to `out`.
+  ReadResult read(FtReading& out);
+
+ private:
+  ModbusLink link_;
+  SensorMap map_;
+};
+
+// How the stop reaches the robot controller: a coil (FC05) or a holding register (FC06).
+struct StopTarget {
+  bool coil = true;
+  int address = 0;
+  int value = 1;  // register value (a coil is written ON)
+};
+
+class RobotStopWriter {
+ public:
+  RobotStopWriter(ModbusEndpoint ep, StopTarget t) : link_(std::move(ep)), target_(t) {}
+  ModbusLink& link() { return link_; }
+  // Writes the stop; reconnects once if needed. False with link().last_error() on failure.
+  bool write_stop();
+
+ private:
+  ModbusLink link_;
+  StopTarget target_;
+};
+
+}  // namespace dressguard::bridge

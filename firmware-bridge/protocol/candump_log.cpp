@@ -1,0 +1,96 @@
+// candump log lines: "(sec.usec) iface id#data".
+#include "candump_log.h"
+
+#include <cstdio>
+#include <stdexcept>
+
+namespace dressguard::protocol {
+namespace {
+
+int hex_value(char c) {
+  if (c >= '0' && c <= '9') return c - '0';
+  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+  return -1;
+}
+
+}  // namespace
+
+std::string format_candump_line(int64_t time_us, std::string_view iface, const Frame& f) {
+  char buf[96];
+  int n = std::snprintf(buf, sizeof buf, "(%lld.%06lld) %.*s %03X#", static_cast<long long>(time_us / 1000000),
+                        static_cast<long long>(time_us % 1000000), static_cast<int>(iface.size()), iface.data(),
+                        static_cast<unsigned>(f.id & 0x7FF));
+  for (int i = 0; i < f.len && i < 8; ++i) n += std::snprintf(buf + n, sizeof buf - n, "%02X", f.data[i]);
+  return std::string(buf, n);
+}
+
+bool parse_candump_line(std::string_view line, LoggedFrame& out, std::string& why) {
+  while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\n')) line.remove_suffix(1);
+  if (line.size() < 3 || line[0] != '(') return why = "expected '(' starting a timestamp", false;
+  const size_t close = line.find(')');
+  if (close == std::string_view::npos) return why = "timestamp has no ')'", false;
+  const std::string_view ts = line.substr(1, close - 1);
+  const size_t dot = ts.find('.');
+  if (dot == std::string_view::npos || dot == 0 || ts.size() - dot - 1 != 6)
+    return why = "timestamp is not seconds.microseconds (6 digits)", false;
+  int64_t sec = 0, usec = 0;
+  for (size_t i = 0; i < ts.size(); ++i) {
+    if (i == dot) continue;
+    if (ts[i] < '0' || ts[i] > '9') return why = "timestamp has a non-digit", false;
+    (i < dot ? sec : usec) = (i < dot ? sec : usec) * 10 + (ts[i] - '0');
+  }
+  std::string_view rest = line.substr(close + 1);
+  if (rest.empty() || rest[0] != ' ') return why = "expected a space after the timestamp", false;
+  rest.remove_prefix(1);
+  const size_t sp = rest.find(' ');
+  if (sp == std::string_view::npos || sp == 0) return why = "expected an interface name", false;
+  out.iface = std::string(rest.substr(0, sp));
+  std::string_view fr = rest.substr(sp + 1);
+  const size_t hash = fr.find('#');
+  if (hash == std::string_view::npos) return why = "frame has no '#'", false;
+  if (hash != 3) return why = "identifier is not 3 hex digits (only classic 11-bit frames)", false;
+  uint32_t id = 0;
+  for (size_t i = 0; i < hash; ++i) {
+    const int v = hex_value(fr[i]);
+    if (v < 0) return why = "identifier is not hex", false;
+    id = id * 16 + static_cast<uint32_t>(v);
+  }
+  if (id > 0x7FF) return why = "identifier above 0x7FF", false;
+  const std::string_view hex = fr.substr(hash + 1);
+  if (!hex.empty() && (hex[0] == '#' || hex[0] == 'R')) return why = "CAN FD or remote frames are not part of the protocol", false;
+  if (hex.size() % 2 != 0 || hex.size() > 16) return why = "data is not 0..8 bytes of hex", false;
+  Frame f;
+  f.id = id;
+  f.len = static_cast<uint8_t>(hex.size() / 2);
+  for (size_t i = 0; i < f.len; ++i) {
+    const int hi = hex_value(hex[2 * i]), lo = hex_value(hex[2 * i + 1]);
+    if (hi < 0 || lo < 0) return why = "data is not hex", false;
+    f.data[i] = static_cast<uint8_t>(hi * 16 + lo);
+  }
+  out.time_us = sec * 1000000 + usec;
+  out.frame = f;
+  return true;
+}
+
+std::vector<LoggedFrame> parse_candump_log(std::string_view text, const std::string& name) {
+  std::vector<LoggedFrame> frames;
+  long line_no = 0;
+  size_t pos = 0;
+  std::string why;
+  while (pos < text.size()) {
+    size_t nl = text.find('\n', pos);
+    if (nl == std::string_view::npos) nl = text.size();
+    std::string_view line = text.substr(pos, nl - pos);
+    pos = nl + 1;
+    ++line_no;
+    if (line.find_first_not_of(" \t\r") == std::string_view::npos) continue;
+    LoggedFrame lf;
+    if (!parse_candump_line(line, lf, why)) throw std::runtime_error(name + ":" + std::to_string(line_no) + ": " + why);
+    lf.line = line_no;
+    frames.push_back(std::move(lf));
+  }
+  return frames;
+}
+
+}  // namespace dressguard::protocol

@@ -1,0 +1,37 @@
+// The candump log format of can-utils (`candump -l`, read by `canplayer` and `log2asc`), in one
+// place for every tool of the project that reads or writes it:
+//
+//   (1700000000.012345) vcan0 100#A5010A00F6FF3200
+//   (seconds.microseconds) interface id#data-in-hex
+//
+// Classic frames only (3 hex digits of identifier, 0..8 data bytes). Host side: allocates.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "dg_protocol.h"
+
+namespace dressguard::protocol {
+
+struct LoggedFrame {
+  int64_t time_us = 0;  // timestamp in microseconds
+  std::string iface;
+  Frame frame;
+  long line = 0;        // 1-based line in the log (0 when built in memory)
+};
+
+// "(sec.usec) iface id#data" (no newline).
+std::string format_candump_line(int64_t time_us, std::string_view iface, const Frame& f);
+
+// Parses one line; returns false with `why` set when it is not a classic candump frame line.
+bool parse_candump_line(std::string_view line, LoggedFrame& out, std::string& why);
+
+// Whole log text. Blank lines are skipped; anything else malformed throws std::runtime_error
+// with "name:line: what" (callers pass the file name for the message).
+std::vector<LoggedFrame> parse_candump_log(std::string_view text, const std::string& name);
+
+}  // namespace dressguard::protocol

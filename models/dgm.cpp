@@ -1,0 +1,384 @@
+// The .dgm model file: encoding, decoding and validation. The byte layout is FORMAT.md's.
+#include "dgm.h"
+
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <system_error>
+
+#include <unistd.h>
+
+namespace dressguard::model {
+
+int OutcomeModel::class_index(std::string_view name) const {
+  for (size_t i = 0; i < classes.size(); ++i)
+    if (classes[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+
+// ---------------------------------------------------------------------------------------------
+// CRC-32 (IEEE, reflected), table built once at compile time.
+namespace {
+constexpr std::array<uint32_t, 256> make_crc_table() {
+  std::array<uint32_t, 256> t{};
+  for (uint32_t i = 0; i < 256; ++i) {
+    uint32_t c = i;
+    for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+    t[i] = c;
+  }
+  return t;
+}
+constexpr std::array<uint32_t, 256> kCrcTable = make_crc_table();
+}  // namespace
+
+uint32_t crc32(const uint8_t* data, size_t size) noexcept {
+  uint32_t c = 0xFFFFFFFFu;
+  for (size_t i = 0; i < size; ++i) c = kCrcTable[(c ^ data[i]) & 0xFFu] ^ (c >> 8);
+  return c ^ 0xFFFFFFFFu;
+}
+
+namespace {
+
+[[noreturn]] void fail(const std::string& source, const std::string& what) {
+  throw ModelError(source + ": " + what);
+}
+
+// Longest string field the loader accepts (metadata, class names): keeps a corrupt length from
+// asking for gigabytes.
+constexpr uint32_t kMaxString = 65536;
+// Fixed part: magic(8) + version(4) + size(4); trailer: CRC(4).
+constexpr size_t kHeaderBytes = 16, kTrailerBytes = 4;
+
+// ---- validation: one small function per rule --------------------------------------------------
+
+void check_finite(double v, const std::string& source, const std::string& what) {
+  if (!std::isfinite(v)) fail(source, what + " is not finite (" + std::to_string(v) + ")");
+}
+
+// A probability vector: entries in [0,1], |sum - 1| <= kStochasticTolerance.
+void check_stochastic(const double* p, int n, const std::string& source, const std::string& what) {
+  double sum = 0.0;
+  for (int j = 0; j < n; ++j) {
+    check_finite(p[j], source, what + " entry " + std::to_string(j));
+    if (p[j] < 0.0 || p[j] > 1.0)
+      fail(source, what + " entry " + std::to_string(j) + " = " + std::to_string(p[j]) + " is not a probability");
+    sum += p[j];
+  }
+  if (std::fabs(sum - 1.0) > kStochasticTolerance) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.17g", sum);
+    fail(source, what + " sums to " + buf + ", not 1 (tolerance 1e-9)");
+  }
+}
+
+// Covariance [[a b][c d]]: symmetric (|b - c| <= 1e-12 max(|a|,|d|)) and positive definite,
+// i.e. a > 0 and det = a d - b^2 > 0 (Sylvester's criterion for 2x2), with det relative to a d
+// above 1e-12 so the inverse the filter precomputes is meaningful.
+void check_covariance(const GaussianEmission& e, const std::string& source, const std::string& what) {
+  for (int r = 0; r < kFeatures; ++r) {
+    check_finite(e.mean[r], source, what + " mean[" + std::to_string(r) + "]");
+    for (int k = 0; k < kFeatures; ++k)
+      check_finite(e.cov[r][k], source, what + " cov[" + std::to_string(r) + "][" + std::to_string(k) + "]");
+  }
+  const double a = e.cov[0][0], b = e.cov[0][1], c = e.cov[1][0], d = e.cov[1][1];
+  if (std::fabs(b - c) > 1e-12 * std::max(std::fabs(a), std::fabs(d)))
+    fail(source, what + " covariance is not symmetric");
+  const double det = a * d - b * b;
+  if (!(a > 0.0) || !(d > 0.0) || !(det > 1e-12 * a * d))
+    fail(source, what + " covariance is not positive definite (det " + std::to_string(det) + ")");
+}
+
+void check_features(const FeatureConvention& f, const std::string& source) {
+  for (int k = 0; k < kFeatures; ++k) {
+    const std::string w = "feature " + std::to_string(k);
+    if (f.axis[k] < 0 || f.axis[k] > 2) fail(source, w + " axis " + std::to_string(f.axis[k]) + " is not 0, 1 or 2");
+    if (f.sign[k] != 1.0 && f.sign[k] != -1.0) fail(source, w + " sign is not +1 or -1");
+    check_finite(f.offset[k], source, w + " offset");
+    check_finite(f.scale[k], source, w + " scale");
+    if (!(f.scale[k] > 0.0)) fail(source, w + " scale is not positive");
+  }
+}
+
+void check_class(const ClassHmm& h, const std::string& source) {
+  const std::string w = "class '" + h.name + "'";
+  if (h.name.empty()) fail(source, "a class has an empty name");
+  if (h.n_states < 1 || h.n_states > kMaxStates)
+    fail(source, w + " has " + std::to_string(h.n_states) + " states (1.." + std::to_string(kMaxStates) + " allowed)");
+  const size_t n = static_cast<size_t>(h.n_states);
+  if (h.initial.size() != n || h.transition.size() != n * n || h.emission.size() != n)
+    fail(source, w + " arrays do not match its state count");
+  check_finite(h.log_prior, source, w + " log prior");
+  if (h.log_prior > 1e-12) fail(source, w + " log prior is positive");
+  check_stochastic(h.initial.data(), h.n_states, source, w + " initial distribution");
+  for (int i = 0; i < h.n_states; ++i)
+    check_stochastic(h.transition.data() + i * n, h.n_states, source, w + " transition row " + std::to_string(i));
+  for (int j = 0; j < h.n_states; ++j) check_covariance(h.emission[j], source, w + " state " + std::to_string(j));
+}
+
+// ---- little-endian writer and bounds-checked reader --------------------------------------------
+
+class Writer {
+ public:
+  void bytes(const void* p, size_t n) {
+    const auto* b = static_cast<const uint8_t*>(p);
+    out_.insert(out_.end(), b, b + n);
+  }
+  void u32(uint32_t v) {
+    for (int i = 0; i < 4; ++i) out_.push_back(static_cast<uint8_t>(v >> (8 * i)));
+  }
+  void i32(int32_t v) { u32(static_cast<uint32_t>(v)); }
+  void f64(double v) {
+    uint64_t u;
+    std::memcpy(&u, &v, 8);
+    for (int i = 0; i < 8; ++i) out_.push_back(static_cast<uint8_t>(u >> (8 * i)));
+  }
+  void str(const std::string& s) {
+    u32(static_cast<uint32_t>(s.size()));
+    bytes(s.data(), s.size());
+  }
+  std::vector<uint8_t>& data() { return out_; }
+
+ private:
+  std::vector<uint8_t> out_;
+};
+
+class Reader {
+ public:
+  Reader(const uint8_t* p, size_t end, size_t pos, const std::string& source) : p_(p), end_(end), pos_(pos), source_(source) {}
+  void need(size_t n, const char* what) {
+    if (n > end_ - pos_)
+      fail(source_, "truncated: " + std::string(what) + " at byte " + std::to_string(pos_) + " needs " +
+                        std::to_string(n) + " bytes, only " + std::to_string(end_ - pos_) + " left");
+  }
+  uint32_t u32(const char* what) {
+    need(4, what);
+    uint32_t v = 0;
+    for (int i = 0; i < 4; ++i) v |= static_cast<uint32_t>(p_[pos_ + i]) << (8 * i);
+    pos_ += 4;
+    return v;
+  }
+  int32_t i32(const char* what) { return static_cast<int32_t>(u32(what)); }
+  double f64(const char* what) {
+    need(8, what);
+    uint64_t u = 0;
+    for (int i = 0; i < 8; ++i) u |= static_cast<uint64_t>(p_[pos_ + i]) << (8 * i);
+    pos_ += 8;
+    double v;
+    std::memcpy(&v, &u, 8);
+    return v;
+  }
+  std::string str(const char* what) {
+    const uint32_t n = u32(what);
+    if (n > kMaxString) fail(source_, std::string(what) + " length " + std::to_string(n) + " exceeds " + std::to_string(kMaxString));
+    need(n, what);
+    std::string s(reinterpret_cast<const char*>(p_ + pos_), n);
+    pos_ += n;
+    return s;
+  }
+  size_t pos() const { return pos_; }
+
+ private:
+  const uint8_t* p_;
+  size_t end_, pos_;
+  const std::string& source_;
+};
+
+}  // namespace
+
+void validate_model(const OutcomeModel& m, const std::string& source) {
+  check_features(m.features, source);
+  if (m.classes.empty() || m.classes.size() > static_cast<size_t>(kMaxClasses))
+    fail(source, std::to_string(m.classes.size()) + " classes (1.." + std::to_string(kMaxClasses) + " allowed)");
+  std::set<std::string> names;
+  double prior_sum = 0.0;
+  for (const auto& h : m.classes) {
+    check_class(h, source);
+    if (!names.insert(h.name).second) fail(source, "class name '" + h.name + "' appears twice");
+    prior_sum += std::exp(h.log_prior);
+  }
+  // Priors are stored as logs; their exponentials must form a distribution (1e-9 as for rows).
+  if (std::fabs(prior_sum - 1.0) > kStochasticTolerance) fail(source, "class priors sum to " + std::to_string(prior_sum) + ", not 1");
+  check_finite(m.stop_threshold, source, "stop threshold");
+  if (!(m.stop_threshold > 0.0 && m.stop_threshold < 1.0)) fail(source, "stop threshold is not in (0, 1)");
+  if (m.stop_consecutive < 1 || m.stop_consecutive > 100000) fail(source, "stop_consecutive is not in 1..100000");
+  for (const std::string* s : {&m.tool_version, &m.created, &m.source_dataset, &m.training_summary})
+    if (s->size() > kMaxString) fail(source, "a metadata string is longer than 65536 bytes");
+}
+
+std::vector<uint8_t> encode_model(const OutcomeModel& m) {
+  validate_model(m, "model to encode");
+  Writer w;
+  w.bytes(kMagic, 8);
+  w.u32(kFormatVersion);
+  w.u32(0);  // total size, patched below
+  w.str(m.tool_version);
+  w.str(m.created);
+  w.str(m.source_dataset);
+  w.str(m.training_summary);
+  for (int k = 0; k < kFeatures; ++k) {
+    w.i32(m.features.axis[k]);
+    w.f64(m.features.sign[k]);
+    w.f64(m.features.offset[k]);
+    w.f64(m.features.scale[k]);
+  }
+  w.f64(m.stop_threshold);
+  w.i32(m.stop_consecutive);
+  w.u32(static_cast<uint32_t>(m.classes.size()));
+  for (const auto& h : m.classes) {
+    w.str(h.name);
+    w.u32(static_cast<uint32_t>(h.n_states));
+    w.f64(h.log_prior);
+    for (double v : h.initial) w.f64(v);
+    for (double v : h.transition) w.f64(v);
+    for (const auto& e : h.emission) {
+      w.f64(e.mean[0]);
+      w.f64(e.mean[1]);
+      w.f64(e.cov[0][0]);
+      w.f64(e.cov[0][1]);
+      w.f64(e.cov[1][0]);
+      w.f64(e.cov[1][1]);
+    }
+  }
+  auto& out = w.data();
+  const uint32_t total = static_cast<uint32_t>(out.size() + kTrailerBytes);
+  for (int i = 0; i < 4; ++i) out[12 + i] = static_cast<uint8_t>(total >> (8 * i));
+  w.u32(crc32(out.data(), out.size()));
+  return std::move(out);
+}
+
+OutcomeModel decode_model(const uint8_t* data, size_t size, const std::string& source) {
+  if (size < kHeaderBytes + kTrailerBytes)
+    fail(source, "truncated: " + std::to_string(size) + " bytes, shorter than the 20-byte header and CRC");
+  if (std::memcmp(data, kMagic, 8) != 0) fail(source, "wrong magic: not a dressguard model file (.dgm)");
+  Reader head(data, size, 8, source);
+  const uint32_t version = head.u32("format version");
+  if (version != kFormatVersion)
+    fail(source, "unsupported format version " + std::to_string(version) + " (this build reads version " +
+                     std::to_string(kFormatVersion) + ")");
+  const uint32_t total = head.u32("file size");
+  if (total > size) fail(source, "truncated: header says " + std::to_string(total) + " bytes, file has " + std::to_string(size));
+  if (total < size) fail(source, "trailing data: header says " + std::to_string(total) + " bytes, file has " + std::to_string(size));
+  const size_t body_end = size - kTrailerBytes;
+  Reader crc_reader(data, size, body_end, source);
+  const uint32_t stored = crc_reader.u32("CRC-32");
+  const uint32_t actual = crc32(data, body_end);
+  if (stored != actual) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "bad CRC-32: stored %08x, computed %08x (file corrupted)", stored, actual);
+    fail(source, buf);
+  }
+
+  Reader r(data, body_end, kHeaderBytes, source);
+  OutcomeModel m;
+  m.tool_version = r.str("tool version");
+  m.created = r.str("creation time");
+  m.source_dataset = r.str("source dataset");
+  m.training_summary = r.str("training summary");
+  for (int k = 0; k < kFeatures; ++k) {
+    m.features.axis[k] = r.i32("feature axis");
+    m.features.sign[k] = r.f64("feature sign");
+    m.features.offset[k] = r.f64("feature offset");
+    m.features.scale[k] = r.f64("feature scale");
+  }
+  m.stop_threshold = r.f64("stop threshold");
+  m.stop_consecutive = r.i32("stop consecutive");
+  const uint32_t n_classes = r.u32("class count");
+  if (n_classes < 1 || n_classes > static_cast<uint32_t>(kMaxClasses))
+    fail(source, std::to_string(n_classes) + " classes (1.." + std::to_string(kMaxClasses) + " allowed)");
+  for (uint32_t c = 0; c < n_classes; ++c) {
+    ClassHmm h;
+    h.name = r.str("class name");
+    const uint32_t n = r.u32("state count");
+    if (n < 1 || n > static_cast<uint32_t>(kMaxStates))
+      fail(source, "class '" + h.name + "' has " + std::to_string(n) + " states (1.." + std::to_string(kMaxStates) + " allowed)");
+    h.n_states = static_cast<int>(n);
+    h.log_prior = r.f64("log prior");
+    r.need(8 * (n + n * n + 6 * n), "HMM parameters");
+    h.initial.resize(n);
+    for (auto& v : h.initial) v = r.f64("initial");
+    h.transition.resize(n * n);
+    for (auto& v : h.transition) v = r.f64("transition");
+    h.emission.resize(n);
+    for (auto& e : h.emission) {
+      e.mean[0] = r.f64("mean");
+      e.mean[1] = r.f64("mean");
+      e.cov[0][0] = r.f64("covariance");
+      e.cov[0][1] = r.f64("covariance");
+      e.cov[1][0] = r.f64("covariance");
+      e.cov[1][1] = r.f64("covariance");
+    }
+    m.classes.push_back(std::move(h));
+  }
+  if (r.pos() != body_end)
+    fail(source, std::to_string(body_end - r.pos()) + " unexplained bytes before the CRC at byte " + std::to_string(r.pos()));
+  validate_model(m, source);
+  return m;
+}
+
+OutcomeModel read_model(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path.string(), std::string("cannot open: ") + std::strerror(errno));
+  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) fail(path.string(), "read error");
+  return decode_model(bytes.data(), bytes.size(), path.string());
+}
+
+void write_model(const std::filesystem::path& path, const OutcomeModel& m) {
+  const std::vector<uint8_t> bytes = encode_model(m);
+  std::error_code ec;
+  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path(), ec);
+  const std::filesystem::path tmp = path.string() + ".tmp." + std::to_string(::getpid());
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) fail(path.string(), std::string("cannot write: ") + std::strerror(errno));
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    out.flush();
+    if (!out) {
+      std::filesystem::remove(tmp, ec);
+      fail(path.string(), "write failed");
+    }
+  }
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    fail(path.string(), "cannot rename the temporary file into place: " + ec.message());
+  }
+}
+
+std::string describe_model(const OutcomeModel& m) {
+  std::ostringstream o;
+  char buf[256];
+  o << "dressguard outcome model (format " << kFormatVersion << ")\n";
+  o << "  tool:     " << m.tool_version << "\n  created:  " << m.created << "\n  source:   " << m.source_dataset << "\n";
+  o << "  training: " << m.training_summary << "\n";
+  static const char* kAxis[] = {"f_motion", "f_lateral", "f_vertical"};
+  for (int k = 0; k < kFeatures; ++k) {
+    std::snprintf(buf, sizeof buf, "  feature %d = (%s%s - %.6g) / %.6g\n", k, m.features.sign[k] < 0 ? "-" : "+",
+                  kAxis[m.features.axis[k]], m.features.offset[k], m.features.scale[k]);
+    o << buf;
+  }
+  std::snprintf(buf, sizeof buf, "  stop policy: P(stop class) > %.4g for %d consecutive samples\n", m.stop_threshold,
+                m.stop_consecutive);
+  o << buf;
+  for (const auto& h : m.classes) {
+    std::snprintf(buf, sizeof buf, "  class '%s': %d states, prior %.4f\n", h.name.c_str(), h.n_states, std::exp(h.log_prior));
+    o << buf;
+    const int n = h.n_states;
+    for (int j = 0; j < n; ++j) {
+      const auto& e = h.emission[j];
+      const double stay = h.transition[j * n + j];
+      std::snprintf(buf, sizeof buf,
+                    "    state %2d: pi %.3f  stay %.4f  mean (%+.4f, %+.4f)  cov [[%.4g, %.4g], [%.4g, %.4g]]\n", j,
+                    h.initial[j], stay, e.mean[0], e.mean[1], e.cov[0][0], e.cov[0][1], e.cov[1][0], e.cov[1][1]);
+      o << buf;
+    }
+  }
+  return o.str();
+}
+
+}  // namespace dressguard::model

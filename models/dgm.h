@@ -1,0 +1,114 @@
+// The outcome model: one left-right HMM per task outcome (paper section V-B), the feature
+// convention that turns raw force samples into the HMMs' two features, and the stop defaults the
+// predictor applies. This header is the model file's in-memory form; `FORMAT.md` documents the
+// `.dgm` bytes that `write_model`/`read_model` exchange. Depends on the standard library only, so
+// the robot-side predictor can link it without anything from offline/.
+//
+// Model (constant) only: the mutable per-trial state lives in filter::ForwardFilter.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace dressguard::model {
+
+// The HMMs see two features, F_motion ("X") and F_vertical ("Y"), paper section V-B.
+inline constexpr int kFeatures = 2;
+// Limits the loader enforces; they bound the predictor's fixed storage.
+inline constexpr int kMaxStates = 32, kMaxClasses = 8;
+// Raw sample axes, in the rig's convention (offline/core/haptic.h): drag negative, up positive.
+inline constexpr int kAxisMotion = 0, kAxisLateral = 1, kAxisVertical = 2;
+
+// How one raw sample (f_motion, f_lateral, f_vertical) in the rig's convention becomes the
+// feature vector x the HMMs model:
+//     x[k] = (sign[k] * raw[axis[k]] - offset[k]) / scale[k]
+// Training sets offset/scale to the training data's mean and standard deviation so that the
+// covariance floor means the same thing for both features. The likelihoods are densities of x
+// (not of the raw forces); the Jacobian 1/(scale0*scale1) is the same for every class and does not
+// change any classification.
+struct FeatureConvention {
+  int axis[kFeatures] = {kAxisMotion, kAxisVertical};  // 0 motion, 1 lateral, 2 vertical
+  double sign[kFeatures] = {1.0, 1.0};                 // +1 or -1
+  double offset[kFeatures] = {0.0, 0.0};               // [N], subtracted after the sign
+  double scale[kFeatures] = {1.0, 1.0};                // [N], > 0
+
+  // The feature vector of one raw sample (formula above).
+  void apply(double f_motion, double f_lateral, double f_vertical, double x[kFeatures]) const noexcept {
+    const double raw[3] = {f_motion, f_lateral, f_vertical};
+    for (int k = 0; k < kFeatures; ++k) x[k] = (sign[k] * raw[axis[k]] - offset[k]) / scale[k];
+  }
+};
+
+// A bivariate Gaussian with full covariance (symmetric, positive definite), in feature units.
+struct GaussianEmission {
+  double mean[kFeatures] = {0.0, 0.0};
+  double cov[kFeatures][kFeatures] = {{1.0, 0.0}, {0.0, 1.0}};
+};
+
+// One class's HMM. Left-right models have zeros below the diagonal of `transition`; the file
+// stores the full matrix, so any topology loads, and the filter detects the band.
+struct ClassHmm {
+  std::string name;                        // e.g. "good", "missed", "caught"
+  int n_states = 0;                        // 1..kMaxStates
+  std::vector<double> initial;             // n_states, sums to 1
+  std::vector<double> transition;          // n_states*n_states row-major, A[i*n+j] = P(j | i)
+  std::vector<GaussianEmission> emission;  // n_states
+  double log_prior = 0.0;                  // log P(class), from the training counts
+};
+
+struct OutcomeModel {
+  // Creation metadata: which tool made the file, when, from what, and how the training went.
+  std::string tool_version;      // e.g. "dressguard 0.1.0"
+  std::string created;           // UTC ISO-8601, e.g. "2026-11-21T23:59:00Z"
+  std::string source_dataset;    // the dataset path or a description
+  std::string training_summary;  // free text: sequences, iterations, log-likelihoods per class
+
+  FeatureConvention features;
+  std::vector<ClassHmm> classes;  // 1..kMaxClasses, unique non-empty names
+
+  // The predictor's StopPolicy defaults: stop when P(stop class | samples) > stop_threshold for
+  // stop_consecutive samples in a row. The stop class is "caught" when present.
+  double stop_threshold = 0.9;
+  int stop_consecutive = 5;
+
+  int class_index(std::string_view name) const;  // -1 if absent
+};
+
+// A model file that cannot be read or is not valid; the message names the file and the problem.
+class ModelError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Loading checks everything FORMAT.md lists (magic, version, size, CRC-32, bounds, finite
+// numbers, stochastic rows within kStochasticTolerance, positive-definite covariances).
+OutcomeModel read_model(const std::filesystem::path& path);
+// Validates, encodes and writes through a temporary file and a rename (never a torn file).
+void write_model(const std::filesystem::path& path, const OutcomeModel& m);
+// The file's bytes; throws ModelError if `m` is not valid (the same checks as loading).
+std::vector<uint8_t> encode_model(const OutcomeModel& m);
+// Parses and validates bytes; `source_name` names them in error messages (e.g. the file path).
+OutcomeModel decode_model(const uint8_t* data, size_t size, const std::string& source_name);
+// Human-readable description (what `dressguard model show` prints).
+std::string describe_model(const OutcomeModel& m);
+// Throws ModelError naming `source_name` and the first problem of `m` (used by encode/decode).
+void validate_model(const OutcomeModel& m, const std::string& source_name);
+
+// A probability vector (the initial distribution, a transition row) is accepted when every
+// entry is in [0, 1] and |sum - 1| <= kStochasticTolerance.
+inline constexpr double kStochasticTolerance = 1e-9;
+
+// The file format's identity (FORMAT.md).
+inline constexpr char kMagic[8] = {'D', 'G', 'M', 'O', 'D', 'E', 'L', '\0'};
+inline constexpr uint32_t kFormatVersion = 1;
+
+// CRC-32 (IEEE 802.3, reflected, polynomial 0xEDB88320, init and final xor 0xFFFFFFFF), the one
+// zlib and PNG use: crc32("123456789") == 0xCBF43926.
+uint32_t crc32(const uint8_t* data, size_t size) noexcept;
+
+}  // namespace dressguard::model

@@ -1,0 +1,193 @@
+// dressguard classify: an outcome model and a labelled dataset -> per-trial classes, accuracy and
+// the confusion matrix; optionally cut at a travel distance (paper Fig. 6) or swept over many.
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <set>
+#include <sstream>
+
+#include "args.h"
+#include "commands.h"
+#include "dataset.h"
+#include "dgm.h"
+#include "files.h"
+#include "hmm.h"
+#include "report.h"
+
+namespace dressguard::cli {
+
+namespace {
+
+// "a:b:step" -> a, a+step, ..., up to b (inclusive within step/1000).
+std::vector<double> parse_sweep(const std::string& s) {
+  double v[3];
+  std::stringstream in(s);
+  std::string part;
+  int k = 0;
+  while (std::getline(in, part, ':')) {
+    if (k >= 3) throw UsageError("--sweep must be START:END:STEP, got '" + s + "'");
+    char* end = nullptr;
+    v[k] = std::strtod(part.c_str(), &end);
+    if (part.empty() || *end != '\0' || !std::isfinite(v[k])) throw UsageError("--sweep: not a number: '" + part + "'");
+    ++k;
+  }
+  if (k != 3) throw UsageError("--sweep must be START:END:STEP, got '" + s + "'");
+  if (!(v[2] > 0) || v[1] < v[0]) throw UsageError("--sweep needs STEP > 0 and END >= START");
+  std::vector<double> out;
+  for (int i = 0;; ++i) {
+    const double d = v[0] + i * v[2];
+    if (d > v[1] + 1e-3 * v[2]) break;
+    out.push_back(d);
+    if (out.size() > 10000) throw UsageError("--sweep has more than 10000 points");
+  }
+  return out;
+}
+
+// tools/plot/hmm_sweep.py: beside the sources this binary was built from, else under the
+// working directory; empty when absent.
+std::filesystem::path find_plot_script() {
+  std::vector<std::filesystem::path> cands;
+  if (const char* s = std::getenv("DRESSGUARD_SOURCE_DIR")) cands.emplace_back(std::filesystem::path(s) / "tools/plot/hmm_sweep.py");
+  char exe[4096];
+  const ssize_t n = ::readlink("/proc/self/exe", exe, sizeof exe - 1);
+  if (n > 0) {
+    exe[n] = '\0';
+    auto p = std::filesystem::path(exe).parent_path();
+    for (int up = 0; up < 5 && !p.empty(); ++up, p = p.parent_path()) cands.push_back(p / "tools/plot/hmm_sweep.py");
+  }
+  cands.emplace_back(std::filesystem::current_path() / "tools/plot/hmm_sweep.py");
+  for (const auto& c : cands)
+    if (std::filesystem::exists(c)) return c;
+  return {};
+}
+
+std::set<std::string> split_list(const std::string& s) {
+  std::set<std::string> out;
+  std::stringstream in(s);
+  std::string item;
+  while (std::getline(in, item, ','))
+    if (!item.empty()) out.insert(item);
+  return out;
+}
+
+}  // namespace
+
+int run_classify(int argc, char** argv) {
+  Args args(argc - 1, argv + 1, {"help", "json", "no-plot"});
+  if (args.has("help")) {
+    std::puts(
+        "usage: dressguard classify --model MODEL.dgm --data DATASET [options] [--json]\n"
+        "  Classifies every labelled trial by the highest posterior (log-likelihood + log prior) and\n"
+        "  prints per-trial results, the accuracy and the confusion matrix (rows truth, columns predicted).\n"
+        "  --truncate-at DIST      cut each trial after the last sample with travel <= DIST metres\n"
+        "  --sweep A:B:STEP        accuracy at every truncation distance A, A+STEP, ..., B (metres)\n"
+        "  --sweep-out PREFIX      with --sweep: write PREFIX.csv and PREFIX.png (tools/plot/hmm_sweep.py)\n"
+        "  --no-plot               with --sweep: write only the CSV\n"
+        "  --participant P[,Q...]  only these participants' trials (leave-one-participant-out)\n"
+        "  --json                  print a machine-readable result");
+    return 0;
+  }
+  args.allow_only({"help", "json", "no-plot", "model", "data", "truncate-at", "sweep", "sweep-out", "participant"});
+  const std::string model_path = args.require("model"), data = args.require("data");
+  const double truncate = args.number("truncate-at", std::numeric_limits<double>::infinity());
+  if (!(truncate > 0)) throw UsageError("--truncate-at must be positive");
+  std::vector<double> sweep;
+  if (auto s = args.get("sweep")) {
+    sweep = parse_sweep(*s);
+    if (!args.get("sweep-out")) throw UsageError("--sweep needs --sweep-out PREFIX");
+    if (args.get("truncate-at")) throw UsageError("--sweep and --truncate-at exclude each other");
+  } else if (args.get("sweep-out")) {
+    throw UsageError("--sweep-out needs --sweep");
+  }
+  const auto only = split_list(args.get("participant").value_or(""));
+
+  model::OutcomeModel m;
+  try {
+    m = model::read_model(model_path);
+  } catch (const model::ModelError& e) {
+    throw InputError(e.what());
+  }
+  const Dataset ds = load_dataset(data);
+  std::vector<const HapticSequence*> trials;
+  for (const auto& t : ds.trials)
+    if (only.empty() || only.count(t.participant)) trials.push_back(&t);
+  if (trials.empty()) throw InputError(data + ": no trials" + (only.empty() ? "" : " of the given participants"));
+  const bool json = args.has("json");
+
+  if (!sweep.empty()) {
+    const std::string prefix = *args.get("sweep-out");
+    std::string csv = "travel_m,accuracy,correct,total\n";
+    std::string rows_json;
+    for (double d : sweep) {
+      const auto ev = hmm::evaluate(m, trials, d);
+      char line[128];
+      std::snprintf(line, sizeof line, "%.6g,%.6f,%d,%d\n", d, ev.accuracy(), ev.correct, ev.total);
+      csv += line;
+      std::snprintf(line, sizeof line, "%s{\"travel_m\": %.6g, \"accuracy\": %.6f, \"correct\": %d, \"total\": %d}",
+                    rows_json.empty() ? "" : ", ", d, ev.accuracy(), ev.correct, ev.total);
+      rows_json += line;
+      if (!json) std::printf("travel %.3f m: accuracy %.4f (%d/%d)\n", d, ev.accuracy(), ev.correct, ev.total);
+    }
+    write_file_atomic(prefix + ".csv", csv);
+    std::string png;
+    if (!args.has("no-plot")) {
+      const auto script = find_plot_script();
+      if (script.empty()) {
+        std::fprintf(stderr, "classify: tools/plot/hmm_sweep.py not found; wrote only %s.csv\n", prefix.c_str());
+      } else {
+        const std::string cmd = "/usr/bin/python3 '" + script.string() + "' '" + prefix + ".csv' '" + prefix + ".png'";
+        if (std::system(cmd.c_str()) == 0) {
+          png = prefix + ".png";
+        } else {
+          std::fprintf(stderr, "classify: plotting failed (%s); wrote only %s.csv\n", cmd.c_str(), prefix.c_str());
+        }
+      }
+    }
+    if (json) {
+      std::printf("{\"sweep\": [%s], \"csv\": %s, \"png\": %s}\n", rows_json.c_str(), hmm::json_string(prefix + ".csv").c_str(),
+                  png.empty() ? "null" : hmm::json_string(png).c_str());
+    } else {
+      std::printf("wrote %s.csv%s\n", prefix.c_str(), png.empty() ? "" : (" and " + png).c_str());
+    }
+    return 0;
+  }
+
+  std::vector<hmm::TrialResult> per;
+  const auto ev = hmm::evaluate(m, trials, truncate, &per);
+  if (json) {
+    std::string rows;
+    for (const auto& r : per) {
+      if (r.truth < 0) continue;
+      std::string ll, post;
+      for (size_t c = 0; c < m.classes.size(); ++c) {
+        ll += (c ? ", " : "") + hmm::json_number(r.result.log_likelihood[c]);
+        post += (c ? ", " : "") + hmm::json_number(r.result.posterior[c]);
+      }
+      rows += (rows.empty() ? "" : ", ") + std::string("{\"id\": ") + hmm::json_string(r.trial->id) +
+              ", \"participant\": " + hmm::json_string(r.trial->participant) + ", \"samples\": " + std::to_string(r.samples) +
+              ", \"truth\": " + hmm::json_string(m.classes[r.truth].name) + ", \"predicted\": " +
+              hmm::json_string(m.classes[r.result.predicted].name) + ", \"log_likelihood\": [" + ll + "], \"posterior\": [" +
+              post + "]}";
+    }
+    std::printf("{\"model\": %s, \"data\": %s, \"truncate_at\": %s, \"trials\": [%s], \"evaluation\": %s}\n",
+                hmm::json_string(model_path).c_str(), hmm::json_string(data).c_str(), hmm::json_number(truncate).c_str(),
+                rows.c_str(), hmm::evaluation_json(ev).c_str());
+    return 0;
+  }
+  std::printf("%-24s %-6s %7s %-8s %-8s %9s\n", "trial", "part.", "samples", "truth", "predicted", "posterior");
+  for (const auto& r : per) {
+    if (r.truth < 0) continue;
+    std::printf("%-24s %-6s %7zu %-8s %-8s %9.4f%s\n", r.trial->id.c_str(), r.trial->participant.c_str(), r.samples,
+                m.classes[r.truth].name.c_str(), m.classes[r.result.predicted].name.c_str(),
+                r.result.posterior[r.result.predicted], r.truth == r.result.predicted ? "" : "   WRONG");
+  }
+  std::printf("\naccuracy %.4f (%d/%d)%s\n", ev.accuracy(), ev.correct, ev.total,
+              ev.skipped ? (", " + std::to_string(ev.skipped) + " trials skipped (unlabelled, label not in the model, or empty)").c_str() : "");
+  std::printf("%s", hmm::confusion_text(ev).c_str());
+  return 0;
+}
+
+}  // namespace dressguard::cli

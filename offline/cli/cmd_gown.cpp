@@ -1,0 +1,185 @@
+// dressguard gown: load (or generate) the gown, reduce it if asked, place it like the paper's
+// simulator, and report what the simulator will get; optionally write the placed mesh and a
+// picture of the scene (tools/plot/gown.py).
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <unistd.h>
+
+#include "args.h"
+#include "commands.h"
+#include "files.h"
+#include "gown.h"
+#include "placement.h"
+
+namespace dressguard::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using gown::GownMesh;
+
+std::string vec_json(const Eigen::Vector3d& v) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "[%.6f, %.6f, %.6f]", v.x(), v.y(), v.z());
+  return buf;
+}
+
+std::string ints_json(const std::vector<int>& v) {
+  std::string s = "[";
+  for (size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + std::to_string(v[i]);
+  return s + "]";
+}
+
+// Everything the picture needs: mesh, grasped vertices, loops, arm and gripper (all in W).
+std::string scene_dump(const GownMesh& m, const gown::PaperScene& s, const std::vector<int>& grasp) {
+  std::string out = "{\n\"frame\": \"W: z up, gravity -z, gripper moves +x\",\n\"x\": [";
+  for (size_t i = 0; i < m.x.size(); ++i) {
+    char buf[80];
+    std::snprintf(buf, sizeof buf, "%s[%.5f,%.5f,%.5f]", i ? "," : "", m.x[i].x(), m.x[i].y(), m.x[i].z());
+    out += buf;
+  }
+  out += "],\n\"triangles\": [";
+  for (size_t i = 0; i < m.triangles.size(); ++i) {
+    const auto& t = m.triangles[i];
+    out += (i ? ",[" : "[") + std::to_string(t[0]) + "," + std::to_string(t[1]) + "," + std::to_string(t[2]) + "]";
+  }
+  out += "],\n\"boundary_loops\": [";
+  for (size_t l = 0; l < m.boundary_loops.size(); ++l) out += (l ? ", " : "") + ints_json(m.boundary_loops[l]);
+  out += "],\n\"sleeve_loop\": " + std::to_string(m.sleeve_loop);
+  out += ",\n\"sleeve_lower_half\": " + ints_json(m.sleeve_lower_half);
+  out += ",\n\"grasp\": " + ints_json(grasp);
+  out += ",\n\"grasp_box\": {\"center\": " + vec_json(s.grasp_box_center_W()) +
+         ", \"half_extent\": " + vec_json(s.grasp_box_half_extent_W()) + "}";
+  out += ",\n\"upper_jaw\": {\"center\": " + vec_json(s.upper_jaw_center_W) + ", \"size\": " + vec_json(s.jaw_size_W) + "}";
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                ",\n\"arm\": {\"fist\": %s, \"wrist\": %s, \"elbow\": %s, \"shoulder\": %s, "
+                "\"r_fist\": %g, \"r_wrist\": %g, \"r_elbow\": %g, \"r_shoulder\": %g}\n}\n",
+                vec_json(s.fist_W()).c_str(), vec_json(s.wrist_W()).c_str(), vec_json(s.elbow_W()).c_str(),
+                vec_json(s.shoulder_W()).c_str(), s.r_fist, s.r_wrist, s.r_elbow, s.r_shoulder);
+  out += buf;
+  return out;
+}
+
+// tools/plot/gown.py: from $DRESSGUARD_SOURCE_DIR, else from the folders above the executable
+// (build/<preset>/offline/cli/dressguard), else from the working directory.
+fs::path plot_script() {
+  const fs::path rel = fs::path("tools") / "plot" / "gown.py";
+  if (const char* src = std::getenv("DRESSGUARD_SOURCE_DIR"); src && fs::exists(fs::path(src) / rel))
+    return fs::path(src) / rel;
+  std::error_code ec;
+  for (fs::path p = fs::read_symlink("/proc/self/exe", ec).parent_path(); !ec && p.has_relative_path();
+       p = p.parent_path())
+    if (fs::exists(p / rel)) return p / rel;
+  if (fs::exists(rel)) return fs::absolute(rel);
+  return {};
+}
+
+std::string shell_quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+}  // namespace
+
+int run_gown(int argc, char** argv) {
+  Args args(argc - 1, argv + 1, {"help", "json", "parametric", "hang"});
+  if (args.has("help")) {
+    std::puts(
+        "usage: dressguard gown [--obj FILE] [--scale S] [--parametric] [--reduced N] [--out MESH.obj]\n"
+        "                       [--dump SCENE.json] [--picture GOWN.png] [--json]\n"
+        "  Loads the gown the simulator runs on, placed in the world frame W (z up, gripper moves +x)\n"
+        "  like the paper's simulator, and prints its statistics.\n"
+        "  --obj FILE      mesh to load (default: shared/data/gown/fullgown.obj when present,\n"
+        "                  else the project's parametric gown)\n"
+        "  --scale S       file units -> metres (default 1.679, the paper's)\n"
+        "  --parametric    use the parametric gown even when the measured one is present\n"
+        "  --reduced N     reduce to about N triangles (quadric edge collapse), e.g. 5000\n"
+        "  --hang          let the gown hang 3 s from the jaws in a crude check (edges only, no\n"
+        "                  bending, no collisions; not the simulator) before reporting and drawing\n"
+        "  --out MESH.obj  write the placed mesh (atomically)\n"
+        "  --dump FILE     write the scene (mesh, grasp, loops, arm, gripper) as JSON for plotting\n"
+        "  --picture PNG   draw the placed gown with grasp, sleeve opening and arm (needs python3 +\n"
+        "                  matplotlib; tools/plot/gown.py)\n"
+        "  --json          print a machine-readable summary");
+    return 0;
+  }
+  args.allow_only({"help", "json", "parametric", "hang", "obj", "scale", "reduced", "out", "dump", "picture"});
+  if (args.has("parametric") && args.has("obj")) throw UsageError("--parametric and --obj exclude each other");
+  gown::GownOptions opt;
+  opt.scale = args.number("scale", 1.679);
+  if (!(opt.scale > 0)) throw UsageError("--scale must be positive");
+  const long reduced = args.integer("reduced", 0);
+  if (reduced < 0 || (reduced > 0 && reduced < 100)) throw UsageError("--reduced wants 0 (full) or at least 100 triangles");
+  opt.target_triangles = static_cast<int>(reduced);
+  if (auto obj = args.get("obj")) opt.obj = *obj;
+
+  const auto t0 = std::chrono::steady_clock::now();
+  opt.parametric = args.has("parametric");
+  const fs::path measured = gown::measured_gown_path();
+  const std::string source =
+      opt.parametric || (opt.obj.empty() && measured.empty()) ? "parametric" : (opt.obj.empty() ? measured : opt.obj).string();
+  GownMesh mesh = gown::load_gown(opt);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  const auto masses = gown::vertex_masses(mesh);
+  double mass = 0;
+  for (double m : masses) mass += m;
+  const auto grasp = gown::grasp_vertices(mesh, opt.scene);  // at placement, before any hang
+  if (args.has("hang")) mesh.x = gown::crude_hang(mesh, opt.scene);
+  const Eigen::Vector3d sleeve_c = gown::loop_centroid(mesh, mesh.sleeve_loop);
+
+  if (auto out = args.get("out")) write_file_atomic(*out, gown::to_obj(mesh));
+  const auto dump = args.get("dump");
+  const auto picture = args.get("picture");
+  if (dump || picture) {
+    const fs::path dump_path =
+        dump ? fs::path(*dump) : fs::temp_directory_path() / ("dressguard-gown-" + std::to_string(::getpid()) + ".json");
+    write_file_atomic(dump_path, scene_dump(mesh, opt.scene, grasp));
+    if (picture) {
+      const fs::path script = plot_script();
+      if (script.empty()) throw std::runtime_error("tools/plot/gown.py not found (set DRESSGUARD_SOURCE_DIR)");
+      const std::string cmd = "/usr/bin/python3 " + shell_quote(script.string()) + " " +
+                              shell_quote(dump_path.string()) + " " + shell_quote(*picture);
+      const int rc = std::system(cmd.c_str());
+      if (!dump) fs::remove(dump_path);
+      if (rc != 0) throw std::runtime_error("the picture script failed: " + cmd);
+    }
+  }
+
+  if (args.has("json")) {
+    std::printf("{\"source\": \"%s\", \"vertices\": %zu, \"triangles\": %zu, \"area_m2\": %.5f, \"mass_kg\": %.5f, "
+                "\"mean_edge_m\": %.5f, \"min_angle_deg\": %.2f, \"seconds\": %.3f, \"hung\": %s, \"loops\": [",
+                source.c_str(), mesh.x.size(), mesh.triangles.size(), gown::total_area(mesh), mass,
+                gown::mean_edge_length(mesh), gown::min_triangle_angle(mesh) * 180 / M_PI, seconds,
+                args.has("hang") ? "true" : "false");
+    for (size_t l = 0; l < mesh.boundary_loops.size(); ++l)
+      std::printf("%s{\"vertices\": %zu, \"perimeter_m\": %.5f, \"centroid\": %s}", l ? ", " : "",
+                  mesh.boundary_loops[l].size(), gown::loop_perimeter(mesh, static_cast<int>(l)),
+                  vec_json(gown::loop_centroid(mesh, static_cast<int>(l))).c_str());
+    std::printf("], \"sleeve_loop\": %d, \"sleeve_center\": %s, \"sleeve_lower_half\": %zu, \"grasped\": %zu}\n",
+                mesh.sleeve_loop, vec_json(sleeve_c).c_str(), mesh.sleeve_lower_half.size(), grasp.size());
+  } else {
+    std::printf("gown: %s%s\n", source.c_str(), args.has("hang") ? " (after a crude 3 s hang from the jaws)" : "");
+    std::printf("  %zu vertices, %zu triangles, area %.4f m^2, mass %.4f kg (%.3f kg/m^2)\n", mesh.x.size(),
+                mesh.triangles.size(), gown::total_area(mesh), mass, mesh.areal_density);
+    std::printf("  mean edge %.2f cm, smallest angle %.1f deg, built in %.3f s\n", gown::mean_edge_length(mesh) * 100,
+                gown::min_triangle_angle(mesh) * 180 / M_PI, seconds);
+    for (size_t l = 0; l < mesh.boundary_loops.size(); ++l) {
+      const auto c = gown::loop_centroid(mesh, static_cast<int>(l));
+      std::printf("  loop %zu: %zu vertices, perimeter %.3f m, centre (%.3f, %.3f, %.3f)%s\n", l,
+                  mesh.boundary_loops[l].size(), gown::loop_perimeter(mesh, static_cast<int>(l)), c.x(), c.y(), c.z(),
+                  static_cast<int>(l) == mesh.sleeve_loop ? "  <- sleeve opening the arm enters" : "");
+    }
+    std::printf("  grasped vertices: %zu; sleeve lower half: %zu vertices\n", grasp.size(),
+                mesh.sleeve_lower_half.size());
+  }
+  return 0;
+}
+
+}  // namespace dressguard::cli

@@ -1,0 +1,119 @@
+// load_gown and the mesh comparisons used to check a reduction.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+
+#include <Eigen/Geometry>
+
+#include "files.h"
+#include "gown.h"
+
+namespace dressguard::gown {
+
+std::filesystem::path measured_gown_path() {
+  const auto shared = shared_dir();
+  if (shared.empty()) return {};
+  auto p = shared / "data" / "gown" / "fullgown.obj";
+  return std::filesystem::exists(p) ? p : std::filesystem::path{};
+}
+
+GownMesh load_gown(const GownOptions& options) {
+  const std::filesystem::path path =
+      options.parametric ? std::filesystem::path{} : (options.obj.empty() ? measured_gown_path() : options.obj);
+  GownMesh mesh;
+  if (path.empty()) {
+    mesh = make_parametric_gown();
+  } else {
+    mesh = read_obj(path, options.scale);
+    place_like_paper(mesh, options.scene);
+  }
+  mesh.areal_density = options.areal_density;
+  if (mesh.boundary_loops.size() < 2)
+    throw_input_error(path.empty() ? "parametric gown" : path, 0,
+                      "the mesh has " + std::to_string(mesh.boundary_loops.size()) +
+                          " boundary loop(s); a gown needs its body opening and a sleeve opening");
+  if (options.target_triangles > 0) mesh = reduce_gown(mesh, options.target_triangles);
+  label_sleeve(mesh, options.scene);
+  return mesh;
+}
+
+namespace {
+
+// Closest point on triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5: the
+// Voronoi regions of the vertices, the edges and the face, in that order).
+Eigen::Vector3d closest_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                    const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + (d1 / (d1 - d3)) * ab;
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + (d2 / (d2 - d6)) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
+  const double denom = va + vb + vc;
+  if (denom == 0) return a;  // degenerate triangle
+  return a + ab * (vb / denom) + ac * (vc / denom);
+}
+
+}  // namespace
+
+double max_distance_to_surface(const GownMesh& from, const GownMesh& to, double search_radius) {
+  const double h = search_radius;
+  auto cell = [h](const Eigen::Vector3d& p) {
+    return Eigen::Vector3i(static_cast<int>(std::floor(p.x() / h)), static_cast<int>(std::floor(p.y() / h)),
+                           static_cast<int>(std::floor(p.z() / h)));
+  };
+  auto key = [](int i, int j, int k) {
+    return (static_cast<int64_t>(i) * 73856093) ^ (static_cast<int64_t>(j) * 19349663) ^
+           (static_cast<int64_t>(k) * 83492791);
+  };
+  std::unordered_map<int64_t, std::vector<int>> grid;
+  for (int f = 0; f < static_cast<int>(to.triangles.size()); ++f) {
+    const auto& t = to.triangles[f];
+    const Eigen::Vector3d lo = to.x[t[0]].cwiseMin(to.x[t[1]]).cwiseMin(to.x[t[2]]);
+    const Eigen::Vector3d hi = to.x[t[0]].cwiseMax(to.x[t[1]]).cwiseMax(to.x[t[2]]);
+    const Eigen::Vector3i c0 = cell(lo), c1 = cell(hi);
+    for (int i = c0.x(); i <= c1.x(); ++i)
+      for (int j = c0.y(); j <= c1.y(); ++j)
+        for (int k = c0.z(); k <= c1.z(); ++k) grid[key(i, j, k)].push_back(f);
+  }
+  double worst = 0;
+  for (const auto& p : from.x) {
+    const Eigen::Vector3i c = cell(p);
+    double best = std::numeric_limits<double>::infinity();
+    for (int i = -1; i <= 1; ++i)
+      for (int j = -1; j <= 1; ++j)
+        for (int k = -1; k <= 1; ++k) {
+          const auto it = grid.find(key(c.x() + i, c.y() + j, c.z() + k));
+          if (it == grid.end()) continue;
+          for (int f : it->second) {
+            const auto& t = to.triangles[f];
+            best = std::min(best, (closest_on_triangle(p, to.x[t[0]], to.x[t[1]], to.x[t[2]]) - p).norm());
+          }
+        }
+    worst = std::max(worst, best);
+  }
+  return worst;
+}
+
+double min_triangle_angle(const GownMesh& mesh) {
+  double worst = M_PI;
+  for (const auto& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d u = mesh.x[t[(k + 1) % 3]] - mesh.x[t[k]];
+      const Eigen::Vector3d v = mesh.x[t[(k + 2) % 3]] - mesh.x[t[k]];
+      worst = std::min(worst, std::atan2(u.cross(v).norm(), u.dot(v)));
+    }
+  return worst;
+}
+
+}  // namespace dressguard::gown

@@ -1,0 +1,103 @@
+// The gown mesh: loading (OBJ), the project's own parametric gown, reduction to a coarser mesh
+// that keeps the shape, boundary loops (the sleeve openings) and the lumped vertex masses.
+//
+// Frames. Everything the simulator sees is in the world frame W, shared by gown and sim:
+//   z up, gravity along -z, the gripper moves along +x.
+// W is the paper's public-simulator frame P (y up, gripper moving toward -x) rotated:
+//   x_W = -x_P,  y_W = z_P,  z_W = y_P      (a proper rotation, det = +1)
+// The scene constants of that simulator (gripper jaws, arm spheres, gown transform) are in
+// placement.h (`PaperScene`), so that gown and sim use the same numbers.
+//
+// Data: the measured gown is gt-rad/learning-forces, physx_simulation/Mesh/fullgown.obj (read in
+// place from shared/data/gown/, never copied into the project).
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "placement.h"
+
+namespace dressguard::gown {
+
+// A triangle mesh of the gown with what the simulator needs to know about it.
+struct GownMesh {
+  std::vector<Eigen::Vector3d> x;                // vertex positions in W [m] (file frame right after read_obj)
+  std::vector<std::array<int, 3>> triangles;     // vertex indices, 0-based, consistently oriented
+  std::vector<std::vector<int>> boundary_loops;  // each ordered around the loop; longest first
+  int sleeve_loop = -1;                          // index into boundary_loops: the opening the arm enters
+  std::vector<int> sleeve_lower_half;            // vertices of the lower half of that opening (paper Fig. 3b),
+                                                 // used to label a trial (paper V-A: d_max <= 7 cm is good)
+  double areal_density = 0.145;                  // [kg/m^2], the paper's simulator value
+};
+
+struct GownOptions {
+  std::filesystem::path obj;  // empty: the measured gown shared/data/gown/fullgown.obj if present,
+                              // else the parametric gown
+  double scale = 1.679;       // file units -> metres (the paper's simulator)
+  int target_triangles = 0;   // 0: full resolution; e.g. 5000 for the reduced gown
+  double areal_density = 0.145;
+  bool parametric = false;    // use the parametric gown even when the measured one is present
+  PaperScene scene{};         // placement of a file's mesh and the grasp box that picks the sleeve
+};
+
+// shared/data/gown/fullgown.obj when shared/data is present, else empty.
+std::filesystem::path measured_gown_path();
+
+// The gown the simulator runs on: loaded (or generated), reduced if asked, placed in W like the
+// paper's simulator, its boundary loops found and the sleeve opening labelled. Throws InputError
+// for a malformed file or a mesh without at least one boundary loop near the grasp box.
+GownMesh load_gown(const GownOptions& options);
+
+// Reads v/f lines of an OBJ (polygons fan-triangulated; 1-based and negative indices; "f a/b/c",
+// "a//c" and "a/b" forms; other lines ignored). Positions are multiplied by `scale` and stay in
+// the file's frame (no placement). Boundary loops are found; the sleeve is not labelled.
+// InputError names file:line on a malformed line or an index out of range.
+GownMesh read_obj(const std::filesystem::path& path, double scale);
+
+// The project's own gown (no shared data needed): a body panel with a sleeve tube, the measured
+// gown's dimensions (area ~1.6 m^2, sleeve opening perimeter 0.47 m, ~1.4 cm mean edge), already
+// placed in W with its sleeve opening near the grasp box, loops found and the sleeve labelled.
+GownMesh make_parametric_gown();
+
+// Quadric-error-metric edge collapse (Garland & Heckbert 1997) down to about `target_triangles`.
+// Boundary loops keep their shape (boundary vertices move only along the boundary, with a
+// boundary quadric), the mesh stays manifold, collapses that would flip a triangle or create a
+// sliver are refused. Deterministic (ties broken by edge index). Loops are found again and the
+// sleeve labelling is carried over (same loop, lower half recomputed) when the input had one.
+GownMesh reduce_gown(const GownMesh& mesh, int target_triangles);
+
+// Loops of edges used by exactly one triangle, each ordered by walking along the boundary,
+// longest (most vertices) first. A vertex where two loops touch is followed consistently.
+std::vector<std::vector<int>> find_boundary_loops(const std::vector<std::array<int, 3>>& tris, int n_vertices);
+
+// Lumped masses [kg]: each triangle gives area * density / 3 to each of its vertices.
+std::vector<double> vertex_masses(const GownMesh& mesh);
+
+// Indices of the vertices inside the axis-aligned box center_W +- half_extent (inclusive).
+std::vector<int> vertices_in_box(const GownMesh& mesh, const Eigen::Vector3d& center_W,
+                                 const Eigen::Vector3d& half_extent);
+
+double total_area(const GownMesh& mesh);  // [m^2]
+
+// --- small helpers used by the command, the tests and the simulator -------------------------
+
+double loop_perimeter(const GownMesh& mesh, int loop);            // [m], closed polygon length
+Eigen::Vector3d loop_centroid(const GownMesh& mesh, int loop);    // mean of the loop's vertices
+double mean_edge_length(const GownMesh& mesh);                    // over unique edges [m]
+
+// One-sided distance [m]: the largest distance from a vertex of `from` to the surface of `to`
+// (exact point-triangle distances, triangles found through a uniform grid of `search_radius`
+// cells). Infinity when some vertex has no triangle of `to` within about search_radius.
+double max_distance_to_surface(const GownMesh& from, const GownMesh& to, double search_radius = 0.05);
+
+// The smallest interior angle of any triangle [rad] (slivers have small ones).
+double min_triangle_angle(const GownMesh& mesh);
+
+// The whole mesh as OBJ text (v and f lines, 1-based), for `dressguard gown --out` and frames.
+std::string to_obj(const GownMesh& mesh);
+
+}  // namespace dressguard::gown

@@ -1,0 +1,132 @@
+// The scene of the paper's public simulator (gt-rad/learning-forces, physx_simulation/), as
+// numbers in the shared world frame W (z up, gravity -z, the gripper moves along +x), so that the
+// gown module and the simulator place gown, gripper and arm alike.
+//
+// W from the simulator's frame P (y up, gripper moving toward -x):
+//   x_W = -x_P,  y_W = z_P,  z_W = y_P      (a proper rotation, det = +1)
+//
+// Where this placement is uncertain (read from that code, never checked by running it):
+//  - The jaws are PxBoxGeometry(0.04, 0.005, 0.06) (half extents) in that code, so the full
+//    sizes 0.08 x 0.01 x 0.12 m (P) are right.
+//  - The gown rotation angles are rounded (1.57, -1.2, -3.14 rad), so the gown is not exactly
+//    axis-aligned; we apply them as given, not as pi/2 and pi.
+//  - That code grips the particles inside both jaws' bounds once the lower jaw has closed (it
+//    pushes the cloth it meets up against the upper jaw, with gravity off). We take every vertex
+//    inside the volume the lower jaw sweeps from z = 0.06 up to the upper jaw (`grasp_box_*`), at
+//    placement; the simulator should then hold them at z = pinch_z_W() (between the jaws).
+//    PhysX contact offsets may add or drop a row of particles at the box's faces.
+//  - The arm starts 0.1 m further along +x_W and moves to its place during settling steps
+//    200-400 (`arm_approach_x_W`); the numbers below are its final place.
+//  - A crude hanging check (edges only, no bending, no collisions; tests/gown) lets the measured
+//    gown's sleeve opening hang about 0.17 m below the arm axis and 0.08 m behind the gripper:
+//    whether the arm enters it at the high setting depends on the bending stiffness and the
+//    settling, i.e. on the simulator, not on this placement.
+//  - The paper's Fig. 3(b) only shows the sleeve hanging toward the fist; the "lower half" of the
+//    opening is our reading: the half of the loop that lies below its centroid (z_W).
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace dressguard::gown {
+
+struct GownMesh;
+
+// W <- P (see the header comment).
+inline Eigen::Matrix3d rotation_WP() {
+  Eigen::Matrix3d R;
+  R << -1, 0, 0,  //
+      0, 0, 1,    //
+      0, 1, 0;
+  return R;
+}
+
+struct PaperScene {
+  // --- gown transform (file -> P): p_P = R_PF * (scale * p_file) + t_P -----------------------
+  double scale = 1.679;           // file units -> metres
+  double rot_y = 1.57;            // [rad] R_PF = Ry(rot_y) * Rx(rot_x) * Rz(rot_z), applied right to left
+  double rot_x = -1.2;            // [rad]
+  double rot_z = -3.14;           // [rad]
+  double forearm_length = 0.31;   // F [m]; the gown's translation is (-F + 0.71, 0, -0.3) in P
+  double gown_offset_x_P = 0.71;  // [m]
+  double gown_offset_z_P = -0.3;  // [m]
+
+  // --- gripper (W) ------------------------------------------------------------------------------
+  Eigen::Vector3d upper_jaw_center_W{-0.17, 0.0, 0.20};  // P: (-F + 0.48, 0.20, 0)
+  Eigen::Vector3d jaw_size_W{0.08, 0.12, 0.01};          // full box sizes x, y, z [m]
+  double lower_jaw_start_z_W = 0.06;                     // the lower jaw's centre before it closes [m]
+  double arm_approach_x_W = 0.1;  // the arm starts this far along +x_W and moves in while settling [m]
+
+  // Height at which the closed jaws hold the grasped vertices: the upper jaw's lower face.
+  double pinch_z_W() const { return upper_jaw_center_W.z() - 0.5 * jaw_size_W.z(); }
+
+  // --- arm (W); all sphere centres at the same height, the high ("good") setting ---------------
+  double r_fist = 0.05, r_wrist = 0.0365, r_elbow = 0.05, r_shoulder = 0.075;  // [m]
+  double upper_arm_length = 0.32;                                               // [m]
+  double arm_height_high_W = 0.1115;    // z_W of the arm axis: -0.13 + r_wrist + 0.205 [m]
+  double arm_offset_middle = -0.123;    // [m] relative to high
+  double arm_offset_low = -0.205;       // [m] relative to high
+
+  // Fist and wrist are centred at x_P = -r_fist (x_W = +0.05), elbow at x_P = -F - r_elbow
+  // (x_W = 0.36), shoulder at the elbow's x with the upper arm sideways along -y_W.
+  Eigen::Vector3d fist_W(double offset = 0) const { return {r_fist, 0, arm_height_high_W + offset}; }
+  Eigen::Vector3d wrist_W(double offset = 0) const { return fist_W(offset); }
+  Eigen::Vector3d elbow_W(double offset = 0) const {
+    return {forearm_length + r_elbow, 0, arm_height_high_W + offset};
+  }
+  Eigen::Vector3d shoulder_W(double offset = 0) const {
+    return elbow_W(offset) + Eigen::Vector3d(0, -upper_arm_length, 0);
+  }
+
+  // The volume the lower jaw sweeps closing from lower_jaw_start_z_W onto the upper jaw: the
+  // vertices inside it at placement (before gravity) are the grasped ones.
+  Eigen::Vector3d grasp_box_center_W() const {
+    const double lo = lower_jaw_start_z_W - 0.5 * jaw_size_W.z();
+    const double hi = upper_jaw_center_W.z() + 0.5 * jaw_size_W.z();
+    return {upper_jaw_center_W.x(), upper_jaw_center_W.y(), 0.5 * (lo + hi)};
+  }
+  Eigen::Vector3d grasp_box_half_extent_W() const {
+    const double lo = lower_jaw_start_z_W - 0.5 * jaw_size_W.z();
+    const double hi = upper_jaw_center_W.z() + 0.5 * jaw_size_W.z();
+    return {0.5 * jaw_size_W.x(), 0.5 * jaw_size_W.y(), 0.5 * (hi - lo)};
+  }
+
+  // R_WF: file frame (already scaled) -> W, and the translation in W.
+  Eigen::Matrix3d rotation_WF() const {
+    using Eigen::AngleAxisd;
+    const Eigen::Matrix3d R_PF = (AngleAxisd(rot_y, Eigen::Vector3d::UnitY()) *
+                                  AngleAxisd(rot_x, Eigen::Vector3d::UnitX()) *
+                                  AngleAxisd(rot_z, Eigen::Vector3d::UnitZ()))
+                                     .toRotationMatrix();
+    return rotation_WP() * R_PF;
+  }
+  Eigen::Vector3d translation_W() const {
+    return rotation_WP() * Eigen::Vector3d(-forearm_length + gown_offset_x_P, 0, gown_offset_z_P);
+  }
+};
+
+// Moves a mesh read in the file frame (already scaled) into W: x_W = R_WF x + t_W.
+void place_like_paper(GownMesh& mesh, const PaperScene& scene = {});
+
+// Picks the sleeve opening: among the loops other than the longest (the hem), the one whose
+// centroid is nearest the grasp box centre; sets mesh.sleeve_loop and
+// mesh.sleeve_lower_half (its vertices below the loop centroid in z_W). Throws std::runtime_error
+// when the mesh has fewer than two boundary loops.
+void label_sleeve(GownMesh& mesh, const PaperScene& scene = {});
+
+// Sets mesh.sleeve_loop = loop and its lower half (the loop's vertices below its centroid in z_W).
+void set_sleeve_loop(GownMesh& mesh, int loop);
+
+// The vertices the gripper holds: vertices_in_box(grasp box).
+std::vector<int> grasp_vertices(const GownMesh& mesh, const PaperScene& scene = {});
+
+// A crude hang to check a placement, NOT the simulator: position-based dynamics with the mesh
+// edges as inextensible distance constraints, the grasped vertices moved to the closed jaws
+// (z = pinch_z_W) and fixed, gravity, 1% velocity damping per step, 300 Hz, 20 Gauss-Seidel
+// passes, no bending, no collisions, `seconds` of simulated time. Returns the hung positions.
+// Run it on the reduced gown (about 1 s for 3 s on 5k triangles).
+std::vector<Eigen::Vector3d> crude_hang(const GownMesh& mesh, const PaperScene& scene = {}, double seconds = 3.0);
+
+}  // namespace dressguard::gown

@@ -1,0 +1,568 @@
+// Outcome HMM training and inference (see hmm.h for the equations and the convergence rule).
+#include "hmm.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace dressguard::hmm {
+
+namespace {
+
+constexpr double kLog2Pi = 1.8378770664093454835606594728112;
+constexpr double kNegInf = -std::numeric_limits<double>::infinity();
+// Normalised forward (and scaled backward) probabilities below this are set to 0, as the online
+// filter does (predictor/filter/emission_update.h): states a left-right model has left behind
+// would otherwise decay through the subnormal range, where arithmetic is ~100x slower.
+constexpr double kFlushBelow = 1e-300;
+
+// Per-state constants for the emission log density: mean, inverse covariance [[p q][q r]] and
+// -log(2 pi) - log|S|/2.
+struct EmissionCache {
+  std::vector<double> m0, m1, p, q, r, c;
+  explicit EmissionCache(const ClassHmm& h) {
+    for (const auto& e : h.emission) {
+      const double a = e.cov[0][0], b = 0.5 * (e.cov[0][1] + e.cov[1][0]), d = e.cov[1][1];
+      const double det = a * d - b * b;
+      m0.push_back(e.mean[0]);
+      m1.push_back(e.mean[1]);
+      p.push_back(d / det);
+      q.push_back(-b / det);
+      r.push_back(a / det);
+      c.push_back(-kLog2Pi - 0.5 * std::log(det));
+    }
+  }
+  double log_density(int j, const double* x) const {
+    const double d0 = x[0] - m0[j], d1 = x[1] - m1[j];
+    return c[j] - 0.5 * (p[j] * d0 * d0 + 2.0 * q[j] * d0 * d1 + r[j] * d1 * d1);
+  }
+};
+
+// The band of a transition matrix: lo[j]..hi[j] are the predecessors i with A_ij possibly > 0.
+struct Band {
+  std::vector<int> lo, hi;   // predecessors of j
+  std::vector<int> slo, shi; // successors of i
+  explicit Band(const ClassHmm& h) {
+    const int n = h.n_states;
+    lo.assign(n, n);
+    hi.assign(n, -1);
+    slo.assign(n, n);
+    shi.assign(n, -1);
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j)
+        if (h.transition[i * n + j] > 0.0) {
+          lo[j] = std::min(lo[j], i);
+          hi[j] = std::max(hi[j], i);
+          slo[i] = std::min(slo[i], j);
+          shi[i] = std::max(shi[i], j);
+        }
+  }
+};
+
+// Raises every eigenvalue of the symmetric 2x2 [[a b][b d]] to at least `floor`.
+void floor_covariance(double cov[2][2], double floor) {
+  const double a = cov[0][0], b = 0.5 * (cov[0][1] + cov[1][0]), d = cov[1][1];
+  const double h = 0.5 * (a + d), g = std::sqrt(0.25 * (a - d) * (a - d) + b * b);
+  double l1 = h + g, l2 = h - g;  // l1 >= l2
+  if (l2 >= floor) return;
+  l1 = std::max(l1, floor);
+  l2 = std::max(l2, floor);
+  // Unit eigenvector of l1: (b, l1 - a) or, when b = 0, the axis of the larger diagonal entry.
+  double v0, v1;
+  if (std::fabs(b) > 1e-300) {
+    v0 = b;
+    v1 = (h + g) - a;
+    const double nrm = std::hypot(v0, v1);
+    v0 /= nrm;
+    v1 /= nrm;
+  } else if (a >= d) {
+    v0 = 1.0, v1 = 0.0;
+  } else {
+    v0 = 0.0, v1 = 1.0;
+  }
+  // S = l1 v v^T + l2 w w^T with w = (-v1, v0).
+  cov[0][0] = l1 * v0 * v0 + l2 * v1 * v1;
+  cov[1][1] = l1 * v1 * v1 + l2 * v0 * v0;
+  cov[0][1] = cov[1][0] = (l1 - l2) * v0 * v1;
+}
+
+// Scratch for one sequence's forward-backward pass, reused across sequences.
+struct Workspace {
+  std::vector<double> alpha, beta, bs, scale;  // T*n, T*n, T*n (shifted emissions), T
+  void resize(size_t T, int n) {
+    if (alpha.size() < T * n) {
+      alpha.resize(T * n);
+      beta.resize(T * n);
+      bs.resize(T * n);
+    }
+    if (scale.size() < T) scale.resize(T);
+  }
+};
+
+// Sufficient statistics of one Baum-Welch iteration. Moments are about ref (the previous mean).
+struct Accumulators {
+  int n;
+  std::vector<double> g0, g, s0, s1, s00, s01, s11, xi;
+  explicit Accumulators(int n_) : n(n_), g0(n_), g(n_), s0(n_), s1(n_), s00(n_), s01(n_), s11(n_), xi(n_ * n_) {}
+};
+
+// Scaled forward-backward on one sequence, band-restricted; adds its statistics to acc and returns
+// log p(seq). bs(t,j) = b_j(x_t) exp(-m_t), zero for unreachable states (pred = 0): then every
+// alpha, beta and product below stays finite (see hmm.h).
+double forward_backward(const ClassHmm& h, const EmissionCache& em, const Band& band, const FeatureSequence& s,
+                        Workspace& w, Accumulators& acc) {
+  const int n = h.n_states;
+  const size_t T = s.size();
+  if (T == 0) return 0.0;
+  w.resize(T, n);
+  const double* A = h.transition.data();
+  double ll = 0.0;
+  for (size_t t = 0; t < T; ++t) {
+    double* al = &w.alpha[t * n];
+    double* b = &w.bs[t * n];
+    const double* x = s.at(t);
+    // pred into al
+    if (t == 0) {
+      for (int j = 0; j < n; ++j) al[j] = h.initial[j];
+    } else {
+      const double* prev = &w.alpha[(t - 1) * n];
+      for (int j = 0; j < n; ++j) {
+        double sum = 0.0;
+        for (int i = band.lo[j]; i <= band.hi[j]; ++i) sum += prev[i] * A[i * n + j];
+        al[j] = sum;
+      }
+    }
+    double m = kNegInf;
+    for (int j = 0; j < n; ++j) {
+      b[j] = em.log_density(j, x);
+      if (al[j] > 0.0 && b[j] > m) m = b[j];
+    }
+    double c = 0.0;
+    for (int j = 0; j < n; ++j) {
+      b[j] = al[j] > 0.0 ? std::exp(b[j] - m) : 0.0;
+      al[j] *= b[j];
+      c += al[j];
+    }
+    const double inv = 1.0 / c;
+    for (int j = 0; j < n; ++j) al[j] = al[j] * inv < kFlushBelow ? 0.0 : al[j] * inv;
+    w.scale[t] = c;
+    ll += std::log(c) + m;
+  }
+  // Backward: beta_T = 1; beta_t(i) = sum_j A_ij bs_{t+1}(j) beta_{t+1}(j) / c_{t+1}.
+  double* bl = &w.beta[(T - 1) * n];
+  for (int j = 0; j < n; ++j) bl[j] = 1.0;
+  for (size_t t = T - 1; t-- > 0;) {
+    const double* nb = &w.beta[(t + 1) * n];
+    const double* b1 = &w.bs[(t + 1) * n];
+    const double ic = 1.0 / w.scale[t + 1];
+    double* cur = &w.beta[t * n];
+    for (int i = 0; i < n; ++i) {
+      double sum = 0.0;
+      for (int j = band.slo[i]; j <= band.shi[i]; ++j) sum += A[i * n + j] * b1[j] * nb[j];
+      cur[i] = sum * ic < kFlushBelow ? 0.0 : sum * ic;
+    }
+  }
+  // Statistics: gamma_t(j) = alpha_t(j) beta_t(j) (sums to 1 per t with this scaling);
+  // xi_t(i,j) = alpha_t(i) A_ij bs_{t+1}(j) beta_{t+1}(j) / c_{t+1}.
+  for (int j = 0; j < n; ++j) acc.g0[j] += w.alpha[j] * w.beta[j];
+  for (size_t t = 0; t < T; ++t) {
+    const double* al = &w.alpha[t * n];
+    const double* be = &w.beta[t * n];
+    const double* x = s.at(t);
+    for (int j = 0; j < n; ++j) {
+      const double gm = al[j] * be[j];
+      if (gm == 0.0) continue;
+      const double d0 = x[0] - em.m0[j], d1 = x[1] - em.m1[j];
+      acc.g[j] += gm;
+      acc.s0[j] += gm * d0;
+      acc.s1[j] += gm * d1;
+      acc.s00[j] += gm * d0 * d0;
+      acc.s01[j] += gm * d0 * d1;
+      acc.s11[j] += gm * d1 * d1;
+    }
+    if (t + 1 < T) {
+      const double* nb = &w.beta[(t + 1) * n];
+      const double* b1 = &w.bs[(t + 1) * n];
+      const double ic = 1.0 / w.scale[t + 1];
+      for (int i = 0; i < n; ++i) {
+        const double ai = al[i] * ic;
+        if (ai == 0.0) continue;
+        for (int j = band.slo[i]; j <= band.shi[i]; ++j) acc.xi[i * n + j] += ai * A[i * n + j] * b1[j] * nb[j];
+      }
+    }
+  }
+  return ll;
+}
+
+// M-step (hmm.h): the re-estimated model from the statistics. A state no sequence visits keeps
+// its previous emission; a row with no transitions out keeps its previous row.
+void maximise(const ClassHmm& in, const Accumulators& acc, size_t n_seqs, double cov_floor, ClassHmm& out) {
+  const int n = in.n_states;
+  out = in;
+  double g0sum = 0.0;
+  for (int j = 0; j < n; ++j) g0sum += acc.g0[j];
+  if (g0sum > 0.0)
+    for (int j = 0; j < n; ++j) out.initial[j] = acc.g0[j] / g0sum;
+  for (int i = 0; i < n; ++i) {
+    double row = 0.0;
+    for (int j = 0; j < n; ++j) row += acc.xi[i * n + j];
+    if (!(row > 0.0)) continue;
+    for (int j = 0; j < n; ++j) out.transition[i * n + j] = acc.xi[i * n + j] / row;
+  }
+  for (int j = 0; j < n; ++j) {
+    const double G = acc.g[j];
+    if (!(G > 1e-300)) continue;
+    auto& e = out.emission[j];
+    // Moments about the previous mean ref: mu = ref + S1/G, Sigma = S2/G - (S1/G)(S1/G)^T.
+    const double dm0 = acc.s0[j] / G, dm1 = acc.s1[j] / G;
+    e.mean[0] = in.emission[j].mean[0] + dm0;
+    e.mean[1] = in.emission[j].mean[1] + dm1;
+    e.cov[0][0] = acc.s00[j] / G - dm0 * dm0;
+    e.cov[1][1] = acc.s11[j] / G - dm1 * dm1;
+    e.cov[0][1] = e.cov[1][0] = acc.s01[j] / G - dm0 * dm1;
+    if (cov_floor > 0.0) floor_covariance(e.cov, cov_floor);
+  }
+  (void)n_seqs;
+}
+
+void check_options(const TrainOptions& opt) {
+  if (opt.n_states < 1 || opt.n_states > model::kMaxStates)
+    throw std::invalid_argument("states must be 1.." + std::to_string(model::kMaxStates));
+  if (opt.band < 0) throw std::invalid_argument("band must be >= 0");
+  if (opt.max_iterations < 1) throw std::invalid_argument("max_iterations must be >= 1");
+}
+
+}  // namespace
+
+ClassHmm initial_left_right(const std::vector<FeatureSequence>& seqs, const TrainOptions& opt) {
+  check_options(opt);
+  const int n = opt.n_states;
+  ClassHmm h;
+  h.n_states = n;
+  h.initial.assign(n, 0.0);
+  h.initial[0] = 1.0;
+  h.transition.assign(n * n, 0.0);
+  h.emission.assign(n, model::GaussianEmission{});
+  // Equal segments: sample t of a length-T sequence belongs to state floor(t n / T).
+  std::vector<double> cnt(n), s0(n), s1(n), s00(n), s01(n), s11(n);
+  double total_len = 0.0;
+  size_t used = 0;
+  for (const auto& s : seqs) {
+    const size_t T = s.size();
+    if (T < static_cast<size_t>(n)) continue;
+    total_len += static_cast<double>(T);
+    ++used;
+    for (size_t t = 0; t < T; ++t) {
+      const int j = static_cast<int>(t * static_cast<size_t>(n) / T);
+      const double* x = s.at(t);
+      cnt[j] += 1;
+      s0[j] += x[0];
+      s1[j] += x[1];
+      s00[j] += x[0] * x[0];
+      s01[j] += x[0] * x[1];
+      s11[j] += x[1] * x[1];
+    }
+  }
+  if (used == 0) throw std::invalid_argument("no training sequence has at least as many samples as states (" + std::to_string(n) + ")");
+  for (int j = 0; j < n; ++j) {
+    auto& e = h.emission[j];
+    e.mean[0] = s0[j] / cnt[j];
+    e.mean[1] = s1[j] / cnt[j];
+    e.cov[0][0] = s00[j] / cnt[j] - e.mean[0] * e.mean[0];
+    e.cov[1][1] = s11[j] / cnt[j] - e.mean[1] * e.mean[1];
+    e.cov[0][1] = e.cov[1][0] = s01[j] / cnt[j] - e.mean[0] * e.mean[1];
+    floor_covariance(e.cov, opt.cov_floor > 0.0 ? opt.cov_floor : 1e-9);
+  }
+  // Transitions: a segment lasts mean_len/n samples, so leaving has probability n/mean_len.
+  const double mean_len = total_len / static_cast<double>(used);
+  const double leave = std::clamp(static_cast<double>(n) / mean_len, 1e-6, 0.5);
+  for (int i = 0; i < n; ++i) {
+    const int reach = std::min(opt.band, n - 1 - i);
+    if (reach == 0) {
+      h.transition[i * n + i] = 1.0;
+      continue;
+    }
+    double wsum = 0.0;
+    for (int d = 1; d <= reach; ++d) wsum += std::ldexp(1.0, -(d - 1));
+    h.transition[i * n + i] = 1.0 - leave;
+    for (int d = 1; d <= reach; ++d) h.transition[i * n + i + d] = leave * std::ldexp(1.0, -(d - 1)) / wsum;
+  }
+  return h;
+}
+
+double baum_welch_step(const ClassHmm& in, const std::vector<FeatureSequence>& seqs, double cov_floor, ClassHmm& out) {
+  const EmissionCache em(in);
+  const Band band(in);
+  Workspace w;
+  Accumulators acc(in.n_states);
+  double ll = 0.0;
+  for (const auto& s : seqs) ll += forward_backward(in, em, band, s, w, acc);
+  maximise(in, acc, seqs.size(), cov_floor, out);
+  return ll;
+}
+
+TrainResult train(const ClassHmm& start, const std::vector<FeatureSequence>& seqs, const TrainOptions& opt) {
+  check_options(opt);
+  size_t n_samples = 0;
+  for (const auto& s : seqs) n_samples += s.size();
+  if (n_samples == 0) throw std::invalid_argument("no training samples");
+  TrainResult r;
+  ClassHmm cur = start, next;
+  double prev = kNegInf;
+  r.log_likelihood = kNegInf;
+  for (int it = 0; it < opt.max_iterations; ++it) {
+    const double ll = baum_welch_step(cur, seqs, opt.cov_floor, next);
+    r.iterations = it + 1;
+    r.history.push_back(ll);
+    if (ll > r.log_likelihood) {
+      r.log_likelihood = ll;
+      r.hmm = cur;
+    }
+    // Gain per sample below tolerance (or a loss, possible only through the covariance floor).
+    if (it > 0 && (ll - prev) / static_cast<double>(n_samples) < opt.tolerance) {
+      r.converged = true;
+      break;
+    }
+    prev = ll;
+    cur = std::move(next);
+  }
+  return r;
+}
+
+TrainResult train(const std::vector<FeatureSequence>& seqs, const TrainOptions& opt) {
+  return train(initial_left_right(seqs, opt), seqs, opt);
+}
+
+double emission_log_density(const model::GaussianEmission& e, const double x[kFeatures]) {
+  // Cholesky S = L L^T, L = [[l00 0][l10 l11]]; log N = -log 2pi - log(l00 l11) - |L^-1 (x-mu)|^2/2.
+  const double l00 = std::sqrt(e.cov[0][0]);
+  const double l10 = e.cov[1][0] / l00;
+  const double l11 = std::sqrt(e.cov[1][1] - l10 * l10);
+  const double z0 = (x[0] - e.mean[0]) / l00;
+  const double z1 = ((x[1] - e.mean[1]) - l10 * z0) / l11;
+  return -kLog2Pi - std::log(l00 * l11) - 0.5 * (z0 * z0 + z1 * z1);
+}
+
+std::vector<double> forward_prefix_log_likelihoods(const ClassHmm& h, const FeatureSequence& s) {
+  // General (full-matrix) scaled forward with Cholesky densities: an implementation independent
+  // of the filter's band path, so the two can check each other.
+  const int n = h.n_states;
+  std::vector<double> alpha(h.initial), pred(n), lb(n), out;
+  out.reserve(s.size());
+  double ll = 0.0;
+  for (size_t t = 0; t < s.size(); ++t) {
+    if (t == 0) {
+      pred = h.initial;
+    } else {
+      for (int j = 0; j < n; ++j) {
+        double sum = 0.0;
+        for (int i = 0; i < n; ++i) sum += alpha[i] * h.transition[i * n + j];
+        pred[j] = sum;
+      }
+    }
+    double m = kNegInf;
+    for (int j = 0; j < n; ++j) {
+      lb[j] = emission_log_density(h.emission[j], s.at(t));
+      if (pred[j] > 0.0) m = std::max(m, lb[j]);
+    }
+    double c = 0.0;
+    for (int j = 0; j < n; ++j) {
+      alpha[j] = pred[j] > 0.0 ? pred[j] * std::exp(lb[j] - m) : 0.0;
+      c += alpha[j];
+    }
+    for (int j = 0; j < n; ++j) alpha[j] = alpha[j] / c < kFlushBelow ? 0.0 : alpha[j] / c;
+    ll += std::log(c) + m;
+    out.push_back(ll);
+  }
+  return out;
+}
+
+double forward_log_likelihood(const ClassHmm& h, const FeatureSequence& s) {
+  if (s.size() == 0) return 0.0;
+  return forward_prefix_log_likelihoods(h, s).back();
+}
+
+ViterbiResult viterbi(const ClassHmm& h, const FeatureSequence& s) {
+  ViterbiResult r;
+  const int n = h.n_states;
+  const size_t T = s.size();
+  if (T == 0) return r;
+  auto lg = [](double p) { return p > 0.0 ? std::log(p) : kNegInf; };
+  std::vector<double> logA(n * n), delta(n), nd(n);
+  for (int k = 0; k < n * n; ++k) logA[k] = lg(h.transition[k]);
+  std::vector<int> back(T * n, -1);
+  for (int j = 0; j < n; ++j) delta[j] = lg(h.initial[j]) + emission_log_density(h.emission[j], s.at(0));
+  for (size_t t = 1; t < T; ++t) {
+    for (int j = 0; j < n; ++j) {
+      double best = kNegInf;
+      int arg = -1;
+      for (int i = 0; i < n; ++i) {
+        const double v = delta[i] + logA[i * n + j];
+        if (v > best) best = v, arg = i;
+      }
+      nd[j] = best + emission_log_density(h.emission[j], s.at(t));
+      back[t * n + j] = arg;
+    }
+    delta.swap(nd);
+  }
+  int last = static_cast<int>(std::max_element(delta.begin(), delta.end()) - delta.begin());
+  r.log_probability = delta[last];
+  r.path.assign(T, 0);
+  for (size_t t = T; t-- > 0;) {
+    r.path[t] = last;
+    if (t > 0) last = back[t * n + last];
+  }
+  return r;
+}
+
+FeatureSequence sample(const ClassHmm& h, size_t T, std::mt19937_64& rng, std::vector<int>* states) {
+  // Inverse-CDF draws from uniform doubles and Box-Muller normals: the same bits on every
+  // platform for one rng state (std::normal_distribution is implementation-defined).
+  auto uniform = [&rng]() { return (static_cast<double>(rng() >> 11) + 0.5) * 0x1.0p-53; };
+  auto draw = [&](const double* p, int n) {
+    double u = uniform(), acc = 0.0;
+    for (int j = 0; j < n; ++j) {
+      acc += p[j];
+      if (u < acc) return j;
+    }
+    for (int j = n - 1; j >= 0; --j)
+      if (p[j] > 0.0) return j;
+    return n - 1;
+  };
+  const int n = h.n_states;
+  FeatureSequence s;
+  s.x.resize(T * kFeatures);
+  if (states) states->resize(T);
+  int st = draw(h.initial.data(), n);
+  for (size_t t = 0; t < T; ++t) {
+    if (t > 0) st = draw(&h.transition[st * n], n);
+    if (states) (*states)[t] = st;
+    const auto& e = h.emission[st];
+    const double r = std::sqrt(-2.0 * std::log(uniform())), th = 2.0 * M_PI * uniform();
+    const double z0 = r * std::cos(th), z1 = r * std::sin(th);
+    const double l00 = std::sqrt(e.cov[0][0]), l10 = e.cov[1][0] / l00, l11 = std::sqrt(e.cov[1][1] - l10 * l10);
+    s.x[t * kFeatures + 0] = e.mean[0] + l00 * z0;
+    s.x[t * kFeatures + 1] = e.mean[1] + l10 * z0 + l11 * z1;
+  }
+  return s;
+}
+
+FeatureSequence features_of(const HapticSequence& trial, const model::FeatureConvention& fc, double truncate_at) {
+  FeatureSequence s;
+  s.x.reserve(trial.samples.size() * kFeatures);
+  for (const auto& smp : trial.samples) {
+    if (smp.travel > truncate_at) break;
+    double x[kFeatures];
+    fc.apply(smp.f_motion, smp.f_lateral, smp.f_vertical, x);
+    s.x.insert(s.x.end(), x, x + kFeatures);
+  }
+  return s;
+}
+
+model::FeatureConvention fit_feature_scaling(const std::vector<const HapticSequence*>& trials) {
+  model::FeatureConvention fc;  // axes motion and vertical, sign +1
+  double n = 0.0, sum[kFeatures] = {}, sq[kFeatures] = {};
+  for (const auto* tr : trials)
+    for (const auto& smp : tr->samples) {
+      double x[kFeatures];
+      fc.apply(smp.f_motion, smp.f_lateral, smp.f_vertical, x);
+      n += 1.0;
+      for (int k = 0; k < kFeatures; ++k) sum[k] += x[k], sq[k] += x[k] * x[k];
+    }
+  if (n < 2.0) return fc;
+  for (int k = 0; k < kFeatures; ++k) {
+    const double mean = sum[k] / n, var = std::max(0.0, sq[k] / n - mean * mean);
+    fc.offset[k] = mean;
+    fc.scale[k] = var > 1e-18 ? std::sqrt(var) : 1.0;
+  }
+  return fc;
+}
+
+model::OutcomeModel train_outcome_model(const std::vector<const HapticSequence*>& trials, const ModelOptions& opt,
+                                        const std::function<void(const std::string&)>& progress) {
+  std::vector<const HapticSequence*> labelled;
+  for (const auto* t : trials)
+    if (t->label) labelled.push_back(t);
+  if (labelled.empty()) throw std::invalid_argument("no labelled trials to train on");
+  model::OutcomeModel m;
+  m.features = fit_feature_scaling(labelled);
+  m.source_dataset = opt.source_dataset;
+  std::string summary;
+  std::vector<int> counts;
+  for (int o = 0; o < kOutcomeCount; ++o) {
+    std::vector<FeatureSequence> seqs;
+    size_t samples = 0;
+    for (const auto* t : labelled)
+      if (static_cast<int>(*t->label) == o) {
+        seqs.push_back(features_of(*t, m.features));
+        samples += seqs.back().size();
+      }
+    if (seqs.empty()) continue;
+    TrainResult r = train(seqs, opt.hmm);
+    r.hmm.name = std::string(outcome_name(static_cast<Outcome>(o)));
+    char buf[256];
+    std::snprintf(buf, sizeof buf, "%s: %zu sequences, %zu samples, %d states, %d iterations%s, log-likelihood %.6g (%.4f/sample)",
+                  r.hmm.name.c_str(), seqs.size(), samples, opt.hmm.n_states, r.iterations, r.converged ? "" : " (not converged)",
+                  r.log_likelihood, r.log_likelihood / static_cast<double>(samples));
+    if (progress) progress(buf);
+    summary += (summary.empty() ? "" : "; ") + std::string(buf);
+    counts.push_back(static_cast<int>(seqs.size()));
+    m.classes.push_back(std::move(r.hmm));
+  }
+  const double total = static_cast<double>(labelled.size());
+  for (size_t c = 0; c < m.classes.size(); ++c)
+    m.classes[c].log_prior = opt.uniform_priors ? -std::log(static_cast<double>(m.classes.size())) : std::log(counts[c] / total);
+  // Renormalise the priors in log space so that their exponentials sum to 1 to rounding.
+  double z = 0.0;
+  for (const auto& h : m.classes) z += std::exp(h.log_prior);
+  for (auto& h : m.classes) h.log_prior -= std::log(z);
+  m.training_summary = summary;
+  return m;
+}
+
+Classification classify(const model::OutcomeModel& m, const FeatureSequence& seq) {
+  Classification r;
+  double best = kNegInf;
+  for (size_t c = 0; c < m.classes.size(); ++c) {
+    const double ll = forward_log_likelihood(m.classes[c], seq);
+    r.log_likelihood.push_back(ll);
+    const double score = ll + m.classes[c].log_prior;
+    if (score > best) best = score, r.predicted = static_cast<int>(c);
+  }
+  double z = 0.0;
+  for (size_t c = 0; c < m.classes.size(); ++c) {
+    r.posterior.push_back(std::exp(r.log_likelihood[c] + m.classes[c].log_prior - best));
+    z += r.posterior.back();
+  }
+  for (double& p : r.posterior) p /= z;
+  return r;
+}
+
+Evaluation evaluate(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials, double truncate_at,
+                    std::vector<TrialResult>* per_trial) {
+  Evaluation ev;
+  for (const auto& h : m.classes) ev.classes.push_back(h.name);
+  const size_t k = m.classes.size();
+  ev.confusion.assign(k, std::vector<int>(k, 0));
+  for (const auto* t : trials) {
+    TrialResult tr;
+    tr.trial = t;
+    if (t->label) tr.truth = m.class_index(outcome_name(*t->label));
+    const FeatureSequence seq = features_of(*t, m.features, truncate_at);
+    tr.samples = seq.size();
+    if (tr.truth < 0 || seq.size() == 0) {
+      ++ev.skipped;
+      tr.truth = -1;
+    } else {
+      tr.result = classify(m, seq);
+      ev.confusion[tr.truth][tr.result.predicted]++;
+      ev.total++;
+      if (tr.result.predicted == tr.truth) ev.correct++;
+    }
+    if (per_trial) per_trial->push_back(std::move(tr));
+  }
+  return ev;
+}
+
+}  // namespace dressguard::hmm

@@ -1,0 +1,149 @@
+// Outcome HMMs offline: Baum-Welch training of left-right HMMs with bivariate full-covariance
+// Gaussian emissions (paper section V-B), the forward log-likelihood, Viterbi, sampling, and the
+// outcome model built from a dataset (one HMM per labelled outcome).
+//
+// Numerics. Every recursion is scaled (Rabiner 1989, section V-A): at each t the forward vector
+// is normalised to sum 1 and the log of the normaliser accumulates, and the emission densities are
+// shifted by their maximum m_t over reachable states before exponentiation. Nothing is ever a
+// product of T probabilities, so sequences of any length keep finite log-likelihoods. Normalised
+// forward probabilities below 1e-300 are set to 0 (no subnormal arithmetic; the online filter does
+// the same): a state that improbable is dropped, which can matter only when a later sample is so
+// far out that such a state alone explains it.
+//
+// Training (Rabiner eq. 40, 52-54 for the Gaussian case):
+//   initialisation: every sequence split into n equal segments, segment j feeding state j's mean
+//     and covariance; pi = (1, 0, ..., 0); A_ii = 1 - n / mean length, the rest of the row spread
+//     over the band j = i+1..i+w with weights halving per step (the last state absorbs).
+//   E-step: scaled forward-backward per sequence, restricted to the band.
+//   M-step: pi_j = mean gamma_1(j); A_ij = sum_t xi_t(i,j) / sum_t gamma_t(i) (zeros stay zero, so
+//     the left-right band is kept); mu_j = sum gamma x / sum gamma;
+//     Sigma_j = sum gamma (x - mu_j)(x - mu_j)^T / sum gamma, accumulated about the previous mean
+//     and corrected exactly (not GHMM's previous-mean covariance), then floored: every eigenvalue of
+//     Sigma_j is raised to at least cov_floor (feature units) so no state collapses onto a point.
+//   Convergence: stop when the log-likelihood gain per training sample is below `tolerance`, or
+//     at `max_iterations`; the result is the best model whose likelihood was evaluated, with that
+//     exact likelihood (never the likelihood of the model before the last update).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "dataset.h"
+#include "dgm.h"
+
+namespace dressguard::hmm {
+
+using model::ClassHmm;
+using model::kFeatures;
+
+// One sequence of feature vectors (x_t in feature units), row-major: x[t*kFeatures + k].
+struct FeatureSequence {
+  std::vector<double> x;
+  size_t size() const { return x.size() / kFeatures; }
+  const double* at(size_t t) const { return x.data() + t * kFeatures; }
+};
+
+struct TrainOptions {
+  int n_states = 10;           // the paper's 10; the study's code used 5
+  int band = 1;                // left-right width: A_ij > 0 only for i <= j <= i + band
+  double cov_floor = 1e-3;     // minimum covariance eigenvalue, feature units squared
+  int max_iterations = 100;
+  double tolerance = 1e-5;     // stop when the log-likelihood gain per sample is below this [nats]
+};
+
+struct TrainResult {
+  ClassHmm hmm;                   // name and log_prior left for the caller
+  int iterations = 0;             // E-steps run
+  bool converged = false;         // tolerance reached (false: max_iterations)
+  double log_likelihood = 0.0;    // total over the training sequences, of `hmm` exactly
+  std::vector<double> history;    // log-likelihood of each evaluated model, in order
+};
+
+// Equal-segment initialisation (above). Throws std::invalid_argument when the sequences are too
+// short to give every state a sample or the options are out of range.
+ClassHmm initial_left_right(const std::vector<FeatureSequence>& seqs, const TrainOptions& opt);
+
+// One Baum-Welch iteration: returns log p(seqs | in) and writes the re-estimated model to `out`.
+// `cov_floor` <= 0 disables the floor (for comparisons with other libraries).
+double baum_welch_step(const ClassHmm& in, const std::vector<FeatureSequence>& seqs, double cov_floor, ClassHmm& out);
+
+// Trains from `start` (usually initial_left_right) until convergence.
+TrainResult train(const ClassHmm& start, const std::vector<FeatureSequence>& seqs, const TrainOptions& opt);
+TrainResult train(const std::vector<FeatureSequence>& seqs, const TrainOptions& opt);
+
+// log p(x_1..T | hmm), general full-matrix scaled forward (any topology). 0 for an empty sequence.
+double forward_log_likelihood(const ClassHmm& hmm, const FeatureSequence& seq);
+// log p(x_1..t | hmm) for every t = 1..T (one forward pass).
+std::vector<double> forward_prefix_log_likelihoods(const ClassHmm& hmm, const FeatureSequence& seq);
+
+// The most probable state path and its joint log-probability log p(x, path), in log space.
+struct ViterbiResult {
+  std::vector<int> path;
+  double log_probability = -std::numeric_limits<double>::infinity();
+};
+ViterbiResult viterbi(const ClassHmm& hmm, const FeatureSequence& seq);
+
+// log N(x; mean, cov) of one emission (Cholesky of the 2x2 covariance).
+double emission_log_density(const model::GaussianEmission& e, const double x[kFeatures]);
+
+// Draws a sequence of T samples (and its states) from the HMM. Deterministic for a given rng state.
+FeatureSequence sample(const ClassHmm& hmm, size_t T, std::mt19937_64& rng, std::vector<int>* states = nullptr);
+
+// ---- outcome models from datasets ----------------------------------------------------------
+
+// The feature vectors of one trial, cut after the last sample with travel <= truncate_at.
+FeatureSequence features_of(const HapticSequence& trial, const model::FeatureConvention& fc,
+                            double truncate_at = std::numeric_limits<double>::infinity());
+
+// F_motion and F_vertical, sign +1, offset/scale = mean/standard deviation over every sample of
+// the trials (scale 1 when a feature is constant).
+model::FeatureConvention fit_feature_scaling(const std::vector<const HapticSequence*>& trials);
+
+struct ModelOptions {
+  TrainOptions hmm;
+  bool uniform_priors = false;  // log_prior = -log(classes) instead of the training counts
+  std::string source_dataset;   // written into the model's metadata
+};
+
+// One HMM per outcome label present in `trials` (in Outcome order: good, missed, caught), trained
+// on the labelled trials; unlabelled trials are ignored. `progress` (may be empty) is told each
+// class's result. Throws std::invalid_argument when no trial is labelled.
+model::OutcomeModel train_outcome_model(const std::vector<const HapticSequence*>& trials, const ModelOptions& opt,
+                                        const std::function<void(const std::string&)>& progress = {});
+
+// The classification of one sequence: per-class log-likelihoods, posteriors (with log priors)
+// and the MAP class (the paper's "highest likelihood" when the priors are equal).
+struct Classification {
+  int predicted = -1;
+  std::vector<double> log_likelihood, posterior;
+};
+Classification classify(const model::OutcomeModel& m, const FeatureSequence& seq);
+
+// Truth-by-prediction counts over a model's classes: confusion[truth][predicted].
+struct Evaluation {
+  std::vector<std::string> classes;
+  std::vector<std::vector<int>> confusion;
+  int correct = 0, total = 0, skipped = 0;  // skipped: unlabelled, label not a model class, or empty
+  double accuracy() const { return total ? static_cast<double>(correct) / total : 0.0; }
+};
+
+// One trial's result in an evaluation.
+struct TrialResult {
+  const HapticSequence* trial = nullptr;
+  int truth = -1;            // model class index of the label, -1 when skipped
+  size_t samples = 0;        // after truncation
+  Classification result;     // empty when skipped
+};
+
+// Classifies every trial (cut at truncate_at travel) and counts the confusion matrix over the
+// trials whose label is one of the model's classes.
+Evaluation evaluate(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials,
+                    double truncate_at = std::numeric_limits<double>::infinity(),
+                    std::vector<TrialResult>* per_trial = nullptr);
+
+}  // namespace dressguard::hmm

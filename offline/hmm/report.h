@@ -1,0 +1,24 @@
+// Text and JSON renderings of outcome models and evaluations, shared by `dressguard train`,
+// `classify` and `model show` (so every command prints a model or a confusion matrix alike).
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "dgm.h"
+#include "hmm.h"
+
+namespace dressguard::hmm {
+
+// A JSON string literal (quotes included), with control characters escaped.
+std::string json_string(std::string_view s);
+// A JSON number; non-finite values become null (JSON has no NaN).
+std::string json_number(double v);
+// The whole model as one JSON object (metadata, features, stop policy, every class's parameters).
+std::string model_json(const model::OutcomeModel& m);
+// The confusion matrix as aligned text, rows = truth, columns = predicted.
+std::string confusion_text(const Evaluation& ev);
+// {"classes": [...], "confusion": [[...]], "correct": n, "total": n, "skipped": n, "accuracy": x}
+std::string evaluation_json(const Evaluation& ev);
+
+}  // namespace dressguard::hmm

@@ -1,0 +1,295 @@
+// Building the constant model (SceneData, GownModel) and the preallocated state.
+#include "model.h"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+namespace dressguard::sim {
+
+RoundCone make_round_cone(V3 a, double ra, V3 b, double rb) {
+  RoundCone c;
+  c.a = a;
+  c.b = b;
+  c.ra = ra;
+  c.rb = rb;
+  const V3 d = b - a;
+  c.len = norm(d);
+  if (c.len > 1e-12) {
+    c.u = (1.0 / c.len) * d;
+    // A round cone needs |ra - rb| < L (otherwise one sphere contains the other).
+    c.sin_phi = std::clamp((ra - rb) / c.len, -0.999, 0.999);
+    c.cos_phi = std::sqrt(1 - c.sin_phi * c.sin_phi);
+  } else {
+    c.u = {1, 0, 0};
+    c.len = 0;
+  }
+  return c;
+}
+
+// In the plane of the axis and p: x along the axis from a, y >= 0 radial. The cone's surface
+// line touches sphere a at a + ra (sin phi, cos phi) and sphere b at b + rb (sin phi, cos phi);
+// the foot of p on that line is s = x cos phi - y sin phi from a's touching point, so
+// s < 0 -> nearest to sphere a, s > L cos phi -> sphere b, else the cone: x sin phi + y cos phi - ra.
+double round_cone_distance(const RoundCone& c, V3 p, V3* normal) {
+  const V3 q = p - c.a;
+  if (c.len == 0) {
+    const double l = norm(q);
+    *normal = l > 1e-15 ? (1.0 / l) * q : V3{0, 0, 1};
+    return l - c.ra;
+  }
+  const double x = dot(q, c.u);
+  const V3 radial = q - x * c.u;
+  const double y = norm(radial);
+  const V3 rhat = y > 1e-15 ? (1.0 / y) * radial : V3{0, 0, 1};
+  const double s = x * c.cos_phi - y * c.sin_phi;
+  if (s < 0) {
+    const double l = norm(q);
+    *normal = l > 1e-15 ? (1.0 / l) * q : rhat;
+    return l - c.ra;
+  }
+  if (s > c.len * c.cos_phi) {
+    const V3 qb = p - c.b;
+    const double l = norm(qb);
+    *normal = l > 1e-15 ? (1.0 / l) * qb : rhat;
+    return l - c.rb;
+  }
+  *normal = c.sin_phi * c.u + c.cos_phi * rhat;
+  return x * c.sin_phi + y * c.cos_phi - c.ra;
+}
+
+namespace {
+
+double cot(V3 a, V3 b) {
+  const double s = norm(cross(a, b));
+  return s > 1e-18 ? dot(a, b) / s : 0.0;
+}
+
+// Reorders constraints by a greedy graph colouring (no two constraints of one colour share a
+// vertex), stable within a colour. This is still one fixed Gauss-Seidel order (deterministic),
+// but consecutive constraints no longer wait for each other's writes, so the CPU overlaps them
+// (measured: about 2x on the solve).
+template <class C, class VertsOf>
+void colour_order(std::vector<C>& cs, int n_vertices, VertsOf verts) {
+  std::vector<uint64_t> used(n_vertices, 0);
+  std::vector<int> colour(cs.size(), 0);
+  for (size_t k = 0; k < cs.size(); ++k) {
+    uint64_t mask = 0;
+    for (int v : verts(cs[k])) mask |= used[v];
+    int c = 0;
+    while (c < 63 && (mask >> c) & 1) ++c;
+    colour[k] = c;
+    for (int v : verts(cs[k])) used[v] |= uint64_t{1} << c;
+  }
+  std::vector<size_t> idx(cs.size());
+  for (size_t k = 0; k < idx.size(); ++k) idx[k] = k;
+  std::stable_sort(idx.begin(), idx.end(), [&](size_t a, size_t b) { return colour[a] < colour[b]; });
+  std::vector<C> out;
+  out.reserve(cs.size());
+  for (size_t k : idx) out.push_back(cs[k]);
+  cs.swap(out);
+}
+
+struct HalfEdge {
+  int32_t a, b, tri, opp;
+};
+
+std::vector<RoundCone> build_arm(const SceneOptions& opt) {
+  const ArmGeometry& g = opt.arm;
+  const V3 gp{opt.grasp_point[0], opt.grasp_point[1], opt.grasp_point[2]};
+  const V3 fist = gp + V3{g.fist_x, 0, g.z_rel[0]};
+  const V3 wrist = fist + V3{g.hand, 0, 0};
+  const V3 elbow = wrist + V3{g.forearm, 0, 0};
+  const V3 shoulder = elbow + V3{0, -g.upper_arm, 0};
+  std::vector<RoundCone> arm;
+  arm.push_back(make_round_cone(elbow, g.r_elbow, elbow, g.r_elbow));  // [0] elbow (label reference)
+  arm.push_back(make_round_cone(fist, g.r_fist, fist, g.r_fist));
+  if (g.hand > 1e-9) arm.push_back(make_round_cone(fist, g.r_fist, wrist, g.r_wrist));
+  arm.push_back(make_round_cone(wrist, g.r_wrist, elbow, g.r_elbow));
+  arm.push_back(make_round_cone(elbow, g.r_elbow, shoulder, g.r_shoulder));
+  return arm;
+}
+
+}  // namespace
+
+const char* friction_scheme_name(FrictionScheme s) {
+  switch (s) {
+    case FrictionScheme::Stock: return "stock";
+    case FrictionScheme::Improved: return "improved";
+    case FrictionScheme::Constraint: return "constraint";
+  }
+  return "?";
+}
+
+int Scene::vertex_count() const { return static_cast<int>(d_->rest.size()); }
+int Scene::triangle_count() const { return static_cast<int>(d_->mesh.tris.size()); }
+double Scene::gown_mass() const { return d_->rest_area * ClothParams{}.areal_density; }
+const ClothMesh& Scene::mesh() const { return d_->mesh; }
+
+Scene make_scene(const ClothMesh& mesh, const SceneOptions& opt) {
+  auto d = std::make_shared<SceneData>();
+  d->mesh = mesh;
+  d->opt = opt;
+  const int n = static_cast<int>(mesh.x.size());
+  if (n == 0 || mesh.tris.empty()) throw std::invalid_argument("make_scene: mesh '" + mesh.name + "' is empty");
+  if (opt.substeps < 1 || opt.step_hz <= 0) throw std::invalid_argument("make_scene: substeps and step_hz must be positive");
+  d->rest.resize(n);
+  for (int i = 0; i < n; ++i) d->rest[i] = {mesh.x[i][0], mesh.x[i][1], mesh.x[i][2]};
+  d->vertex_area.assign(n, 0.0);
+  std::vector<HalfEdge> he;
+  he.reserve(mesh.tris.size() * 3);
+  for (size_t t = 0; t < mesh.tris.size(); ++t) {
+    const auto& tr = mesh.tris[t];
+    for (int k = 0; k < 3; ++k)
+      if (tr[k] < 0 || tr[k] >= n)
+        throw std::invalid_argument("make_scene: triangle " + std::to_string(t) + " has vertex index " +
+                                    std::to_string(tr[k]) + " outside 0.." + std::to_string(n - 1));
+    const V3 a = d->rest[tr[0]], b = d->rest[tr[1]], c = d->rest[tr[2]];
+    const double area = 0.5 * norm(cross(b - a, c - a));
+    d->rest_area += area;
+    {
+      // Rest frame: e1 along the first edge, e2 perpendicular in the plane; Dm = [[l1, p], [0, q]].
+      const double l1 = norm(b - a);
+      if (l1 > 1e-12 && area > 1e-14) {
+        const V3 e1 = (1.0 / l1) * (b - a);
+        const double p = dot(c - a, e1);
+        const double q = 2 * area / l1;
+        ShearTri st{{tr[0], tr[1], tr[2]}, {1.0 / l1, -p / (l1 * q), 0.0, 1.0 / q}, area};
+        d->shear.push_back(st);
+      }
+    }
+    for (int k = 0; k < 3; ++k) d->vertex_area[tr[k]] += area / 3;
+    for (int k = 0; k < 3; ++k) {
+      const int32_t u = tr[k], v = tr[(k + 1) % 3], o = tr[(k + 2) % 3];
+      he.push_back({std::min(u, v), std::max(u, v), static_cast<int32_t>(t), o});
+    }
+  }
+  std::sort(he.begin(), he.end(), [](const HalfEdge& p, const HalfEdge& q) {
+    return p.a != q.a ? p.a < q.a : p.b != q.b ? p.b < q.b : p.tri < q.tri;
+  });
+  for (size_t k = 0; k < he.size();) {
+    size_t e = k + 1;
+    while (e < he.size() && he[e].a == he[k].a && he[e].b == he[k].b) ++e;
+    const int32_t i = he[k].a, j = he[k].b;
+    d->stretch.push_back({i, j, norm(d->rest[i] - d->rest[j])});
+    if (e - k >= 2) {  // interior edge: a bending stencil (first two triangles)
+      const int32_t o2 = he[k].opp, o3 = he[k + 1].opp;
+      const V3 x0 = d->rest[i], x1 = d->rest[j], x2 = d->rest[o2], x3 = d->rest[o3];
+      const V3 e0 = x1 - x0, e1 = x2 - x0, e2 = x3 - x0, e3 = x2 - x1, e4 = x3 - x1;
+      const double a0 = 0.5 * norm(cross(e0, e1)), a1 = 0.5 * norm(cross(e0, e2));
+      if (a0 > 1e-14 && a1 > 1e-14) {
+        const double c01 = cot(e0, e1), c02 = cot(e0, e2), c03 = cot((-1.0) * e0, e3), c04 = cot((-1.0) * e0, e4);
+        const double sc = std::sqrt(3.0 / (a0 + a1));
+        BendStencil b{{i, j, o2, o3}, {sc * (c03 + c04), sc * (c01 + c02), -sc * (c01 + c03), -sc * (c02 + c04)}};
+        d->bend.push_back(b);
+      }
+    }
+    k = e;
+  }
+  if (opt.colour_order) {
+  colour_order(d->stretch, n, [](const DistanceLink& l) { return std::array<int, 2>{l.i, l.j}; });
+  colour_order(d->shear, n, [](const ShearTri& t) { return std::array<int, 3>{t.v[0], t.v[1], t.v[2]}; });
+  colour_order(d->bend, n, [](const BendStencil& b) { return std::array<int, 4>{b.v[0], b.v[1], b.v[2], b.v[3]}; });
+  }
+  // Grasp: the given vertices, else those inside the jaw box around the grasp point.
+  d->grasped.assign(n, 0);
+  if (!mesh.grasp.empty()) {
+    for (int g : mesh.grasp) {
+      if (g < 0 || g >= n) throw std::invalid_argument("make_scene: grasp vertex " + std::to_string(g) + " out of range");
+      d->grasped[g] = 1;
+    }
+  } else if (opt.require_grasp) {
+    const V3 c{opt.grasp_point[0] + opt.jaw_centre[0], opt.grasp_point[1] + opt.jaw_centre[1],
+               opt.grasp_point[2] + opt.jaw_centre[2]};
+    for (int i = 0; i < n; ++i) {
+      const V3 q = d->rest[i] - c;
+      if (std::abs(q.x) <= opt.jaw_half[0] && std::abs(q.y) <= opt.jaw_half[1] && std::abs(q.z) <= opt.jaw_half[2])
+        d->grasped[i] = 1;
+    }
+  }
+  for (int i = 0; i < n; ++i)
+    if (d->grasped[i]) d->grasp_list.push_back(i);
+  if (d->grasp_list.empty() && opt.require_grasp) throw std::invalid_argument("make_scene: no vertex of '" + mesh.name + "' is inside the jaw box");
+  for (int v : mesh.sleeve_opening)
+    if (v < 0 || v >= n) throw std::invalid_argument("make_scene: sleeve opening vertex " + std::to_string(v) + " out of range");
+  d->opening = std::vector<int32_t>(mesh.sleeve_opening.begin(), mesh.sleeve_opening.end());
+  for (const auto& pl : opt.planes) {
+    const V3 nn{pl[0], pl[1], pl[2]};
+    const double l = norm(nn);
+    if (l < 1e-12) throw std::invalid_argument("make_scene: a plane has a zero normal");
+    d->planes.push_back({(1.0 / l) * nn, pl[3] / l});
+  }
+  if (opt.with_arm) {
+    d->arm = build_arm(opt);
+    d->elbow = d->arm[0].a;
+  }
+  return Scene(std::move(d));
+}
+
+double compliance_of(double k, double alpha_soft, double alpha_stiff) {
+  k = std::clamp(k, 0.0, 1.0);
+  return std::exp(std::log(alpha_soft) + k * (std::log(alpha_stiff) - std::log(alpha_soft)));
+}
+
+GownModel make_model(const SceneData& s, const ClothParams& p, FrictionScheme scheme, bool self_collision, double arm_dz) {
+  GownModel m;
+  m.scene = &s;
+  m.substeps = s.opt.substeps;
+  m.dt = 1.0 / s.opt.step_hz;
+  m.h = m.dt / m.substeps;
+  const int n = static_cast<int>(s.rest.size());
+  m.mass.resize(n);
+  m.w.resize(n);
+  for (int i = 0; i < n; ++i) {
+    m.mass[i] = std::max(s.vertex_area[i] * p.areal_density, 1e-12);
+    m.w[i] = s.grasped[i] ? 0.0 : 1.0 / m.mass[i];
+  }
+  // Ranges documented in trial.h (ClothParams).
+  m.alpha_stretch = compliance_of(p.stretch, 1e-2, 1e-7);
+  m.alpha_shear = compliance_of(p.shear, 1e0, 1e-5);
+  m.alpha_bend = compliance_of(p.bend, 1e7, 1e1);
+  m.friction = std::max(0.0, p.friction);
+  m.self_friction = std::max(0.0, p.self_friction);
+  m.damping_factor = std::exp(-std::max(0.0, p.damping) * m.h);
+  m.scheme = scheme;
+  m.self_collision = self_collision;
+  m.arm = s.arm;
+  for (auto& c : m.arm) {
+    c.a.z += arm_dz;
+    c.b.z += arm_dz;
+  }
+  m.elbow = s.elbow + V3{0, 0, arm_dz};
+  return m;
+}
+
+GownState make_state(const GownModel& m) {
+  const SceneData& sc = *m.scene;
+  const size_t n = sc.rest.size();
+  GownState s;
+  s.x = sc.rest;
+  s.p = sc.rest;
+  s.v.assign(n, {});
+  s.anchor.assign(n, {});
+  s.anchored.assign(n, 0);
+  s.cand.assign(n, {});
+  s.contact_n.assign(n, {});
+  s.contact_dn.assign(n, 0.0);
+  s.contact_acc.assign(n, {});
+  s.ext_force.assign(n, {});
+  size_t table = 1;
+  while (table < 2 * n) table <<= 1;
+  s.cell_start.assign(table + 1, 0);
+  s.cell_sorted.assign(n, 0);
+  s.cell_of.assign(n, 0);
+  const size_t cap = m.self_collision ? 16 * n : 0;
+  s.pairs.resize(cap);
+  return s;
+}
+
+double current_area(const GownModel& m, const GownState& s) {
+  double a = 0;
+  for (const auto& t : m.scene->mesh.tris) a += 0.5 * norm(cross(s.x[t[1]] - s.x[t[0]], s.x[t[2]] - s.x[t[0]]));
+  return a;
+}
+
+}  // namespace dressguard::sim

@@ -1,0 +1,156 @@
+// The simulator's data, apart from its solvers (MuJoCo's mjModel / mjData idea):
+//   SceneData  (constant): rest shape, topology, constraint lists, bending weights, arm, grasp.
+//   GownModel  (constant per trial): SceneData plus the masses and compliances of ClothParams.
+//   GownState  (mutable): positions, velocities, collision candidates and every scratch buffer,
+//              allocated once by make_state(); the step functions allocate nothing.
+//
+// Precision: double. A substep is 1/6000 s, so gravity moves a vertex by g h^2 = 2.7e-7 m per
+// substep, only about 4 ulps of a float at 1 m from the origin: float positions would round the
+// physics away. Layout: positions as an array of xyz structs, because the constraint solvers
+// gather vertices in mesh order (one cache line per vertex), while no loop would vectorise over
+// separate x/y/z arrays anyway.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "trial.h"
+
+namespace dressguard::sim {
+
+struct V3 {
+  double x = 0, y = 0, z = 0;
+};
+inline V3 operator+(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline V3 operator-(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline V3 operator*(double s, V3 a) { return {s * a.x, s * a.y, s * a.z}; }
+inline V3& operator+=(V3& a, V3 b) { a.x += b.x; a.y += b.y; a.z += b.z; return a; }
+inline V3& operator-=(V3& a, V3 b) { a.x -= b.x; a.y -= b.y; a.z -= b.z; return a; }
+inline double dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline V3 cross(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+inline double norm(V3 a) { return std::sqrt(dot(a, a)); }
+
+// A distance constraint between two vertices (the stretch edges).
+struct DistanceLink {
+  int32_t i, j;
+  double rest;  // [m]
+};
+
+// A triangle's in-plane shear: its vertices, the inverse rest-frame matrix and its rest area.
+struct ShearTri {
+  int32_t v[3];
+  double dm_inv[4];  // [[a, b], [c, d]] row-major
+  double area;       // [m^2]
+};
+
+// An isometric bending stencil (Bergou et al. 2006): edge (v0, v1), opposite vertices v2, v3,
+// and the weights k (the cotangent weights scaled by sqrt(3 / (A0 + A1))), see bending_constraint().
+struct BendStencil {
+  int32_t v[4];
+  double k[4];
+};
+
+// A round cone (tapered capsule): the convex hull of sphere (a, ra) and sphere (b, rb).
+// A sphere is a round cone with a == b.
+struct RoundCone {
+  V3 a, b;
+  double ra = 0, rb = 0;
+  // Precomputed: axis u, length L, and the slant: sin_phi = (ra - rb) / L.
+  V3 u;
+  double len = 0, sin_phi = 0, cos_phi = 1;
+};
+RoundCone make_round_cone(V3 a, double ra, V3 b, double rb);
+
+// Signed distance from p to the round cone's surface and the outward normal there.
+double round_cone_distance(const RoundCone& c, V3 p, V3* normal);
+
+// A half-space {p : dot(n, p) >= d} used as a floor or an incline in tests.
+struct HalfSpace {
+  V3 n;
+  double d = 0;
+};
+
+struct SceneData {
+  ClothMesh mesh;                    // rest mesh, world frame
+  SceneOptions opt;
+  std::vector<V3> rest;              // rest positions
+  std::vector<double> vertex_area;   // [m^2] one third of the adjacent triangles' area
+  double rest_area = 0;              // [m^2]
+  std::vector<DistanceLink> stretch; // every mesh edge
+  std::vector<ShearTri> shear;       // one per triangle
+  std::vector<BendStencil> bend;     // one per interior edge
+  std::vector<uint8_t> grasped;      // 1 when held by the gripper (kinematic)
+  std::vector<int32_t> grasp_list;
+  std::vector<int32_t> opening;      // sleeve opening loop
+  // Colliders: the arm's round cones (index 0 is the elbow sphere, used for the label) and
+  // planes for tests. The arm is placed at a trial's height by translating these along z.
+  std::vector<RoundCone> arm;        // at arm height offset 0 relative to z_rel[High] (see arm_at())
+  std::vector<HalfSpace> planes;
+  V3 elbow;                          // elbow centre at the High height
+};
+
+// The per-trial constant model: compliances and masses for one ClothParams.
+struct GownModel {
+  const SceneData* scene = nullptr;
+  double h = 0;                       // [s] substep
+  double dt = 0;                      // [s] output step
+  int substeps = 0;
+  std::vector<double> mass;           // [kg]
+  std::vector<double> w;              // inverse mass (0 for grasped vertices)
+  double alpha_stretch = 0, alpha_shear = 0, alpha_bend = 0;  // XPBD compliances
+  double friction = 0, self_friction = 0;
+  double damping_factor = 1;          // per substep
+  FrictionScheme scheme = FrictionScheme::Improved;
+  bool self_collision = true;
+  std::vector<RoundCone> arm;         // placed at the trial's height
+  V3 elbow;
+  V3 gravity{0, 0, -9.81};
+};
+
+// Compliance from a stiffness in [0, 1]: log-linear between alpha_soft (k = 0) and alpha_stiff.
+double compliance_of(double k, double alpha_soft, double alpha_stiff);
+GownModel make_model(const SceneData& s, const ClothParams& p, FrictionScheme scheme, bool self_collision,
+                     double arm_dz);
+
+// Up to two arm colliders near a vertex, found once per output step.
+struct ArmCandidates {
+  int8_t c[2] = {-1, -1};
+};
+
+struct SelfPair {
+  int32_t i, j;
+};
+
+struct GownState {
+  std::vector<V3> x, p, v;            // positions, positions at the substep's start, velocities
+  std::vector<V3> anchor;             // Constraint friction: stick point of each arm contact
+  std::vector<uint8_t> anchored;
+  std::vector<ArmCandidates> cand;
+  std::vector<V3> contact_n;          // last contact normal of the output step (Stock friction)
+  std::vector<double> contact_dn;     // sum of normal corrections over the output step [m]
+  std::vector<V3> contact_acc;        // sum over substeps of the contact force on each vertex
+  std::vector<V3> ext_force;          // per-vertex external force (the perturbation)
+  // Self-collision: spatial hash and pair list, capacities fixed in make_state().
+  std::vector<int32_t> cell_start, cell_sorted;
+  std::vector<uint32_t> cell_of;
+  std::vector<SelfPair> pairs;
+  size_t pair_count = 0;
+  long pairs_dropped = 0;
+  V3 grip_offset;                     // gripper displacement from its start
+  V3 grip_accel;                      // gripper acceleration (inertia of the grasped vertices)
+  V3 force_acc;                       // sum over substeps of the force of the gown on the gripper
+  long force_count = 0;
+};
+
+GownState make_state(const GownModel& m);
+
+// One output step: collision candidates (arm, self-collision hash), then `substeps` substeps of
+// integrate + solve. `grip_from`/`grip_to` are the gripper offsets at the step's start and end
+// (linearly interpolated over the substeps), `grip_accel` its acceleration.
+void step(const GownModel& m, GownState& s, V3 grip_from, V3 grip_to, V3 grip_accel);
+
+// Total triangle area of the current positions.
+double current_area(const GownModel& m, const GownState& s);
+
+}  // namespace dressguard::sim

@@ -1,0 +1,117 @@
+#include "params.h"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "files.h"
+#include "model.h"
+
+namespace dressguard::sim {
+namespace {
+
+double* field(ClothParams& p, const std::string& name) {
+  if (name == "stretch") return &p.stretch;
+  if (name == "shear") return &p.shear;
+  if (name == "bend") return &p.bend;
+  if (name == "friction") return &p.friction;
+  if (name == "self_friction") return &p.self_friction;
+  if (name == "damping") return &p.damping;
+  if (name == "areal_density") return &p.areal_density;
+  return nullptr;
+}
+
+}  // namespace
+
+ClothParams parse_params(const std::string& text, const std::filesystem::path& file) {
+  ClothParams p;
+  // Turn JSON punctuation into spaces and split records at newlines and commas.
+  std::string t = text;
+  for (char& c : t)
+    if (c == '{' || c == '}' || c == '"' || c == ':' || c == '=' || c == '\t' || c == '\r') c = ' ';
+  std::istringstream in(t);
+  std::string line;
+  long lineno = 0;
+  while (std::getline(in, line)) {
+    ++lineno;
+    if (auto h = line.find('#'); h != std::string::npos) line.resize(h);
+    std::istringstream recs(line);
+    std::string rec;
+    while (std::getline(recs, rec, ',')) {
+      std::istringstream ws(rec);
+      std::string name, value, extra;
+      if (!(ws >> name)) continue;
+      if (!(ws >> value)) throw_input_error(file, lineno, "parameter '" + name + "' has no value");
+      if (ws >> extra) throw_input_error(file, lineno, "unexpected '" + extra + "' after " + name);
+      double* f = field(p, name);
+      if (!f) throw_input_error(file, lineno, "unknown parameter '" + name + "' (stretch, shear, bend, friction, self_friction, damping, areal_density)");
+      double v = 0;
+      auto [ptr, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
+      if (ec != std::errc() || ptr != value.data() + value.size() || !std::isfinite(v))
+        throw_input_error(file, lineno, "parameter '" + name + "': '" + value + "' is not a number");
+      *f = v;
+    }
+  }
+  if (p.areal_density <= 0) throw_input_error(file, 0, "areal_density must be positive");
+  return p;
+}
+
+ClothParams read_params(const std::filesystem::path& file) { return parse_params(read_file(file), file); }
+
+std::string format_params(const ClothParams& p) {
+  char b[512];
+  std::snprintf(b, sizeof b,
+                "stretch %.17g\nshear %.17g\nbend %.17g\nfriction %.17g\nself_friction %.17g\ndamping %.17g\n"
+                "areal_density %.17g\n",
+                p.stretch, p.shear, p.bend, p.friction, p.self_friction, p.damping, p.areal_density);
+  return b;
+}
+
+std::string params_json(const ClothParams& p) {
+  char b[512];
+  std::snprintf(b, sizeof b,
+                "{\"stretch\": %.17g, \"shear\": %.17g, \"bend\": %.17g, \"friction\": %.17g, \"self_friction\": %.17g, "
+                "\"damping\": %.17g, \"areal_density\": %.17g}",
+                p.stretch, p.shear, p.bend, p.friction, p.self_friction, p.damping, p.areal_density);
+  return b;
+}
+
+std::string scene_json(const Scene& scene, const TrialSpec& spec, const TrialResult& r) {
+  const SceneData& sc = scene.data();
+  const double dz = sc.opt.arm.z_rel[static_cast<int>(spec.height)] - sc.opt.arm.z_rel[0] + spec.arm_offset;
+  std::ostringstream o;
+  o.precision(6);
+  o << "{\"tris\": [";
+  for (size_t t = 0; t < sc.mesh.tris.size(); ++t)
+    o << (t ? "," : "") << '[' << sc.mesh.tris[t][0] << ',' << sc.mesh.tris[t][1] << ',' << sc.mesh.tris[t][2] << ']';
+  o << "],\n\"arm\": [";
+  for (size_t k = 0; k < sc.arm.size(); ++k) {
+    const RoundCone& c = sc.arm[k];
+    o << (k ? "," : "") << "{\"a\": [" << c.a.x << ',' << c.a.y << ',' << c.a.z + dz << "], \"ra\": " << c.ra
+      << ", \"b\": [" << c.b.x << ',' << c.b.y << ',' << c.b.z + dz << "], \"rb\": " << c.rb << '}';
+  }
+  o << "],\n\"grip\": [" << sc.opt.grasp_point[0] << ',' << sc.opt.grasp_point[1] << ',' << sc.opt.grasp_point[2] << "],";
+  o << "\"jaw_half\": [" << sc.opt.jaw_half[0] << ',' << sc.opt.jaw_half[1] << ',' << sc.opt.jaw_half[2] << "],";
+  o << "\"grasped\": [";
+  for (size_t k = 0; k < sc.grasp_list.size(); ++k) o << (k ? "," : "") << sc.grasp_list[k];
+  o << "], \"opening\": [";
+  for (size_t k = 0; k < sc.opening.size(); ++k) o << (k ? "," : "") << sc.opening[k];
+  o << "],\n\"label\": \"" << outcome_name(r.outcome) << "\", \"travel\": " << r.travel << ", \"d_max\": " << r.d_max << ", \"contact_travel\": " << r.contact_travel
+    << ", \"height\": \"" << arm_height_name(spec.height) << "\", \"arm_offset\": " << spec.arm_offset << ",\n\"frames\": [";
+  for (size_t f = 0; f < r.frames.size(); ++f) {
+    const Frame& fr = r.frames[f];
+    o << (f ? ",\n" : "") << "{\"t\": " << fr.t << ", \"travel\": " << fr.travel << ", \"x\": [";
+    for (size_t k = 0; k < fr.xyz.size(); ++k) o << (k ? "," : "") << fr.xyz[k];
+    o << "]}";
+  }
+  o << "],\n\"samples\": [";
+  for (size_t k = 0; k < r.seq.samples.size(); ++k) {
+    const HapticSample& s = r.seq.samples[k];
+    o << (k ? "," : "") << '[' << s.t << ',' << s.travel << ',' << s.f_motion << ',' << s.f_lateral << ',' << s.f_vertical << ']';
+  }
+  o << "]}\n";
+  return o.str();
+}
+
+}  // namespace dressguard::sim

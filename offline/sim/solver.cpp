@@ -1,0 +1,303 @@
+// The XPBD "small steps" solver (Macklin et al. 2019): one output step = collision detection
+// once, then `substeps` x (integrate, solve each constraint once in a fixed Gauss-Seidel order,
+// resolve contacts with friction, update velocities). Allocation-free: every buffer lives in
+// GownState. Deterministic: fixed orders everywhere (constraint lists, hash buckets, pairs).
+#include <algorithm>
+#include <cmath>
+
+#include "constraints.h"
+#include "model.h"
+
+namespace dressguard::sim {
+namespace {
+
+// Arm candidates of every free vertex within a margin of the surface: the exact distance is
+// re-evaluated every substep against these (at most two round cones per vertex, enough at the
+// elbow where the forearm and upper arm meet).
+void detect_arm(const GownModel& m, GownState& s) {
+  const SceneData& sc = *m.scene;
+  const double base = sc.opt.contact_offset + 0.01;
+  const int n = static_cast<int>(s.x.size());
+  const int shapes = static_cast<int>(m.arm.size());
+  for (int i = 0; i < n; ++i) {
+    ArmCandidates c;
+    if (!sc.grasped[i] && shapes > 0) {
+      const double margin = base + 2.0 * norm(s.v[i]) * m.dt;
+      double best[2] = {1e300, 1e300};
+      for (int k = 0; k < shapes; ++k) {
+        V3 nrm;
+        const double phi = round_cone_distance(m.arm[k], s.x[i], &nrm);
+        if (phi >= margin) continue;
+        if (phi < best[0]) {
+          best[1] = best[0];
+          c.c[1] = c.c[0];
+          best[0] = phi;
+          c.c[0] = static_cast<int8_t>(k);
+        } else if (phi < best[1]) {
+          best[1] = phi;
+          c.c[1] = static_cast<int8_t>(k);
+        }
+      }
+    }
+    s.cand[i] = c;
+    if (c.c[0] < 0) s.anchored[i] = 0;
+  }
+}
+
+inline uint32_t hash_cell(int64_t ix, int64_t iy, int64_t iz, uint32_t mask) {
+  const uint64_t h = static_cast<uint64_t>(ix) * 73856093ULL ^ static_cast<uint64_t>(iy) * 19349663ULL ^
+                     static_cast<uint64_t>(iz) * 83492791ULL;
+  return static_cast<uint32_t>(h) & mask;
+}
+
+// Self-collision candidates (paper IV-A.3): a spatial hash of the vertices with cells as wide as
+// the search radius, built once per output step by a counting sort; pairs closer than the search
+// radius, excluding pairs whose rest distance is already within 1.5 collision distances (mesh
+// neighbours) and pairs of two grasped vertices.
+void detect_self(const GownModel& m, GownState& s) {
+  const SceneData& sc = *m.scene;
+  s.pair_count = 0;
+  const int n = static_cast<int>(s.x.size());
+  const double ds = sc.opt.self_distance;
+  double vmax = 0;
+  for (int i = 0; i < n; ++i) vmax = std::max(vmax, dot(s.v[i], s.v[i]));
+  vmax = std::sqrt(vmax);
+  const double r = ds + std::clamp(2.0 * vmax * m.dt, 0.5 * ds, 2.0 * ds);
+  const double inv = 1.0 / r;
+  const uint32_t table = static_cast<uint32_t>(s.cell_start.size() - 1);
+  const uint32_t mask = table - 1;
+  std::fill(s.cell_start.begin(), s.cell_start.end(), 0);
+  for (int i = 0; i < n; ++i) {
+    const V3 q = s.x[i];
+    const uint32_t h = hash_cell(static_cast<int64_t>(std::floor(q.x * inv)), static_cast<int64_t>(std::floor(q.y * inv)),
+                                 static_cast<int64_t>(std::floor(q.z * inv)), mask);
+    s.cell_of[i] = h;
+    s.cell_start[h + 1]++;
+  }
+  for (uint32_t k = 0; k < table; ++k) s.cell_start[k + 1] += s.cell_start[k];
+  // Scatter in vertex order using cell_start as cursors, then restore the starts.
+  for (int i = 0; i < n; ++i) s.cell_sorted[s.cell_start[s.cell_of[i]]++] = i;
+  for (uint32_t k = table; k > 0; --k) s.cell_start[k] = s.cell_start[k - 1];
+  s.cell_start[0] = 0;
+  const double r2 = r * r, excl2 = (1.5 * ds) * (1.5 * ds);
+  const size_t cap = s.pairs.size();
+  for (int i = 0; i < n; ++i) {
+    const V3 q = s.x[i];
+    const int64_t cx = static_cast<int64_t>(std::floor(q.x * inv)), cy = static_cast<int64_t>(std::floor(q.y * inv)),
+                  cz = static_cast<int64_t>(std::floor(q.z * inv));
+    uint32_t seen[27];
+    int nseen = 0;
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          const uint32_t h = hash_cell(cx + dx, cy + dy, cz + dz, mask);
+          bool dup = false;
+          for (int k = 0; k < nseen; ++k) dup |= seen[k] == h;
+          if (dup) continue;
+          seen[nseen++] = h;
+          for (int32_t a = s.cell_start[h]; a < s.cell_start[h + 1]; ++a) {
+            const int j = s.cell_sorted[a];
+            if (j <= i) continue;
+            if (sc.grasped[i] && sc.grasped[j]) continue;
+            const V3 d = s.x[j] - q;
+            if (dot(d, d) >= r2) continue;
+            const V3 dr = sc.rest[j] - sc.rest[i];
+            if (dot(dr, dr) < excl2) continue;
+            if (s.pair_count < cap) {
+              s.pairs[s.pair_count++] = {i, j};
+            } else {
+              s.pairs_dropped++;
+            }
+          }
+        }
+  }
+}
+
+// Integration: the grasped vertices follow the gripper, the others move under gravity, the
+// perturbation and velocity damping (symplectic Euler prediction of XPBD).
+void integrate(const GownModel& m, GownState& s, V3 grip) {
+  const SceneData& sc = *m.scene;
+  const int n = static_cast<int>(s.x.size());
+  const double h = m.h, decay = m.damping_factor;
+  for (int i = 0; i < n; ++i) {
+    s.p[i] = s.x[i];
+    if (sc.grasped[i]) {
+      s.x[i] = sc.rest[i] + grip;
+      continue;
+    }
+    V3 v = decay * s.v[i];
+    v += h * (m.gravity + m.w[i] * s.ext_force[i]);
+    s.v[i] = v;
+    s.x[i] += h * v;
+  }
+}
+
+// Distance constraints in list order (fixed Gauss-Seidel order); the force they exert on
+// grasped vertices is added to `force` (XPBD: f = grad C lambda / h^2).
+void solve_links(const GownModel& m, GownState& s, const std::vector<DistanceLink>& links, double alpha_t,
+                 double inv_h2, V3& force) {
+  const uint8_t* grasped = m.scene->grasped.data();
+  V3* x = s.x.data();
+  const double* w = m.w.data();
+  for (const DistanceLink& l : links) {
+    V3 nrm;
+    const double dl = distance_constraint(x[l.i], x[l.j], w[l.i], w[l.j], l.rest, alpha_t, &nrm);
+    if (grasped[l.i] | grasped[l.j]) {
+      if (grasped[l.i]) force += (dl * inv_h2) * nrm;
+      if (grasped[l.j]) force -= (dl * inv_h2) * nrm;
+    }
+  }
+}
+
+// In-plane shear per triangle; alpha_shear / A per triangle (see shear_constraint()).
+void solve_shear(const GownModel& m, GownState& s, double inv_h2, V3& force) {
+  const uint8_t* grasped = m.scene->grasped.data();
+  V3* x = s.x.data();
+  const double* w = m.w.data();
+  const double at = m.alpha_shear * inv_h2;
+  for (const ShearTri& t : m.scene->shear) {
+    V3 g[3];
+    const double dl = shear_constraint(x[t.v[0]], x[t.v[1]], x[t.v[2]], w[t.v[0]], w[t.v[1]], w[t.v[2]], t.dm_inv,
+                                       at / t.area, g);
+    if (grasped[t.v[0]] | grasped[t.v[1]] | grasped[t.v[2]])
+      for (int a = 0; a < 3; ++a)
+        if (grasped[t.v[a]]) force += (dl * inv_h2) * g[a];
+  }
+}
+
+void solve_bending(const GownModel& m, GownState& s, double alpha_t, double inv_h2, V3& force) {
+  const uint8_t* grasped = m.scene->grasped.data();
+  V3* x = s.x.data();
+  const double* w = m.w.data();
+  for (const BendStencil& b : m.scene->bend) {
+    const double w4[4] = {w[b.v[0]], w[b.v[1]], w[b.v[2]], w[b.v[3]]};
+    const V3 dl = bending_constraint(x[b.v[0]], x[b.v[1]], x[b.v[2]], x[b.v[3]], w4, b.k, alpha_t);
+    if (grasped[b.v[0]] | grasped[b.v[1]] | grasped[b.v[2]] | grasped[b.v[3]])
+      for (int a = 0; a < 4; ++a)
+        if (grasped[b.v[a]]) force += (b.k[a] * inv_h2) * dl;
+  }
+}
+
+// One contact against a static collider with the chosen friction scheme.
+inline void collide_static(const GownModel& m, GownState& s, int i, double phi, V3 nrm) {
+  const double dn = contact_constraint(s.x[i], phi, nrm, m.scene->opt.contact_offset);
+  if (dn <= 0) return;
+  s.contact_n[i] = nrm;
+  s.contact_dn[i] += dn;
+  if (m.scheme == FrictionScheme::Improved) {
+    friction_position(s.x[i], s.p[i], nrm, dn, m.friction);
+  } else if (m.scheme == FrictionScheme::Constraint) {
+    if (!s.anchored[i]) {
+      s.anchor[i] = s.p[i];
+      s.anchored[i] = 1;
+    }
+    friction_anchor(s.x[i], s.anchor[i], nrm, dn, m.friction, m.friction * m.scene->opt.kinetic_ratio);
+  }
+}
+
+// Contacts with the arm's candidate round cones and the test planes; the collision force on
+// each vertex (paper eq. 2: f = m dx_col / h^2) is accumulated for the per-vertex contact map.
+void solve_contacts(const GownModel& m, GownState& s, double inv_h2) {
+  const SceneData& sc = *m.scene;
+  const int n = static_cast<int>(s.x.size());
+  const double off = sc.opt.contact_offset;
+  const bool planes = !sc.planes.empty();
+  for (int i = 0; i < n; ++i) {
+    if (s.cand[i].c[0] < 0 && !planes) continue;
+    if (sc.grasped[i]) continue;
+    const V3 before = s.x[i];
+    const double dn_before = s.contact_dn[i];
+    for (int k = 0; k < 2; ++k) {
+      const int c = s.cand[i].c[k];
+      if (c < 0) break;
+      V3 nrm;
+      const double phi = round_cone_distance(m.arm[c], s.x[i], &nrm);
+      collide_static(m, s, i, phi, nrm);
+    }
+    for (const HalfSpace& pl : sc.planes) {
+      const double phi = dot(pl.n, s.x[i]) - pl.d;
+      if (phi - off > 1e-3) s.anchored[i] = 0;
+      collide_static(m, s, i, phi, pl.n);
+    }
+    if (s.contact_dn[i] > dn_before) s.contact_acc[i] += (m.mass[i] * inv_h2) * (s.x[i] - before);
+  }
+}
+
+// Self-collision with self-friction (paper IV-A.3): vertex pairs kept `ds` apart, and their
+// relative tangential slip of this substep removed up to mu_self times the normal correction
+// (the same rule as against the arm; none in the Stock scheme, as in stock PhysX).
+void solve_self(const GownModel& m, GownState& s) {
+  const double ds = m.scene->opt.self_distance, mus = m.self_friction;
+  const bool position_friction = m.scheme != FrictionScheme::Stock && mus > 0;
+  for (size_t k = 0; k < s.pair_count; ++k) {
+    const int i = s.pairs[k].i, j = s.pairs[k].j;
+    const double wi = m.w[i], wj = m.w[j], wsum = wi + wj;
+    const V3 d = s.x[i] - s.x[j];
+    const double len2 = dot(d, d);
+    if (len2 >= ds * ds || wsum <= 0 || len2 < 1e-24) continue;
+    const double len = std::sqrt(len2);
+    const V3 nrm = (1.0 / len) * d;
+    const double dl = (ds - len) / wsum;
+    s.x[i] += (wi * dl) * nrm;
+    s.x[j] -= (wj * dl) * nrm;
+    if (position_friction) {
+      const V3 u = (s.x[i] - s.p[i]) - (s.x[j] - s.p[j]);
+      const V3 ut = u - dot(u, nrm) * nrm;
+      const double lt = norm(ut);
+      if (lt > 1e-15) {
+        const double f = std::min(1.0, mus * (ds - len) / lt) / wsum;
+        s.x[i] -= (wi * f) * ut;
+        s.x[j] += (wj * f) * ut;
+      }
+    }
+  }
+}
+
+// v = (x - p) / h.
+void update_velocities(const GownModel& m, GownState& s) {
+  const int n = static_cast<int>(s.x.size());
+  const double inv_h = 1.0 / m.h;
+  for (int i = 0; i < n; ++i) s.v[i] = inv_h * (s.x[i] - s.p[i]);
+}
+
+// Stock PBD friction, once per output step: the tangential velocity loses at most mu times the
+// step's normal velocity change (sum of the substeps' normal corrections / h).
+void stock_friction(const GownModel& m, GownState& s) {
+  const int n = static_cast<int>(s.x.size());
+  for (int i = 0; i < n; ++i)
+    if (s.contact_dn[i] > 0) friction_velocity(s.v[i], s.contact_n[i], s.contact_dn[i], m.friction, m.h);
+}
+
+void substep(const GownModel& m, GownState& s, V3 grip, V3 grip_accel) {
+  const SceneData& sc = *m.scene;
+  const double inv_h2 = 1.0 / (m.h * m.h);
+  integrate(m, s, grip);
+  V3 force{0, 0, 0};  // of the gown on the gripper, this substep
+  solve_links(m, s, sc.stretch, m.alpha_stretch * inv_h2, inv_h2, force);
+  solve_shear(m, s, inv_h2, force);
+  solve_bending(m, s, m.alpha_bend * inv_h2, inv_h2, force);
+  solve_contacts(m, s, inv_h2);
+  if (m.self_collision) solve_self(m, s);
+  update_velocities(m, s);
+  // The grasped vertices' own weight and inertia also load the gripper.
+  for (int g : sc.grasp_list) force += m.mass[g] * (m.gravity - grip_accel);
+  s.force_acc += force;
+  s.force_count++;
+}
+
+}  // namespace
+
+void step(const GownModel& m, GownState& s, V3 grip_from, V3 grip_to, V3 grip_accel) {
+  detect_arm(m, s);
+  if (m.self_collision) detect_self(m, s);
+  std::fill(s.contact_dn.begin(), s.contact_dn.end(), 0.0);
+  for (int k = 0; k < m.substeps; ++k) {
+    const double f = static_cast<double>(k + 1) / m.substeps;
+    const V3 grip = grip_from + f * (grip_to - grip_from);
+    s.grip_offset = grip;
+    substep(m, s, grip, grip_accel);
+  }
+  if (m.scheme == FrictionScheme::Stock) stock_friction(m, s);
+}
+
+}  // namespace dressguard::sim

@@ -1,0 +1,175 @@
+// The trial runner (paper V-A): grasp, gravity, settling with the optional perturbation, pull,
+// stop, label. The haptic samples follow the rig (shared/data/README.md).
+#include "trial.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <random>
+
+#include "model.h"
+
+namespace dressguard::sim {
+namespace {
+
+// Uniform in [lo, hi) from 53 random bits, the same on every standard library (unlike
+// std::uniform_real_distribution, whose algorithm is unspecified).
+double uniform(std::mt19937_64& rng, double lo, double hi) {
+  return lo + (hi - lo) * (static_cast<double>(rng() >> 11) * 0x1.0p-53);
+}
+
+// The rig's motion profile: constant acceleration up to the pull speed, then constant speed.
+struct Profile {
+  double a, v, max_travel;
+  double travel(double t) const {
+    const double ta = v / a;
+    const double s = t < ta ? 0.5 * a * t * t : 0.5 * a * ta * ta + v * (t - ta);
+    return std::min(s, max_travel);
+  }
+  double accel(double t) const { return t < v / a ? a : 0.0; }
+};
+
+bool all_finite(const GownState& s) {
+  for (const V3& q : s.x)
+    if (!std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z)) return false;
+  return true;
+}
+
+Frame make_frame(const GownState& s, double t, double travel) {
+  Frame f;
+  f.t = t;
+  f.travel = travel;
+  f.xyz.reserve(s.x.size() * 3);
+  for (const V3& q : s.x) {
+    f.xyz.push_back(static_cast<float>(q.x));
+    f.xyz.push_back(static_cast<float>(q.y));
+    f.xyz.push_back(static_cast<float>(q.z));
+  }
+  return f;
+}
+
+}  // namespace
+
+Outcome label_outcome(bool full_travel, double d_max) {
+  if (full_travel) return Outcome::Missed;
+  return d_max <= 0.07 ? Outcome::Good : Outcome::Caught;
+}
+
+TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const TrialSpec& spec) {
+  const SceneData& sc = scene.data();
+  const int hi = static_cast<int>(spec.height);
+  const double arm_dz = sc.opt.arm.z_rel[hi] - sc.opt.arm.z_rel[0] + spec.arm_offset;
+  const GownModel m = make_model(sc, params, spec.friction_scheme, spec.self_collision, arm_dz);
+  GownState s = make_state(m);
+  TrialResult r;
+  double total_mass = 0;
+  for (double q : m.mass) total_mass += q;
+  r.weight = total_mass * 9.81;
+  const int n = static_cast<int>(s.x.size());
+
+  std::vector<double> frame_times = spec.frame_times;
+  std::sort(frame_times.begin(), frame_times.end());
+  size_t next_frame = 0;
+  auto maybe_frame = [&](double t, double travel) {
+    while (spec.keep_frames && next_frame < frame_times.size() && frame_times[next_frame] <= t + 1e-9) {
+      r.frames.push_back(make_frame(s, t, travel));
+      ++next_frame;
+    }
+  };
+
+  // Perturbation (paper V-A): one random horizontal force, uniform in X and lateral up to 6 N,
+  // spread equally over all vertices for 0.5 s (output steps 180-330), then settling.
+  const auto clock0 = std::chrono::steady_clock::now();
+  std::mt19937_64 rng(spec.seed);
+  const double fx = uniform(rng, -6.0, 6.0), fy = uniform(rng, -6.0, 6.0);
+  const int perturb_from = 180, perturb_to = 330;
+  const V3 zero{0, 0, 0};
+  for (int k = 0; k < spec.settle_steps; ++k) {
+    const bool on = spec.gown_noise && k >= perturb_from && k < perturb_to;
+    const bool was_on = spec.gown_noise && k - 1 >= perturb_from && k - 1 < perturb_to;
+    if (on != was_on)
+      for (int i = 0; i < n; ++i) s.ext_force[i] = on ? V3{fx / n, fy / n, 0} : zero;
+    if ((spec.settle_steps - k) % 3 == 0) {  // the bias sample is the last 3 steps before the pull
+      s.force_acc = zero;
+      s.force_count = 0;
+    }
+    step(m, s, zero, zero, zero);
+    maybe_frame((k + 1 - spec.settle_steps) * m.dt, 0.0);
+  }
+  for (int i = 0; i < n; ++i) s.ext_force[i] = zero;
+  // The sensor is biased at the start of the trial (data README): the settled gown's force,
+  // mainly its weight, is removed from every sample.
+  const V3 bias = s.force_count ? (1.0 / s.force_count) * s.force_acc : zero;
+  r.bias = {bias.x, bias.y, bias.z};
+  // The lower half of the sleeve opening as it hangs after settling (paper Fig. 3b, red dots).
+  std::vector<int32_t> lower;
+  if (!sc.opening.empty()) {
+    double zmean = 0;
+    for (int v : sc.opening) zmean += s.x[v].z;
+    zmean /= sc.opening.size();
+    for (int v : sc.opening)
+      if (s.x[v].z <= zmean) lower.push_back(v);
+  }
+
+  const auto clock1 = std::chrono::steady_clock::now();
+  r.wall_settle = std::chrono::duration<double>(clock1 - clock0).count();
+  const Profile prof{spec.acceleration, spec.speed, spec.max_travel};
+  r.seq.height = spec.height;
+  r.seq.speed = spec.speed;
+  r.seq.id = std::string("sim-") + std::string(arm_height_name(spec.height)) + "-" + std::to_string(spec.seed);
+  double t = 0;
+  bool full = false;
+  r.finite = all_finite(s);
+  const double max_time = spec.max_travel / spec.speed + spec.speed / spec.acceleration + 5.0;
+  while (r.finite && t < max_time) {
+    s.force_acc = zero;
+    s.force_count = 0;
+    for (int i = 0; i < n; ++i) s.contact_acc[i] = zero;
+    for (int k = 0; k < 3; ++k) {
+      const double t1 = t + m.dt;
+      const V3 g0{prof.travel(t), 0, 0}, g1{prof.travel(t1), 0, 0};
+      step(m, s, g0, g1, V3{prof.accel(t), 0, 0});
+      t = t1;
+      maybe_frame(t, g1.x);
+    }
+    const V3 f = (1.0 / s.force_count) * s.force_acc - bias;
+    const double travel = prof.travel(t);
+    r.seq.samples.push_back({t, travel, f.x, f.y, f.z});
+    r.finite = all_finite(s);
+    if (r.contact_t < 0)
+      for (int i = 0; i < n; ++i)
+        if (s.contact_acc[i].x != 0 || s.contact_acc[i].y != 0 || s.contact_acc[i].z != 0) {
+          r.contact_t = t;
+          r.contact_travel = travel;
+          break;
+        }
+    if (std::abs(f.x) >= spec.force_limit || std::abs(f.z) >= spec.force_limit) {
+      r.stopped_by_force = true;
+      break;
+    }
+    if (travel >= spec.max_travel - 1e-12) {
+      full = true;
+      break;
+    }
+  }
+  r.wall_pull = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock1).count();
+  r.travel = prof.travel(t);
+  r.self_pairs_dropped = s.pairs_dropped;
+  r.d_max = 0;
+  if (!full) {
+    for (int v : lower) r.d_max = std::max(r.d_max, std::abs(s.x[v].x - m.elbow.x));
+  }
+  r.outcome = label_outcome(full, r.d_max);
+  r.seq.label = r.outcome;
+  r.area_ratio = current_area(m, s) / sc.rest_area;
+  // Contact force of the cloth on the arm per vertex, averaged over the last sample.
+  if (s.force_count > 0)
+    for (int i = 0; i < n; ++i) {
+      const V3 c = (-1.0 / s.force_count) * s.contact_acc[i];
+      if (c.x != 0 || c.y != 0 || c.z != 0) r.contacts.push_back({i, {c.x, c.y, c.z}});
+    }
+  if (spec.keep_frames && (r.frames.empty() || r.frames.back().t < t - 1e-9)) r.frames.push_back(make_frame(s, t, r.travel));
+  return r;
+}
+
+}  // namespace dressguard::sim

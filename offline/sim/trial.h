@@ -1,0 +1,190 @@
+// The haptic simulation of one sleeve-pulling trial (paper section IV-A and V-A).
+//
+// A Scene is the constant model of the trial (gown mesh, masses, constraints, the arm's tapered
+// capsules, the gripper's grasp), built once and reused for thousands of trials, the way MuJoCo
+// separates mjModel from mjData. simulate_trial() creates its own mutable state, so any number of
+// threads may simulate trials of one Scene at once (no shared mutable state).
+//
+// Frame (world, metres): x = the gripper's direction of motion (from the fist toward the elbow),
+// y = lateral (the upper arm goes toward -y), z = up; gravity -9.81 m/s^2 along z. The gripper
+// starts at x = 0 and pulls along +x. The reported forces use the rig's convention (core/haptic.h):
+// f_motion = F.x (drag negative), f_lateral = F.y, f_vertical = F.z, with F the force that the
+// gown exerts on the gripper, biased to zero at the start of the pull like the real sensor.
+//
+// Time (paper IV-A, V-A; Macklin et al. 2019 "small steps"): 300 Hz output steps, each split into
+// `substeps` (20) XPBD substeps that each integrate and solve every constraint once; collision
+// candidates (arm and self) are found once per output step; one haptic sample per 3 output steps
+// (100 Hz), the force averaged over the sample's 60 substeps.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "haptic.h"
+
+namespace dressguard::sim {
+
+// The cloth's calibrated material (paper IV-B.2: isotropic stretch, shear, bending, friction,
+// self-friction). The three stiffnesses are dimensionless in [0, 1] and map log-linearly onto
+// XPBD compliances (see compliance_of() in model.h), so that an optimizer can search a box:
+//   stretch: edge distance compliance   1e-2 (k=0) ... 1e-7 m/N (k=1), per metre of rest length
+//   shear:   in-plane shear compliance per triangle (1 / shear modulus) 1e0 (k=0) ... 1e-5 m/N (k=1)
+//   bend:    isometric bending compliance 1e+2 (k=0) ... 1e-3 1/(N m) (k=1)
+// friction: Coulomb coefficient cloth-arm, [0, 2]; self_friction: cloth-cloth, [0, 2].
+// damping [1/s]: velocity decay rate (v *= exp(-damping h) per substep), fixed by default.
+// areal_density [kg/m^2]: 0.145 as the paper's simulator, fixed by default.
+struct ClothParams {
+  double stretch = 0.8;
+  double shear = 0.5;
+  double bend = 0.5;
+  double friction = 0.5;
+  double self_friction = 0.2;
+  double damping = 0.5;
+  double areal_density = 0.145;
+};
+
+// Friction of cloth against the arm and itself (paper IV-A.2, the point of the "improved" scheme):
+//  Stock:      PBD as in stock PhysX: contacts push vertices out along the normal in every
+//              substep, and once per output step the friction impulse (bounded by mu times the
+//              step's normal impulse) changes only the velocity; the tangential slip already made
+//              by gravity and internal constraints stays, so friction is underestimated (the
+//              paper's claim, tested). No cloth-cloth friction (stock PhysX has none, paper IV-A.3).
+//  Improved:   the paper's fix: the friction correction is applied to the positions (and so to
+//              the velocities) in every substep that resolves the contact; self-friction likewise.
+//  Constraint: static friction as a positional stick constraint holding each contact at its anchor
+//              while the tangential correction stays within mu times the normal correction, and
+//              dynamic friction bounded by mu times the normal correction otherwise (Macklin et
+//              al. 2014 "Unified particle physics", XPBD rigid bodies 2020).
+enum class FrictionScheme { Stock = 0, Improved = 1, Constraint = 2 };
+const char* friction_scheme_name(FrictionScheme s);
+
+// One trial's conditions.
+struct TrialSpec {
+  ArmHeight height = ArmHeight::High;
+  double arm_offset = 0.0;      // [m] added to the height's nominal arm height (paper IV-B.2)
+  double speed = 0.1;           // [m/s] pull speed (0.1 or 0.15 in the study)
+  double acceleration = 1.0;    // [m/s^2] the rig's acceleration up to `speed`
+  uint64_t seed = 0;            // drives the perturbation force
+  bool gown_noise = false;      // paper V-A: uniform X/lateral force up to 6 N over all vertices
+  double max_travel = 0.85;     // [m] end of the rig's travel
+  double force_limit = 10.0;    // [N] stop when |f_motion| or |f_vertical| reaches it
+  FrictionScheme friction_scheme = FrictionScheme::Improved;
+  bool self_collision = true;
+  int settle_steps = 500;       // output steps of settling after the grasp (300 Hz)
+  bool keep_frames = false;     // keep gown positions at `frame_times` (for pictures)
+  std::vector<double> frame_times;  // [s] since the start of the pull; negative = before the pull
+};
+
+// Per-vertex contact force on the arm (paper eq. 2, f = m dx_col / dt^2), time-averaged over
+// the last sample before the stop; kept for force maps on the arm.
+struct ContactForce {
+  int vertex = 0;
+  std::array<double, 3> force{};  // [N] world frame, force of the cloth on the arm
+};
+
+// Gown positions at one time, for pictures.
+struct Frame {
+  double t = 0;                     // [s] since the start of the pull (negative: settling)
+  double travel = 0;                // [m]
+  std::vector<float> xyz;           // 3 per vertex, world frame
+};
+
+struct TrialResult {
+  HapticSequence seq;               // samples from the start of the pull; label set
+  Outcome outcome = Outcome::Missed;
+  double d_max = 0;                 // [m] paper V-A label distance (NaN-free; 0 when missed)
+  bool stopped_by_force = false;
+  double travel = 0;                // [m] gripper travel at the stop
+  double contact_t = -1;            // [s] first sample with cloth-arm contact (-1: none)
+  double contact_travel = -1;       // [m] travel then
+  double weight = 0;                // [N] gown weight m g
+  std::array<double, 3> bias{};     // [N] raw force at the start of the pull, removed from samples
+  double area_ratio = 1;            // final triangle area / rest area (explosion check)
+  bool finite = true;               // every position stayed finite
+  std::vector<ContactForce> contacts;
+  std::vector<Frame> frames;
+  long self_pairs_dropped = 0;      // self-collision pairs beyond the preallocated capacity
+  double wall_settle = 0, wall_pull = 0;  // [s] wall time of grasp+settling and of the pull
+};
+
+// The arm (data README; paper IV: capsules, fixed, uniform friction). Spheres fist, wrist,
+// elbow, shoulder joined by tapered capsules (round cones); forearm along +x pointing at the
+// gripper's start, upper arm horizontal toward -y.
+struct ArmGeometry {
+  double r_fist = 0.05, r_wrist = 0.0365, r_elbow = 0.05, r_shoulder = 0.075;  // [m]
+  double hand = 0.0;          // [m] fist centre to wrist centre (0 in the paper's simulator)
+  double forearm = 0.31;      // [m] wrist centre to elbow centre
+  double upper_arm = 0.32;    // [m] elbow centre to shoulder centre
+  double fist_x = 0.22;       // [m] fist centre ahead of the gripper's start along +x
+  // Arm axis height relative to the grasp point for each ArmHeight (data README: high arm
+  // 0.0885 m below the upper jaw; middle -0.123 m and low -0.205 m from high).
+  std::array<double, 3> z_rel = {-0.0885, -0.2115, -0.2935};
+};
+
+// A triangle mesh already placed in the world frame, with what the simulator needs to know.
+struct ClothMesh {
+  std::vector<std::array<double, 3>> x;       // [m] vertex positions
+  std::vector<std::array<int, 3>> tris;
+  std::vector<int> grasp;                     // vertices held by the gripper (may be empty: use the jaw box)
+  std::vector<int> sleeve_opening;            // the sleeve opening's boundary loop (labels, paper V-A)
+  std::string name;
+};
+
+struct SceneOptions {
+  ArmGeometry arm;
+  int substeps = 20;              // XPBD substeps per output step
+  double step_hz = 300;           // output steps per second
+  double contact_offset = 0.004;  // [m] cloth thickness kept from the arm
+  double self_distance = 0.008;   // [m] self-collision distance (data README: 0.008)
+  double kinetic_ratio = 0.8;     // Constraint scheme: dynamic / static friction coefficient
+  // Jaw box (centre relative to the grasp point, half extents) used when ClothMesh::grasp is empty.
+  std::array<double, 3> jaw_centre{0, 0, 0};
+  std::array<double, 3> jaw_half{0.04, 0.06, 0.01};
+  std::array<double, 3> grasp_point{0, 0, 0};  // [m] world position of the grasp at travel 0
+  bool with_arm = true;
+  bool colour_order = true;       // false: constraints in mesh order (the benchmark's baseline)
+  bool require_grasp = true;      // false: no jaw box; only ClothMesh::grasp is held (physics tests)
+  std::vector<std::array<double, 4>> planes;  // test colliders {p : n.p >= d} as (n.x, n.y, n.z, d)
+};
+
+struct SceneData;  // model.h
+// The constant model of a trial. Cheap to copy (shared, immutable).
+class Scene {
+ public:
+  Scene() = default;
+  explicit Scene(std::shared_ptr<const SceneData> d) : d_(std::move(d)) {}
+  const SceneData& data() const { return *d_; }
+  int vertex_count() const;
+  int triangle_count() const;
+  double gown_mass() const;                   // [kg] at the density the scene was built with
+  const ClothMesh& mesh() const;              // rest mesh (world frame)
+ private:
+  std::shared_ptr<const SceneData> d_;
+};
+
+// Builds the constant model: topology, constraint lists (stretch edges, shear triangles,
+// bending stencils), rest lengths, bending matrices, the arm, the grasp set. Throws
+// std::invalid_argument naming the problem (empty mesh, bad index, no grasped vertex...).
+// Masses are derived from ClothParams::areal_density at trial time.
+Scene make_scene(const ClothMesh& mesh, const SceneOptions& opt = {});
+
+// Which gown a default scene uses.
+enum class GownResolution { Full = 0, Reduced = 1, Coarse = 2 };
+
+// The default scene: the measured gown when the gown module and shared/data provide it, else the
+// simulator's own parametric sleeve-and-panel gown (see meshes.h). Coarse is a small version
+// for fast tests.
+Scene make_default_scene(GownResolution res = GownResolution::Reduced);
+
+// One trial: grasp, gravity, settling (with the optional perturbation during output steps
+// 180-330, i.e. 0.5 s), then the pull until max_travel or the force limit. Deterministic: the
+// same inputs give the same bits (single thread, no fast-math).
+TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const TrialSpec& spec);
+
+// The label rule of paper V-A from the final state; exposed for tests.
+Outcome label_outcome(bool full_travel, double d_max);
+
+}  // namespace dressguard::sim

@@ -1,0 +1,446 @@
+// The predictor's logic (see predictor_core.h for the per-sample steps and the real-time contract).
+#include "predictor_core.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace dressguard::predictor {
+
+using protocol::E2EStatus;
+using protocol::MsgId;
+using protocol::PredictorState;
+using protocol::StatusCounter;
+
+const char* event_kind_name(EventKind k) {
+  switch (k) {
+    case EventKind::TrialStarted: return "trial_started";
+    case EventKind::TrialEnded: return "trial_ended";
+    case EventKind::BadFrame: return "bad_frame";
+    case EventKind::LostFrames: return "lost_frames";
+    case EventKind::KernelDrops: return "kernel_drops";
+    case EventKind::StopSent: return "stop_sent";
+    case EventKind::StopConfirmed: return "stop_confirmed";
+    case EventKind::StopRetry: return "stop_retry";
+    case EventKind::TxError: return "tx_error";
+    case EventKind::BusError: return "bus_error";
+    case EventKind::ModelMissing: return "model_missing";
+    case EventKind::Posteriors: return "posteriors";
+  }
+  return "unknown";
+}
+
+double commanded_travel(double speed, double accel, double t) noexcept {
+  if (t <= 0.0 || speed <= 0.0) return 0.0;
+  if (accel <= 0.0) return speed * t;
+  const double t_ramp = speed / accel;
+  if (t < t_ramp) return 0.5 * accel * t * t;
+  return speed * speed / (2.0 * accel) + speed * (t - t_ramp);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Configuration file
+
+namespace {
+
+[[noreturn]] void config_error(const std::string& name, long line, const std::string& what) {
+  throw std::runtime_error(name + ":" + std::to_string(line) + ": " + what);
+}
+
+double config_number(const std::string& name, long line, const std::string& key, const std::string& v) {
+  size_t used = 0;
+  double d = 0;
+  try {
+    d = std::stod(v, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != v.size() || !std::isfinite(d)) config_error(name, line, key + ": '" + v + "' is not a number");
+  return d;
+}
+
+std::string trim(const std::string& s) {
+  const size_t a = s.find_first_not_of(" \t\r");
+  if (a == std::string::npos) return "";
+  const size_t b = s.find_last_not_of(" \t\r");
+  return s.substr(a, b - a + 1);
+}
+
+}  // namespace
+
+PredictorConfig parse_predictor_config(const std::string& text, const std::string& name, std::vector<ConfigEntry>* others) {
+  PredictorConfig c;
+  std::istringstream in(text);
+  std::string raw;
+  long line = 0;
+  while (std::getline(in, raw)) {
+    ++line;
+    const size_t hash = raw.find('#');
+    const std::string s = trim(hash == std::string::npos ? raw : raw.substr(0, hash));
+    if (s.empty()) continue;
+    const size_t eq = s.find('=');
+    if (eq == std::string::npos) config_error(name, line, "expected 'key = value'");
+    const std::string key = trim(s.substr(0, eq)), v = trim(s.substr(eq + 1));
+    auto num = [&] { return config_number(name, line, key, v); };
+    auto positive = [&](double lo) {
+      const double d = num();
+      if (d < lo) config_error(name, line, key + " must be >= " + std::to_string(lo));
+      return d;
+    };
+    auto ms = [&] { return static_cast<int64_t>(positive(0.001) * 1e6); };
+    if (key == "stop_threshold") {
+      c.stop_threshold = num();
+      if (!(c.stop_threshold > 0.0 && c.stop_threshold < 1.0)) config_error(name, line, "stop_threshold must be in (0, 1)");
+    } else if (key == "stop_consecutive") {
+      c.stop_consecutive = static_cast<int>(positive(1));
+    } else if (key == "hard_limit_n") {
+      c.hard_limit_n = positive(0.01);
+    } else if (key == "sensor_timeout_ms") {
+      c.sensor_timeout_ns = ms();
+    } else if (key == "bad_frame_budget") {
+      c.bad_frame_budget = static_cast<int>(positive(0));
+    } else if (key == "bad_frame_weight") {
+      c.bad_frame_weight = static_cast<int>(positive(1));
+    } else if (key == "max_delta_counter") {
+      const double d = positive(1);
+      if (d > 127) config_error(name, line, "max_delta_counter must be <= 127");
+      c.max_delta_counter = static_cast<uint8_t>(d);
+    } else if (key == "status_period_ms") {
+      c.status_period_ns = ms();
+    } else if (key == "heartbeat_period_ms") {
+      c.heartbeat_period_ns = ms();
+    } else if (key == "posteriors_period_ms") {
+      c.posteriors_period_ns = ms();
+    } else if (key == "stop_retry_ms") {
+      c.stop_retry_ns = ms();
+    } else if (key == "sample_period_ms") {
+      c.sample_period_s = positive(0.001) / 1000.0;
+    } else if (key == "acceleration_m_s2") {
+      c.acceleration_m_s2 = positive(0.0);
+    } else if (key == "mount_axes") {
+      // Three tokens, one per rig axis (motion, lateral, vertical): [-]x|y|z.
+      std::istringstream t(v);
+      std::string tok;
+      int k = 0;
+      while (t >> tok) {
+        if (k == 3) config_error(name, line, "mount_axes takes three axes");
+        double sign = 1.0;
+        if (tok[0] == '-' || tok[0] == '+') {
+          sign = tok[0] == '-' ? -1.0 : 1.0;
+          tok = tok.substr(1);
+        }
+        if (tok != "x" && tok != "y" && tok != "z") config_error(name, line, "mount_axes: '" + tok + "' is not x, y or z");
+        c.mount.axis[k] = tok[0] - 'x';
+        c.mount.sign[k] = sign;
+        ++k;
+      }
+      if (k != 3) config_error(name, line, "mount_axes takes three axes");
+    } else if (key == "mount_bias") {
+      std::istringstream t(v);
+      for (int k = 0; k < 3; ++k) {
+        std::string tok;
+        if (!(t >> tok)) config_error(name, line, "mount_bias takes three numbers [N]");
+        c.mount.bias[k] = config_number(name, line, key, tok);
+      }
+    } else if (others) {
+      others->push_back({key, v, line});
+    } else {
+      config_error(name, line, "unknown key '" + key + "'");
+    }
+  }
+  return c;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Predictor
+
+Predictor::Predictor(const model::OutcomeModel* model, const PredictorConfig& cfg, PredictorSink& sink)
+    : cfg_(cfg),
+      sink_(sink),
+      chk_force_(MsgId::FtForce, cfg.max_delta_counter),
+      chk_torque_(MsgId::FtTorque, cfg.max_delta_counter),
+      chk_start_(MsgId::TrialStart, 127),
+      chk_end_(MsgId::TrialEnd, 127),
+      chk_hb_(MsgId::HeartbeatBridge, 127) {
+  if (model) {
+    caught_ = model->class_index("caught");
+    if (caught_ < 0) throw model::ModelError("model has no class named 'caught': the predictor cannot stop on it");
+    filter_.emplace(*model);
+    threshold_ = model->stop_threshold;
+    consecutive_needed_ = model->stop_consecutive;
+  }
+  if (cfg_.stop_threshold > 0.0 && cfg_.stop_threshold < 1.0) threshold_ = cfg_.stop_threshold;
+  if (cfg_.stop_consecutive > 0) consecutive_needed_ = cfg_.stop_consecutive;
+  if (consecutive_needed_ < 1) consecutive_needed_ = 1;
+  decision_.state = filter_ ? PredictorState::Idle : PredictorState::Fault;
+}
+
+Event Predictor::make_event(EventKind k, int64_t now_ns) const noexcept {
+  Event e;
+  e.kind = k;
+  e.time_ns = now_ns;
+  e.trial = decision_.trial;
+  e.sample = decision_.sample;
+  return e;
+}
+
+bool Predictor::checked(protocol::E2EChecker& chk, const Frame& f, int64_t now_ns, uint32_t& lost) noexcept {
+  const E2EStatus s = chk.check(f, lost);
+  switch (s) {
+    case E2EStatus::Ok:
+    case E2EStatus::Initial: return true;
+    case E2EStatus::OkSomeLost:
+    case E2EStatus::WrongSequence: {
+      if (s == E2EStatus::WrongSequence) count(StatusCounter::WrongSequence);
+      count(StatusCounter::LostFrames, lost);
+      Event e = make_event(EventKind::LostFrames, now_ns);
+      e.can_id = f.id;
+      e.status = s;
+      e.value = lost;
+      emit(e);
+      charge_bad(lost, now_ns);
+      return true;
+    }
+    case E2EStatus::Repeated: count(StatusCounter::Repeated); break;
+    case E2EStatus::Late: count(StatusCounter::Late); break;
+    case E2EStatus::Corrupted: count(StatusCounter::Corrupted); charge_bad(1, now_ns); break;
+    case E2EStatus::BadLength: count(StatusCounter::BadLength); charge_bad(1, now_ns); break;
+  }
+  Event e = make_event(EventKind::BadFrame, now_ns);
+  e.can_id = f.id;
+  e.status = s;
+  emit(e);
+  return false;
+}
+
+// Leaky bucket: +weight per bad frame, -1 per accepted sample (in on_force), stop above
+// budget * weight. Repeated and late frames are not charged: they carry no new data, and a
+// sensor that only repeats itself is caught by the deadline.
+void Predictor::charge_bad(uint32_t frames, int64_t now_ns) noexcept {
+  bad_score_ += static_cast<int64_t>(frames) * cfg_.bad_frame_weight;
+  if (decision_.state == PredictorState::InTrial &&
+      bad_score_ > static_cast<int64_t>(cfg_.bad_frame_budget) * cfg_.bad_frame_weight)
+    stop(StopReason::BadFrames, now_ns);
+}
+
+void Predictor::on_frame(const Frame& f, int64_t now_ns) noexcept {
+  if (start_ns_ < 0) start_ns_ = now_ns;
+  uint32_t lost = 0;
+  switch (f.id) {
+    case protocol::id_of(MsgId::FtForce): on_force(f, now_ns); break;
+    case protocol::id_of(MsgId::FtTorque):
+      // Torques are E2E-checked and counted; the outcome models use forces only (section V-B).
+      checked(chk_torque_, f, now_ns, lost);
+      break;
+    case protocol::id_of(MsgId::TrialStart): on_trial_start(f, now_ns); break;
+    case protocol::id_of(MsgId::TrialEnd): on_trial_end(f, now_ns); break;
+    case protocol::id_of(MsgId::HeartbeatBridge): checked(chk_hb_, f, now_ns, lost); break;
+    default: break;  // the kernel filters let nothing else through; replay may see anything
+  }
+}
+
+// Trial frames are sporadic: a counter seen again after a long silence is a restarted robot
+// controller, not a duplicate, so their checkers resynchronise after kEventResyncNs.
+void Predictor::resync_events(int64_t now_ns) noexcept {
+  if (last_event_ns_ >= 0 && now_ns - last_event_ns_ > kEventResyncNs) {
+    chk_start_.reset();
+    chk_end_.reset();
+  }
+  last_event_ns_ = now_ns;
+}
+
+void Predictor::on_trial_start(const Frame& f, int64_t now_ns) noexcept {
+  uint32_t lost = 0;
+  resync_events(now_ns);
+  if (!checked(chk_start_, f, now_ns, lost)) return;
+  chk_end_.reset();  // this trial's end is the first of its kind
+  // The sample stream resynchronises at a trial start: its first sample is sample 0, and a
+  // counter jump since the previous trial is no loss inside this one.
+  chk_force_.reset();
+  chk_torque_.reset();
+  protocol::TrialStart m;
+  protocol::decode(f, m);
+  decision_ = Decision{};
+  ++trials_started_;
+  decision_.trial = m.trial_id;
+  decision_.speed_m_s = m.speed_mm_s / 1000.0;
+  decision_.state = filter_ ? PredictorState::InTrial : PredictorState::Fault;
+  consecutive_ = 0;
+  bad_score_ = 0;
+  samples_started_ = false;
+  trial_start_ns_ = now_ns;
+  last_sample_ns_ = now_ns;  // the deadline runs from the trial start until the first sample
+  emit(make_event(EventKind::TrialStarted, now_ns));
+  if (filter_) {
+    filter_->reset();
+  } else {
+    emit(make_event(EventKind::ModelMissing, now_ns));
+    stop(StopReason::ModelError, now_ns);
+  }
+}
+
+void Predictor::on_trial_end(const Frame& f, int64_t now_ns) noexcept {
+  uint32_t lost = 0;
+  resync_events(now_ns);
+  if (!checked(chk_end_, f, now_ns, lost)) return;
+  protocol::TrialEnd m;
+  protocol::decode(f, m);
+  if (m.trial_id != decision_.trial) return;  // the end of a trial we never saw start
+  Event e = make_event(EventKind::TrialEnded, now_ns);
+  e.reason = decision_.reason;
+  e.value = m.samples;
+  emit(e);
+  if (decision_.state == PredictorState::InTrial) decision_.state = PredictorState::Idle;
+  if (decision_.state == PredictorState::Stopped && !stop_pending_) decision_.state = PredictorState::Idle;
+}
+
+void Predictor::on_force(const Frame& f, int64_t now_ns) noexcept {
+  uint32_t lost = 0;
+  if (!checked(chk_force_, f, now_ns, lost)) return;
+  count(StatusCounter::Samples);
+  if (decision_.state != PredictorState::InTrial) return;
+  // Logical time: the sensor's counter, lost samples included (the first sample of a trial is 0).
+  if (samples_started_) decision_.sample += 1 + lost;
+  samples_started_ = true;
+  last_sample_ns_ = now_ns;
+  if (bad_score_ > 0) --bad_score_;
+
+  // Scaling and mounting: sensor counts -> rig axes [N].
+  protocol::FtForce m;
+  protocol::decode(f, m);
+  const double fs[3] = {protocol::force_newtons(m.fx), protocol::force_newtons(m.fy), protocol::force_newtons(m.fz)};
+  double rig[3];
+  for (int k = 0; k < 3; ++k) rig[k] = cfg_.mount.sign[k] * fs[cfg_.mount.axis[k]] - cfg_.mount.bias[k];
+
+  filter_->step(rig[0], rig[1], rig[2]);
+  decision_.stop_f_motion = rig[0];
+  decision_.stop_f_vertical = rig[2];
+
+  // StopPolicy, hard limit first: it needs no model to be right.
+  if (std::fabs(rig[0]) > cfg_.hard_limit_n || std::fabs(rig[2]) > cfg_.hard_limit_n) {
+    stop(StopReason::HardLimit, now_ns);
+    return;
+  }
+  if (filter_->posterior(caught_) > threshold_) {
+    if (++consecutive_ >= consecutive_needed_) stop(StopReason::Caught, now_ns);
+  } else {
+    consecutive_ = 0;
+  }
+}
+
+void Predictor::stop(StopReason r, int64_t now_ns) noexcept {
+  if (decision_.state == PredictorState::Stopped) return;
+  decision_.state = PredictorState::Stopped;
+  decision_.reason = r;
+  decision_.stop_sample = decision_.sample;
+  for (int c = 0; c < 3; ++c) decision_.stop_p[c] = (filter_ && c < filter_->classes()) ? filter_->posterior(c) : 0.0;
+  count(StatusCounter::Stops);
+  const double pc = (filter_ && caught_ >= 0) ? filter_->posterior(caught_) : 0.0;
+  stop_frame_ = protocol::encode(protocol::Stop{0, r, static_cast<uint8_t>(std::lround(pc * 255.0)), decision_.trial,
+                                                static_cast<uint16_t>(decision_.sample)});
+  stop_pending_ = true;
+  stop_retries_ = 0;
+  send_stop_frame(now_ns);
+  Event e = make_event(EventKind::StopSent, now_ns);
+  e.reason = r;
+  e.f_motion = decision_.stop_f_motion;
+  e.f_vertical = decision_.stop_f_vertical;
+  for (int c = 0; c < 3; ++c) e.p[c] = decision_.stop_p[c];
+  emit(e);
+}
+
+// Every (re)transmission takes a fresh alive counter, so the receiver's E2E check never
+// discards a retry as "repeated"; the echo is matched by that counter.
+void Predictor::send_stop_frame(int64_t now_ns) noexcept {
+  stop_frame_.data[1] = ctr_stop_.next();
+  protocol::protect(stop_frame_, MsgId::Stop);
+  stop_sent_ns_ = now_ns;
+  const uint8_t r = sink_.transmit_stop(stop_frame_);
+  if (r != 0) {
+    count(StatusCounter::TxErrors);
+    Event e = make_event(EventKind::TxError, now_ns);
+    e.can_id = stop_frame_.id;
+    e.send_result = r;
+    emit(e);
+  }
+}
+
+void Predictor::on_stop_echo(const Frame& f, int64_t now_ns) noexcept {
+  if (!stop_pending_ || f.id != stop_frame_.id || f.data[1] != stop_frame_.data[1]) return;
+  stop_pending_ = false;
+  Event e = make_event(EventKind::StopConfirmed, now_ns);
+  e.reason = decision_.reason;
+  e.value = stop_retries_;
+  emit(e);
+}
+
+void Predictor::on_kernel_drops(uint32_t cumulative, int64_t now_ns) noexcept {
+  if (cumulative == kernel_drops_seen_) return;
+  const uint32_t d = cumulative - kernel_drops_seen_;
+  kernel_drops_seen_ = cumulative;
+  count(StatusCounter::KernelDrops, d);
+  Event e = make_event(EventKind::KernelDrops, now_ns);
+  e.value = d;
+  emit(e);
+}
+
+void Predictor::on_bus_error(uint32_t error_class, int64_t now_ns) noexcept {
+  count(StatusCounter::TxErrors);
+  Event e = make_event(EventKind::BusError, now_ns);
+  e.value = error_class;
+  emit(e);
+}
+
+void Predictor::on_shutdown(int64_t now_ns) noexcept {
+  if (decision_.state == PredictorState::InTrial) stop(StopReason::Shutdown, now_ns);
+}
+
+void Predictor::on_tick(int64_t now_ns) noexcept {
+  if (start_ns_ < 0) {
+    start_ns_ = now_ns;
+    next_status_ns_ = next_hb_ns_ = next_post_ns_ = now_ns;
+  }
+  // Sensor deadline (E2E has no timeout of its own).
+  if (decision_.state == PredictorState::InTrial && now_ns - last_sample_ns_ > cfg_.sensor_timeout_ns) {
+    count(StatusCounter::Timeouts);
+    // The deciding "sample" of a timeout is the one that never came.
+    if (samples_started_) decision_.sample += 1;
+    stop(StopReason::SensorTimeout, now_ns);
+  }
+  // Unconfirmed stop: resend (ENOBUFS, bus-off recovery, or a lost echo).
+  if (stop_pending_ && now_ns - stop_sent_ns_ >= cfg_.stop_retry_ns) {
+    ++stop_retries_;
+    count(StatusCounter::TxRetries);
+    Event e = make_event(EventKind::StopRetry, now_ns);
+    e.value = stop_retries_;
+    emit(e);
+    send_stop_frame(now_ns);
+  }
+  const auto u16 = [](uint32_t v) { return static_cast<uint16_t>(v > 0xFFFF ? 0xFFFF : v); };
+  const uint16_t uptime_s = u16(static_cast<uint32_t>((now_ns - start_ns_) / 1000000000));
+  if (now_ns >= next_hb_ns_) {
+    next_hb_ns_ = now_ns + cfg_.heartbeat_period_ns;
+    sink_.transmit(protocol::encode(protocol::HeartbeatPredictor{ctr_hb_.next(), decision_.state,
+                                                                 static_cast<uint8_t>(filter_ ? 1 : 0), decision_.trial,
+                                                                 uptime_s}));
+  }
+  if (now_ns >= next_status_ns_) {
+    next_status_ns_ = now_ns + cfg_.status_period_ns;
+    const uint8_t p = status_page_;
+    status_page_ = static_cast<uint8_t>((status_page_ + 1) % protocol::kStatusPages);
+    // Samples is sent mod 65536 (it wraps by design); the others saturate.
+    const uint32_t v0 = counters_[2 * p], v1 = counters_[2 * p + 1];
+    const bool samples_page = 2 * p == static_cast<int>(StatusCounter::Samples);
+    sink_.transmit(protocol::encode(protocol::PredictorStatus{ctr_status_.next(), p, decision_.state,
+                                                              samples_page ? static_cast<uint16_t>(v0) : u16(v0), u16(v1)}));
+  }
+  if (filter_ && decision_.state != PredictorState::Idle && now_ns >= next_post_ns_) {
+    next_post_ns_ = now_ns + cfg_.posteriors_period_ns;
+    protocol::Posteriors m{ctr_post_.next(), static_cast<uint16_t>(decision_.sample), {0, 0, 0}, decision_.state};
+    for (int c = 0; c < 3 && c < filter_->classes(); ++c)
+      m.p[c] = static_cast<uint8_t>(std::lround(filter_->posterior(c) * 255.0));
+    sink_.transmit(protocol::encode(m));
+  }
+}
+
+}  // namespace dressguard::predictor

@@ -1,0 +1,126 @@
+// The dressguard-predictor daemon's machinery around the Predictor (predictor/core): one
+// real-time event loop blocking in epoll on the CAN receive socket, the stop socket, a timerfd
+// and a shutdown eventfd; a lock-free queue to a normal-priority thread that logs with spdlog;
+// the real-time setup; a latency histogram. The loop runs on any CanPort, so host tests drive it
+// on the in-process bus and the VM test on vcan.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "can_port.h"
+#include "predictor_core.h"
+#include "spsc_queue.h"
+
+namespace spdlog {
+class logger;
+}
+
+namespace dressguard::predictor {
+
+using EventQueue = SpscQueue<Event, 4096>;
+
+// Fixed-bin histogram (no allocation when adding): bins of `bin_ns`, the last one open-ended.
+class LatencyHistogram {
+ public:
+  static constexpr int kBins = 4096;
+  explicit LatencyHistogram(int64_t bin_ns = 50) : bin_ns_(bin_ns) {}
+  void add(int64_t ns) noexcept {
+    int64_t b = ns < 0 ? 0 : ns / bin_ns_;
+    if (b >= kBins) b = kBins - 1;
+    ++bins_[static_cast<size_t>(b)];
+    ++count_;
+    if (ns > max_) max_ = ns;
+  }
+  uint64_t count() const { return count_; }
+  int64_t max() const { return max_; }
+  int64_t bin_ns() const { return bin_ns_; }
+  // Upper edge of the bin holding quantile q (0..1), in ns.
+  int64_t quantile(double q) const;
+  const std::array<uint64_t, kBins>& bins() const { return bins_; }
+  void merge(const LatencyHistogram& o);
+
+ private:
+  int64_t bin_ns_;
+  std::array<uint64_t, kBins> bins_{};
+  uint64_t count_ = 0;
+  int64_t max_ = 0;
+};
+
+// Drains the event queue into spdlog on a normal-priority thread (spdlog takes locks).
+class EventLogger {
+ public:
+  EventLogger(EventQueue& q, std::shared_ptr<spdlog::logger> log, const std::vector<std::string>& class_names);
+  ~EventLogger();  // drains what is left, then joins
+  void stop();
+
+ private:
+  void run();
+  void log_one(const Event& e);
+  EventQueue& q_;
+  std::shared_ptr<spdlog::logger> log_;
+  std::vector<std::string> names_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+struct DaemonOptions {
+  int64_t tick_ns = 1'000'000;         // timerfd period: deadline resolution, stop retry pacing
+  int64_t shutdown_grace_ns = 50'000'000;  // wait this long for a shutdown stop's echo
+};
+
+class PredictorDaemon final : private PredictorSink {
+ public:
+  // `rx`: kernel filters for the F/T, trial and bridge-heartbeat identifiers; also sends status,
+  // posteriors and heartbeats. `stop_port`: its own socket, filter = Stop, own echoes on.
+  PredictorDaemon(const model::OutcomeModel* model, const PredictorConfig& cfg, can::CanPort& rx,
+                  can::CanPort& stop_port, EventQueue& events, const DaemonOptions& opt = {});
+  ~PredictorDaemon() override;
+
+  // The event loop; returns 0 after a clean shutdown, 1 on an unrecoverable error (logged via
+  // the queue). Call from the thread that should be real-time.
+  int run();
+  // Async-signal-safe: a write to an eventfd.
+  void request_shutdown() noexcept;
+
+  const Predictor& predictor() const { return predictor_; }
+  // Frame read (kernel receive) to decision made, per F/T force frame, and the same with the
+  // stop frame's send() included when that frame stopped.
+  const LatencyHistogram& processing() const { return processing_; }
+  const LatencyHistogram& processing_with_stop() const { return processing_stop_; }
+
+  // The identifiers the receive socket filters for.
+  static std::vector<uint32_t> receive_ids();
+
+ private:
+  uint8_t transmit_stop(const Frame& f) noexcept override;
+  uint8_t transmit(const Frame& f) noexcept override;
+  void event(const Event& e) noexcept override;
+  void drain_rx(int64_t now) noexcept;
+  void drain_stop(int64_t now) noexcept;
+
+  can::CanPort& rx_;
+  can::CanPort& stop_port_;
+  EventQueue& events_;
+  DaemonOptions opt_;
+  Predictor predictor_;
+  int epoll_fd_ = -1, timer_fd_ = -1, shutdown_fd_ = -1;
+  LatencyHistogram processing_, processing_stop_;
+  uint32_t stops_sent_ = 0;
+};
+
+// Real-time setup, each step optional: a step that is not permitted yields a warning string
+// (mlockall without CAP_IPC_LOCK, SCHED_FIFO without CAP_SYS_NICE, a CPU that does not exist).
+struct RtOptions {
+  bool lock_memory = true;
+  int fifo_priority = 80;  // 0: stay SCHED_OTHER
+  int cpu = -1;            // -1: no affinity
+};
+std::vector<std::string> setup_realtime(const RtOptions& opt);
+
+}  // namespace dressguard::predictor

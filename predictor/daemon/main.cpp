@@ -1,0 +1,194 @@
+// dressguard-predictor: the real-time predictor daemon. See predictor/README.md.
+#include <signal.h>
+
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+#include <string>
+#include <vector>
+
+#include "daemon.h"
+#include "dgm.h"
+
+using namespace dressguard;
+using namespace dressguard::predictor;
+
+namespace {
+
+PredictorDaemon* g_daemon = nullptr;
+void on_signal(int) {
+  if (g_daemon) g_daemon->request_shutdown();
+}
+
+const char* kUsage =
+    "usage: dressguard-predictor [--config FILE] [--interface IF] [--model MODEL.dgm] [options]\n"
+    "  Runs the outcome HMMs' forward filter on the F/T samples of a CAN bus and sends a stop\n"
+    "  frame when 'caught' becomes likely, the force exceeds the hard limit, or the sensor fails.\n"
+    "  --config FILE        key = value file (see predictor/daemon/dressguard-predictor.conf)\n"
+    "  --interface IF       SocketCAN interface (default can0; config key 'interface')\n"
+    "  --model FILE         outcome model (.dgm); one that does not load refuses every trial\n"
+    "  --set KEY=VALUE      override one config key (repeatable)\n"
+    "  --no-rt              skip mlockall, SCHED_FIFO and CPU affinity\n"
+    "  --latency-report     print the processing-latency histogram summary at exit\n"
+    "  --help               this text\n"
+    "Config keys: interface, model, rt_priority (80; 0 = none), cpu (-1), mlock (1), tick_ms (1),\n"
+    "log_level (info), and the predictor's: stop_threshold, stop_consecutive, hard_limit_n,\n"
+    "sensor_timeout_ms, bad_frame_budget, bad_frame_weight, max_delta_counter, status_period_ms,\n"
+    "heartbeat_period_ms, posteriors_period_ms, stop_retry_ms, sample_period_ms, acceleration_m_s2,\n"
+    "mount_axes, mount_bias.\n"
+    "Exit codes: 0 clean shutdown (SIGTERM/SIGINT), 1 runtime error, 2 bad arguments or config.";
+
+std::string read_text(const std::string& path) {
+  FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) throw std::runtime_error(path + ": cannot open (" + std::strerror(errno) + ")");
+  std::string s;
+  char buf[4096];
+  size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) s.append(buf, n);
+  std::fclose(f);
+  return s;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string config_path, config_text, iface_arg, model_arg;
+  bool no_rt = false, latency_report = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "dressguard-predictor: %s needs a value (see --help)\n", a.c_str());
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--help" || a == "-h") {
+      std::puts(kUsage);
+      return 0;
+    } else if (a == "--config") {
+      config_path = value();
+    } else if (a == "--interface") {
+      iface_arg = value();
+    } else if (a == "--model") {
+      model_arg = value();
+    } else if (a == "--set") {
+      config_text += value() + "\n";
+    } else if (a == "--no-rt") {
+      no_rt = true;
+    } else if (a == "--latency-report") {
+      latency_report = true;
+    } else {
+      std::fprintf(stderr, "dressguard-predictor: unknown option '%s' (see --help)\n", a.c_str());
+      return 2;
+    }
+  }
+
+  auto log = spdlog::stderr_color_mt("predictor");
+  log->set_pattern("%Y-%m-%dT%H:%M:%S.%e %^%l%$ %v");
+
+  PredictorConfig cfg;
+  std::string iface = "can0", model_path;
+  RtOptions rt;
+  DaemonOptions dopt;
+  try {
+    const std::string text = (config_path.empty() ? std::string() : read_text(config_path)) + config_text;
+    std::vector<ConfigEntry> others;
+    cfg = parse_predictor_config(text, config_path.empty() ? "--set" : config_path, &others);
+    for (const auto& e : others) {
+      auto integer = [&] {
+        try {
+          size_t used = 0;
+          const long v = std::stol(e.value, &used);
+          if (used == e.value.size()) return v;
+        } catch (const std::exception&) {
+        }
+        throw std::runtime_error(config_path + ":" + std::to_string(e.line) + ": " + e.key + ": '" + e.value + "' is not an integer");
+      };
+      if (e.key == "interface") iface = e.value;
+      else if (e.key == "model") model_path = e.value;
+      else if (e.key == "rt_priority") rt.fifo_priority = static_cast<int>(integer());
+      else if (e.key == "cpu") rt.cpu = static_cast<int>(integer());
+      else if (e.key == "mlock") rt.lock_memory = integer() != 0;
+      else if (e.key == "tick_ms") dopt.tick_ns = integer() * 1000000;
+      else if (e.key == "log_level") log->set_level(spdlog::level::from_str(e.value));
+      else throw std::runtime_error(config_path + ":" + std::to_string(e.line) + ": unknown key '" + e.key + "'");
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "dressguard-predictor: %s\n", e.what());
+    return 2;
+  }
+  if (!iface_arg.empty()) iface = iface_arg;
+  if (!model_arg.empty()) model_path = model_arg;
+  if (dopt.tick_ns <= 0) {
+    std::fprintf(stderr, "dressguard-predictor: tick_ms must be >= 1\n");
+    return 2;
+  }
+
+  // A model that does not load is not a reason to exit: the daemon stays up and refuses every
+  // trial with a ModelError stop, so the robot cannot run unguarded.
+  std::unique_ptr<model::OutcomeModel> model;
+  std::vector<std::string> names;
+  if (model_path.empty()) {
+    log->error("no model configured: every trial will be stopped (model_error)");
+  } else {
+    try {
+      model = std::make_unique<model::OutcomeModel>(model::read_model(model_path));
+      for (const auto& c : model->classes) names.push_back(c.name);
+      if (model->class_index("caught") < 0) throw model::ModelError(model_path + ": no class named 'caught'");
+      log->info("model {}: {} classes, stop when P(caught) > {} for {} samples", model_path, names.size(),
+                model->stop_threshold, model->stop_consecutive);
+    } catch (const std::exception& e) {
+      log->error("model did not load: {}; every trial will be stopped (model_error)", e.what());
+      model.reset();
+    }
+  }
+
+  try {
+    can::PortOptions rx_opt;
+    rx_opt.ids = PredictorDaemon::receive_ids();
+    can::PortOptions stop_opt;
+    stop_opt.ids = {protocol::id_of(protocol::MsgId::Stop)};
+    stop_opt.receive_own = true;
+    auto rx = can::open_socketcan(iface, rx_opt);
+    auto stop_port = can::open_socketcan(iface, stop_opt);
+    static EventQueue events;  // 4096 events: static storage, not on the stack
+    EventLogger logger(events, log, names);  // before the RT setup: it must not inherit SCHED_FIFO
+    PredictorDaemon daemon(model.get(), cfg, *rx, *stop_port, events, dopt);
+    g_daemon = &daemon;
+    struct sigaction sa{};
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGTERM, &sa, nullptr);
+    sigaction(SIGINT, &sa, nullptr);
+    if (!no_rt) {
+      for (const auto& w : setup_realtime(rt)) log->warn("real-time setup: {}", w);
+    }
+    log->info("listening on {} (threshold {}, k {}, hard limit {} N, sensor timeout {} ms)", iface,
+              daemon.predictor().threshold(), daemon.predictor().consecutive(), cfg.hard_limit_n,
+              cfg.sensor_timeout_ns / 1000000);
+    const int rc = daemon.run();
+    g_daemon = nullptr;
+    logger.stop();
+    std::string counters;
+    for (int c = 0; c < static_cast<int>(protocol::StatusCounter::Count); ++c)
+      counters += std::string(c ? " " : "") + protocol::status_counter_name(static_cast<protocol::StatusCounter>(c)) + "=" +
+                  std::to_string(daemon.predictor().counter(static_cast<protocol::StatusCounter>(c)));
+    log->info("shutting down: {}", counters);
+    if (latency_report) {
+      const auto& h = daemon.processing();
+      const auto& hs = daemon.processing_with_stop();
+      log->info("processing latency (frame read to decision): n={} median={} ns p99.9={} ns max={} ns", h.count(),
+                h.quantile(0.5), h.quantile(0.999), h.max());
+      log->info("processing latency with the stop frame sent: n={} median={} ns max={} ns", hs.count(),
+                hs.quantile(0.5), hs.max());
+    }
+    log->flush();
+    return rc;
+  } catch (const std::exception& e) {
+    log->critical("{}", e.what());
+    return 1;
+  }
+}

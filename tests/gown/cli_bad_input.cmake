@@ -1,0 +1,22 @@
+# `dressguard gown` on bad input exits 2 with one line that names what was wrong, writing nothing.
+execute_process(COMMAND ${DG} gown --obj /nonexistent/gown.obj --out /tmp/dg_gown_never_written.obj
+                RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "/nonexistent/gown.obj")
+  message(FATAL_ERROR "missing file: expected exit 2 naming the file, got rc=${rc}: ${err}")
+endif()
+if(EXISTS /tmp/dg_gown_never_written.obj)
+  message(FATAL_ERROR "a failed load wrote its output")
+endif()
+execute_process(COMMAND ${DG} gown --reduced 7 RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "--reduced")
+  message(FATAL_ERROR "bad --reduced not named: rc=${rc} ${err}")
+endif()
+execute_process(COMMAND ${DG} gown --sclae 2 RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "--sclae")
+  message(FATAL_ERROR "unknown option not named: rc=${rc} ${err}")
+endif()
+# The parametric gown always works (no shared data needed) and --json is one JSON object.
+execute_process(COMMAND ${DG} gown --parametric --json RESULT_VARIABLE rc OUTPUT_VARIABLE out)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "^{\"source\": \"parametric\".*\"sleeve_loop\": [0-9]+")
+  message(FATAL_ERROR "gown --parametric --json: rc=${rc} ${out}")
+endif()

@@ -1,0 +1,157 @@
+// OBJ reading on small files written here: forms of the face line, fan triangulation, errors
+// that name file:line, and the boundary loops of known shapes.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+#include "files.h"
+#include "gown.h"
+
+namespace fs = std::filesystem;
+using namespace dressguard;
+using namespace dressguard::gown;
+
+namespace {
+
+fs::path write_obj(const std::string& name, const std::string& text) {
+  const fs::path p = fs::temp_directory_path() / ("dg_gown_test_" + std::to_string(::getpid()) + "_" + name);
+  std::ofstream(p) << text;
+  return p;
+}
+
+// The InputError message of read_obj on `text` ("" when it does not throw).
+std::string error_of(const std::string& name, const std::string& text) {
+  const fs::path p = write_obj(name, text);
+  std::string msg;
+  try {
+    read_obj(p, 1.0);
+  } catch (const InputError& e) {
+    msg = e.what();
+  }
+  fs::remove(p);
+  return msg;
+}
+
+// An n x n grid of unit squares as an OBJ, each square one quad face.
+std::string grid_obj(int n, double h) {
+  std::string s;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) s += "v " + std::to_string(i * h) + " " + std::to_string(j * h) + " 0\n";
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int a = j * (n + 1) + i + 1;
+      s += "f " + std::to_string(a) + " " + std::to_string(a + 1) + " " + std::to_string(a + n + 2) + " " +
+           std::to_string(a + n + 1) + "\n";
+    }
+  return s;
+}
+
+}  // namespace
+
+TEST(ReadObj, AcceptsEveryFaceFormAndNegativeIndices) {
+  // One unit square four ways: plain, v/vt/vn, v//vn, negative; plus comments, normals, blank lines.
+  const std::string text =
+      "# square\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nvt 0 0\n\n"
+      "f 1 2 3\nf 1/1/1 3/1/1 4/1/1\nf 1//1 2//1 4//1\nf -4 -2 -1\ng group\ns off\n";
+  const fs::path p = write_obj("forms.obj", text);
+  const GownMesh m = read_obj(p, 2.0);
+  fs::remove(p);
+  ASSERT_EQ(m.x.size(), 4u);
+  ASSERT_EQ(m.triangles.size(), 4u);
+  EXPECT_EQ(m.triangles[1], (std::array<int, 3>{0, 2, 3}));
+  EXPECT_EQ(m.triangles[3], (std::array<int, 3>{0, 2, 3}));  // -4 -2 -1 after 4 vertices
+  EXPECT_DOUBLE_EQ(m.x[2].x(), 2.0);                         // scaled by 2
+  EXPECT_DOUBLE_EQ(m.x[2].y(), 2.0);
+}
+
+TEST(ReadObj, FanTriangulatesPolygonsAndKeepsArea) {
+  // A regular hexagon as one face: 4 triangles, area 3 sqrt(3)/2 r^2 (exact, a planar fan).
+  std::string text;
+  for (int k = 0; k < 6; ++k)
+    text += "v " + std::to_string(std::cos(k * M_PI / 3)) + " " + std::to_string(std::sin(k * M_PI / 3)) + " 0\n";
+  text += "f 1 2 3 4 5 6\n";
+  const fs::path p = write_obj("hex.obj", text);
+  const GownMesh m = read_obj(p, 1.0);
+  fs::remove(p);
+  EXPECT_EQ(m.triangles.size(), 4u);
+  EXPECT_NEAR(total_area(m), 1.5 * std::sqrt(3.0), 1e-5);  // 1e-5: coordinates printed with 6 digits
+  ASSERT_EQ(m.boundary_loops.size(), 1u);
+  EXPECT_EQ(m.boundary_loops[0].size(), 6u);
+}
+
+TEST(ReadObj, ErrorsNameFileAndLine) {
+  EXPECT_NE(error_of("a.obj", "v 0 0 0\nv 1 0\n").find("a.obj"), std::string::npos);
+  EXPECT_NE(error_of("a.obj", "v 0 0 0\nv 1 0\n").find(":2:"), std::string::npos);  // short vertex
+  EXPECT_NE(error_of("b.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n").find(":4:"), std::string::npos);  // range
+  EXPECT_NE(error_of("c.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n").find(":4:"), std::string::npos);  // 2 vertices
+  EXPECT_NE(error_of("d.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 x 3\n").find(":4:"), std::string::npos);  // not a number
+  EXPECT_NE(error_of("e.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 0\n").find(":4:"), std::string::npos);  // index 0
+  EXPECT_NE(error_of("f.obj", "v 0 0 nan\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").find(":1:"), std::string::npos);
+  EXPECT_NE(error_of("g.obj", "v 0 0 0\n").find("no faces"), std::string::npos);
+  EXPECT_NE(error_of("h.obj", "v 0 0 0\nv 1 0 0\nf 1 2 1\n").find(":3:"), std::string::npos);  // degenerate
+  EXPECT_THROW(read_obj("/nonexistent/gown.obj", 1.0), InputError);
+}
+
+TEST(BoundaryLoops, GridHasOneOrderedLoopOfItsPerimeter) {
+  const fs::path p = write_obj("grid.obj", grid_obj(5, 0.1));
+  const GownMesh m = read_obj(p, 1.0);
+  fs::remove(p);
+  ASSERT_EQ(m.boundary_loops.size(), 1u);
+  EXPECT_EQ(m.boundary_loops[0].size(), 20u);  // 4 sides x 5 edges
+  // Ordered: consecutive loop vertices are one grid step apart (0.1), so the perimeter is 2.0.
+  EXPECT_NEAR(loop_perimeter(m, 0), 2.0, 1e-9);
+  EXPECT_NEAR(total_area(m), 0.25, 1e-9);
+}
+
+TEST(BoundaryLoops, AnnulusHasTwoLoopsLongestFirst) {
+  // A 4x4 grid with the middle 2x2 squares removed: outer loop 16 edges, inner 8 edges.
+  std::vector<std::array<int, 3>> tris;
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 4; ++i) {
+      if (i >= 1 && i <= 2 && j >= 1 && j <= 2) continue;
+      const int a = j * 5 + i;
+      tris.push_back({a, a + 1, a + 6});
+      tris.push_back({a, a + 6, a + 5});
+    }
+  const auto loops = find_boundary_loops(tris, 25);
+  ASSERT_EQ(loops.size(), 2u);
+  EXPECT_EQ(loops[0].size(), 16u);
+  EXPECT_EQ(loops[1].size(), 8u);
+}
+
+TEST(Masses, LumpedMassesSumToAreaTimesDensity) {
+  const fs::path p = write_obj("grid.obj", grid_obj(4, 0.25));
+  GownMesh m = read_obj(p, 1.0);
+  fs::remove(p);
+  m.areal_density = 0.145;
+  const auto mass = vertex_masses(m);
+  double sum = 0;
+  for (double v : mass) sum += v;
+  EXPECT_NEAR(sum, 0.145 * 1.0, 1e-12);  // exact up to rounding
+  // A corner vertex touches one or two of the 32 triangles (area 1/32 each): 1/3 or 2/3 of one.
+  EXPECT_GT(mass[0], 0.0);
+  EXPECT_LE(mass[0], 2.0 / 3.0 * 0.145 / 32 + 1e-15);
+}
+
+TEST(Box, VerticesInBoxIsInclusiveAndAxisAligned) {
+  const fs::path p = write_obj("grid.obj", grid_obj(4, 0.25));
+  const GownMesh m = read_obj(p, 1.0);
+  fs::remove(p);
+  // Centre (0.5, 0.5), half 0.25: the 3 x 3 grid points 0.25..0.75.
+  EXPECT_EQ(vertices_in_box(m, {0.5, 0.5, 0}, {0.25, 0.25, 0.01}).size(), 9u);
+  EXPECT_EQ(vertices_in_box(m, {0.5, 0.5, 1}, {0.25, 0.25, 0.01}).size(), 0u);
+}
+
+TEST(ToObj, RoundTripsThroughReadObj) {
+  const fs::path p = write_obj("grid.obj", grid_obj(3, 0.2));
+  const GownMesh m = read_obj(p, 1.0);
+  const fs::path q = write_obj("grid2.obj", to_obj(m));
+  const GownMesh n = read_obj(q, 1.0);
+  fs::remove(p);
+  fs::remove(q);
+  ASSERT_EQ(n.x.size(), m.x.size());
+  ASSERT_EQ(n.triangles, m.triangles);
+  for (size_t i = 0; i < m.x.size(); ++i) EXPECT_NEAR((n.x[i] - m.x[i]).norm(), 0, 1e-6);  // 6 printed digits
+}

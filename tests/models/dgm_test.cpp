@@ -1,0 +1,226 @@
+// The .dgm model file: round trip, size, and every rejection FORMAT.md promises, each with a
+// message that names the problem; the shipped default model's checksum.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <limits>
+
+#include "dgm.h"
+
+using namespace dressguard::model;
+
+namespace {
+
+// A valid 3-class, 10-state left-right model with a few unique values to patch in the bytes.
+OutcomeModel sample_model() {
+  OutcomeModel m;
+  m.tool_version = "dressguard test";
+  m.created = "2026-11-21T00:00:00Z";
+  m.source_dataset = "synthetic";
+  m.training_summary = "none";
+  m.features.offset[0] = -2.5;
+  m.features.scale[0] = 1.75;
+  m.features.offset[1] = 0.25;
+  m.features.scale[1] = 0.5;
+  const char* names[] = {"good", "missed", "caught"};
+  for (int c = 0; c < 3; ++c) {
+    ClassHmm h;
+    h.name = names[c];
+    h.n_states = 10;
+    h.initial.assign(10, 0.0);
+    h.initial[0] = 1.0;
+    h.transition.assign(100, 0.0);
+    for (int i = 0; i < 10; ++i) {
+      h.transition[i * 10 + i] = i == 9 ? 1.0 : 0.875;
+      if (i < 9) h.transition[i * 10 + i + 1] = 0.125;
+    }
+    for (int j = 0; j < 10; ++j) {
+      GaussianEmission e;
+      e.mean[0] = 0.5 * j + c;
+      e.mean[1] = -0.25 * j;
+      e.cov[0][0] = 0.5;
+      e.cov[0][1] = e.cov[1][0] = 0.125;
+      e.cov[1][1] = 0.75;
+      h.emission.push_back(e);
+    }
+    h.log_prior = std::log(1.0 / 3.0);
+    m.classes.push_back(h);
+  }
+  // Unique markers (values that occur nowhere else in the file).
+  m.classes[1].emission[2].mean[0] = 1.2345678901;
+  m.classes[2].transition[3 * 10 + 3] = 0.8765432109;
+  m.classes[2].transition[3 * 10 + 4] = 1.0 - 0.8765432109;
+  m.classes[0].emission[5].cov[1][1] = 0.6543210987;
+  return m;
+}
+
+void fix_crc(std::vector<uint8_t>& b) {
+  const uint32_t c = crc32(b.data(), b.size() - 4);
+  for (int i = 0; i < 4; ++i) b[b.size() - 4 + i] = static_cast<uint8_t>(c >> (8 * i));
+}
+
+// Replaces the (unique) little-endian double `from` by `to` and repairs the CRC, so the check
+// under test is the semantic one, not the CRC.
+std::vector<uint8_t> patched(double from, double to) {
+  auto b = encode_model(sample_model());
+  uint8_t f[8], t[8];
+  std::memcpy(f, &from, 8);
+  std::memcpy(t, &to, 8);
+  int hits = 0;
+  for (size_t i = 0; i + 8 <= b.size(); ++i)
+    if (std::memcmp(&b[i], f, 8) == 0) std::memcpy(&b[i], t, 8), ++hits;
+  EXPECT_EQ(hits, 1) << "marker not unique";
+  fix_crc(b);
+  return b;
+}
+
+// Decoding `b` throws ModelError whose message contains `what` and the source name.
+void expect_rejected(const std::vector<uint8_t>& b, const std::string& what) {
+  try {
+    decode_model(b.data(), b.size(), "bad.dgm");
+    ADD_FAILURE() << "accepted a file that should fail with: " << what;
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind("bad.dgm: ", 0), 0u) << e.what();
+  }
+}
+
+}  // namespace
+
+// The standard check value of CRC-32/IEEE.
+TEST(ModelFile, Crc32KnownAnswer) {
+  const char* s = "123456789";
+  EXPECT_EQ(crc32(reinterpret_cast<const uint8_t*>(s), 9), 0xCBF43926u);
+}
+
+TEST(ModelFile, RoundTripIsExactAndSmall) {
+  const auto m = sample_model();
+  const auto b = encode_model(m);
+  // 3 classes x 10 states: 3 x (8 x (10 + 100 + 60) + 20) bytes of HMM + metadata: ~4.2 KB.
+  EXPECT_LT(b.size(), 8192u);
+  EXPECT_EQ(std::memcmp(b.data(), "DGMODEL", 8), 0);
+  const auto d = decode_model(b.data(), b.size(), "mem");
+  EXPECT_EQ(encode_model(d), b);  // bit-exact
+  EXPECT_EQ(d.created, m.created);
+  EXPECT_EQ(d.classes[2].name, "caught");
+  EXPECT_EQ(d.classes[1].emission[2].mean[0], 1.2345678901);
+  EXPECT_EQ(d.features.scale[0], 1.75);
+  EXPECT_EQ(d.class_index("missed"), 1);
+  EXPECT_EQ(d.class_index("nope"), -1);
+  const std::string text = describe_model(d);
+  EXPECT_NE(text.find("class 'caught': 10 states"), std::string::npos) << text;
+  EXPECT_NE(text.find("f_vertical"), std::string::npos) << text;
+}
+
+TEST(ModelFile, WriteIsAtomicAndReadBack) {
+  const auto dir = std::filesystem::temp_directory_path() / ("dgm_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto path = dir / "m.dgm";
+  write_model(path, sample_model());
+  const auto first = read_model(path);
+  EXPECT_EQ(first.classes.size(), 3u);
+  // Writing an invalid model fails before touching the file: the old file stays whole.
+  auto bad = sample_model();
+  bad.classes[0].transition[0] = 0.5;
+  EXPECT_THROW(write_model(path, bad), ModelError);
+  EXPECT_NO_THROW(read_model(path));
+  int files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) files += e.is_regular_file();
+  EXPECT_EQ(files, 1) << "a temporary file was left behind";
+  try {
+    read_model(dir / "absent.dgm");
+    ADD_FAILURE();
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("absent.dgm"), std::string::npos);
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ModelFileRejects, WrongMagic) {
+  auto b = encode_model(sample_model());
+  b[0] = 'X';
+  expect_rejected(b, "wrong magic");
+}
+
+TEST(ModelFileRejects, WrongVersion) {
+  auto b = encode_model(sample_model());
+  b[8] = 2;
+  fix_crc(b);
+  expect_rejected(b, "unsupported format version 2");
+}
+
+TEST(ModelFileRejects, BadCrc) {
+  auto b = encode_model(sample_model());
+  b[b.size() / 2] ^= 0x10;
+  expect_rejected(b, "bad CRC-32");
+}
+
+TEST(ModelFileRejects, Truncated) {
+  const auto b = encode_model(sample_model());
+  for (size_t keep : {size_t{0}, size_t{7}, size_t{19}, size_t{100}, b.size() - 1}) {
+    std::vector<uint8_t> t(b.begin(), b.begin() + keep);
+    expect_rejected(t, "truncated");
+  }
+  // A consistent but lying size field: the body ends before the fields do.
+  auto c = b;
+  c.resize(200);
+  for (int i = 0; i < 4; ++i) c[12 + i] = static_cast<uint8_t>(200u >> (8 * i));
+  fix_crc(c);
+  expect_rejected(c, "truncated");
+  auto extra = b;
+  extra.push_back(0);
+  expect_rejected(extra, "trailing data");
+}
+
+TEST(ModelFileRejects, NonFiniteNumbers) {
+  expect_rejected(patched(1.2345678901, std::numeric_limits<double>::quiet_NaN()), "is not finite");
+  expect_rejected(patched(1.2345678901, std::numeric_limits<double>::infinity()), "is not finite");
+}
+
+TEST(ModelFileRejects, TransitionRowNotSummingToOne) {
+  expect_rejected(patched(0.8765432109, 0.8765432109 + 1e-6), "transition row 3 sums to");
+  // Within the stated tolerance (1e-9) a row is accepted.
+  const auto ok = patched(0.8765432109, 0.8765432109 + 1e-11);
+  EXPECT_NO_THROW(decode_model(ok.data(), ok.size(), "ok"));
+}
+
+TEST(ModelFileRejects, CovarianceNotPositiveDefinite) {
+  expect_rejected(patched(0.6543210987, -0.5), "not positive definite");
+  expect_rejected(patched(0.6543210987, 0.125 * 0.125 / 0.5), "not positive definite");  // det = 0
+}
+
+TEST(ModelFileRejects, SemanticChecksOnEncode) {
+  auto m = sample_model();
+  m.classes[1].name = "good";
+  EXPECT_THROW(encode_model(m), ModelError);
+  m = sample_model();
+  m.features.scale[1] = 0.0;
+  EXPECT_THROW(encode_model(m), ModelError);
+  m = sample_model();
+  m.classes[0].log_prior = 0.0;  // priors then sum to 5/3
+  EXPECT_THROW(encode_model(m), ModelError);
+}
+
+// The shipped default model: its bytes match the recorded SHA-256 and it loads (CRC and all).
+TEST(DefaultModel, ChecksumMatches) {
+  const std::filesystem::path dir = std::filesystem::path(DRESSGUARD_SOURCE_DIR) / "models";
+  const auto model = dir / "default.dgm", sum = dir / "default.dgm.sha256";
+  if (!std::filesystem::exists(model)) GTEST_SKIP() << "models/default.dgm is not built yet (the integrator adds it)";
+  ASSERT_TRUE(std::filesystem::exists(sum)) << "models/default.dgm has no default.dgm.sha256 beside it";
+  std::ifstream in(sum);
+  std::string expected;
+  in >> expected;
+  ASSERT_EQ(expected.size(), 64u) << "default.dgm.sha256 does not start with a SHA-256 hex digest";
+  const std::string cmd = "sha256sum '" + model.string() + "'";
+  FILE* p = popen(cmd.c_str(), "r");
+  ASSERT_NE(p, nullptr);
+  char buf[65] = {};
+  ASSERT_EQ(fread(buf, 1, 64, p), 64u);
+  pclose(p);
+  EXPECT_EQ(std::string(buf), expected) << "models/default.dgm changed without updating its checksum";
+  const auto m = read_model(model);
+  EXPECT_GE(m.classes.size(), 2u);
+}

@@ -1,0 +1,155 @@
+// The daemon's event loop on the in-process CAN bus (SocketCAN semantics, this host has no
+// AF_CAN): the robot side hears the stop frames, the stop is confirmed by its own echo, a silent
+// sensor is stopped by the deadline, SIGTERM's path shuts down cleanly, the logger thread writes
+// what happened through spdlog, and the loop thread allocates nothing after start-up.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
+#include <sstream>
+#include <thread>
+
+#include "alloc_counter.h"
+#include "daemon.h"
+#include "test_model.h"
+
+using namespace dressguard;
+using namespace dressguard::predictor;
+using namespace std::chrono_literals;
+
+namespace {
+
+struct Rig {
+  can::InProcBus bus;
+  std::unique_ptr<can::CanPort> rx, stop_port, sensor, robot;
+  model::OutcomeModel model = testkit::test_model();
+  EventQueue events;
+  std::ostringstream log_text;
+  std::shared_ptr<spdlog::logger> log;
+  std::unique_ptr<EventLogger> logger;
+  std::unique_ptr<PredictorDaemon> daemon;
+  std::thread loop;
+  int rc = -1;
+  uint64_t loop_allocations = 0;
+  testkit::FrameSource src;
+
+  explicit Rig(bool with_model = true) {
+    rx = bus.open({PredictorDaemon::receive_ids(), false, true});
+    stop_port = bus.open({{protocol::id_of(protocol::MsgId::Stop)}, true, true});
+    sensor = bus.open({{}, false, true});
+    robot = bus.open({{protocol::id_of(protocol::MsgId::Stop), protocol::id_of(protocol::MsgId::PredictorStatus)}, false, true});
+    log = std::make_shared<spdlog::logger>("test", std::make_shared<spdlog::sinks::ostream_sink_mt>(log_text));
+    logger = std::make_unique<EventLogger>(events, log, std::vector<std::string>{"good", "missed", "caught"});
+    daemon = std::make_unique<PredictorDaemon>(with_model ? &model : nullptr, PredictorConfig{}, *rx, *stop_port, events);
+    loop = std::thread([this] {
+      testkit::CountAllocations count;
+      rc = daemon->run();
+      loop_allocations = count.count();
+    });
+  }
+  ~Rig() { shutdown(); }
+  void shutdown() {
+    if (loop.joinable()) {
+      daemon->request_shutdown();
+      loop.join();
+      logger->stop();
+    }
+  }
+  void send_sample(double f_motion, double f_vertical) {
+    sensor->send(src.force(f_motion, f_vertical));
+    sensor->send(src.torque());
+    src.next();
+  }
+  // Waits up to `timeout` for a stop frame on the robot's port.
+  bool wait_stop(protocol::Stop& s, std::chrono::milliseconds timeout = 2000ms) {
+    const auto end = std::chrono::steady_clock::now() + timeout;
+    protocol::Frame f;
+    can::RxInfo info;
+    while (std::chrono::steady_clock::now() < end) {
+      while (robot->receive(f, info) == 1)
+        if (protocol::decode(f, s)) return true;
+      std::this_thread::sleep_for(200us);
+    }
+    return false;
+  }
+};
+
+TEST(Daemon, CaughtTrialIsStoppedAndConfirmedByEcho) {
+  Rig rig;
+  rig.sensor->send(rig.src.trial_start(11));
+  for (int i = 0; i < 10; ++i) {
+    rig.send_sample(-2.0, 0.0);
+    std::this_thread::sleep_for(1ms);
+  }
+  protocol::Stop s{};
+  for (int i = 0; i < 30 && !rig.wait_stop(s, 5ms); ++i) rig.send_sample(-6.0, -1.0);
+  ASSERT_EQ(s.reason, protocol::StopReason::Caught);
+  EXPECT_EQ(s.trial_id, 11);
+  EXPECT_GE(s.sample, 12) << "10 good samples, then at least 3 caught ones";
+  // The echo on the stop socket confirms the stop (allow the loop a moment).
+  for (int i = 0; i < 100 && rig.daemon->predictor().stop_pending(); ++i) std::this_thread::sleep_for(1ms);
+  EXPECT_FALSE(rig.daemon->predictor().stop_pending());
+  rig.shutdown();
+  EXPECT_EQ(rig.rc, 0);
+  EXPECT_NE(rig.log_text.str().find("STOP trial 11"), std::string::npos) << rig.log_text.str();
+  EXPECT_NE(rig.log_text.str().find("confirmed"), std::string::npos) << rig.log_text.str();
+  EXPECT_EQ(rig.loop_allocations, 0u) << "the event loop allocated after start-up";
+  EXPECT_GE(rig.daemon->processing().count() + rig.daemon->processing_with_stop().count(), 13u);
+}
+
+TEST(Daemon, SilentSensorIsAFailSafeStop) {
+  Rig rig;
+  rig.sensor->send(rig.src.trial_start(2));
+  for (int i = 0; i < 5; ++i) rig.send_sample(-2.0, 0.0);
+  const auto t0 = std::chrono::steady_clock::now();
+  protocol::Stop s{};
+  ASSERT_TRUE(rig.wait_stop(s));
+  const auto waited = std::chrono::steady_clock::now() - t0;
+  EXPECT_EQ(s.reason, protocol::StopReason::SensorTimeout);
+  // The deadline is 50 ms; the lower bound is exact (no early stop). The upper bound only says
+  // "the timer works": this shared host's scheduling is not a real-time measurement.
+  EXPECT_GE(waited, 49ms);
+  EXPECT_LT(waited, 1000ms);
+}
+
+TEST(Daemon, UnconfirmedStopIsRetriedUntilTheEchoComes) {
+  Rig rig;
+  rig.bus.set_echo(false);
+  rig.sensor->send(rig.src.trial_start(4));
+  rig.send_sample(-25.0, 0.0);  // hard limit
+  protocol::Stop s{};
+  ASSERT_TRUE(rig.wait_stop(s));
+  EXPECT_EQ(s.reason, protocol::StopReason::HardLimit);
+  std::this_thread::sleep_for(20ms);  // retries every 2 ms while the echo is missing
+  EXPECT_TRUE(rig.daemon->predictor().stop_pending());
+  rig.bus.set_echo(true);
+  for (int i = 0; i < 200 && rig.daemon->predictor().stop_pending(); ++i) std::this_thread::sleep_for(1ms);
+  EXPECT_FALSE(rig.daemon->predictor().stop_pending());
+  EXPECT_GE(rig.daemon->predictor().counter(protocol::StatusCounter::TxRetries), 3u);
+  int stops = 1;
+  while (rig.wait_stop(s, 5ms)) ++stops;
+  EXPECT_GE(stops, 4) << "the robot heard the retries";
+}
+
+TEST(Daemon, ShutdownDuringATrialStopsTheRobotFirst) {
+  Rig rig;
+  rig.sensor->send(rig.src.trial_start(5));
+  for (int i = 0; i < 3; ++i) rig.send_sample(-2.0, 0.0);
+  std::this_thread::sleep_for(5ms);
+  rig.shutdown();
+  EXPECT_EQ(rig.rc, 0);
+  protocol::Stop s{};
+  ASSERT_TRUE(rig.wait_stop(s, 100ms));
+  EXPECT_EQ(s.reason, protocol::StopReason::Shutdown);
+}
+
+TEST(Daemon, WithoutAModelEveryTrialIsRefused) {
+  Rig rig(false);
+  rig.sensor->send(rig.src.trial_start(9));
+  protocol::Stop s{};
+  ASSERT_TRUE(rig.wait_stop(s));
+  EXPECT_EQ(s.reason, protocol::StopReason::ModelError);
+}
+
+}  // namespace

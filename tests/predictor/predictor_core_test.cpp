@@ -1,0 +1,366 @@
+// The predictor's logic without a bus: each StopPolicy rule, the E2E handling of bad frames, the
+// stop transmission's confirmation and retries, the status counters, the config file, and zero
+// heap allocations per sample.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "alloc_counter.h"
+#include "predictor_core.h"
+#include "test_model.h"
+
+using namespace dressguard;
+using namespace dressguard::predictor;
+using protocol::Frame;
+using protocol::PredictorState;
+using protocol::StatusCounter;
+
+namespace {
+
+constexpr int64_t kMs = 1'000'000;
+
+// Records everything; transmit_stop answers with a scripted result.
+class RecordingSink : public PredictorSink {
+ public:
+  uint8_t transmit_stop(const Frame& f) noexcept override {
+    stops.push_back(f);
+    if (fail_next > 0) {
+      --fail_next;
+      return 1;  // can::SendResult::NoBuffers
+    }
+    return 0;
+  }
+  uint8_t transmit(const Frame& f) noexcept override {
+    others.push_back(f);
+    return 0;
+  }
+  void event(const Event& e) noexcept override { events.push_back(e); }
+  std::vector<Frame> stops, others;
+  std::vector<Event> events;
+  int fail_next = 0;
+};
+
+struct Harness {
+  model::OutcomeModel model = testkit::test_model();
+  PredictorConfig cfg;
+  RecordingSink sink;
+  testkit::FrameSource src;
+  std::unique_ptr<Predictor> p;
+  int64_t now = 0;
+  explicit Harness(bool with_model = true, PredictorConfig c = {}) : cfg(c) {
+    p = std::make_unique<Predictor>(with_model ? &model : nullptr, cfg, sink);
+  }
+  void start(uint16_t trial = 1) { p->on_frame(src.trial_start(trial), now); }
+  // One sample, 10 ms after the previous one, with ticks in between.
+  void sample(double f_motion, double f_vertical) {
+    for (int i = 0; i < 10; ++i) p->on_tick(now += kMs);
+    p->on_frame(src.force(f_motion, f_vertical), now);
+    p->on_frame(src.torque(), now);
+    src.next();
+  }
+  protocol::Stop last_stop() const {
+    protocol::Stop s{};
+    EXPECT_FALSE(sink.stops.empty());
+    if (!sink.stops.empty()) protocol::decode(sink.stops.back(), s);
+    return s;
+  }
+};
+
+TEST(StopPolicy, CaughtStopsAfterKConsecutiveSamplesAboveThreshold) {
+  Harness h;
+  h.start(7);
+  // An independent filter gives the posterior after each sample; the policy must stop at the
+  // first index where the last k = 3 posteriors all exceed 0.9.
+  filter::ForwardFilter ref(h.model);
+  ref.reset();
+  int expected_stop = -1, run = 0;
+  for (int i = 0; i < 40 && h.sink.stops.empty(); ++i) {
+    const double f = i < 10 ? -2.0 : -6.0;  // good-like drag, then caught-like
+    h.sample(f, f < -3 ? -1.0 : 0.0);
+    ref.step(f, 0.0, f < -3 ? -1.0 : 0.0);
+    run = ref.posterior(2) > 0.9 ? run + 1 : 0;
+    if (run == 3 && expected_stop < 0) expected_stop = i;
+  }
+  ASSERT_EQ(h.sink.stops.size(), 1u);
+  const auto s = h.last_stop();
+  EXPECT_EQ(s.reason, protocol::StopReason::Caught);
+  EXPECT_EQ(s.trial_id, 7);
+  EXPECT_EQ(static_cast<int>(s.sample), expected_stop);
+  EXPECT_GT(s.p_caught, 0.9 * 255);
+  EXPECT_EQ(h.p->decision().state, PredictorState::Stopped);
+}
+
+TEST(StopPolicy, GoodTrialNeverStops) {
+  Harness h;
+  h.start();
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.3);
+  for (int i = 0; i < 600; ++i) h.sample(-2.0 + noise(rng), noise(rng));
+  EXPECT_TRUE(h.sink.stops.empty());
+  EXPECT_EQ(h.p->decision().state, PredictorState::InTrial);
+  EXPECT_EQ(h.p->decision().sample, 599u);
+}
+
+TEST(StopPolicy, HardLimitStopsOnEitherAxisEvenWhenTheModelSaysGood) {
+  for (int axis = 0; axis < 2; ++axis) {
+    Harness h;
+    h.start();
+    for (int i = 0; i < 5; ++i) h.sample(-2.0, 0.0);
+    h.sample(axis == 0 ? -9.99 : -2.0, axis == 1 ? 9.99 : 0.0);  // at the limit: no stop
+    EXPECT_TRUE(h.sink.stops.empty());
+    h.sample(axis == 0 ? -10.01 : -2.0, axis == 1 ? 10.01 : 0.0);  // 0.01 N above: stop
+    ASSERT_EQ(h.sink.stops.size(), 1u);
+    EXPECT_EQ(h.last_stop().reason, protocol::StopReason::HardLimit);
+    EXPECT_EQ(h.last_stop().sample, 6);
+  }
+}
+
+TEST(StopPolicy, SensorTimeoutStopsWithinTheDeadlinePlusOneTick) {
+  Harness h;
+  h.start();
+  for (int i = 0; i < 5; ++i) h.sample(-2.0, 0.0);
+  const int64_t last = h.now;
+  while (h.sink.stops.empty() && h.now < last + 200 * kMs) h.p->on_tick(h.now += kMs);
+  ASSERT_EQ(h.sink.stops.size(), 1u);
+  EXPECT_EQ(h.last_stop().reason, protocol::StopReason::SensorTimeout);
+  // Deadline 50 ms, ticks of 1 ms: the stop comes in (50, 51] ms after the last sample.
+  EXPECT_GT(h.now - last, h.cfg.sensor_timeout_ns);
+  EXPECT_LE(h.now - last, h.cfg.sensor_timeout_ns + kMs);
+  EXPECT_EQ(h.last_stop().sample, 5) << "the deciding sample is the one that never came";
+  EXPECT_EQ(h.p->counter(StatusCounter::Timeouts), 1u);
+}
+
+TEST(StopPolicy, NoTimeoutOutsideATrial) {
+  Harness h;
+  for (int i = 0; i < 500; ++i) h.p->on_tick(h.now += kMs);
+  EXPECT_TRUE(h.sink.stops.empty());
+}
+
+TEST(StopPolicy, ModelThatDidNotLoadRefusesEveryTrial) {
+  Harness h(false);
+  EXPECT_EQ(h.p->decision().state, PredictorState::Fault);
+  h.start(3);
+  ASSERT_EQ(h.sink.stops.size(), 1u);
+  EXPECT_EQ(h.last_stop().reason, protocol::StopReason::ModelError);
+  EXPECT_EQ(h.last_stop().trial_id, 3);
+}
+
+TEST(E2EHandling, CorruptedRepeatedLateFramesAreCountedAndNotUsed) {
+  Harness h;
+  h.start();
+  for (int i = 0; i < 30; ++i) h.sample(-2.0, 0.0);
+  // A corrupted caught-like frame must not reach the filter.
+  Frame bad = h.src.force(-50.0, 0.0);
+  bad.data[4] ^= 0x01;
+  h.p->on_frame(bad, h.now);
+  EXPECT_TRUE(h.sink.stops.empty()) << "a corrupted -50 N frame was used";
+  // A repeated frame (same counter as the last sample) and a late one are discarded.
+  testkit::FrameSource old = h.src;
+  old.sample_counter = static_cast<uint8_t>(h.src.sample_counter - 1);
+  h.p->on_frame(old.force(-50.0, 0.0), h.now);
+  old.sample_counter = static_cast<uint8_t>(h.src.sample_counter - 5);
+  h.p->on_frame(old.force(-50.0, 0.0), h.now);
+  EXPECT_TRUE(h.sink.stops.empty());
+  EXPECT_EQ(h.p->counter(StatusCounter::Corrupted), 1u);
+  EXPECT_EQ(h.p->counter(StatusCounter::Repeated), 1u);
+  EXPECT_EQ(h.p->counter(StatusCounter::Late), 1u);
+  EXPECT_EQ(h.p->decision().sample, 29u);
+}
+
+TEST(E2EHandling, LostFramesAdvanceLogicalTime) {
+  Harness h;
+  h.start();
+  for (int i = 0; i < 10; ++i) h.sample(-2.0, 0.0);
+  h.src.next();  // sample 10 lost (both frames)
+  h.src.next();  // sample 11 lost
+  h.sample(-2.0, 0.0);
+  EXPECT_EQ(h.p->decision().sample, 12u);
+  EXPECT_EQ(h.p->counter(StatusCounter::LostFrames), 4u) << "2 force + 2 torque frames";
+  EXPECT_TRUE(h.sink.stops.empty()) << "two lost samples are within the budget";
+}
+
+TEST(E2EHandling, BurstOfCorruptedFramesIsAFailSafeStop) {
+  Harness h;
+  h.start();
+  for (int i = 0; i < 10; ++i) h.sample(-2.0, 0.0);
+  // Budget 5 x weight 20 = 100: the 6th corrupted frame in a row exceeds it.
+  for (int i = 0; i < 6; ++i) {
+    Frame bad = h.src.force(-2.0, 0.0);
+    bad.data[2] ^= 0x80;
+    h.p->on_frame(bad, h.now);
+    if (i < 5) {
+      EXPECT_TRUE(h.sink.stops.empty()) << i;
+    }
+  }
+  ASSERT_EQ(h.sink.stops.size(), 1u);
+  EXPECT_EQ(h.last_stop().reason, protocol::StopReason::BadFrames);
+}
+
+TEST(E2EHandling, SparseCorruptionDoesNotStop) {
+  Harness h;
+  h.start();
+  // One corrupted frame every 25 samples for 1000 samples: the bucket drains in between.
+  for (int i = 0; i < 1000; ++i) {
+    if (i % 25 == 0) {
+      Frame bad = h.src.force(-2.0, 0.0);
+      bad.data[3] ^= 0x04;
+      h.p->on_frame(bad, h.now);
+    }
+    h.sample(-2.0, 0.0);
+  }
+  EXPECT_TRUE(h.sink.stops.empty());
+  EXPECT_EQ(h.p->counter(StatusCounter::Corrupted), 40u);
+}
+
+TEST(StopTransmission, RetriedUntilEchoConfirmsWithFreshCounters) {
+  Harness h;
+  h.sink.fail_next = 2;  // ENOBUFS twice
+  h.start();
+  h.sample(-20.0, 0.0);  // hard limit
+  ASSERT_EQ(h.sink.stops.size(), 1u);
+  EXPECT_TRUE(h.p->stop_pending());
+  for (int i = 0; i < 10; ++i) h.p->on_tick(h.now += kMs);  // retries every 2 ms
+  ASSERT_GE(h.sink.stops.size(), 3u);
+  EXPECT_EQ(h.p->counter(StatusCounter::TxErrors), 2u);
+  // The echo of the latest transmission confirms; an echo of an older one would not.
+  h.p->on_stop_echo(h.sink.stops.front(), h.now);
+  EXPECT_TRUE(h.p->stop_pending()) << "an old frame's echo must not confirm the latest";
+  h.p->on_stop_echo(h.sink.stops.back(), h.now);
+  EXPECT_FALSE(h.p->stop_pending());
+  const size_t sent = h.sink.stops.size();
+  for (int i = 0; i < 20; ++i) h.p->on_tick(h.now += kMs);
+  EXPECT_EQ(h.sink.stops.size(), sent) << "no retries after confirmation";
+  // Each retry has its own counter, so the robot's E2E check never drops one as repeated.
+  for (size_t i = 1; i < h.sink.stops.size(); ++i) EXPECT_NE(h.sink.stops[i].data[1], h.sink.stops[i - 1].data[1]);
+  for (const auto& f : h.sink.stops) {
+    protocol::Stop s;
+    ASSERT_TRUE(protocol::decode(f, s));
+    EXPECT_EQ(s.reason, protocol::StopReason::HardLimit);
+  }
+}
+
+TEST(Status, PagesCarryEveryCounter) {
+  Harness h;
+  h.start();
+  for (int i = 0; i < 5; ++i) h.sample(-2.0, 0.0);
+  Frame bad = h.src.force(-2.0, 0.0);
+  bad.data[3] ^= 1;
+  h.p->on_frame(bad, h.now);
+  h.p->on_frame(bad, h.now);
+  h.sink.others.clear();
+  for (int i = 0; i < 700; ++i) h.p->on_tick(h.now += kMs);  // 7 status periods
+  uint32_t seen[12] = {};
+  bool page_seen[6] = {};
+  int heartbeats = 0;
+  for (const auto& f : h.sink.others) {
+    protocol::PredictorStatus st;
+    if (protocol::decode(f, st)) {
+      ASSERT_LT(st.page, 6);
+      page_seen[st.page] = true;
+      seen[2 * st.page] = st.value0;
+      seen[2 * st.page + 1] = st.value1;
+    }
+    protocol::HeartbeatPredictor hb;
+    if (protocol::decode(f, hb)) ++heartbeats;
+  }
+  for (bool b : page_seen) EXPECT_TRUE(b);
+  EXPECT_EQ(seen[static_cast<int>(StatusCounter::Corrupted)], 2u);
+  EXPECT_EQ(seen[static_cast<int>(StatusCounter::Samples)], 5u);
+  EXPECT_EQ(seen[static_cast<int>(StatusCounter::Stops)], 1u) << "the 50 ms timeout stopped the silent trial";
+  EXPECT_GE(heartbeats, 6);  // 10 Hz over 0.7 s
+}
+
+TEST(Mounting, SensorAxesMapToRigAxes) {
+  PredictorConfig cfg;
+  // Sensor z points against the motion, sensor x is vertical: motion = -z, vertical = x.
+  cfg = parse_predictor_config("mount_axes = -z y x\nmount_bias = 0 0 1.5\n", "t.conf");
+  Harness h(true, cfg);
+  h.start();
+  // Sensor reads z = +10.5 N (motion -10.5 N): hard limit through the mapping.
+  for (int i = 0; i < 10; ++i) h.p->on_tick(h.now += kMs);
+  h.p->on_frame(protocol::encode(protocol::FtForce{0, 150, 0, 1050}), h.now);
+  ASSERT_EQ(h.sink.stops.size(), 1u);
+  EXPECT_EQ(h.last_stop().reason, protocol::StopReason::HardLimit);
+  EXPECT_NEAR(h.p->decision().stop_f_motion, -10.5, 1e-9);
+  EXPECT_NEAR(h.p->decision().stop_f_vertical, 0.0, 1e-9) << "x = 1.5 N minus the 1.5 N bias";
+}
+
+TEST(Config, ParsesKeysAndNamesBadLines) {
+  std::vector<ConfigEntry> others;
+  const auto c = parse_predictor_config(
+      "# comment\nstop_threshold = 0.8\nstop_consecutive=4\nsensor_timeout_ms = 30\ninterface = vcan0\n", "p.conf",
+      &others);
+  EXPECT_DOUBLE_EQ(c.stop_threshold, 0.8);
+  EXPECT_EQ(c.stop_consecutive, 4);
+  EXPECT_EQ(c.sensor_timeout_ns, 30 * kMs);
+  ASSERT_EQ(others.size(), 1u);
+  EXPECT_EQ(others[0].key, "interface");
+  for (const char* bad : {"stop_threshold = 1.5\n", "x\n", "hard_limit_n = ten\n", "mount_axes = x y w\n", "bogus = 1\n"}) {
+    try {
+      parse_predictor_config(std::string("\n") + bad, "p.conf");
+      ADD_FAILURE() << "accepted: " << bad;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("p.conf:2:"), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(CommandedTravel, TrapezoidProfile) {
+  // 0.1 m/s at 1 m/s^2: ramp 0.1 s covering 5 mm, then 0.1 m/s.
+  EXPECT_NEAR(commanded_travel(0.1, 1.0, 0.05), 0.00125, 1e-12);
+  EXPECT_NEAR(commanded_travel(0.1, 1.0, 0.1), 0.005, 1e-12);
+  EXPECT_NEAR(commanded_travel(0.1, 1.0, 6.0), 0.595, 1e-12);
+}
+
+TEST(RealTime, NoHeapAllocationPerSampleTickOrStop) {
+  if (!testkit::malloc_intercepted()) GTEST_LOG_(INFO) << "malloc not intercepted (sanitizer build): counting operator new only";
+  // Sink that stores into fixed arrays (as the daemon's does: a lock-free ring).
+  struct FixedSink : PredictorSink {
+    uint8_t transmit_stop(const Frame&) noexcept override { return 0; }
+    uint8_t transmit(const Frame&) noexcept override { return 0; }
+    void event(const Event& e) noexcept override { last = e; }
+    Event last;
+  } sink;
+  model::OutcomeModel m = testkit::test_model();
+  Predictor p(&m, PredictorConfig{}, sink);
+  testkit::FrameSource src;
+  std::mt19937 rng(1);
+  std::normal_distribution<double> noise(0.0, 0.5);
+  // Frames are prepared before counting (the daemon reads them into a stack buffer).
+  std::vector<Frame> frames;
+  for (int trial = 0; trial < 10; ++trial) {
+    frames.push_back(src.trial_start(static_cast<uint16_t>(trial)));
+    for (int i = 0; i < 1000; ++i) {
+      frames.push_back(src.force(trial % 2 ? -6.0 + noise(rng) : -2.0 + noise(rng), noise(rng)));
+      if (i % 97 == 5) frames.back().data[5] ^= 1;  // corrupted frames take the error paths too
+      frames.push_back(src.torque());
+      src.next();
+    }
+    frames.push_back(src.trial_end(static_cast<uint16_t>(trial), 1000));
+  }
+  {
+    // The counter itself works: one vector is at least one allocation.
+    testkit::CountAllocations probe;
+    std::vector<int> v(100);
+    EXPECT_GE(probe.count(), 1u);
+  }
+  int64_t now = 0;
+  uint64_t allocations = 0;
+  {
+    testkit::CountAllocations count;
+    for (const Frame& f : frames) {
+      p.on_frame(f, now += 5 * kMs);
+      p.on_tick(now);
+      p.on_stop_echo(f, now);
+    }
+    p.on_shutdown(now);
+    allocations = count.count();
+  }
+  EXPECT_EQ(allocations, 0u) << "the predictor allocated on its hot path";
+  EXPECT_GE(p.counter(StatusCounter::Samples), 9000u);
+  EXPECT_GE(p.counter(StatusCounter::Stops), 5u) << "the caught trials stopped (so the stop path was counted too)";
+}
+
+}  // namespace

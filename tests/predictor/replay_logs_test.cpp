@@ -1,0 +1,212 @@
+// The test logs (tests/data/robot/, outcome in the file name) replayed through the predictor's
+// code with a model fitted to other synthetic trials (seed 1; the logs are seed 2): every caught
+// trial stops for "caught" before the rig's 10 N limit (the margin is printed), no good or missed
+// trial stops, and each fault log is handled as the protocol says. Plus `dressguard replay --json`
+// and the measured trials of the study when shared/data is present.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "candump_log.h"
+#include "dgm.h"
+#include "replay.h"
+
+using namespace dressguard;
+using namespace dressguard::predictor;
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kLogs = fs::path(DRESSGUARD_SOURCE_DIR) / "tests/data/robot";
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+model::OutcomeModel load_model() { return model::read_model(DG_TEST_MODEL); }
+
+std::vector<protocol::LoggedFrame> load(const fs::path& p) { return protocol::parse_candump_log(slurp(p), p.string()); }
+
+// Index of the first F/T sample above 10 N on the motion or vertical axis (identity mount), or -1;
+// and the trial's sample count per its TrialEnd frame.
+struct LogFacts {
+  long first_over_limit = -1;
+  long samples = 0;
+  protocol::TrialEndReason end = protocol::TrialEndReason::Completed;
+};
+LogFacts facts(const std::vector<protocol::LoggedFrame>& frames) {
+  LogFacts f;
+  long index = -1;
+  for (const auto& lf : frames) {
+    protocol::FtForce m;
+    protocol::TrialEnd e;
+    if (protocol::decode(lf.frame, m)) {
+      ++index;
+      if (f.first_over_limit < 0 && (std::abs(m.fx) > 1000 || std::abs(m.fz) > 1000)) f.first_over_limit = index;
+    } else if (protocol::decode(lf.frame, e)) {
+      f.samples = e.samples;
+      f.end = e.reason;
+    }
+  }
+  return f;
+}
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+TEST(ReplayLogs, EveryTestLogHasTheOutcomeInItsName) {
+  const auto m = load_model();
+  int caught = 0, clean_other = 0, faults = 0;
+  double min_margin_s = 1e9;
+  for (const auto& entry : fs::directory_iterator(kLogs)) {
+    const std::string name = entry.path().filename().string();
+    if (entry.path().extension() != ".log") continue;
+    const auto frames = load(entry.path());
+    const LogFacts lf = facts(frames);
+    PredictorConfig cfg;
+    if (name.find("nocaughtrule") != std::string::npos) cfg.stop_consecutive = 100000;
+    const auto r = replay_frames(&m, cfg, frames);
+    ASSERT_EQ(r.trials.size(), 1u) << name;
+    const auto& t = r.trials[0];
+    const auto counter = [&](protocol::StatusCounter c) { return r.counters[static_cast<size_t>(c)]; };
+    SCOPED_TRACE(name);
+    if (name.rfind("fault-", 0) == 0) {
+      ++faults;
+      if (ends_with(name, "-nostop.log")) {
+        EXPECT_FALSE(t.stopped) << protocol::stop_reason_name(t.reason) << " at " << t.stop_sample;
+        // --corrupt 50,300 --drop 120 --repeat 200 --delay 250:2 (make_test_logs.sh)
+        EXPECT_EQ(counter(protocol::StatusCounter::Corrupted), 4u);  // both frames of 50 and 300
+        EXPECT_EQ(counter(protocol::StatusCounter::Repeated), 2u);  // force and torque of sample 200
+        EXPECT_EQ(counter(protocol::StatusCounter::Late), 2u);      // sample 250's two frames
+        // Lost (2 frames each): 120 dropped, 250 missing when 251 arrived (it came late), and
+        // the discarded corrupted samples 50 and 300, seen missing when 51 and 301 arrived.
+        EXPECT_EQ(counter(protocol::StatusCounter::LostFrames), 8u);
+        EXPECT_EQ(t.samples, static_cast<uint32_t>(lf.samples)) << "logical time kept despite the faults";
+      } else {
+        const auto pos = name.find("-expect-");
+        ASSERT_NE(pos, std::string::npos);
+        const std::string reason = name.substr(pos + 8, name.size() - pos - 8 - 4);
+        ASSERT_TRUE(t.stopped);
+        EXPECT_EQ(protocol::stop_reason_name(t.reason), reason);
+        if (reason == "hard_limit") {
+          EXPECT_EQ(static_cast<long>(t.stop_sample), lf.first_over_limit) << "the hard limit fires on its sample";
+          EXPECT_GT(std::fabs(t.f_motion), 10.0);
+        }
+        if (reason == "sensor_timeout") {
+          EXPECT_EQ(t.stop_sample, 150u) << "--gap 150:300: sample 150 never came";
+          // The stop comes one deadline (50 ms) after sample 149, within one 1 ms tick.
+          const double since_last = t.log_time - 149 * 0.01 - 0.01;
+          EXPECT_GT(since_last, 0.050 - 1e-6);
+          EXPECT_LE(since_last, 0.0515);
+        }
+        if (reason == "bad_frames") {
+          EXPECT_GE(counter(protocol::StatusCounter::Corrupted), 6u);
+        }
+      }
+    } else if (ends_with(name, "-caught.log")) {
+      ++caught;
+      ASSERT_TRUE(t.stopped);
+      EXPECT_EQ(t.reason, protocol::StopReason::Caught);
+      ASSERT_EQ(lf.end, protocol::TrialEndReason::RobotForceLimit) << "the log ends where the rig's 10 N stop fired";
+      // The rig's own stop would have come at sample lf.samples (the first one above 10 N).
+      EXPECT_LT(static_cast<long>(t.stop_sample), lf.samples);
+      const double margin_s = (lf.samples - static_cast<long>(t.stop_sample)) * 0.01;
+      min_margin_s = std::min(min_margin_s, margin_s);
+      std::printf("  %-28s caught at sample %4u (F_motion %6.2f N, travel %.3f m): %.2f s before the 10 N limit\n",
+                  name.c_str(), t.stop_sample, t.f_motion, t.travel, margin_s);
+    } else {
+      ++clean_other;
+      EXPECT_FALSE(t.stopped) << "stopped for " << protocol::stop_reason_name(t.reason) << " at sample " << t.stop_sample;
+      EXPECT_LT(t.max_p_caught, 0.95);
+      std::printf("  %-28s no stop, max P(caught) %.3f\n", name.c_str(), t.max_p_caught);
+    }
+  }
+  EXPECT_EQ(caught, 3);
+  EXPECT_EQ(clean_other, 6);
+  EXPECT_EQ(faults, 4);
+  std::printf("  smallest margin before the 10 N limit: %.2f s\n", min_margin_s);
+}
+
+TEST(ReplayLogs, ModelThatDoesNotLoadStopsEveryTrial) {
+  const auto frames = load(kLogs / "syn2-good-0-good.log");
+  const auto r = replay_frames(nullptr, PredictorConfig{}, frames);
+  ASSERT_EQ(r.trials.size(), 1u);
+  EXPECT_TRUE(r.trials[0].stopped);
+  EXPECT_EQ(r.trials[0].reason, protocol::StopReason::ModelError);
+}
+
+std::string run(const std::string& cmd, int& rc) {
+  std::string out;
+  FILE* p = popen(cmd.c_str(), "r");
+  std::array<char, 4096> buf;
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) out.append(buf.data(), n);
+  rc = pclose(p);
+  return out;
+}
+
+TEST(ReplayCli, JsonReportsTheStop) {
+  int rc = 0;
+  const std::string out =
+      run(std::string(DG_CLI) + " replay --model " + DG_TEST_MODEL + " --log " + (kLogs / "syn2-caught-0-caught.log").string() + " --json", rc);
+  EXPECT_EQ(rc, 0);
+  for (const char* key : {"\"stopped\": true", "\"reason\": \"caught\"", "\"stop_time\": ", "\"travel\": ", "\"posteriors\": {\"good\": ",
+                          "\"caught\": "})
+    EXPECT_NE(out.find(key), std::string::npos) << key << " missing in " << out;
+  const std::string bad = run(std::string(DG_CLI) + " replay --model /nonexistent.dgm --log x.log 2>&1", rc);
+  EXPECT_EQ(WEXITSTATUS(rc), 2);
+  EXPECT_NE(bad.find("/nonexistent.dgm"), std::string::npos) << bad;
+  fs::path tmp = fs::temp_directory_path() / "dg_replay_badlog.log";
+  std::ofstream(tmp) << "(1700000000.000000) vcan0 100#00\nnot a frame\n";
+  const std::string bad2 = run(std::string(DG_CLI) + " replay --model " + DG_TEST_MODEL + " --log " + tmp.string() + " 2>&1", rc);
+  EXPECT_EQ(WEXITSTATUS(rc), 2);
+  EXPECT_NE(bad2.find(tmp.string() + ":2:"), std::string::npos) << bad2;
+  fs::remove(tmp);
+}
+
+TEST(ReplayMeasured, StudyTrialsHitTheHardLimitWhereTheRigStopped) {
+  const char* sd = std::getenv("DRESSGUARD_SHARED_DIR");
+  const fs::path study = fs::path(sd ? sd : DRESSGUARD_SHARED_DIR) / "data/kapusta2016-calibration-trials";
+  if (!fs::exists(study)) GTEST_SKIP() << "shared/data not present: measured-data logs not generated";
+  // Logs are generated here, at test time, never committed (the data is not redistributable).
+  const fs::path tmp = fs::temp_directory_path() / ("dg_measured_" + std::to_string(::getpid()));
+  int rc = 0;
+  run(std::string(DG_CLI) + " import --study " + study.string() + " --out " + (tmp / "ds").string() + " >/dev/null", rc);
+  ASSERT_EQ(rc, 0);
+  run(std::string(DG_CLI) + " export-candump --data " + (tmp / "ds").string() + " --rig-limit 0 --out " + (tmp / "logs").string() + " >/dev/null", rc);
+  ASSERT_EQ(rc, 0);
+  const auto m = load_model();
+  PredictorConfig cfg;
+  cfg.stop_consecutive = 100000;  // the caught rule off: the hard limit alone
+  int good = 0;
+  for (const auto& e : fs::directory_iterator(tmp / "logs")) {
+    const auto frames = load(e.path());
+    const auto lf = facts(frames);
+    const auto r = replay_frames(&m, cfg, frames);
+    ASSERT_EQ(r.trials.size(), 1u);
+    EXPECT_EQ(r.counters[static_cast<size_t>(protocol::StatusCounter::Corrupted)], 0u);
+    const std::string name = e.path().filename().string();
+    if (ends_with(name, "-good.log")) {
+      // The study's good trials end at the rig's |F| > 10 N stop: our hard limit fires on that sample.
+      ++good;
+      ASSERT_TRUE(r.trials[0].stopped) << name;
+      EXPECT_EQ(r.trials[0].reason, protocol::StopReason::HardLimit) << name;
+      EXPECT_EQ(static_cast<long>(r.trials[0].stop_sample), lf.first_over_limit) << name;
+    } else if (lf.first_over_limit < 0) {
+      EXPECT_FALSE(r.trials[0].stopped) << name;
+    }
+  }
+  EXPECT_GE(good, 5);
+  fs::remove_all(tmp);
+}
+
+}  // namespace

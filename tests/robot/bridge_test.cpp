@@ -1,0 +1,264 @@
+// The firmware bridge: its portable core (frames per reading, the stop latch, heartbeats), and
+// the Linux port against real Modbus TCP peers on 127.0.0.1 (dg_modbus_emulator, a libmodbus
+// server with fault injection, as the sensor and as the robot controller) with the CAN side on
+// the in-process bus; mbpoll as an independent Modbus client checks what the peers hold.
+#include <gtest/gtest.h>
+#include <modbus.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <thread>
+
+#include "bridge_app.h"
+#include "bridge_core.h"
+#include "can_port.h"
+
+using namespace dressguard;
+using namespace dressguard::bridge;
+using namespace std::chrono_literals;
+
+namespace {
+
+// ---- portable core ---------------------------------------------------------------------------
+
+TEST(BridgeCore, ReadingBecomesTwoFramesWithOneCounter) {
+  BridgeCore c;
+  bridge_init(c, {}, 0);
+  Frame f[2];
+  for (int i = 0; i < 300; ++i) {
+    ASSERT_EQ(bridge_on_reading(c, FtReading{{-250, 30, -1000}, {15, -2, 0}}, i * 10, f), 2);
+    protocol::FtForce force;
+    protocol::FtTorque torque;
+    ASSERT_TRUE(protocol::decode(f[0], force));
+    ASSERT_TRUE(protocol::decode(f[1], torque));
+    EXPECT_EQ(force.counter, static_cast<uint8_t>(i));
+    EXPECT_EQ(torque.counter, force.counter);
+    EXPECT_EQ(force.fz, -1000);
+    EXPECT_EQ(torque.my, -2);
+  }
+  EXPECT_EQ(c.state, protocol::BridgeState::Ok);
+}
+
+TEST(BridgeCore, StopLatchesUntilTheNextTrialAndIgnoresCorruptStops) {
+  BridgeCore c;
+  bridge_init(c, {}, 0);
+  Frame bad = protocol::encode(protocol::Stop{0, protocol::StopReason::Caught, 250, 1, 100});
+  bad.data[6] ^= 1;
+  EXPECT_EQ(bridge_on_frame(c, bad, 1), BridgeAction::None);
+  EXPECT_EQ(c.bad_frames, 1u);
+  EXPECT_FALSE(bridge_stop_latched(c));
+  const Frame stop = protocol::encode(protocol::Stop{1, protocol::StopReason::Caught, 250, 1, 100});
+  EXPECT_EQ(bridge_on_frame(c, stop, 2), BridgeAction::StopRobot);
+  EXPECT_EQ(bridge_on_frame(c, stop, 3), BridgeAction::None) << "already latched";
+  EXPECT_EQ(c.state, protocol::BridgeState::StopLatched);
+  bridge_on_frame(c, protocol::encode(protocol::TrialStart{0, 2, 100, protocol::HeightClass::High}), 4);
+  EXPECT_FALSE(bridge_stop_latched(c));
+  EXPECT_EQ(bridge_on_frame(c, protocol::encode(protocol::Stop{2, protocol::StopReason::HardLimit, 0, 2, 5}), 5),
+            BridgeAction::StopRobot);
+}
+
+TEST(BridgeCore, SilentPredictorStopsWhenConfigured) {
+  BridgeCore c;
+  bridge_init(c, BridgeConfig{100, 300}, 0);
+  Frame hb;
+  BridgeAction a;
+  for (uint32_t t = 0; t <= 300; t += 10) {
+    bridge_on_frame(c, protocol::encode(protocol::HeartbeatPredictor{static_cast<uint8_t>(t / 10), protocol::PredictorState::Idle, 1, 0, 0}), t);
+    bridge_on_tick(c, t, &hb, &a);
+    EXPECT_EQ(a, BridgeAction::None) << t;
+  }
+  for (uint32_t t = 310; t <= 700; t += 10) {
+    bridge_on_tick(c, t, &hb, &a);
+    if (a == BridgeAction::StopRobot) {
+      EXPECT_GT(t - 300, 300u);
+      EXPECT_LE(t - 300, 310u);
+      return;
+    }
+  }
+  FAIL() << "no stop for a predictor silent 300 ms";
+}
+
+TEST(BridgeCore, HeartbeatCarriesSensorState) {
+  BridgeCore c;
+  bridge_init(c, {}, 0);
+  bridge_on_sensor_error(c, 5);
+  Frame hb;
+  BridgeAction a;
+  ASSERT_EQ(bridge_on_tick(c, 10, &hb, &a), 1);
+  protocol::HeartbeatBridge m;
+  ASSERT_TRUE(protocol::decode(hb, m));
+  EXPECT_EQ(m.state, protocol::BridgeState::SensorLost);
+  EXPECT_EQ(m.sensor_errors, 1);
+  EXPECT_EQ(bridge_on_tick(c, 50, &hb, &a), 0) << "next heartbeat only after 100 ms";
+}
+
+// ---- Linux port against Modbus TCP peers ------------------------------------------------------
+
+class Emulator {
+ public:
+  Emulator() {
+    int fds[2];
+    if (pipe(fds) != 0) return;
+    pid_ = fork();
+    if (pid_ == 0) {
+      dup2(fds[1], 1);
+      close(fds[0]);
+      execl(DG_EMULATOR, DG_EMULATOR, "--port", "0", static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    close(fds[1]);
+    FILE* f = fdopen(fds[0], "r");
+    if (std::fscanf(f, "listening on %d", &port_) != 1) port_ = -1;
+    std::fclose(f);
+  }
+  ~Emulator() {
+    if (pid_ > 0) {
+      kill(pid_, SIGTERM);
+      waitpid(pid_, nullptr, 0);
+    }
+  }
+  int port() const { return port_; }
+  std::string spec() const { return "tcp:127.0.0.1:" + std::to_string(port_); }
+  // The test's own Modbus client, for setting registers.
+  bool write(int addr, std::vector<uint16_t> values) {
+    modbus_t* c = modbus_new_tcp("127.0.0.1", port_);
+    const bool ok = modbus_connect(c) == 0 && modbus_write_registers(c, addr, static_cast<int>(values.size()), values.data()) ==
+                                                  static_cast<int>(values.size());
+    modbus_close(c);
+    modbus_free(c);
+    return ok;
+  }
+
+ private:
+  pid_t pid_ = -1;
+  int port_ = -1;
+};
+
+std::string mbpoll(const std::string& args) {
+  std::string out;
+  FILE* p = popen(("mbpoll -m tcp -0 -1 " + args + " 2>&1").c_str(), "r");
+  if (!p) return out;
+  std::array<char, 512> buf;
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) out.append(buf.data(), n);
+  pclose(p);
+  return out;
+}
+
+struct BridgeRig {
+  Emulator sensor_emu, robot_emu;
+  can::InProcBus bus;
+  std::unique_ptr<can::CanPort> bridge_port, listener, predictor;
+  std::unique_ptr<ModbusSensor> sensor;
+  std::unique_ptr<RobotStopWriter> robot;
+  std::unique_ptr<BridgeApp> app;
+  std::thread loop;
+  BridgeRig() {
+    bridge_port = bus.open({{protocol::id_of(protocol::MsgId::Stop), protocol::id_of(protocol::MsgId::TrialStart)}, false, true});
+    listener = bus.open({{protocol::id_of(protocol::MsgId::FtForce), protocol::id_of(protocol::MsgId::FtTorque),
+                          protocol::id_of(protocol::MsgId::HeartbeatBridge)}, false, true});
+    predictor = bus.open({{}, false, true});
+    sensor = std::make_unique<ModbusSensor>(ModbusEndpoint{sensor_emu.spec(), 9, 20}, SensorMap{});
+    robot = std::make_unique<RobotStopWriter>(ModbusEndpoint{robot_emu.spec(), 1, 200}, StopTarget{true, 7, 1});
+    BridgeAppConfig cfg;
+    cfg.backoff_min_ms = 20;
+    cfg.backoff_max_ms = 160;
+    app = std::make_unique<BridgeApp>(cfg, *sensor, robot.get(), *bridge_port);
+    loop = std::thread([this] { app->run(); });
+  }
+  ~BridgeRig() {
+    app->request_shutdown();
+    loop.join();
+  }
+  // Force frames received within `d`, the last one in *last.
+  int collect(std::chrono::milliseconds d, protocol::FtForce* last = nullptr, protocol::HeartbeatBridge* hb = nullptr) {
+    const auto end = std::chrono::steady_clock::now() + d;
+    int n = 0;
+    Frame f;
+    can::RxInfo info;
+    while (std::chrono::steady_clock::now() < end) {
+      while (listener->receive(f, info) == 1) {
+        protocol::FtForce m;
+        protocol::HeartbeatBridge h;
+        if (protocol::decode(f, m)) {
+          ++n;
+          if (last) *last = m;
+        } else if (hb && protocol::decode(f, h)) {
+          *hb = h;
+        }
+      }
+      std::this_thread::sleep_for(1ms);
+    }
+    return n;
+  }
+};
+
+TEST(BridgeModbus, EmulatorAnswersAnIndependentClient) {
+  Emulator emu;
+  ASSERT_GT(emu.port(), 0) << "emulator did not start";
+  ASSERT_TRUE(emu.write(180, {static_cast<uint16_t>(-250), 30, static_cast<uint16_t>(-1000), 15, static_cast<uint16_t>(-2), 0}));
+  const std::string out = mbpoll("-p " + std::to_string(emu.port()) + " -a 9 -r 180 -c 6 -t 4 127.0.0.1");
+  // mbpoll prints unsigned 16-bit values: -250 is 65286.
+  EXPECT_NE(out.find("[180]: \t65286"), std::string::npos) << out;
+  EXPECT_NE(out.find("[182]: \t64536"), std::string::npos) << out;
+  EXPECT_NE(out.find("[183]: \t15"), std::string::npos) << out;
+}
+
+TEST(BridgeModbus, ReadingsFlowToCanAndSurviveFaults) {
+  BridgeRig rig;
+  ASSERT_GT(rig.sensor_emu.port(), 0);
+  ASSERT_TRUE(rig.sensor_emu.write(180, {static_cast<uint16_t>(-250), 30, static_cast<uint16_t>(-1000), 15, 0, 0}));
+  protocol::FtForce last{};
+  protocol::HeartbeatBridge hb{};
+  // 100 Hz for 300 ms: about 30 frames (this shared host's timer jitter: accept >= 15).
+  const int normal = rig.collect(300ms, &last, &hb);
+  EXPECT_GE(normal, 15);
+  EXPECT_EQ(last.fx, -250);
+  EXPECT_EQ(last.fz, -1000);
+  EXPECT_EQ(hb.state, protocol::BridgeState::Ok);
+
+  // Exceptions: no frames at all (never stale data), the heartbeat says the sensor is lost.
+  ASSERT_TRUE(rig.sensor_emu.write(900, {1}));
+  rig.collect(50ms);  // frames already in flight
+  EXPECT_EQ(rig.collect(200ms, nullptr, &hb), 0) << "frames sent while the sensor answers with exceptions";
+  EXPECT_EQ(hb.state, protocol::BridgeState::SensorLost);
+  // Timeouts (the sensor does not answer): the same.
+  ASSERT_TRUE(rig.sensor_emu.write(900, {2}));
+  rig.collect(50ms);
+  EXPECT_EQ(rig.collect(200ms), 0) << "frames sent while the sensor times out";
+  // Back to normal with new values: the first frames carry them.
+  ASSERT_TRUE(rig.sensor_emu.write(180, {100, 0, 0, 0, 0, 0}));
+  ASSERT_TRUE(rig.sensor_emu.write(900, {0}));
+  EXPECT_GE(rig.collect(200ms, &last), 5);
+  EXPECT_EQ(last.fx, 100);
+  EXPECT_GE(rig.app->stats().sensor_errors.load(), 10u);
+
+  // Unplugged for 400 ms: reconnect with backoff, no frames in the dark.
+  const uint64_t reconnects = rig.app->stats().reconnects.load();
+  ASSERT_TRUE(rig.sensor_emu.write(901, {400}));
+  ASSERT_TRUE(rig.sensor_emu.write(900, {3}));
+  rig.collect(30ms);
+  EXPECT_EQ(rig.collect(300ms), 0) << "frames while the sensor was gone";
+  EXPECT_GE(rig.collect(1000ms), 20) << "did not come back after the sensor did";
+  EXPECT_GT(rig.app->stats().reconnects.load(), reconnects);
+  EXPECT_GE(rig.app->stats().connect_failures.load(), 1u) << "the backoff never tried while it was gone";
+}
+
+TEST(BridgeModbus, StopFrameWritesTheRobotsStopCoil) {
+  BridgeRig rig;
+  ASSERT_GT(rig.robot_emu.port(), 0);
+  const std::string coil = "-p " + std::to_string(rig.robot_emu.port()) + " -a 1 -r 7 -c 1 -t 0 127.0.0.1";
+  EXPECT_NE(mbpoll(coil).find("[7]: \t0"), std::string::npos);
+  rig.predictor->send(protocol::encode(protocol::Stop{0, protocol::StopReason::Caught, 240, 3, 250}));
+  for (int i = 0; i < 200 && rig.app->stats().stops_written.load() == 0; ++i) std::this_thread::sleep_for(1ms);
+  EXPECT_EQ(rig.app->stats().stops_written.load(), 1u);
+  // Read back by mbpoll, an independent Modbus client.
+  EXPECT_NE(mbpoll(coil).find("[7]: \t1"), std::string::npos) << mbpoll(coil);
+}
+
+}  // namespace

@@ -1,0 +1,123 @@
+// dg_modbus_emulator: a Modbus TCP server written with libmodbus's server API, standing in for
+// the Robotiq FT 300 sensor (holding registers 180-185) and for a robot controller (coils,
+// holding registers) in the bridge's tests. Several clients at once (select(), as libmodbus's own
+// multi-client example). Fault injection by magic registers, as libmodbus's unit-test-server does:
+//   holding register 900 = 0  normal
+//                          1  answer every read of register 180 with exception 04 (server failure)
+//                          2  never answer a read of register 180 (the client times out)
+//                          3  disappear: close every connection and the listening socket for
+//                             register 901 milliseconds, then listen again (the sensor unplugged)
+//   holding register 910      number of reads of register 180 answered (mod 65536)
+// The registers 180-185 are set by clients (FC06/FC16), e.g. by the test.
+//
+//   dg_modbus_emulator [--port N]      prints "listening on PORT" (N = 0: any free port)
+#include <arpa/inet.h>
+#include <modbus.h>
+#include <netinet/in.h>
+#include <sys/select.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <thread>
+
+namespace {
+
+constexpr int kFaultMode = 900, kDarkMs = 901, kReadsServed = 910, kFtRegister = 180;
+
+int listen_on(modbus_t* ctx, int& port) {
+  // modbus_tcp_listen binds the port of the context; for port 0 ask the kernel which it chose.
+  const int s = modbus_tcp_listen(ctx, 8);
+  if (s < 0) return -1;
+  sockaddr_in a{};
+  socklen_t len = sizeof a;
+  getsockname(s, reinterpret_cast<sockaddr*>(&a), &len);
+  port = ntohs(a.sin_port);
+  return s;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int port = 0;
+  for (int i = 1; i + 1 < argc; i += 2)
+    if (!std::strcmp(argv[i], "--port")) port = std::atoi(argv[i + 1]);
+  modbus_t* ctx = modbus_new_tcp("127.0.0.1", port);
+  modbus_mapping_t* map = modbus_mapping_new(1000, 0, 1000, 0);
+  if (!ctx || !map) {
+    std::fprintf(stderr, "dg_modbus_emulator: %s\n", modbus_strerror(errno));
+    return 1;
+  }
+  int server = listen_on(ctx, port);
+  if (server < 0) {
+    std::fprintf(stderr, "dg_modbus_emulator: listen: %s\n", modbus_strerror(errno));
+    return 1;
+  }
+  // Rebind later to the same port.
+  modbus_free(ctx);
+  ctx = modbus_new_tcp("127.0.0.1", port);
+  std::printf("listening on %d\n", port);
+  std::fflush(stdout);
+  fd_set refset;
+  FD_ZERO(&refset);
+  FD_SET(server, &refset);
+  int fdmax = server;
+  uint8_t query[MODBUS_TCP_MAX_ADU_LENGTH];
+  const int hl = modbus_get_header_length(ctx);
+  for (;;) {
+    fd_set rdset = refset;
+    if (select(fdmax + 1, &rdset, nullptr, nullptr, nullptr) < 0) {
+      if (errno == EINTR) continue;
+      return 1;
+    }
+    for (int fd = 0; fd <= fdmax; ++fd) {
+      if (!FD_ISSET(fd, &rdset)) continue;
+      if (fd == server) {
+        sockaddr_in a{};
+        socklen_t len = sizeof a;
+        const int c = accept(server, reinterpret_cast<sockaddr*>(&a), &len);
+        if (c >= 0) {
+          FD_SET(c, &refset);
+          if (c > fdmax) fdmax = c;
+        }
+        continue;
+      }
+      modbus_set_socket(ctx, fd);
+      const int rc = modbus_receive(ctx, query);
+      if (rc <= 0) {
+        close(fd);
+        FD_CLR(fd, &refset);
+        continue;
+      }
+      const int function = query[hl];
+      const int address = (query[hl + 1] << 8) | query[hl + 2];
+      const bool ft_read = (function == 0x03 || function == 0x04) && address == kFtRegister;
+      const int mode = map->tab_registers[kFaultMode];
+      if (ft_read && mode == 2) continue;  // silence: the client's response timeout fires
+      if (ft_read && mode == 1) {
+        modbus_reply_exception(ctx, query, MODBUS_EXCEPTION_SLAVE_OR_SERVER_FAILURE);
+        continue;
+      }
+      modbus_reply(ctx, query, rc, map);
+      if (ft_read) ++map->tab_registers[kReadsServed];
+      if (map->tab_registers[kFaultMode] == 3) {
+        // Unplugged: every connection and the listener go away, then come back.
+        for (int f = 0; f <= fdmax; ++f)
+          if (FD_ISSET(f, &refset)) close(f);
+        FD_ZERO(&refset);
+        const int dark = map->tab_registers[kDarkMs];
+        map->tab_registers[kFaultMode] = 0;
+        std::this_thread::sleep_for(std::chrono::milliseconds(dark));
+        for (int attempt = 0; attempt < 100 && (server = modbus_tcp_listen(ctx, 8)) < 0; ++attempt)
+          std::this_thread::sleep_for(std::chrono::milliseconds(10));  // TIME_WAIT: SO_REUSEADDR is set by libmodbus
+        if (server < 0) return 1;
+        FD_SET(server, &refset);
+        fdmax = server;
+        break;
+      }
+    }
+  }
+}

@@ -1,0 +1,48 @@
+#!/usr/bin/python3
+"""Accuracy against travel distance (paper Fig. 6) from `dressguard classify --sweep`'s CSV.
+
+usage: hmm_sweep.py SWEEP.csv OUT.png [SWEEP2.csv LABEL2 ...]
+The CSV has columns travel_m,accuracy,correct,total. Extra CSV/label pairs add curves (e.g. a
+simulation-trained and a measured-data-trained classifier on one plot).
+"""
+import csv
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+
+
+def read(path):
+    xs, ys = [], []
+    with open(path, newline="") as f:
+        for row in csv.DictReader(f):
+            xs.append(float(row["travel_m"]))
+            ys.append(100.0 * float(row["accuracy"]))
+    return xs, ys
+
+
+def main(argv):
+    if len(argv) < 3 or len(argv) % 2 == 0:
+        sys.stderr.write(__doc__)
+        return 2
+    curves = [(argv[1], "classifier")] + [(argv[i], argv[i + 1]) for i in range(3, len(argv), 2)]
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for path, label in curves:
+        xs, ys = read(path)
+        ax.plot(xs, ys, marker="o", label=label)
+    ax.set_xlabel("travel distance of the end effector [m]")
+    ax.set_ylabel("accuracy [%]")
+    ax.set_ylim(0, 100)
+    ax.grid(True, alpha=0.3)
+    ax.set_title("Outcome classification on truncated sequences")
+    if len(curves) > 1:
+        ax.legend()
+    fig.tight_layout()
+    fig.savefig(argv[2], dpi=120)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))

@@ -1,0 +1,62 @@
+#!/bin/sh
+# Runs inside the test VM (busybox sh, as root, from /init). Every scenario starts the predictor
+# daemon on vcan0, replays candump logs with canplayer, records the bus with candump -d, stops
+# the daemon with SIGTERM, and prints its recording and log between markers on the console
+# (ttyS0) for tools/vm/run_vm_tests.py, which decodes the frames and asserts on them.
+D=/data
+MODEL=$D/model.dgm
+say() { echo "DG-VM: $*"; }
+section() { echo "DG-VM-BEGIN $1"; cat "$2"; echo "DG-VM-END $1"; }
+
+if ! ip link add dev vcan0 type vcan 2>/dev/null; then ip2 link add dev vcan0 type vcan || say "FATAL no vcan0"; fi
+ip link set vcan0 txqueuelen 1000 2>/dev/null
+ip link set up vcan0 || ip2 link set up vcan0
+say "vcan0 $(cat /sys/class/net/vcan0/operstate)"
+
+# scenario NAME "DAEMON ARGS" RECORD_FILTER then the commands to play (as a function "play_NAME").
+scenario() {
+  name=$1; dargs=$2; filter=$3
+  candump -L -d vcan0$filter > /tmp/$name.rec 2>&1 &
+  cpid=$!
+  dressguard-predictor --interface vcan0 $dargs --latency-report > /tmp/$name.log 2>&1 &
+  dpid=$!
+  sleep 0.5
+  say "scenario $name start"
+  play_$name
+  sleep 0.3
+  kill -TERM $dpid
+  wait $dpid
+  say "scenario $name daemon_exit $?"
+  kill $cpid 2>/dev/null
+  wait $cpid 2>/dev/null
+  section $name.rec /tmp/$name.rec
+  section $name.log /tmp/$name.log
+}
+
+# A: every clean trial and two fault logs, paced by canplayer (-t: one frame per 1 ms gap);
+# the assertions use the payloads' counters, not this pacing.
+play_clean() {
+  for f in $D/logs/syn2-*.log $D/logs/fault-isolated-*.log $D/logs/fault-burst-*.log; do
+    say "play $(basename $f)"
+    canplayer -t -g 1 -I $f
+    sleep 1.1   # > 1 s: the robot's trial counters restart with each log (see PROTOCOL.md)
+  done
+}
+scenario clean "--model $MODEL" ",080:7FF,300:7FF"
+
+# B: a caught trial past the 10 N limit with the caught rule disabled: the hard limit stops it.
+play_hardlimit() { canplayer -t -g 1 -I $D/logs/fault-nocaughtrule-*.log; }
+scenario hardlimit "--model $MODEL --set stop_consecutive=100000" ",080:7FF,100:7FF"
+
+# C: the sensor goes silent for 300 ms, played in real time (timestamps honoured).
+play_gap() { canplayer -I $D/logs/fault-gap-*.log; }
+scenario gap "--model $MODEL" ",080:7FF,100:7FF"
+
+# D: a model that does not load: the first trial is refused.
+play_nomodel() { head -n 40 $D/logs/syn2-good-0-good.log | canplayer -t -g 1; }
+scenario nomodel "--model $D/does-not-exist.dgm" ",080:7FF"
+
+# E: end-to-end latency through the kernel: frame in (the probe's send) to stop frame out (the
+# probe's receive), hard-limit trials back to back.
+play_latency() { bench_predictor --e2e vcan0 --trials 2000 > /tmp/latency.out 2>&1; section latency.out /tmp/latency.out; }
+scenario latency "--model $MODEL" ",080:7FF"
