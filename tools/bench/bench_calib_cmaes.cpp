@@ -102,6 +102,7 @@ void row(const char* name, int n, double reference) {
 }  // namespace
 
 int main() {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // a row as soon as it is measured
   std::printf("CMA-ES: evaluations to f <= 1e-8, median of 31 seeds (failures: budget %ld used up)\n", kBudget);
   std::printf("%-10s %3s %10s %4s %10s %4s %8s %10s %8s %8s\n", "function", "n", "ours", "fail", "pagmo", "fail",
               "ratio", "reference", "ours_s", "pagmo_s");
