@@ -6,7 +6,10 @@
 //
 // pagmo is driven one generation per evolve() call with memory = true (its state persists), box
 // [-5, 5]^n (pagmo needs finite bounds; the optimum and the start are far inside), ftol = xtol =
-// 1e-30 so that its own stopping rules do not end the run before the target.
+// -1 so that its own stopping rules never end the run before the target (with the start
+// population all at x0, pagmo's x-spread test "< xtol" is true at once for any xtol >= 0 and it
+// returns without a single evaluation). The lambda evaluations of the start population are not
+// counted.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -62,7 +65,7 @@ long pagmo_run(int n, unsigned seed) {
   pagmo::population pop{prob, 0u, seed};
   for (int i = 0; i < lambda; ++i) pop.push_back(pagmo::vector_double(n, 0.1));
   const auto start = pop.get_problem().get_fevals();
-  pagmo::cmaes algo(1, -1, -1, -1, -1, 0.5, 1e-30, 1e-30, /*memory=*/true, /*force_bounds=*/false, seed);
+  pagmo::cmaes algo(1, -1, -1, -1, -1, 0.5, -1.0, -1.0, /*memory=*/true, /*force_bounds=*/false, seed);
   while (pop.champion_f()[0] > 1e-8) {
     pop = algo.evolve(pop);
     if (static_cast<long>(pop.get_problem().get_fevals() - start) >= kBudget) return -1;
