@@ -12,7 +12,9 @@
 //     writes DIR/eval.json.
 //   bench_calib_pipeline timing [--gown ...] [--generations G --population N] [--threads T]
 //     Wall time per simulation and of a G x N calibration of participant 4, with the final
-//     objective, and the projection to the paper's 50 x 32 budget from the measured pace.
+//     objective, and the projection to the paper's 50 x 32 budget from the measured pace. Under
+//     mpirun (e.g. -n 1 and -n 2 with --threads 1) the calibration's wall time gives the MPI
+//     scaling efficiency T1 / (2 T2).
 //
 // Everything runs through dg_calib's public API (the same code as the commands).
 #include <algorithm>
@@ -251,6 +253,8 @@ int run_timing(const std::map<std::string, std::string>& a) {
   const double cal_s = seconds_since(t0);
   const double sims = static_cast<double>(o.generations) * o.population * inputs.size();
   const double full_sims = 50.0 * 32 * inputs.size();
+  if (!Comm::world().is_root()) return 0;
+  std::printf("ranks %d x threads %d\n", Comm::world().size(), thread_count(o.threads));
   std::printf("gown %s: scene %.1f s; one simulation (%s, %zu samples) %.1f s on one thread\n", gown.c_str(), scene_s,
               inputs[0].id.c_str(), one.samples.size(), one_s);
   std::printf("calibration of participant 4 (%zu sequences), %d x %d = %.0f simulations on %d thread(s): %.1f s "
