@@ -68,15 +68,20 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// The force curve of a trial cut at `cut` m of travel, resampled every 5 mm on [0, cut] (the
-// last sample held beyond the trial's end), both axes: the 1-NN's feature vector.
+// The force curve of a trial cut at `cut` m of travel, linearly interpolated every 5 mm on
+// [0, cut] (the last sample held beyond the trial's end), both axes: the 1-NN's feature vector.
 std::vector<double> curve_features(const HapticSequence& t, double cut) {
   std::vector<double> f;
   std::size_t j = 0;
-  for (double x = 0.0; x <= cut + 1e-9; x += 0.005) {
+  for (int k = 0; k * 0.005 <= cut + 1e-9; ++k) {
+    const double x = k * 0.005;
     while (j + 1 < t.samples.size() && t.samples[j + 1].travel <= x) ++j;
-    f.push_back(t.samples[j].f_motion);
-    f.push_back(t.samples[j].f_vertical);
+    const HapticSample& a = t.samples[j];
+    const HapticSample& b = t.samples[std::min(j + 1, t.samples.size() - 1)];
+    const double span = b.travel - a.travel;
+    const double u = span > 1e-12 ? std::clamp((x - a.travel) / span, 0.0, 1.0) : 0.0;
+    f.push_back(a.f_motion + u * (b.f_motion - a.f_motion));
+    f.push_back(a.f_vertical + u * (b.f_vertical - a.f_vertical));
   }
   return f;
 }
@@ -173,9 +178,10 @@ int run_eval(const std::map<std::string, std::string>& a) {
     StcOptions stc_o;
     stc_o.source = synth.string();
     double stc[5] = {}, bc[5] = {};
-    std::string stc_error, bc_error;
+    std::string stc_error, bc_error, stc_classes;
     try {
       const auto m = build_outcome_model(strain, stc_o);
+      for (const auto& c : m.classes) stc_classes += (stc_classes.empty() ? "" : "+") + c.name;
       stc[0] = accuracy(m, test, std::numeric_limits<double>::infinity());
       for (int c = 0; c < 4; ++c) stc[c + 1] = accuracy(m, test, kCuts[c]);
     } catch (const std::exception& e) {
@@ -193,10 +199,10 @@ int run_eval(const std::map<std::string, std::string>& a) {
     char params[64];
     std::snprintf(params, sizeof params, "%.2f %.2f %.2f %.2f %.2f", r.cloth.stretch, r.cloth.shear, r.cloth.bend,
                   r.cloth.friction, r.cloth.self_friction);
-    std::printf("%-4s %-8.3f %-28s | %5.0f %5.0f %5.0f %5.0f %5.0f   | %5.0f %5.0f %5.0f %5.0f %5.0f  (%.0f s)%s%s\n",
+    std::printf("%-4s %-8.3f %-28s | %5.0f %5.0f %5.0f %5.0f %5.0f   | %5.0f %5.0f %5.0f %5.0f %5.0f  (%.0f s) STC classes %s%s%s\n",
                 p.c_str(), r.objective, params, 100 * stc[0], 100 * stc[1], 100 * stc[2], 100 * stc[3], 100 * stc[4],
                 100 * bc[0], 100 * bc[1], 100 * bc[2], 100 * bc[3], 100 * bc[4], seconds_since(t0),
-                stc_error.empty() ? "" : (" STC failed: " + stc_error).c_str(),
+                stc_classes.c_str(), stc_error.empty() ? "" : (" STC failed: " + stc_error).c_str(),
                 bc_error.empty() ? "" : (" BC failed: " + bc_error).c_str());
     std::fflush(stdout);
     Json row = calibration_to_json(cal);
@@ -205,6 +211,12 @@ int run_eval(const std::map<std::string, std::string>& a) {
     row.set("stc_accuracy_whole_and_cuts", js);
     row.set("bc_accuracy_whole_and_cuts", jb);
     row.set("seconds", seconds_since(t0));
+    row.set("stc_classes", stc_classes);
+    int synth_labels[kOutcomeCount] = {};
+    for (const auto* t : strain) synth_labels[static_cast<int>(*t->label)]++;
+    Json jl = Json::object();
+    for (int k = 0; k < kOutcomeCount; ++k) jl.set(std::string(outcome_name(static_cast<Outcome>(k))), synth_labels[k]);
+    row.set("synthesized_labels", jl);
     rows.push(row);
     for (int c = 0; c < 5; ++c) sum_stc[c] += stc[c], sum_bc[c] += bc[c];
     ++n;
