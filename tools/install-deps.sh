@@ -24,6 +24,8 @@ packages=(
   python3-pymodbus mbpoll
   # plots
   python3-matplotlib python3-numpy
+  # pagmo2's CMA-ES, the side-by-side comparison for our own (tools/bench/bench_calib_cmaes.cpp)
+  libpagmo-dev
 )
 if [ -z "${DRESSGUARD_SKIP_APT_UPDATE:-}" ]; then
   apt-get update -qq

@@ -15,9 +15,12 @@ model::OutcomeModel build_outcome_model(const std::vector<const HapticSequence*>
 
 double accuracy(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials, double truncate_at,
                 int* counted) {
-  const hmm::Evaluation e = hmm::evaluate(m, trials, truncate_at);
-  if (counted) *counted = e.total;
-  return e.accuracy();
+  std::vector<const HapticSequence*> labelled;
+  for (const auto* t : trials)
+    if (t->label && !t->samples.empty()) labelled.push_back(t);
+  const hmm::Evaluation e = hmm::evaluate(m, labelled, truncate_at);
+  if (counted) *counted = static_cast<int>(labelled.size());
+  return labelled.empty() ? 0.0 : static_cast<double>(e.correct) / labelled.size();
 }
 
 }  // namespace dressguard::calib

@@ -20,9 +20,10 @@ struct StcOptions {
 // Trains the HMMs of every outcome present among the labelled trials.
 model::OutcomeModel build_outcome_model(const std::vector<const HapticSequence*>& trials, const StcOptions& o);
 
-// The fraction of `trials` whose label the model predicts, with every trial cut after
-// `truncate_at` metres of travel (infinity: whole). Trials whose label is not a class of the
-// model are skipped.
+// The fraction of the labelled `trials` whose label the model predicts, with every trial cut
+// after `truncate_at` metres of travel (infinity: whole). A trial whose label is not a class of
+// the model counts as wrong (a model trained on simulated data without any "good" trial cannot
+// be right about a good trial); `counted` receives the number of labelled trials.
 double accuracy(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials,
                 double truncate_at, int* counted = nullptr);
 

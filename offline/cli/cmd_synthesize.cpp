@@ -67,9 +67,9 @@ int run_synthesize(int argc, char** argv) {
   }
   args.allow_only({"help", "json", "no-gown-noise", "no-arm-noise", "calibration", "out", "per-height", "seed",
                    "gown", "threads"});
-  const Calibration cal = read_calibration(args.require("calibration"));
   const std::string out = args.require("out");
-  const SynthesisOptions o = synthesis_options_from(args);
+  const SynthesisOptions o = synthesis_options_from(args);  // options first: a usage error needs no file
+  const Calibration cal = read_calibration(args.require("calibration"));
   const std::string gown = args.get("gown").value_or(cal.gown);
   const SynthesisSummary s = run_synthesis(cal, gown, o, out);
   if (Comm::world().is_root()) {

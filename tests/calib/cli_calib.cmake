@@ -1,0 +1,41 @@
+# The calibrate / synthesize / build-model commands: bad input exits 2 with one line naming the
+# problem (file and line where there is one); build-model --data trains a model from a dataset.
+# -DDG=<dressguard> -DWORK=<dir> -DSTUDY=<study dir or empty>
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK})
+
+function(expect_fail what expect)
+  execute_process(COMMAND ${DG} ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 2)
+    message(FATAL_ERROR "${what}: expected exit 2, got ${rc}\n${out}\n${err}")
+  endif()
+  string(FIND "${err}" "${expect}" at)
+  if(at EQUAL -1)
+    message(FATAL_ERROR "${what}: stderr lacks '${expect}':\n${err}")
+  endif()
+endfunction()
+
+expect_fail("calibrate without --data" "--data" calibrate --participant 1 --out ${WORK}/c.json)
+expect_fail("calibrate with an unknown objective" "--objective" calibrate --data ${WORK} --participant 1 --out ${WORK}/c.json --objective mse)
+expect_fail("calibrate with a typo option" "--sed" calibrate --data ${WORK} --participant 1 --out ${WORK}/c.json --sed 3)
+expect_fail("calibrate on a missing dataset" "manifest.csv" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json)
+file(WRITE ${WORK}/bad.json "{\"format\": \"dressguard-calibration 1\",\n\"participant\": 4,\n}")
+expect_fail("synthesize with a bad calibration file" "bad.json" synthesize --calibration ${WORK}/bad.json --out ${WORK}/s)
+expect_fail("synthesize with --per-height 1" "--per-height" synthesize --calibration ${WORK}/bad.json --out ${WORK}/s --per-height 1)
+expect_fail("build-model with both inputs" "exactly one" build-model --calibration ${WORK}/bad.json --data ${WORK} --out ${WORK}/m.dgm)
+
+if(STUDY)
+  execute_process(COMMAND ${DG} import --study ${STUDY} --out ${WORK}/study RESULT_VARIABLE rc)
+  file(WRITE ${WORK}/bounds.txt "friction 0 2\nstiffness 0 1\n")
+  expect_fail("calibrate with a bad bounds file" "bounds.txt:2: unknown parameter 'stiffness'"
+              calibrate --data ${WORK}/study --participant 4 --out ${WORK}/c.json --bounds ${WORK}/bounds.txt)
+  expect_fail("calibrate an absent participant" "participant '42'" calibrate --data ${WORK}/study --participant 42 --out ${WORK}/c.json)
+  if(HMM)
+    execute_process(COMMAND ${DG} build-model --data ${WORK}/study --out ${WORK}/m.dgm --states 5 --json
+                    RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+    if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/m.dgm OR NOT out MATCHES "\"classes\": 2")
+      message(FATAL_ERROR "build-model --data failed (${rc}):\n${out}\n${err}")
+    endif()
+  endif()
+endif()
+file(REMOVE_RECURSE ${WORK})
