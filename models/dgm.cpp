@@ -15,6 +15,13 @@
 
 namespace dressguard::model {
 
+EmissionTerms emission_terms(const GaussianEmission& e) noexcept {
+  constexpr double kLog2Pi = 1.8378770664093454835606594728112;  // log(2 pi)
+  const double a = e.cov[0][0], b = 0.5 * (e.cov[0][1] + e.cov[1][0]), d = e.cov[1][1];
+  const double det = a * d - b * b;
+  return {e.mean[0], e.mean[1], d / det, -b / det, a / det, -kLog2Pi - 0.5 * std::log(det)};
+}
+
 int OutcomeModel::class_index(std::string_view name) const {
   for (size_t i = 0; i < classes.size(); ++i)
     if (classes[i].name == name) return static_cast<int>(i);

@@ -50,6 +50,15 @@ struct GaussianEmission {
   double cov[kFeatures][kFeatures] = {{1.0, 0.0}, {0.0, 1.0}};
 };
 
+// The constants of one emission's log density, computed once per model by the trainer and the
+// online filter alike. For S = [[a b][b d]] and z = x - mean:
+//     S^-1 = [[ip iq][iq ir]] = [[d -b][-b a]] / det,   det = a d - b^2
+//     log N(x; mean, S) = lconst - (ip z0^2 + 2 iq z0 z1 + ir z1^2) / 2,   lconst = -log(2 pi) - log(det) / 2
+struct EmissionTerms {
+  double mean0, mean1, ip, iq, ir, lconst;
+};
+EmissionTerms emission_terms(const GaussianEmission& e) noexcept;
+
 // One class's HMM. Left-right models have zeros below the diagonal of `transition`; the file
 // stores the full matrix, so any topology loads, and the filter detects the band.
 struct ClassHmm {

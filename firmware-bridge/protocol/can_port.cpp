@@ -51,6 +51,10 @@ class SocketCanPort final : public CanPort {
       fail_close("setsockopt(CAN_RAW_RECV_OWN_MSGS) on " + iface);
     const int one = 1;
     if (setsockopt(fd_, SOL_SOCKET, SO_RXQ_OVFL, &one, sizeof one) < 0) fail_close("setsockopt(SO_RXQ_OVFL) on " + iface);
+    if (opt.receive_buffer > 0 &&
+        setsockopt(fd_, SOL_SOCKET, SO_RCVBUFFORCE, &opt.receive_buffer, sizeof opt.receive_buffer) < 0 &&
+        setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &opt.receive_buffer, sizeof opt.receive_buffer) < 0)
+      fail_close("setsockopt(SO_RCVBUF) on " + iface);
     ifreq ifr{};
     std::strncpy(ifr.ifr_name, iface.c_str(), IFNAMSIZ - 1);
     if (ioctl(fd_, SIOCGIFINDEX, &ifr) < 0) fail_close("no CAN interface '" + iface + "' (SIOCGIFINDEX)");

@@ -41,6 +41,7 @@ struct PortOptions {
   std::vector<uint32_t> ids;    // exact 11-bit identifiers to receive (kernel filters); empty: none
   bool receive_own = false;     // echo own frames back (CAN_RAW_RECV_OWN_MSGS)
   bool error_frames = true;     // receive bus-off / controller error frames
+  int receive_buffer = 0;       // SO_RCVBUF(FORCE) bytes, 0: the kernel's default
 };
 
 class CanPort {

@@ -35,8 +35,10 @@ std::string ints_json(const std::vector<int>& v) {
 }
 
 // Everything the picture needs: mesh, grasped vertices, loops, arm and gripper (all in W).
-std::string scene_dump(const GownMesh& m, const gown::PaperScene& s, const std::vector<int>& grasp) {
-  std::string out = "{\n\"frame\": \"W: z up, gravity -z, gripper moves +x\",\n\"x\": [";
+std::string scene_dump(const GownMesh& m, const gown::PaperScene& s, const std::vector<int>& grasp, bool hung) {
+  std::string out = "{\n\"frame\": \"W: z up, gravity -z, gripper moves +x\",\n\"state\": \"";
+  out += hung ? "after a crude 3 s hang (edges only, no bending, no collisions)" : "placed, before gravity";
+  out += "\",\n\"x\": [";
   for (size_t i = 0; i < m.x.size(); ++i) {
     char buf[80];
     std::snprintf(buf, sizeof buf, "%s[%.5f,%.5f,%.5f]", i ? "," : "", m.x[i].x(), m.x[i].y(), m.x[i].z());
@@ -88,16 +90,17 @@ std::string shell_quote(const std::string& s) {
 }  // namespace
 
 int run_gown(int argc, char** argv) {
-  Args args(argc - 1, argv + 1, {"help", "json", "parametric", "hang"});
+  Args args(argc - 1, argv + 1, {"help", "json", "parametric", "hang", "in-world"});
   if (args.has("help")) {
     std::puts(
-        "usage: dressguard gown [--obj FILE] [--scale S] [--parametric] [--reduced N] [--out MESH.obj]\n"
-        "                       [--dump SCENE.json] [--picture GOWN.png] [--json]\n"
+        "usage: dressguard gown [--obj FILE [--scale S] [--in-world] | --parametric] [--reduced N] [--hang]\n"
+        "                       [--out MESH.obj] [--dump SCENE.json] [--picture GOWN.png] [--json]\n"
         "  Loads the gown the simulator runs on, placed in the world frame W (z up, gripper moves +x)\n"
         "  like the paper's simulator, and prints its statistics.\n"
         "  --obj FILE      mesh to load (default: shared/data/gown/fullgown.obj when present,\n"
         "                  else the project's parametric gown)\n"
         "  --scale S       file units -> metres (default 1.679, the paper's)\n"
+        "  --in-world      the OBJ is already placed in W (as --out writes it; use --scale 1)\n"
         "  --parametric    use the parametric gown even when the measured one is present\n"
         "  --reduced N     reduce to about N triangles (quadric edge collapse), e.g. 5000\n"
         "  --hang          let the gown hang 3 s from the jaws in a crude check (edges only, no\n"
@@ -109,7 +112,7 @@ int run_gown(int argc, char** argv) {
         "  --json          print a machine-readable summary");
     return 0;
   }
-  args.allow_only({"help", "json", "parametric", "hang", "obj", "scale", "reduced", "out", "dump", "picture"});
+  args.allow_only({"help", "json", "parametric", "hang", "in-world", "obj", "scale", "reduced", "out", "dump", "picture"});
   if (args.has("parametric") && args.has("obj")) throw UsageError("--parametric and --obj exclude each other");
   gown::GownOptions opt;
   opt.scale = args.number("scale", 1.679);
@@ -121,6 +124,7 @@ int run_gown(int argc, char** argv) {
 
   const auto t0 = std::chrono::steady_clock::now();
   opt.parametric = args.has("parametric");
+  opt.already_in_W = args.has("in-world");
   const fs::path measured = gown::measured_gown_path();
   const std::string source =
       opt.parametric || (opt.obj.empty() && measured.empty()) ? "parametric" : (opt.obj.empty() ? measured : opt.obj).string();
@@ -140,7 +144,7 @@ int run_gown(int argc, char** argv) {
   if (dump || picture) {
     const fs::path dump_path =
         dump ? fs::path(*dump) : fs::temp_directory_path() / ("dressguard-gown-" + std::to_string(::getpid()) + ".json");
-    write_file_atomic(dump_path, scene_dump(mesh, opt.scene, grasp));
+    write_file_atomic(dump_path, scene_dump(mesh, opt.scene, grasp, args.has("hang")));
     if (picture) {
       const fs::path script = plot_script();
       if (script.empty()) throw std::runtime_error("tools/plot/gown.py not found (set DRESSGUARD_SOURCE_DIR)");

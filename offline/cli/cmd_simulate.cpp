@@ -29,7 +29,7 @@ std::vector<double> parse_times(const std::string& s) {
 }  // namespace
 
 int run_simulate(int argc, char** argv) {
-  Args args(argc - 1, argv + 1, {"help", "json", "noise", "no-self-collision"});
+  Args args(argc - 1, argv + 1, {"help", "json", "noise", "arm-noise", "no-self-collision", "parametric"});
   if (args.has("help")) {
     std::puts(
         "usage: dressguard simulate --height high|middle|low --out FILE.csv [options]\n"
@@ -40,8 +40,12 @@ int run_simulate(int argc, char** argv) {
         "  --arm-offset M    [m] added to the height's arm height (default 0)\n"
         "  --speed V         [m/s] pull speed, 0.1 or 0.15 (default 0.1)\n"
         "  --params FILE     cloth parameters ('name value' lines or flat JSON; see offline/sim/params.h)\n"
-        "  --seed S          seed of the perturbation (default 0); --noise turns the perturbation on\n"
-        "  --gown G          full | reduced | coarse (default reduced)\n"
+        "  --seed S          seed of the noise models (default 0)\n"
+        "  --noise           the paper's gown perturbation (random force up to 6 N for 0.5 s)\n"
+        "  --arm-noise       the paper's arm-height noise (+-1.5 cm high/low, -6..0 cm middle)\n"
+        "  --gown G          full | reduced | coarse (default reduced): the measured gown at ~20k, 5k,\n"
+        "                    1.5k triangles (the gown module's parametric gown without shared/data)\n"
+        "  --parametric      the gown module's parametric gown even when the measured one is present\n"
         "  --friction F      stock | improved | constraint (default improved)\n"
         "  --no-self-collision\n"
         "  --frames T1,T2,.. [s] since the start of the pull (negative: settling) to keep the gown\n"
@@ -49,8 +53,8 @@ int run_simulate(int argc, char** argv) {
         "  --json            print the summary as JSON");
     return 0;
   }
-  args.allow_only({"help", "json", "noise", "no-self-collision", "height", "arm-offset", "speed", "params", "seed",
-                   "gown", "friction", "out", "frames"});
+  args.allow_only({"help", "json", "noise", "arm-noise", "no-self-collision", "height", "arm-offset", "speed", "params", "seed",
+                   "gown", "friction", "out", "frames", "parametric"});
   sim::TrialSpec spec;
   const std::string hs = args.require("height");
   const auto h = parse_arm_height(hs);
@@ -64,6 +68,7 @@ int run_simulate(int argc, char** argv) {
   if (seed < 0) throw UsageError("--seed must be non-negative");
   spec.seed = static_cast<uint64_t>(seed);
   spec.gown_noise = args.has("noise");
+  spec.arm_noise = args.has("arm-noise");
   spec.self_collision = !args.has("no-self-collision");
   const std::string fr = args.get("friction").value_or("improved");
   if (fr == "stock") spec.friction_scheme = sim::FrictionScheme::Stock;
@@ -86,7 +91,7 @@ int run_simulate(int argc, char** argv) {
     for (double t = -1.6; t < 12.0; t += 0.25) spec.frame_times.push_back(t);
   }
 
-  const sim::Scene scene = sim::make_default_scene(res);
+  const sim::Scene scene = sim::make_default_scene(res, args.has("parametric"));
   const sim::TrialResult r = sim::simulate_trial(scene, params, spec);
   if (!r.finite) throw std::runtime_error("the simulation diverged (non-finite positions)");
 
@@ -99,7 +104,7 @@ int run_simulate(int argc, char** argv) {
                 "\"stopped_by_force\": %s, \"contact_travel\": %.6f, \"samples\": %zu, \"f_motion\": %.6f, "
                 "\"f_lateral\": %.6f, \"f_vertical\": %.6f, \"weight\": %.6f, \"area_ratio\": %.6f, "
                 "\"out\": \"%s\", \"params\": %s}",
-                std::string(outcome_name(r.outcome)).c_str(), hs.c_str(), spec.arm_offset, spec.speed,
+                std::string(outcome_name(r.outcome)).c_str(), hs.c_str(), r.arm_offset, spec.speed,
                 static_cast<unsigned long long>(spec.seed), spec.gown_noise ? "true" : "false", gs.c_str(), fr.c_str(),
                 r.travel, r.d_max, r.stopped_by_force ? "true" : "false", r.contact_travel, r.seq.samples.size(),
                 last.f_motion, last.f_lateral, last.f_vertical, r.weight, r.area_ratio, out.c_str(),
@@ -114,7 +119,7 @@ int run_simulate(int argc, char** argv) {
     std::printf("%s\n", b);
   } else {
     std::printf("%s at %s arm (offset %+.3f m): travel %.3f m, d_max %.3f m, final F motion %.2f N vertical %.2f N -> %s\n",
-                std::string(outcome_name(r.outcome)).c_str(), hs.c_str(), spec.arm_offset, r.travel, r.d_max,
+                std::string(outcome_name(r.outcome)).c_str(), hs.c_str(), r.arm_offset, r.travel, r.d_max,
                 last.f_motion, last.f_vertical, out.c_str());
   }
   return 0;

@@ -43,9 +43,9 @@ int run_train(int argc, char** argv) {
         "  F_vertical (paper V-B): equal-segment initialisation, Baum-Welch to convergence.\n"
         "  --states N              states per HMM (default 10, the paper; the study's code used 5)\n"
         "  --band W                left-right width: state i may go to i..i+W (default 1)\n"
-        "  --cov-floor V           minimum covariance eigenvalue in scaled feature units (default 1e-3)\n"
+        "  --cov-floor V           minimum covariance eigenvalue in scaled feature units (default 0.05)\n"
         "  --max-iter N            Baum-Welch iterations at most (default 100)\n"
-        "  --tolerance T           stop when the gain per sample is below T nats (default 1e-5)\n"
+        "  --tolerance T           stop when the gain per sample is below T nats (default 1e-6)\n"
         "  --uniform-priors        equal class priors instead of the training counts\n"
         "  --exclude-participant P[,Q...]  leave these participants out (leave-one-participant-out)\n"
         "  --stop-threshold X      predictor default: stop when P(caught) > X ... (default 0.9)\n"
@@ -60,9 +60,9 @@ int run_train(int argc, char** argv) {
   hmm::ModelOptions opt;
   opt.hmm.n_states = static_cast<int>(args.integer("states", 10));
   opt.hmm.band = static_cast<int>(args.integer("band", 1));
-  opt.hmm.cov_floor = args.number("cov-floor", 1e-3);
+  opt.hmm.cov_floor = args.number("cov-floor", opt.hmm.cov_floor);
   opt.hmm.max_iterations = static_cast<int>(args.integer("max-iter", 100));
-  opt.hmm.tolerance = args.number("tolerance", 1e-5);
+  opt.hmm.tolerance = args.number("tolerance", 1e-6);
   opt.uniform_priors = args.has("uniform-priors");
   opt.source_dataset = data;
   if (opt.hmm.n_states < 1 || opt.hmm.n_states > model::kMaxStates)

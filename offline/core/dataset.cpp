@@ -74,6 +74,15 @@ void check_time_increases(const std::vector<HapticSample>& s, const fs::path& fi
   }
 }
 
+// Parses the five fields of one row (names as the file calls its columns) and appends the sample.
+void append_sample(const std::vector<std::string_view>& f, const char* const names[5], const fs::path& file,
+                   long line, std::vector<HapticSample>& out) {
+  double v[5];
+  for (int i = 0; i < 5; ++i) v[i] = parse_double(f[i], file, line, names[i]);
+  out.push_back({v[0], v[1], v[2], v[3], v[4]});
+  check_time_increases(out, file, line);
+}
+
 }  // namespace
 
 std::vector<HapticSample> read_trial_csv(const fs::path& path) {
@@ -88,10 +97,7 @@ std::vector<HapticSample> read_trial_csv(const fs::path& path) {
     const auto f = split(line, ',');
     if (f.size() != 5) throw_input_error(path, n, "expected 5 columns, found " + std::to_string(f.size()));
     static constexpr const char* names[] = {"t", "travel", "f_motion", "f_lateral", "f_vertical"};
-    double v[5];
-    for (int i = 0; i < 5; ++i) v[i] = parse_double(f[i], path, n, names[i]);
-    out.push_back({v[0], v[1], v[2], v[3], v[4]});
-    check_time_increases(out, path, n);
+    append_sample(f, names, path, n, out);
   });
   if (out.empty()) throw_input_error(path, 0, "no samples");
   return out;
@@ -168,10 +174,7 @@ std::vector<HapticSample> read_study_trial(const fs::path& path) {
     if (f.empty()) return;
     if (f.size() != 5) throw_input_error(path, n, "expected 5 space-separated columns, found " + std::to_string(f.size()));
     static constexpr const char* names[] = {"t", "position", "F_motion", "F_lateral", "F_vertical"};
-    double v[5];
-    for (int i = 0; i < 5; ++i) v[i] = parse_double(f[i], path, n, names[i]);
-    out.push_back({v[0], v[1], v[2], v[3], v[4]});
-    check_time_increases(out, path, n);
+    append_sample(f, names, path, n, out);
   });
   if (out.empty()) throw_input_error(path, 0, "no samples");
   return out;

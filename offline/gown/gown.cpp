@@ -26,14 +26,18 @@ GownMesh load_gown(const GownOptions& options) {
     mesh = make_parametric_gown();
   } else {
     mesh = read_obj(path, options.scale);
-    place_like_paper(mesh, options.scene);
+    if (!options.already_in_W) place_like_paper(mesh, options.scene);
   }
   mesh.areal_density = options.areal_density;
   if (mesh.boundary_loops.size() < 2)
     throw_input_error(path.empty() ? "parametric gown" : path, 0,
                       "the mesh has " + std::to_string(mesh.boundary_loops.size()) +
                           " boundary loop(s); a gown needs its body opening and a sleeve opening");
-  if (options.target_triangles > 0) mesh = reduce_gown(mesh, options.target_triangles);
+  if (options.target_triangles > 0) {
+    std::vector<bool> frozen(mesh.x.size(), false);
+    for (int v : grasp_vertices(mesh, options.scene)) frozen[v] = true;
+    mesh = reduce_gown(mesh, options.target_triangles, frozen);
+  }
   label_sleeve(mesh, options.scene);
   return mesh;
 }

@@ -8,6 +8,15 @@
 // The scene constants of that simulator (gripper jaws, arm spheres, gown transform) are in
 // placement.h (`PaperScene`), so that gown and sim use the same numbers.
 //
+// How the simulator uses it:
+//   GownOptions opt;                       // defaults: measured gown if present, scale 1.679
+//   opt.target_triangles = 5000;           // or 0 for the full 20k-triangle mesh
+//   GownMesh g = load_gown(opt);           // placed in W, loops found, sleeve labelled
+//   auto m = vertex_masses(g);             // lumped (the paper's simulator gives every particle
+//                                          // the same mass, total area * density / n)
+//   auto held = grasp_vertices(g, opt.scene);   // then hold them at z = opt.scene.pinch_z_W()
+//   g.sleeve_lower_half                    // for the outcome label (paper V-A)
+//
 // Data: the measured gown is gt-rad/learning-forces, physx_simulation/Mesh/fullgown.obj (read in
 // place from shared/data/gown/, never copied into the project).
 #pragma once
@@ -41,14 +50,16 @@ struct GownOptions {
   int target_triangles = 0;   // 0: full resolution; e.g. 5000 for the reduced gown
   double areal_density = 0.145;
   bool parametric = false;    // use the parametric gown even when the measured one is present
+  bool already_in_W = false;  // the file is already placed in W (as `dressguard gown --out` writes
+                              // it, scale 1): skip the paper's transform
   PaperScene scene{};         // placement of a file's mesh and the grasp box that picks the sleeve
 };
 
 // shared/data/gown/fullgown.obj when shared/data is present, else empty.
 std::filesystem::path measured_gown_path();
 
-// The gown the simulator runs on: loaded (or generated), reduced if asked, placed in W like the
-// paper's simulator, its boundary loops found and the sleeve opening labelled. Throws InputError
+// The gown the simulator runs on: loaded (or generated), placed in W like the paper's simulator,
+// reduced if asked (keeping the grasped vertices as they are), its boundary loops found and the sleeve opening labelled. Throws InputError
 // for a malformed file or a mesh without at least one boundary loop near the grasp box.
 GownMesh load_gown(const GownOptions& options);
 
@@ -69,6 +80,9 @@ GownMesh make_parametric_gown();
 // sliver are refused. Deterministic (ties broken by edge index). Loops are found again and the
 // sleeve labelling is carried over (same loop, lower half recomputed) when the input had one.
 GownMesh reduce_gown(const GownMesh& mesh, int target_triangles);
+// The same, with vertices that neither move nor disappear (frozen[v], sized like mesh.x or
+// shorter). load_gown freezes the grasped vertices, so every resolution holds the same patch.
+GownMesh reduce_gown(const GownMesh& mesh, int target_triangles, const std::vector<bool>& frozen);
 
 // Loops of edges used by exactly one triangle, each ordered by walking along the boundary,
 // longest (most vertices) first. A vertex where two loops touch is followed consistently.

@@ -41,26 +41,57 @@ std::vector<std::vector<int>> find_boundary_loops(const std::vector<std::array<i
   std::sort(he.begin(), he.end(), [](const HalfEdge& l, const HalfEdge& r) {
     return l.key != r.key ? l.key < r.key : (l.a != r.a ? l.a < r.a : l.b < r.b);
   });
-  // Outgoing boundary edges per vertex (a vertex where two loops touch has two).
-  std::vector<std::vector<int>> out(n_vertices);
+  // Boundary edges per vertex, undirected (so a mesh whose triangles are not consistently
+  // oriented still closes its loops); `forward` marks the direction a triangle walks the edge.
+  struct Link {
+    int to;
+    bool forward;
+    bool used;
+  };
+  std::vector<std::vector<Link>> links(n_vertices);
   for (size_t i = 0; i < he.size();) {
     size_t j = i;
     while (j < he.size() && he[j].key == he[i].key) ++j;
-    if (j - i == 1) out[he[i].a].push_back(he[i].b);
+    if (j - i == 1) {
+      links[he[i].a].push_back({he[i].b, true, false});
+      links[he[i].b].push_back({he[i].a, false, false});
+    }
     i = j;
   }
+  auto take = [&](int from, int to) {  // marks edge {from, to} used in both lists
+    for (auto& l : links[from])
+      if (l.to == to && !l.used) {
+        l.used = true;
+        break;
+      }
+    for (auto& l : links[to])
+      if (l.to == from && !l.used) {
+        l.used = true;
+        break;
+      }
+  };
+  // The next unused boundary edge at v: the forward one (walk like the triangles) if any.
+  auto next_from = [&](int v) {
+    int pick = -1;
+    for (const auto& l : links[v])
+      if (!l.used) {
+        if (l.forward) return l.to;
+        if (pick < 0) pick = l.to;
+      }
+    return pick;
+  };
   std::vector<std::vector<int>> loops;
   for (int start = 0; start < n_vertices; ++start) {
-    while (!out[start].empty()) {
+    for (int first = next_from(start); first >= 0; first = next_from(start)) {
       std::vector<int> loop{start};
-      int cur = start;
-      while (true) {
-        if (out[cur].empty()) break;  // open chain: inconsistent orientation; keep what was walked
-        const int next = out[cur].front();
-        out[cur].erase(out[cur].begin());
-        if (next == start) break;
-        loop.push_back(next);
-        cur = next;
+      take(start, first);
+      int cur = first;
+      while (cur != start) {
+        loop.push_back(cur);
+        const int nxt = next_from(cur);
+        if (nxt < 0) break;  // an open chain: cannot happen on a boundary of a surface
+        take(cur, nxt);
+        cur = nxt;
       }
       if (loop.size() >= 3) loops.push_back(std::move(loop));
     }

@@ -17,10 +17,13 @@
 //    PhysX contact offsets may add or drop a row of particles at the box's faces.
 //  - The arm starts 0.1 m further along +x_W and moves to its place during settling steps
 //    200-400 (`arm_approach_x_W`); the numbers below are its final place.
-//  - A crude hanging check (edges only, no bending, no collisions; tests/gown) lets the measured
-//    gown's sleeve opening hang about 0.17 m below the arm axis and 0.08 m behind the gripper:
-//    whether the arm enters it at the high setting depends on the bending stiffness and the
-//    settling, i.e. on the simulator, not on this placement.
+//  - A crude hanging check (crude_hang: edges only, no bending, no collisions) lets the measured
+//    gown's sleeve opening (reduced gown) hang with its centre about 0.15 m below the arm axis
+//    (its top 0.11 m below) and 0.05 m behind the jaws, lying nearly flat: placed, the paper's
+//    grip is on the sleeve's root, 0.2 m from the rim. Whether the arm enters the opening at the
+//    high setting then depends on the bending stiffness and the settling, i.e. on the simulator.
+//  - Also in that code, not here: every particle gets the same mass (total / n; we lump by area)
+//    and the grasped particles' masses are scaled up (grip_massscale).
 //  - The paper's Fig. 3(b) only shows the sleeve hanging toward the fist; the "lower half" of the
 //    opening is our reading: the half of the loop that lies below its centroid (z_W).
 #pragma once

@@ -8,6 +8,8 @@
 //    The alpha term (a point quadric) makes E strictly convex, so the optimum is one 3x3 solve,
 //    and it makes flat regions (where Q alone is ~0 everywhere) collapse their shortest edges
 //    first, at their midpoints: the reduced cloth keeps near-uniform triangles.
+//  - frozen vertices (load_gown freezes the grasped patch, so the gripper holds the same cloth at
+//    every resolution) neither move nor go; an edge's other end collapses onto them;
 //  - a boundary vertex stays on its loop: two boundary vertices collapse only along a boundary
 //    edge, an interior vertex collapses onto a boundary vertex's position;
 //  - the link condition (the two end points share exactly the edge's opposite vertices) keeps
@@ -76,8 +78,9 @@ struct Candidate {
 
 class Reducer {
  public:
-  Reducer(const GownMesh& m) : x_(m.x), tris_(m.triangles) {
+  Reducer(const GownMesh& m, std::vector<bool> frozen) : x_(m.x), tris_(m.triangles), frozen_(std::move(frozen)) {
     const int nv = static_cast<int>(x_.size());
+    frozen_.resize(nv, false);
     vf_.resize(nv);
     for (int f = 0; f < static_cast<int>(tris_.size()); ++f)
       for (int v : tris_[f]) vf_[v].push_back(f);
@@ -108,8 +111,9 @@ class Reducer {
         boundary_[a] = true;
         loop_of_[a] = static_cast<int>(l);
         // The plane through the boundary edge, perpendicular to its face.
-        const int f = common_faces(a, b).front();
-        const auto& t = tris_[f];
+        const auto faces = common_faces(a, b);
+        if (faces.empty()) continue;
+        const auto& t = tris_[faces.front()];
         const Eigen::Vector3d fn = (x_[t[1]] - x_[t[0]]).cross(x_[t[2]] - x_[t[0]]);
         const Eigen::Vector3d e = x_[b] - x_[a];
         const Eigen::Vector3d pn = e.cross(fn);
@@ -157,15 +161,22 @@ class Reducer {
   void push_edge(int u, int w) {
     int a = u, b = w;
     Eigen::Vector3d target;
-    const bool bu = boundary_[u], bw = boundary_[w];
+    const bool bu = boundary_[u], bw = boundary_[w], fu = frozen_[u], fw = frozen_[w];
+    if (fu && fw) return;
     if (bu && bw) {
       if (common_faces(u, w).size() != 1) return;  // interior edge between two boundary points
       const int l = loop_of_[u];
       if (l < 0 || loop_of_[w] != l || loop_count_[l] <= loop_min_[l]) return;
     }
     Quadric q = Q_[u] + Q_[w] + point_quadric(x_[u], kAlpha) + point_quadric(x_[w], kAlpha);
-    if (bu != bw) {
-      if (bw) std::swap(a, b);  // the boundary vertex survives, where it is
+    if (fu || fw || bu != bw) {
+      // One end stays where it is: the frozen one, else the boundary one. A boundary vertex is
+      // never pulled off its loop onto a frozen interior one.
+      const int keep = (fu || fw) ? (fu ? u : w) : (bu ? u : w);
+      const int gone = keep == u ? w : u;
+      if (boundary_[gone] && !boundary_[keep]) return;
+      a = keep;
+      b = gone;
       target = x_[a];
     } else {
       // Minimise E(v): the upper-left 3x3 of q is positive definite thanks to the point quadrics.
@@ -255,6 +266,7 @@ class Reducer {
   std::vector<Eigen::Vector3d> x_;
   std::vector<std::array<int, 3>> tris_;
   std::vector<std::vector<int>> vf_;
+  std::vector<bool> frozen_;  // vertices that neither move nor go (the grasped patch)
   std::vector<bool> alive_f_, alive_v_, boundary_;
   std::vector<int> stamp_, loop_of_, loop_count_, loop_min_;
   std::vector<Quadric> Q_;
@@ -264,10 +276,12 @@ class Reducer {
 
 }  // namespace
 
-GownMesh reduce_gown(const GownMesh& mesh, int target_triangles) {
+GownMesh reduce_gown(const GownMesh& mesh, int target_triangles) { return reduce_gown(mesh, target_triangles, {}); }
+
+GownMesh reduce_gown(const GownMesh& mesh, int target_triangles, const std::vector<bool>& frozen) {
   if (target_triangles <= 0) throw std::invalid_argument("reduce_gown: target_triangles must be positive");
   if (target_triangles >= static_cast<int>(mesh.triangles.size())) return mesh;
-  GownMesh out = Reducer(mesh).run(target_triangles, mesh.areal_density);
+  GownMesh out = Reducer(mesh, frozen).run(target_triangles, mesh.areal_density);
   if (mesh.sleeve_loop >= 0 && out.boundary_loops.size() >= 2) {
     // The same opening: the reduced loop whose centroid is nearest the old one's.
     const Eigen::Vector3d c = loop_centroid(mesh, mesh.sleeve_loop);

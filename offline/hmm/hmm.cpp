@@ -1,6 +1,8 @@
 // Outcome HMM training and inference (see hmm.h for the equations and the convergence rule).
 #include "hmm.h"
 
+#include "emission_update.h"  // predictor/filter: the vector exp
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -23,14 +25,13 @@ struct EmissionCache {
   std::vector<double> m0, m1, p, q, r, c;
   explicit EmissionCache(const ClassHmm& h) {
     for (const auto& e : h.emission) {
-      const double a = e.cov[0][0], b = 0.5 * (e.cov[0][1] + e.cov[1][0]), d = e.cov[1][1];
-      const double det = a * d - b * b;
-      m0.push_back(e.mean[0]);
-      m1.push_back(e.mean[1]);
-      p.push_back(d / det);
-      q.push_back(-b / det);
-      r.push_back(a / det);
-      c.push_back(-kLog2Pi - 0.5 * std::log(det));
+      const model::EmissionTerms t = model::emission_terms(e);
+      m0.push_back(t.mean0);
+      m1.push_back(t.mean1);
+      p.push_back(t.ip);
+      q.push_back(t.iq);
+      r.push_back(t.ir);
+      c.push_back(t.lconst);
     }
   }
   double log_density(int j, const double* x) const {
@@ -88,14 +89,55 @@ void floor_covariance(double cov[2][2], double floor) {
 }
 
 // Scratch for one sequence's forward-backward pass, reused across sequences.
+// One HMM laid out for the filter's update kernel: padded structure-of-arrays emissions and the
+// band diagonals B_d[j] = A_{j-d,j} (band -1: the caller predicts with the full matrix).
+struct KernelModel {
+  int np = 0;
+  std::vector<double> diag, m0, m1, ip, iq, ir, lc;
+  filter::ClassBlock block;
+  filter::ClassUpdateFn update = filter::class_update_best();
+  explicit KernelModel(const ClassHmm& h, const Band& band) {
+    const int n = h.n_states;
+    np = (n + 3) & ~3;
+    int w = 0;
+    for (int j = 0; j < n; ++j) {
+      if (band.lo[j] < j - filter::kMaxBand) w = -1;
+      if (w >= 0) w = std::max(w, j - band.lo[j]);
+      if (band.hi[j] > j) w = -1;  // a predecessor after j: not left-right
+    }
+    for (int j = 0; j < np; ++j) {
+      model::GaussianEmission e;
+      if (j < n) e = h.emission[j];
+      const model::EmissionTerms t = model::emission_terms(e);
+      m0.push_back(t.mean0), m1.push_back(t.mean1);
+      ip.push_back(t.ip), iq.push_back(t.iq), ir.push_back(t.ir);
+      lc.push_back(t.lconst);
+    }
+    if (w >= 0)
+      for (int d = 0; d <= w; ++d)
+        for (int j = 0; j < np; ++j) diag.push_back(j < n && j - d >= 0 ? h.transition[(j - d) * n + j] : 0.0);
+    block.n_padded = np;
+    block.band = w;
+    for (int d = 0; d <= w; ++d) block.diag[d] = diag.data() + d * np;
+    block.m0 = m0.data(), block.m1 = m1.data(), block.ip = ip.data(), block.iq = iq.data(), block.ir = ir.data();
+    block.lc = lc.data();
+  }
+};
+
 struct Workspace {
-  std::vector<double> alpha, beta, bs, scale;  // T*n, T*n, T*n (shifted emissions), T
+  std::vector<double> alpha, beta, bs, scale;  // T*n, 2*n (two rows), T*n (shifted emissions), T
+  KernelModel km;
+  std::vector<double> row, pred, logb, ex;     // one padded row for the kernel
+  std::vector<double> v;                        // bs * beta / c of the row after
+  Workspace(const ClassHmm& h, const Band& band)
+      : km(h, band), row(filter::kBandPad + km.np, 0.0), pred(km.np, 0.0), logb(km.np, 0.0), ex(km.np, 0.0),
+        v(h.n_states, 0.0) {}
   void resize(size_t T, int n) {
     if (alpha.size() < T * n) {
       alpha.resize(T * n);
-      beta.resize(T * n);
       bs.resize(T * n);
     }
+    if (beta.size() < static_cast<size_t>(2 * n)) beta.resize(2 * n);
     if (scale.size() < T) scale.resize(T);
   }
 };
@@ -118,60 +160,69 @@ double forward_backward(const ClassHmm& h, const EmissionCache& em, const Band& 
   w.resize(T, n);
   const double* A = h.transition.data();
   double ll = 0.0;
+  // Forward with the filter's per-class update (predictor/filter/emission_update.h): band
+  // prediction, log densities, exp and normalisation four states at a time. It works in place on
+  // a padded row (kBandPad zeros, then the states); each alpha_t and its shifted emissions are
+  // copied out to the T x n arrays the backward pass reads.
+  const KernelModel& km = w.km;
+  double* row = w.row.data() + filter::kBandPad;
   for (size_t t = 0; t < T; ++t) {
     double* al = &w.alpha[t * n];
     double* b = &w.bs[t * n];
     const double* x = s.at(t);
-    // pred into al
+    bool given = false;
     if (t == 0) {
-      for (int j = 0; j < n; ++j) al[j] = h.initial[j];
-    } else {
-      const double* prev = &w.alpha[(t - 1) * n];
+      for (int j = 0; j < km.np; ++j) w.pred[j] = j < n ? h.initial[j] : 0.0;
+      given = true;
+    } else if (km.block.band < 0) {
       for (int j = 0; j < n; ++j) {
         double sum = 0.0;
-        for (int i = band.lo[j]; i <= band.hi[j]; ++i) sum += prev[i] * A[i * n + j];
-        al[j] = sum;
+        for (int i = band.lo[j]; i <= band.hi[j]; ++i) sum += row[i] * A[i * n + j];
+        w.pred[j] = sum;
       }
+      given = true;
     }
-    double m = kNegInf;
+    double m = 0.0;
+    const double c = km.update(km.block, given, x[0], x[1], row, w.pred.data(), w.logb.data(), &m, w.ex.data());
     for (int j = 0; j < n; ++j) {
-      b[j] = em.log_density(j, x);
-      if (al[j] > 0.0 && b[j] > m) m = b[j];
+      al[j] = row[j];
+      b[j] = w.ex[j];
     }
-    double c = 0.0;
-    for (int j = 0; j < n; ++j) {
-      b[j] = al[j] > 0.0 ? std::exp(b[j] - m) : 0.0;
-      al[j] *= b[j];
-      c += al[j];
-    }
-    const double inv = 1.0 / c;
-    for (int j = 0; j < n; ++j) al[j] = al[j] * inv < kFlushBelow ? 0.0 : al[j] * inv;
     w.scale[t] = c;
     ll += std::log(c) + m;
   }
-  // Backward: beta_T = 1; beta_t(i) = sum_j A_ij bs_{t+1}(j) beta_{t+1}(j) / c_{t+1}.
-  double* bl = &w.beta[(T - 1) * n];
-  for (int j = 0; j < n; ++j) bl[j] = 1.0;
-  for (size_t t = T - 1; t-- > 0;) {
-    const double* nb = &w.beta[(t + 1) * n];
-    const double* b1 = &w.bs[(t + 1) * n];
-    const double ic = 1.0 / w.scale[t + 1];
-    double* cur = &w.beta[t * n];
-    for (int i = 0; i < n; ++i) {
-      double sum = 0.0;
-      for (int j = band.slo[i]; j <= band.shi[i]; ++j) sum += A[i * n + j] * b1[j] * nb[j];
-      cur[i] = sum * ic < kFlushBelow ? 0.0 : sum * ic;
+  // Backward pass fused with the statistics, t = T-1 down to 0, two beta rows only:
+  //   v_j       = bs_{t+1}(j) beta_{t+1}(j) / c_{t+1}
+  //   beta_t(i) = sum_j A_ij v_j                      (beta_T = 1)
+  //   xi_t(i,j) = alpha_t(i) A_ij v_j                 (each product A_ij v_j serves both)
+  //   gamma_t(j) = alpha_t(j) beta_t(j)               (sums to 1 per t with this scaling)
+  double* nb = w.beta.data();      // beta_{t+1}
+  double* cur = w.beta.data() + n;  // beta_t
+  double* v = w.v.data();
+  for (size_t tt = T; tt-- > 0;) {
+    const double* al = &w.alpha[tt * n];
+    if (tt == T - 1) {
+      for (int j = 0; j < n; ++j) cur[j] = 1.0;
+    } else {
+      const double* b1 = &w.bs[(tt + 1) * n];
+      const double ic = 1.0 / w.scale[tt + 1];
+      for (int j = 0; j < n; ++j) v[j] = b1[j] * nb[j] * ic;
+      for (int i = 0; i < n; ++i) {
+        const double ai = al[i];
+        double sum = 0.0;
+        const double* Ai = A + i * n;
+        double* xi = acc.xi.data() + i * n;
+        for (int j = band.slo[i]; j <= band.shi[i]; ++j) {
+          const double pr = Ai[j] * v[j];
+          sum += pr;
+          xi[j] += ai * pr;
+        }
+        cur[i] = sum < kFlushBelow ? 0.0 : sum;
+      }
     }
-  }
-  // Statistics: gamma_t(j) = alpha_t(j) beta_t(j) (sums to 1 per t with this scaling);
-  // xi_t(i,j) = alpha_t(i) A_ij bs_{t+1}(j) beta_{t+1}(j) / c_{t+1}.
-  for (int j = 0; j < n; ++j) acc.g0[j] += w.alpha[j] * w.beta[j];
-  for (size_t t = 0; t < T; ++t) {
-    const double* al = &w.alpha[t * n];
-    const double* be = &w.beta[t * n];
-    const double* x = s.at(t);
+    const double* x = s.at(tt);
     for (int j = 0; j < n; ++j) {
-      const double gm = al[j] * be[j];
+      const double gm = al[j] * cur[j];
       if (gm == 0.0) continue;
       const double d0 = x[0] - em.m0[j], d1 = x[1] - em.m1[j];
       acc.g[j] += gm;
@@ -181,16 +232,9 @@ double forward_backward(const ClassHmm& h, const EmissionCache& em, const Band& 
       acc.s01[j] += gm * d0 * d1;
       acc.s11[j] += gm * d1 * d1;
     }
-    if (t + 1 < T) {
-      const double* nb = &w.beta[(t + 1) * n];
-      const double* b1 = &w.bs[(t + 1) * n];
-      const double ic = 1.0 / w.scale[t + 1];
-      for (int i = 0; i < n; ++i) {
-        const double ai = al[i] * ic;
-        if (ai == 0.0) continue;
-        for (int j = band.slo[i]; j <= band.shi[i]; ++j) acc.xi[i * n + j] += ai * A[i * n + j] * b1[j] * nb[j];
-      }
-    }
+    if (tt == 0)
+      for (int j = 0; j < n; ++j) acc.g0[j] += al[j] * cur[j];
+    std::swap(nb, cur);
   }
   return ll;
 }
@@ -294,7 +338,7 @@ ClassHmm initial_left_right(const std::vector<FeatureSequence>& seqs, const Trai
 double baum_welch_step(const ClassHmm& in, const std::vector<FeatureSequence>& seqs, double cov_floor, ClassHmm& out) {
   const EmissionCache em(in);
   const Band band(in);
-  Workspace w;
+  Workspace w(in, band);
   Accumulators acc(in.n_states);
   double ll = 0.0;
   for (const auto& s : seqs) ll += forward_backward(in, em, band, s, w, acc);

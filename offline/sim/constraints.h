@@ -14,13 +14,17 @@
 
 namespace dressguard::sim {
 
-// Distance (stretch along mesh edges, shear across the edge of two triangles):
-//   C = |x_i - x_j| - L,   grad_i C = n = (x_i - x_j) / |x_i - x_j|,   grad_j C = -n.
+// Stretch along a mesh edge, a distance constraint:
+//   C = |x_i - x_j| - L,   grad_i C = n = (x_i - x_j) / |x_i - x_j|,   grad_j C = -n,
+// with compliance alpha_t in tension and alpha_c (softer) in compression: woven fabric buckles
+// under almost no compressive load, so a sleeve tube must not stand up like a straw (PhysX's
+// cloth has a separate, soft compression stiffness for the same reason).
 // Writes n (the gradient on i); returns dlambda (0 if degenerate or both vertices fixed).
-inline double distance_constraint(V3& xi, V3& xj, double wi, double wj, double rest, double alpha_t, V3* n_out) {
+inline double distance_constraint(V3& xi, V3& xj, double wi, double wj, double rest, double alpha_t, double alpha_c,
+                                  V3* n_out) {
   const V3 d = xi - xj;
   const double len = norm(d);
-  const double denom = wi + wj + alpha_t;
+  const double denom = wi + wj + (len < rest ? alpha_c : alpha_t);
   if (len < 1e-12 || denom <= 0) {
     *n_out = {0, 0, 0};
     return 0;

@@ -209,6 +209,9 @@ Scene make_scene(const ClothMesh& mesh, const SceneOptions& opt) {
   }
   for (int i = 0; i < n; ++i)
     if (d->grasped[i]) d->grasp_list.push_back(i);
+  d->grasp_target = d->rest;
+  if (opt.jaw_close_steps > 0)
+    for (int g : d->grasp_list) d->grasp_target[g].z = opt.grasp_point[2] - opt.jaw_half[2];
   if (d->grasp_list.empty() && opt.require_grasp) throw std::invalid_argument("make_scene: no vertex of '" + mesh.name + "' is inside the jaw box");
   for (int v : mesh.sleeve_opening)
     if (v < 0 || v >= n) throw std::invalid_argument("make_scene: sleeve opening vertex " + std::to_string(v) + " out of range");
@@ -246,6 +249,7 @@ GownModel make_model(const SceneData& s, const ClothParams& p, FrictionScheme sc
   }
   // Ranges documented in trial.h (ClothParams).
   m.alpha_stretch = compliance_of(p.stretch, 1e-2, 1e-7);
+  m.alpha_compress = m.alpha_stretch * s.opt.compression_softening;
   m.alpha_shear = compliance_of(p.shear, 1e0, 1e-5);
   m.alpha_bend = compliance_of(p.bend, 1e7, 1e1);
   m.friction = std::max(0.0, p.friction);

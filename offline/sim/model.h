@@ -82,6 +82,7 @@ struct SceneData {
   std::vector<BendStencil> bend;     // one per interior edge
   std::vector<uint8_t> grasped;      // 1 when held by the gripper (kinematic)
   std::vector<int32_t> grasp_list;
+  std::vector<V3> grasp_target;      // where the closed jaws hold each vertex (rest elsewhere)
   std::vector<int32_t> opening;      // sleeve opening loop
   // Colliders: the arm's round cones (index 0 is the elbow sphere, used for the label) and
   // planes for tests. The arm is placed at a trial's height by translating these along z.
@@ -99,6 +100,7 @@ struct GownModel {
   std::vector<double> mass;           // [kg]
   std::vector<double> w;              // inverse mass (0 for grasped vertices)
   double alpha_stretch = 0, alpha_shear = 0, alpha_bend = 0;  // XPBD compliances
+  double alpha_compress = 0;          // stretch edges under compression (SceneOptions::compression_softening)
   double friction = 0, self_friction = 0;
   double damping_factor = 1;          // per substep
   FrictionScheme scheme = FrictionScheme::Improved;
@@ -138,6 +140,7 @@ struct GownState {
   size_t pair_count = 0;
   long pairs_dropped = 0;
   V3 grip_offset;                     // gripper displacement from its start
+  double jaw_closed = 1;              // 0: grasped vertices at rest positions, 1: at grasp_target
   V3 grip_accel;                      // gripper acceleration (inertia of the grasped vertices)
   V3 force_acc;                       // sum over substeps of the force of the gown on the gripper
   long force_count = 0;

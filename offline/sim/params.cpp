@@ -79,7 +79,7 @@ std::string params_json(const ClothParams& p) {
 
 std::string scene_json(const Scene& scene, const TrialSpec& spec, const TrialResult& r) {
   const SceneData& sc = scene.data();
-  const double dz = sc.opt.arm.z_rel[static_cast<int>(spec.height)] - sc.opt.arm.z_rel[0] + spec.arm_offset;
+  const double dz = sc.opt.arm.z_rel[static_cast<int>(spec.height)] - sc.opt.arm.z_rel[0] + r.arm_offset;
   std::ostringstream o;
   o.precision(6);
   o << "{\"tris\": [";
@@ -98,7 +98,7 @@ std::string scene_json(const Scene& scene, const TrialSpec& spec, const TrialRes
   o << "], \"opening\": [";
   for (size_t k = 0; k < sc.opening.size(); ++k) o << (k ? "," : "") << sc.opening[k];
   o << "],\n\"label\": \"" << outcome_name(r.outcome) << "\", \"travel\": " << r.travel << ", \"d_max\": " << r.d_max << ", \"contact_travel\": " << r.contact_travel
-    << ", \"height\": \"" << arm_height_name(spec.height) << "\", \"arm_offset\": " << spec.arm_offset << ",\n\"frames\": [";
+    << ", \"height\": \"" << arm_height_name(spec.height) << "\", \"arm_offset\": " << r.arm_offset << ",\n\"frames\": [";
   for (size_t f = 0; f < r.frames.size(); ++f) {
     const Frame& fr = r.frames[f];
     o << (f ? ",\n" : "") << "{\"t\": " << fr.t << ", \"travel\": " << fr.travel << ", \"x\": [";

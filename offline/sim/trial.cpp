@@ -58,10 +58,17 @@ Outcome label_outcome(bool full_travel, double d_max) {
 TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const TrialSpec& spec) {
   const SceneData& sc = scene.data();
   const int hi = static_cast<int>(spec.height);
-  const double arm_dz = sc.opt.arm.z_rel[hi] - sc.opt.arm.z_rel[0] + spec.arm_offset;
+  // One random stream per trial: the perturbation force first, then the arm-height noise.
+  std::mt19937_64 rng(spec.seed);
+  const double fx = uniform(rng, -6.0, 6.0), fy = uniform(rng, -6.0, 6.0);
+  double arm_offset = spec.arm_offset;
+  if (spec.arm_noise)
+    arm_offset += spec.height == ArmHeight::Middle ? uniform(rng, -0.06, 0.0) : uniform(rng, -0.015, 0.015);
+  const double arm_dz = sc.opt.arm.z_rel[hi] - sc.opt.arm.z_rel[0] + arm_offset;
   const GownModel m = make_model(sc, params, spec.friction_scheme, spec.self_collision, arm_dz);
   GownState s = make_state(m);
   TrialResult r;
+  r.arm_offset = arm_offset;
   double total_mass = 0;
   for (double q : m.mass) total_mass += q;
   r.weight = total_mass * 9.81;
@@ -80,8 +87,6 @@ TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const 
   // Perturbation (paper V-A): one random horizontal force, uniform in X and lateral up to 6 N,
   // spread equally over all vertices for 0.5 s (output steps 180-330), then settling.
   const auto clock0 = std::chrono::steady_clock::now();
-  std::mt19937_64 rng(spec.seed);
-  const double fx = uniform(rng, -6.0, 6.0), fy = uniform(rng, -6.0, 6.0);
   const int perturb_from = 180, perturb_to = 330;
   const V3 zero{0, 0, 0};
   for (int k = 0; k < spec.settle_steps; ++k) {
@@ -93,6 +98,8 @@ TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const 
       s.force_acc = zero;
       s.force_count = 0;
     }
+    const int close = sc.opt.jaw_close_steps;
+    s.jaw_closed = close > 0 ? std::min(1.0, (k + 1.0) / close) : 1.0;
     step(m, s, zero, zero, zero);
     maybe_frame((k + 1 - spec.settle_steps) * m.dt, 0.0);
   }

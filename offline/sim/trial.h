@@ -30,11 +30,16 @@ namespace dressguard::sim {
 // The cloth's calibrated material (paper IV-B.2: isotropic stretch, shear, bending, friction,
 // self-friction). The three stiffnesses are dimensionless in [0, 1] and map log-linearly onto
 // XPBD compliances (see compliance_of() in model.h), so that an optimizer can search a box:
-//   stretch: edge distance compliance   1e-2 (k=0) ... 1e-7 m/N (k=1), per metre of rest length
+//   stretch: edge distance compliance 1e-2 (k=0) ... 1e-7 m/N (k=1) in tension (a triangulated
+//            membrane's edge stiffness does not depend on the edge length); 1000x softer in
+//            compression (SceneOptions::compression_softening)
 //   shear:   in-plane shear compliance per triangle (1 / shear modulus) 1e0 (k=0) ... 1e-5 m/N (k=1)
-//   bend:    isometric bending compliance 1e+2 (k=0) ... 1e-3 1/(N m) (k=1)
+//   bend:    isometric bending compliance (1 / bending stiffness) 1e7 (k=0) ... 1e1 1/(N m) (k=1);
+//            k = 0.5 is 1e-4 N m, stiff cotton; light gown fabric is nearer 1e-6 (k = 0.17)
 // friction: Coulomb coefficient cloth-arm, [0, 2]; self_friction: cloth-cloth, [0, 2].
-// damping [1/s]: velocity decay rate (v *= exp(-damping h) per substep), fixed by default.
+// damping [1/s]: velocity decay rate (v *= exp(-damping h) per substep), fixed by default; 2/s lets
+// the gown settle within the 500 settling steps (1.7 s) as in the paper, and costs the pulled
+// gown only m * 2/s * 0.1 m/s = 0.05 N of drag.
 // areal_density [kg/m^2]: 0.145 as the paper's simulator, fixed by default.
 struct ClothParams {
   double stretch = 0.8;
@@ -42,7 +47,7 @@ struct ClothParams {
   double bend = 0.5;
   double friction = 0.5;
   double self_friction = 0.2;
-  double damping = 0.5;
+  double damping = 2.0;
   double areal_density = 0.145;
 };
 
@@ -69,6 +74,7 @@ struct TrialSpec {
   double acceleration = 1.0;    // [m/s^2] the rig's acceleration up to `speed`
   uint64_t seed = 0;            // drives the perturbation force
   bool gown_noise = false;      // paper V-A: uniform X/lateral force up to 6 N over all vertices
+  bool arm_noise = false;       // paper V-A: arm height + U[-1.5, 1.5] cm (high, low), U[-6, 0] cm (middle)
   double max_travel = 0.85;     // [m] end of the rig's travel
   double force_limit = 10.0;    // [N] stop when |f_motion| or |f_vertical| reaches it
   FrictionScheme friction_scheme = FrictionScheme::Improved;
@@ -93,6 +99,7 @@ struct Frame {
 };
 
 struct TrialResult {
+  double arm_offset = 0;            // [m] the arm offset used (spec.arm_offset plus the arm noise)
   HapticSequence seq;               // samples from the start of the pull; label set
   Outcome outcome = Outcome::Missed;
   double d_max = 0;                 // [m] paper V-A label distance (NaN-free; 0 when missed)
@@ -140,10 +147,15 @@ struct SceneOptions {
   double contact_offset = 0.004;  // [m] cloth thickness kept from the arm
   double self_distance = 0.008;   // [m] self-collision distance (data README: 0.008)
   double kinetic_ratio = 0.8;     // Constraint scheme: dynamic / static friction coefficient
+  double compression_softening = 1000;  // edge compliance in compression / in tension (fabric buckles)
   // Jaw box (centre relative to the grasp point, half extents) used when ClothMesh::grasp is empty.
   std::array<double, 3> jaw_centre{0, 0, 0};
   std::array<double, 3> jaw_half{0.04, 0.06, 0.01};
   std::array<double, 3> grasp_point{0, 0, 0};  // [m] world position of the grasp at travel 0
+  // The jaws close on the grasped vertices: over the first `jaw_close_steps` output steps they
+  // move from their placed positions onto the plane z = grasp_point.z - jaw_half.z (the upper
+  // jaw's lower face), pinched between the jaws as in the paper's simulator. 0: held as placed.
+  int jaw_close_steps = 60;
   bool with_arm = true;
   bool colour_order = true;       // false: constraints in mesh order (the benchmark's baseline)
   bool require_grasp = true;      // false: no jaw box; only ClothMesh::grasp is held (physics tests)
@@ -177,7 +189,8 @@ enum class GownResolution { Full = 0, Reduced = 1, Coarse = 2 };
 // The default scene: the measured gown when the gown module and shared/data provide it, else the
 // simulator's own parametric sleeve-and-panel gown (see meshes.h). Coarse is a small version
 // for fast tests.
-Scene make_default_scene(GownResolution res = GownResolution::Reduced);
+// `parametric`: the gown module's parametric gown even when the measured one is present.
+Scene make_default_scene(GownResolution res = GownResolution::Reduced, bool parametric = false);
 
 // One trial: grasp, gravity, settling (with the optional perturbation during output steps
 // 180-330, i.e. 0.5 s), then the pull until max_travel or the force limit. Deterministic: the

@@ -210,25 +210,28 @@ int PredictorDaemon::run() {
       return 1;
     }
     const int64_t now = now_ns();
+    // Frames first, then the timer: when the thread was late, the frames that waited must
+    // count before the deadline is judged (never a timeout for samples already queued).
+    bool timer = false, shutdown = false;
     for (int i = 0; i < n; ++i) {
       switch (evs[i].data.u64) {
         case kTagRx: drain_rx(now); break;
         case kTagStop: drain_stop(now); break;
-        case kTagTimer: {
-          uint64_t expirations;
-          [[maybe_unused]] ssize_t r = ::read(timer_fd_, &expirations, sizeof expirations);
-          predictor_.on_tick(now);
-          break;
-        }
-        case kTagShutdown: {
-          uint64_t v;
-          [[maybe_unused]] ssize_t r = ::read(shutdown_fd_, &v, sizeof v);
-          if (shutdown_at < 0) {
-            shutdown_at = now;
-            predictor_.on_shutdown(now);
-          }
-          break;
-        }
+        case kTagTimer: timer = true; break;
+        case kTagShutdown: shutdown = true; break;
+      }
+    }
+    if (timer) {
+      uint64_t expirations;
+      [[maybe_unused]] ssize_t r = ::read(timer_fd_, &expirations, sizeof expirations);
+      predictor_.on_tick(now_ns());
+    }
+    if (shutdown) {
+      uint64_t v;
+      [[maybe_unused]] ssize_t r = ::read(shutdown_fd_, &v, sizeof v);
+      if (shutdown_at < 0) {
+        shutdown_at = now;
+        predictor_.on_shutdown(now);
       }
     }
     // Clean shutdown: once no stop is waiting for its echo, or after the grace period.

@@ -29,7 +29,7 @@ using EventQueue = SpscQueue<Event, 4096>;
 class LatencyHistogram {
  public:
   static constexpr int kBins = 4096;
-  explicit LatencyHistogram(int64_t bin_ns = 50) : bin_ns_(bin_ns) {}
+  explicit LatencyHistogram(int64_t bin_ns = 100) : bin_ns_(bin_ns) {}  // 100 ns x 4096: up to 410 us
   void add(int64_t ns) noexcept {
     int64_t b = ns < 0 ? 0 : ns / bin_ns_;
     if (b >= kBins) b = kBins - 1;

@@ -149,6 +149,7 @@ int main(int argc, char** argv) {
   try {
     can::PortOptions rx_opt;
     rx_opt.ids = PredictorDaemon::receive_ids();
+    rx_opt.receive_buffer = 1 << 20;  // ~1.5 s of a saturated 1 Mbit/s bus: a late thread loses nothing
     can::PortOptions stop_opt;
     stop_opt.ids = {protocol::id_of(protocol::MsgId::Stop)};
     stop_opt.receive_own = true;

@@ -3,7 +3,7 @@
 //     logb_j  = lc_j - q_j / 2,   q_j = (x - mu_j)^T S_j^-1 (x - mu_j)     (Gaussian log density)
 //     m       = max { logb_j : pred_j > 0 }
 //     alpha_j = pred_j exp(logb_j - m) / c,   c = sum_j pred_j exp(logb_j - m)   (0 below kFlushBelow)
-// returning log c + m, the sample's log-likelihood increment (see forward_filter.h).
+// returning c and m: the sample's log-likelihood increment is log c + m (see forward_filter.h).
 //
 // Two implementations with one contract: a portable one with std::exp, and one for x86-64 CPUs
 // with AVX2 and FMA that does four states at a time with an inline exp (~1 ulp). ForwardFilter
@@ -38,13 +38,27 @@ struct ClassBlock {
 };
 
 // `pred_given`: pred already holds the prediction (first sample, or a general topology);
-// otherwise it is computed from alpha by the band. Returns log c + m.
+// otherwise it is computed from alpha by the band. Returns c (> 0) and writes m to *m_out.
+// e_out (may be null; offline training uses it): exp(logb_j - m) for reachable states, else 0.
 using ClassUpdateFn = double (*)(const ClassBlock& b, bool pred_given, double x0, double x1, double* alpha, double* pred,
-                                 double* logb) noexcept;
+                                 double* logb, double* m_out, double* e_out) noexcept;
 
 double class_update_portable(const ClassBlock& b, bool pred_given, double x0, double x1, double* alpha, double* pred,
-                             double* logb) noexcept;
+                             double* logb, double* m_out, double* e_out) noexcept;
+// The best update this CPU has (AVX2 when available, else portable).
+ClassUpdateFn class_update_best();
 // nullptr when the CPU (or the compiler) lacks AVX2 + FMA.
 ClassUpdateFn class_update_avx2();
+
+// out[k] = exp(x[k]) for k < 8, every x[k] <= 0 (values below -708 give 0): the posterior's
+// softmax over up to kMaxClasses = 8 classes in one call.
+using Exp8Fn = void (*)(const double* x, double* out) noexcept;
+void exp8_portable(const double* x, double* out) noexcept;
+Exp8Fn exp8_avx2();  // nullptr without AVX2 + FMA
+
+// out[k] = exp(x[k]) for k < n, n a multiple of 4, every x[k] <= 0 (below -708: 0), with the
+// best implementation this CPU has (chosen once). For offline loops (hmm training); the filter
+// itself binds its functions at construction.
+void exp_nonpositive_batch(const double* x, double* out, int n) noexcept;
 
 }  // namespace dressguard::filter

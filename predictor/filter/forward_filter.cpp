@@ -2,13 +2,27 @@
 #include "forward_filter.h"
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 
 namespace dressguard::filter {
 
 namespace {
-constexpr double kLog2Pi = 1.8378770664093454835606594728112;  // log(2 pi)
+constexpr double kLn2 = 0.69314718055994530941723212145818;
 int padded(int n) { return (n + 3) & ~3; }
+
+// v = mant 2^k with mant in [0.5, 1): returns mant and adds k to `e` (v normal and > 0, which the
+// product of normalisers c_t stays since it is renormalised every sample). frexp without a call.
+double split_exponent(double v, double& e) noexcept {
+  uint64_t bits;
+  std::memcpy(&bits, &v, sizeof bits);
+  const int k = static_cast<int>((bits >> 52) & 0x7FF) - 1022;
+  bits = (bits & ~(uint64_t{0x7FF} << 52)) | (uint64_t{1022} << 52);
+  std::memcpy(&v, &bits, sizeof v);
+  e += k;
+  return v;
+}
 }  // namespace
 
 ForwardFilter::ForwardFilter(const model::OutcomeModel& m) : features_(m.features) {
@@ -53,48 +67,56 @@ ForwardFilter::ForwardFilter(const model::OutcomeModel& m) : features_(m.feature
       // Padding states get the unit Gaussian: finite values that are multiplied by pred = 0.
       model::GaussianEmission e;
       if (j < n) e = h.emission[j];
-      const double a = e.cov[0][0], b = 0.5 * (e.cov[0][1] + e.cov[1][0]), d = e.cov[1][1];
-      const double det = a * d - b * b;
-      mean0_.push_back(e.mean[0]);
-      mean1_.push_back(e.mean[1]);
-      ip_.push_back(d / det);
-      iq_.push_back(-b / det);
-      ir_.push_back(a / det);
-      lconst_.push_back(-kLog2Pi - 0.5 * std::log(det));
+      const model::EmissionTerms t = model::emission_terms(e);
+      mean0_.push_back(t.mean0);
+      mean1_.push_back(t.mean1);
+      ip_.push_back(t.ip);
+      iq_.push_back(t.iq);
+      ir_.push_back(t.ir);
+      lconst_.push_back(t.lconst);
     }
     total += np;
-  }
-  // The constant blocks the per-class update reads (pointers into the arrays above, now final).
-  for (int c = 0; c < n_classes_; ++c) {
-    ClassBlock b;
-    const int o = offset_[c], np = padded(n_states_[c]);
-    b.n_padded = np;
-    b.band = band_[c] <= kMaxBand ? band_[c] : -1;
-    if (b.band >= 0)
-      for (int d = 0; d <= b.band; ++d) b.diag[d] = coef_.data() + diag_offset_[c] + d * np;
-    b.m0 = mean0_.data() + o;
-    b.m1 = mean1_.data() + o;
-    b.ip = ip_.data() + o;
-    b.iq = iq_.data() + o;
-    b.ir = ir_.data() + o;
-    b.lc = lconst_.data() + o;
-    blocks_.push_back(b);
   }
   alpha_.assign(total, 0.0);
   scratch_.assign(total, 0.0);
   logb_.assign(total, 0.0);
-  loglik_.assign(n_classes_, 0.0);
+  shift_sum_.assign(n_classes_, 0.0);
+  exp2_.assign(n_classes_, 0.0);
+  mant_.assign(n_classes_, 1.0);
+  score_.assign(n_classes_, 0.0);
   posterior_.assign(n_classes_, 0.0);
   update_ = class_update_avx2();
   if (!update_) update_ = class_update_portable;
+  exp8_ = exp8_avx2();
+  if (!exp8_) exp8_ = exp8_portable;
   reset();
+}
+
+// The constant arrays of class c as the update reads them. Built per step from offsets (a few
+// additions) rather than stored as pointers, so that copies and moves of a filter stay valid.
+ClassBlock ForwardFilter::block(int c) const noexcept {
+  ClassBlock b;
+  const int o = offset_[c], np = padded(n_states_[c]);
+  b.n_padded = np;
+  b.band = band_[c] <= kMaxBand ? band_[c] : -1;
+  if (b.band >= 0)
+    for (int d = 0; d <= b.band; ++d) b.diag[d] = coef_.data() + diag_offset_[c] + d * np;
+  b.m0 = mean0_.data() + o;
+  b.m1 = mean1_.data() + o;
+  b.ip = ip_.data() + o;
+  b.iq = iq_.data() + o;
+  b.ir = ir_.data() + o;
+  b.lc = lconst_.data() + o;
+  return b;
 }
 
 bool ForwardFilter::vectorised() const noexcept { return update_ != class_update_portable; }
 
 void ForwardFilter::reset() noexcept {
   for (int c = 0; c < n_classes_; ++c) {
-    loglik_[c] = 0.0;
+    shift_sum_[c] = 0.0;
+    exp2_[c] = 0.0;
+    mant_[c] = 1.0;
     posterior_[c] = std::exp(log_prior_[c]);
   }
   for (size_t k = 0; k < alpha_.size(); ++k) alpha_[k] = initial_[k];
@@ -117,7 +139,7 @@ void ForwardFilter::step_features(const double x[model::kFeatures]) noexcept {
   const bool first = samples_ == 0;
   double best_score = -std::numeric_limits<double>::infinity();
   for (int c = 0; c < n_classes_; ++c) {
-    const ClassBlock& b = blocks_[c];
+    const ClassBlock b = block(c);
     const int n = n_states_[c], o = offset_[c];
     double* alpha = alpha_.data() + o;
     double* pred = scratch_.data() + o;
@@ -135,19 +157,33 @@ void ForwardFilter::step_features(const double x[model::kFeatures]) noexcept {
       }
       given = true;
     }
-    loglik_[c] += update_(b, given, x[0], x[1], alpha, pred, logb_.data() + o);
-    const double score = loglik_[c] + log_prior_[c];
+    double m = 0.0;
+    const double cs = update_(b, given, x[0], x[1], alpha, pred, logb_.data() + o, &m, nullptr);
+    // L_c = M_c + E_c ln 2 + log(mant_c): sum the shifts m, multiply the normalisers into the
+    // mantissa and move its binary exponent into E_c (bit operations, no log per sample).
+    shift_sum_[c] += m;
+    mant_[c] = split_exponent(mant_[c] * cs, exp2_[c]);
+    const double score = shift_sum_[c] + exp2_[c] * kLn2 + log_prior_[c];
+    score_[c] = score;
     if (score > best_score) best_score = score;
   }
-  // Posterior: softmax of L_c + log prior_c, shifted by the maximum.
+  // Posterior: P_c proportional to exp(L_c + log prior_c - best) = exp(score_c - best) mant_c,
+  // with mant_c in [0.5, 1): no overflow, and the best class contributes at least 0.5.
+  double arg[model::kMaxClasses], e[model::kMaxClasses];
+  for (int c = 0; c < model::kMaxClasses; ++c) arg[c] = c < n_classes_ ? score_[c] - best_score : -1000.0;
+  exp8_(arg, e);
   double z = 0.0;
   for (int c = 0; c < n_classes_; ++c) {
-    posterior_[c] = std::exp(loglik_[c] + log_prior_[c] - best_score);
+    posterior_[c] = e[c] * mant_[c];
     z += posterior_[c];
   }
   const double iz = 1.0 / z;
   for (int c = 0; c < n_classes_; ++c) posterior_[c] *= iz;
   ++samples_;
+}
+
+double ForwardFilter::log_likelihood(int c) const noexcept {
+  return shift_sum_[c] + exp2_[c] * kLn2 + std::log(mant_[c]);
 }
 
 int ForwardFilter::best() const noexcept {

@@ -5,14 +5,16 @@
 //     pred_j   = sum_i alpha_{t-1}(i) A_ij            (alpha_0 = pi, so pred at t=1 is pi_j)
 //     u_j      = pred_j * exp(log b_j(x_t) - m_t)     (m_t = max log b_j over states with pred_j > 0)
 //     c_t      = sum_j u_j,   alpha_t(j) = u_j / c_t
-//     log p(x_1..t | c) = sum_{s<=t} (log c_s + m_s)
+//     log p(x_1..t | c) = sum_{s<=t} (log c_s + m_s)   (kept as sum m_s + log prod c_s, the product
+//                                                     as mantissa and binary exponent: no log per sample)
 // Shifting by m_t keeps c_t away from underflow however improbable the sample, so sequences of any
 // length keep a finite log-likelihood. The posterior adds the model's log prior:
 //     P(c | x_1..t) = exp(L_c + log_prior_c) / sum_k exp(L_k + log_prior_k).
 // Left-right models have A_ij = 0 outside i <= j <= i+w: the filter finds the band width w at
-// construction and sums only inside it, O(states * (w+1)) per class per sample; any other topology
-// takes the general O(states^2) sum. The emission update (Gaussian densities, exp, normalisation)
-// runs four states at a time on CPUs with AVX2+FMA (emission_update.h), else portably.
+// construction and sums only inside it, O(states * (w+1)) per class per sample (w <= 4); any other
+// topology, or a wider band, takes the general O(states^2) sum. The emission update (Gaussian
+// densities, exp, normalisation) runs four states at a time on CPUs with AVX2+FMA
+// (emission_update.h), else portably.
 //
 // Real-time contract: the constructor allocates everything; reset() and step() allocate nothing,
 // throw nothing, lock nothing and log nothing (tests/hmm/filter_alloc_test.cpp counts).
@@ -33,6 +35,7 @@ class ForwardFilter {
   // Copies what it needs from `m` (which may then be destroyed). `m` must be valid (read_model
   // validates); throws model::ModelError otherwise.
   explicit ForwardFilter(const model::OutcomeModel& m);
+  // Copyable and movable (a copy allocates; a copy carries the trial state along).
 
   // Start of a trial: alpha_0 = pi, log-likelihoods 0, posterior = prior.
   void reset() noexcept;
@@ -45,7 +48,8 @@ class ForwardFilter {
   // P(class c | samples so far), including the model's log prior.
   double posterior(int c) const noexcept { return posterior_[c]; }
   // Running log p(x_1..t | class c) of the feature vectors; 0 before the first sample.
-  double log_likelihood(int c) const noexcept { return loglik_[c]; }
+  // (Kept as sum of shifts + binary exponent + mantissa; this call takes the one log.)
+  double log_likelihood(int c) const noexcept;
   // The normalised state probabilities alpha_t(j) of class c (n_states(c) entries).
   const double* state_probabilities(int c) const noexcept { return alpha_.data() + offset_[c]; }
   int n_states(int c) const noexcept { return n_states_[c]; }
@@ -60,6 +64,7 @@ class ForwardFilter {
   bool vectorised() const noexcept;
 
  private:
+  ClassBlock block(int c) const noexcept;
   // Constant after construction. Flat arrays: offset_[c] indexes class c's first state, each
   // class preceded by kBandPad zeros and padded to a multiple of 4 states (emission_update.h);
   // coef_ holds each class's band diagonals (or full matrix) from diag_offset_[c].
@@ -71,11 +76,13 @@ class ForwardFilter {
   std::vector<double> coef_;
   // Emission j: mean, inverse covariance (p, q, r) = [[p q][q r]], constant -log(2 pi) - log|S|/2.
   std::vector<double> mean0_, mean1_, ip_, iq_, ir_, lconst_;
-  std::vector<ClassBlock> blocks_;
   ClassUpdateFn update_ = nullptr;
+  Exp8Fn exp8_ = nullptr;
   // Mutable per-trial state.
   std::vector<double> alpha_, scratch_, logb_;
-  std::vector<double> loglik_, posterior_;
+  // log p(x_1..t | c) = shift_sum_ + exp2_ ln 2 + log(mant_), mant_ in [0.5, 1): the product of
+  // the normalisers c_t is kept as mantissa and exponent, so a sample costs no log.
+  std::vector<double> shift_sum_, exp2_, mant_, score_, posterior_;
   long samples_ = 0, rejected_ = 0;
 };
 

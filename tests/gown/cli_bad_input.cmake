@@ -20,3 +20,15 @@ execute_process(COMMAND ${DG} gown --parametric --json RESULT_VARIABLE rc OUTPUT
 if(NOT rc EQUAL 0 OR NOT out MATCHES "^{\"source\": \"parametric\".*\"sleeve_loop\": [0-9]+")
   message(FATAL_ERROR "gown --parametric --json: rc=${rc} ${out}")
 endif()
+# --out then --in-world --scale 1 reads back the same gown (same stats line for line).
+execute_process(COMMAND ${DG} gown --parametric --out ${CMAKE_CURRENT_BINARY_DIR}/dg_gown_roundtrip.obj
+                RESULT_VARIABLE rc OUTPUT_QUIET)
+execute_process(COMMAND ${DG} gown --parametric --json RESULT_VARIABLE rc1 OUTPUT_VARIABLE a)
+execute_process(COMMAND ${DG} gown --obj ${CMAKE_CURRENT_BINARY_DIR}/dg_gown_roundtrip.obj --in-world --scale 1 --json
+                RESULT_VARIABLE rc2 OUTPUT_VARIABLE b)
+file(REMOVE ${CMAKE_CURRENT_BINARY_DIR}/dg_gown_roundtrip.obj)
+string(REGEX REPLACE "\"source\": \"[^\"]*\"|\"seconds\": [0-9.]+" "" a "${a}")
+string(REGEX REPLACE "\"source\": \"[^\"]*\"|\"seconds\": [0-9.]+" "" b "${b}")
+if(NOT rc EQUAL 0 OR NOT rc2 EQUAL 0 OR NOT a STREQUAL b)
+  message(FATAL_ERROR "--out / --in-world round trip differs:\n${a}\n${b}")
+endif()

@@ -121,6 +121,13 @@ TEST(BoundaryLoops, AnnulusHasTwoLoopsLongestFirst) {
   EXPECT_EQ(loops[1].size(), 8u);
 }
 
+TEST(BoundaryLoops, InconsistentOrientationStillClosesTheLoop) {
+  // A unit square as two triangles, the second one flipped: one loop of 4 all the same.
+  const auto loops = find_boundary_loops({{0, 1, 2}, {0, 3, 2}}, 4);
+  ASSERT_EQ(loops.size(), 1u);
+  EXPECT_EQ(loops[0].size(), 4u);
+}
+
 TEST(Masses, LumpedMassesSumToAreaTimesDensity) {
   const fs::path p = write_obj("grid.obj", grid_obj(4, 0.25));
   GownMesh m = read_obj(p, 1.0);

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <map>
+#include <set>
 
 #include "gown.h"
 
@@ -42,4 +43,25 @@ TEST(ParametricGown, OneConsistentlyOrientedSurface) {
   int twice = 0;
   for (const auto& [e, n] : directed) twice += n > 1;
   EXPECT_EQ(twice, 0);
+}
+
+TEST(ParametricGown, SleeveLowerHalfIsOneArcOfAboutHalfTheOpening) {
+  // The outcome label (paper V-A) uses the lower half of the opening: one contiguous arc of the
+  // loop, 40-60% of its vertices, all below the opening's centre.
+  for (int target : {0, 5000}) {
+    GownOptions o;
+    o.parametric = true;
+    o.target_triangles = target;
+    const GownMesh m = load_gown(o);
+    const auto& loop = m.boundary_loops.at(m.sleeve_loop);
+    const std::set<int> low(m.sleeve_lower_half.begin(), m.sleeve_lower_half.end());
+    int runs = 0;
+    for (size_t i = 0; i < loop.size(); ++i)
+      runs += low.count(loop[i]) && !low.count(loop[(i + loop.size() - 1) % loop.size()]);
+    EXPECT_EQ(runs, 1);
+    EXPECT_GE(low.size(), 0.4 * loop.size());
+    EXPECT_LE(low.size(), 0.6 * loop.size());
+    // It is the hanging side: below the opening's centre.
+    for (int v : low) EXPECT_LT(m.x[v].z(), loop_centroid(m, m.sleeve_loop).z());
+  }
 }

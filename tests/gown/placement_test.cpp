@@ -91,13 +91,17 @@ TEST(Placement, ParametricSleeveOpeningHangsOpenInFrontOfTheFist) {
   const GownMesh m = make_parametric_gown();
   const PaperScene s;
   expect_opening_near_grasp(m, s, 0.02);  // 1 cm ahead of the box by construction
-  const GownMesh r = reduce_gown(m, 5000);  // the hang on the reduced gown: fast, same shape
+  GownOptions opt;  // the hang on the reduced gown the simulator gets (grasped patch kept): fast
+  opt.parametric = true;
+  opt.target_triangles = 5000;
+  const GownMesh r = load_gown(opt);
   const auto x = crude_hang(r, s);
   const OpeningPose o = opening(r, x);
   // Hanging from the jaws the opening spans the fist at the high setting (0.06..0.16 m), so the
-  // arm can enter; it sits between the jaws and the fist along x.
-  EXPECT_LT(o.z_min, s.fist_W().z() - s.r_fist);
-  EXPECT_GT(o.z_max, s.fist_W().z() + s.r_fist);
+  // arm can enter, up to 1.5 cm (about half a reduced edge: the crude hang's resolution); it sits
+  // between the jaws and the fist along x.
+  EXPECT_LT(o.z_min, s.fist_W().z() - s.r_fist + 0.015);
+  EXPECT_GT(o.z_max, s.fist_W().z() + s.r_fist - 0.015);
   EXPECT_GT(o.centroid.x(), s.upper_jaw_center_W.x() - 0.05);
   EXPECT_LT(o.centroid.x(), s.fist_W().x());
   // And is above the fist at the low setting (the miss).
@@ -113,7 +117,9 @@ TEST(Placement, MeasuredSleeveOpeningNearTheGraspBox) {
   // Placed (before gravity), the opening lies 0.2 m above and behind the jaws (the paper grips
   // the sleeve near its root, not at its rim): within 0.25 m of the grasp box.
   expect_opening_near_grasp(m, s, 0.25);
-  const GownMesh r = reduce_gown(m, 5000);
+  GownOptions opt;
+  opt.target_triangles = 5000;
+  const GownMesh r = load_gown(opt);
   const auto x = crude_hang(r, s);
   const OpeningPose o = opening(r, x);
   std::printf("measured, hung: opening centroid (%.3f, %.3f, %.3f), z %.3f..%.3f\n", o.centroid.x(), o.centroid.y(),

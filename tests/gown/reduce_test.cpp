@@ -93,6 +93,27 @@ TEST(ReduceGown, LoadGownReducesWhenAsked) {
   EXPECT_GE(m.sleeve_loop, 1);
 }
 
+TEST(ReduceGown, LoadGownKeepsTheGraspedPatchAtEveryResolution) {
+  // The gripper must hold the same cloth at every resolution: each grasped vertex of the full
+  // gown is still there, exactly, in the reduced ones (frozen during the collapse).
+  for (int target : {5000, 1500}) {
+    GownOptions o;
+    o.parametric = true;
+    const GownMesh full = load_gown(o);
+    o.target_triangles = target;
+    const GownMesh red = load_gown(o);
+    const auto held_full = grasp_vertices(full);
+    const auto held_red = grasp_vertices(red);
+    ASSERT_GE(held_full.size(), 10u);
+    EXPECT_GE(held_red.size(), held_full.size());
+    for (int v : held_full) {
+      const bool found = std::any_of(held_red.begin(), held_red.end(), [&](int r) { return red.x[r] == full.x[v]; });
+      EXPECT_TRUE(found) << "grasped vertex " << v << " lost at " << target << " triangles";
+    }
+    EXPECT_NEAR(static_cast<double>(red.triangles.size()), target, 0.1 * target);
+  }
+}
+
 TEST(ReduceGown, TargetAboveSizeReturnsTheMeshUnchanged) {
   const GownMesh m = make_parametric_gown();
   const GownMesh r = reduce_gown(m, 1000000);

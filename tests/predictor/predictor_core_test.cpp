@@ -241,6 +241,25 @@ TEST(StopTransmission, RetriedUntilEchoConfirmsWithFreshCounters) {
   }
 }
 
+TEST(StopTransmission, BusOffIsCountedAndTheStopKeepsRetrying) {
+  Harness h;
+  h.sink.fail_next = 1000;  // every send fails while the controller is bus-off
+  h.start();
+  h.sample(-20.0, 0.0);
+  h.p->on_bus_error(0x40 /* CAN_ERR_BUSOFF */, h.now);
+  for (int i = 0; i < 20; ++i) h.p->on_tick(h.now += kMs);
+  EXPECT_TRUE(h.p->stop_pending());
+  EXPECT_GE(h.sink.stops.size(), 10u) << "retried every 2 ms while the bus is off";
+  EXPECT_GE(h.p->counter(StatusCounter::TxErrors), 11u);  // 1 bus error + the failed sends
+  h.sink.fail_next = 0;  // the controller recovered (restart-ms)
+  for (int i = 0; i < 3; ++i) h.p->on_tick(h.now += kMs);
+  h.p->on_stop_echo(h.sink.stops.back(), h.now);
+  EXPECT_FALSE(h.p->stop_pending());
+  bool logged = false;
+  for (const auto& e : h.sink.events) logged |= e.kind == EventKind::BusError && e.value == 0x40;
+  EXPECT_TRUE(logged);
+}
+
 TEST(Status, PagesCarryEveryCounter) {
   Harness h;
   h.start();

@@ -136,6 +136,57 @@ TEST(ReplayLogs, EveryTestLogHasTheOutcomeInItsName) {
   std::printf("  smallest margin before the 10 N limit: %.2f s\n", min_margin_s);
 }
 
+TEST(ReplayLogs, ModelTrainedByBaumWelchGetsTheCleanOutcomesRight) {
+  // The project's trainer on the same seed-1 trials (`dressguard train`, see CMakeLists.txt).
+  const auto m = model::read_model(DG_TRAINED_MODEL);
+  int checked = 0;
+  for (const auto& entry : fs::directory_iterator(kLogs)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("syn2-", 0) != 0) continue;
+    const auto frames = load(entry.path());
+    const auto r = replay_frames(&m, PredictorConfig{}, frames);
+    ASSERT_EQ(r.trials.size(), 1u) << name;
+    const auto& t = r.trials[0];
+    if (ends_with(name, "-caught.log")) {
+      EXPECT_TRUE(t.stopped && t.reason == protocol::StopReason::Caught) << name;
+      EXPECT_LT(static_cast<long>(t.stop_sample), facts(frames).samples) << name;
+      std::printf("  trained model: %-26s caught at sample %u, %.2f s before the 10 N limit\n", name.c_str(),
+                  t.stop_sample, (facts(frames).samples - static_cast<long>(t.stop_sample)) * 0.01);
+    } else {
+      EXPECT_FALSE(t.stopped) << name << ": " << protocol::stop_reason_name(t.reason) << " at " << t.stop_sample;
+    }
+    ++checked;
+  }
+  EXPECT_EQ(checked, 9);
+}
+
+TEST(ReplayLogs, DefaultModelRunsTheFaultLogsAndReportsTheCleanOnes) {
+  // models/default.dgm is trained on the simulator's trials, not on these synthetic ones: its
+  // outcomes on the clean logs are printed, not asserted. The fail-safes do not depend on the
+  // model: with the caught rule off, each fault log must stop for its reason.
+  const fs::path def = fs::path(DRESSGUARD_SOURCE_DIR) / "models/default.dgm";
+  if (!fs::exists(def)) GTEST_SKIP() << "models/default.dgm not present yet";
+  const auto m = model::read_model(def);
+  for (const auto& entry : fs::directory_iterator(kLogs)) {
+    const std::string name = entry.path().filename().string();
+    const auto frames = load(entry.path());
+    const auto pos = name.find("-expect-");
+    PredictorConfig cfg;
+    if (pos != std::string::npos) cfg.stop_consecutive = 100000;
+    const auto r = replay_frames(&m, cfg, frames);
+    ASSERT_EQ(r.trials.size(), 1u) << name;
+    const auto& t = r.trials[0];
+    if (pos != std::string::npos) {
+      EXPECT_TRUE(t.stopped) << name;
+      EXPECT_EQ(protocol::stop_reason_name(t.reason), name.substr(pos + 8, name.size() - pos - 12)) << name;
+    } else {
+      std::printf("  default model: %-36s %s", name.c_str(), t.stopped ? protocol::stop_reason_name(t.reason) : "no stop");
+      if (t.stopped) std::printf(" at sample %u (F_motion %.2f N)", t.stop_sample, t.f_motion);
+      std::printf("\n");
+    }
+  }
+}
+
 TEST(ReplayLogs, ModelThatDoesNotLoadStopsEveryTrial) {
   const auto frames = load(kLogs / "syn2-good-0-good.log");
   const auto r = replay_frames(nullptr, PredictorConfig{}, frames);
@@ -171,6 +222,11 @@ TEST(ReplayCli, JsonReportsTheStop) {
   EXPECT_EQ(WEXITSTATUS(rc), 2);
   EXPECT_NE(bad2.find(tmp.string() + ":2:"), std::string::npos) << bad2;
   fs::remove(tmp);
+  // export-candump: bad input names the problem, exit 2, nothing written.
+  const std::string bad3 = run(std::string(DG_CLI) + " export-candump --trial /nonexistent/t.csv --out /tmp/dg_never.log 2>&1", rc);
+  EXPECT_EQ(WEXITSTATUS(rc), 2);
+  EXPECT_NE(bad3.find("/nonexistent/t.csv"), std::string::npos) << bad3;
+  EXPECT_FALSE(fs::exists("/tmp/dg_never.log"));
 }
 
 TEST(ReplayMeasured, StudyTrialsHitTheHardLimitWhereTheRigStopped) {

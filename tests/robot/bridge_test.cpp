@@ -8,7 +8,13 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <fcntl.h>
+#include <poll.h>
+#include <stdlib.h>
+#include <termios.h>
+
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <string>
@@ -259,6 +265,93 @@ TEST(BridgeModbus, StopFrameWritesTheRobotsStopCoil) {
   EXPECT_EQ(rig.app->stats().stops_written.load(), 1u);
   // Read back by mbpoll, an independent Modbus client.
   EXPECT_NE(mbpoll(coil).find("[7]: \t1"), std::string::npos) << mbpoll(coil);
+}
+
+// A null-modem cable made of two pseudo-terminals: bytes written to one end's slave come out of
+// the other end's slave (a thread copies between the two masters), so libmodbus's RTU code runs
+// on real tty devices with termios, as on the FT 300's RS-485 adapter.
+class NullModem {
+ public:
+  NullModem() {
+    for (int k = 0; k < 2; ++k) {
+      master_[k] = posix_openpt(O_RDWR | O_NOCTTY);
+      grantpt(master_[k]);
+      unlockpt(master_[k]);
+      name_[k] = ptsname(master_[k]);
+      // Keep a slave open so that the master never sees a hang-up between the clients' opens.
+      hold_[k] = ::open(name_[k].c_str(), O_RDWR | O_NOCTTY);
+      termios t;
+      tcgetattr(hold_[k], &t);
+      cfmakeraw(&t);
+      tcsetattr(hold_[k], TCSANOW, &t);
+    }
+    relay_ = std::thread([this] {
+      char buf[256];
+      while (!stop_.load()) {
+        pollfd p[2] = {{master_[0], POLLIN, 0}, {master_[1], POLLIN, 0}};
+        if (poll(p, 2, 20) <= 0) continue;
+        for (int k = 0; k < 2; ++k) {
+          if (!(p[k].revents & POLLIN)) continue;
+          const ssize_t n = ::read(master_[k], buf, sizeof buf);
+          if (n > 0) [[maybe_unused]] ssize_t w = ::write(master_[1 - k], buf, static_cast<size_t>(n));
+        }
+      }
+    });
+  }
+  ~NullModem() {
+    stop_.store(true);
+    relay_.join();
+    for (int k = 0; k < 2; ++k) {
+      ::close(hold_[k]);
+      ::close(master_[k]);
+    }
+  }
+  const std::string& end(int k) const { return name_[k]; }
+
+ private:
+  int master_[2] = {-1, -1}, hold_[2] = {-1, -1};
+  std::string name_[2];
+  std::atomic<bool> stop_{false};
+  std::thread relay_;
+};
+
+TEST(BridgeModbus, RtuSensorOnASerialLine) {
+  NullModem cable;
+  // The emulator serves the sensor's registers on one end of the cable.
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const int devnull = ::open("/dev/null", O_WRONLY);
+    dup2(devnull, 1);
+    execl(DG_EMULATOR, DG_EMULATOR, "--rtu", cable.end(0).c_str(), "--slave", "9", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  std::this_thread::sleep_for(200ms);
+  // The test sets the registers through the bridge's own link type, on the other end.
+  ModbusLink setter(ModbusEndpoint{"rtu:" + cable.end(1) + ":115200:N", 9, 500});
+  ASSERT_TRUE(setter.connect()) << setter.last_error();
+  const uint16_t values[6] = {static_cast<uint16_t>(-420), 17, 999, 1, 2, 3};
+  ASSERT_EQ(modbus_write_registers(setter.ctx(), 180, 6, values), 6) << modbus_strerror(errno);
+  setter.close();
+  ModbusSensor sensor(ModbusEndpoint{"rtu:" + cable.end(1) + ":115200:N", 9, 500}, SensorMap{});
+  ASSERT_TRUE(sensor.link().connect()) << sensor.link().last_error();
+  FtReading r{};
+  EXPECT_EQ(sensor.read(r), ReadResult::Ok) << sensor.link().last_error();
+  EXPECT_EQ(r.force[0], -420);
+  EXPECT_EQ(r.force[2], 999);
+  EXPECT_EQ(r.torque[2], 3);
+  // An exception on the line: reported as such, the link kept.
+  ModbusLink fault(ModbusEndpoint{"rtu:" + cable.end(1) + ":115200:N", 9, 500});
+  sensor.link().close();
+  ASSERT_TRUE(fault.connect());
+  const uint16_t one = 1;
+  ASSERT_EQ(modbus_write_registers(fault.ctx(), 900, 1, &one), 1);
+  fault.close();
+  ASSERT_TRUE(sensor.link().connect());
+  EXPECT_EQ(sensor.read(r), ReadResult::Exception) << sensor.link().last_error();
+  EXPECT_TRUE(sensor.link().connected());
+  sensor.link().close();
+  kill(pid, SIGTERM);
+  waitpid(pid, nullptr, 0);
 }
 
 }  // namespace

@@ -11,6 +11,8 @@
 // The registers 180-185 are set by clients (FC06/FC16), e.g. by the test.
 //
 //   dg_modbus_emulator [--port N]      prints "listening on PORT" (N = 0: any free port)
+//   dg_modbus_emulator --rtu DEVICE [--slave N]   Modbus RTU (115200 8N1) on a serial device
+//                                      (a pty in the tests); prints "serving DEVICE"
 #include <arpa/inet.h>
 #include <modbus.h>
 #include <netinet/in.h>
@@ -41,10 +43,44 @@ int listen_on(modbus_t* ctx, int& port) {
 
 }  // namespace
 
+// RTU: one client on the line; the same registers and fault modes (3 is not available on a line).
+int serve_rtu(const char* device, int slave) {
+  modbus_t* ctx = modbus_new_rtu(device, 115200, 'N', 8, 1);
+  modbus_mapping_t* map = modbus_mapping_new(1000, 0, 1000, 0);
+  if (!ctx || !map || modbus_set_slave(ctx, slave) != 0 || modbus_connect(ctx) != 0) {
+    std::fprintf(stderr, "dg_modbus_emulator: %s: %s\n", device, modbus_strerror(errno));
+    return 1;
+  }
+  std::printf("serving %s\n", device);
+  std::fflush(stdout);
+  uint8_t query[MODBUS_RTU_MAX_ADU_LENGTH];
+  const int hl = modbus_get_header_length(ctx);
+  for (;;) {
+    const int rc = modbus_receive(ctx, query);
+    if (rc <= 0) continue;  // not for us, or a garbled frame: wait for the next
+    const int function = query[hl];
+    const int address = (query[hl + 1] << 8) | query[hl + 2];
+    const bool ft_read = (function == 0x03 || function == 0x04) && address == kFtRegister;
+    const int mode = map->tab_registers[kFaultMode];
+    if (ft_read && mode == 2) continue;
+    if (ft_read && mode == 1) {
+      modbus_reply_exception(ctx, query, MODBUS_EXCEPTION_SLAVE_OR_SERVER_FAILURE);
+      continue;
+    }
+    modbus_reply(ctx, query, rc, map);
+    if (ft_read) ++map->tab_registers[kReadsServed];
+  }
+}
+
 int main(int argc, char** argv) {
-  int port = 0;
-  for (int i = 1; i + 1 < argc; i += 2)
+  int port = 0, slave = 9;
+  const char* rtu = nullptr;
+  for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--port")) port = std::atoi(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--rtu")) rtu = argv[i + 1];
+    if (!std::strcmp(argv[i], "--slave")) slave = std::atoi(argv[i + 1]);
+  }
+  if (rtu) return serve_rtu(rtu, slave);
   modbus_t* ctx = modbus_new_tcp("127.0.0.1", port);
   modbus_mapping_t* map = modbus_mapping_new(1000, 0, 1000, 0);
   if (!ctx || !map) {

@@ -8,6 +8,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <system_error>
 
 #include "can_port.h"
 #include "candump_log.h"
@@ -254,6 +255,17 @@ TEST(InProcBus, FiltersEchoesAndDrops) {
   while (a->receive(rx, info) == 1) ++got;
   EXPECT_LT(got, 5000);
   EXPECT_EQ(static_cast<int>(info.kernel_drops), 5000 - got);
+}
+
+TEST(SocketCan, OpeningFailsWithANamedReasonWhereTheKernelHasNoCan) {
+  using namespace dressguard::can;
+  if (socketcan_available()) GTEST_SKIP() << "this kernel has AF_CAN: the VM test covers SocketCAN";
+  try {
+    open_socketcan("vcan0", {});
+    FAIL() << "opened a CAN socket on a kernel without AF_CAN";
+  } catch (const std::system_error& e) {
+    EXPECT_NE(std::string(e.what()).find("vcan0"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -40,6 +40,7 @@ TEST(SimPhysics, HangingGownForceEqualsWeight) {
   mesh.grasp = {top - 1, top, top + 1};
   SceneOptions opt;
   opt.with_arm = false;
+  opt.jaw_close_steps = 0;  // held where they are
   const Scene scene = make_scene(mesh, opt);
   ClothParams p;
   p.damping = 4.0;  // settle within the test's 4 s

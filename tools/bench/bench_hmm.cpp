@@ -231,7 +231,7 @@ int main(int argc, char** argv) {
     sink += ghmm_bridge::baum_welch(g, gs, 1e-4, 500).reported_log_likelihood;
   }
   const double t_ghmm = since(t0);
-  std::printf("full training of the three classes: ours %.3f s (tolerance 1e-5 nats/sample), GHMM %.3f s (eps 1e-4), ratio %.2fx\n",
+  std::printf("full training of the three classes: ours %.3f s (tolerance 1e-6 nats/sample), GHMM %.3f s (eps 1e-4), ratio %.2fx\n",
               t_train, t_ghmm, t_ghmm / t_train);
   {
     const auto s = hmm::sample(m.classes[0], 770, rng);

@@ -16,6 +16,7 @@
 #include <cstring>
 #include <string>
 
+#include "dataset.h"
 #include "ghmm_bridge.h"
 #include "hmm.h"
 
@@ -70,9 +71,13 @@ int usage() {
   std::puts(
       "usage: dg_ghmm_compare [--states N] [--sequences N] [--heldout N] [--min-len T] [--max-len T]\n"
       "                       [--seed S] [--ghmm-eps E] [--heldout-slack NATS] [--timing-iterations K]\n"
+      "                       [--study LABEL [--held-participant P]] [--tolerance NATS]\n"
       "  Draws sequences from a known left-right HMM, builds the equal-segment initial model, and\n"
       "  compares our HMM with GHMM on them (see the header of ghmm_compare.cpp). Defaults: 10 states,\n"
-      "  40 training + 20 held-out sequences of 300-500 samples, seed 1, GHMM eps 1e-4, slack 1e-3.");
+      "  40 training + 20 held-out sequences of 300-500 samples, seed 1, GHMM eps 1e-4, slack 1e-3.\n"
+      "  --study LABEL: instead, the measured study's trials of that outcome (good or missed) in\n"
+      "  scaled features, participant P (default 4) held out; exit 77 when the data are absent.\n"
+      "  --tolerance: our stop rule, gain per sample in nats (default 1e-6, as dressguard train).");
   return 2;
 }
 
@@ -80,9 +85,10 @@ int usage() {
 
 int main(int argc, char** argv) {
   int states = 10, n_train = 40, n_held = 20, timing_iters = 0;
+  std::string study_label, held_participant = "4";
   size_t min_len = 300, max_len = 500;
   uint64_t seed = 1;
-  double ghmm_eps = 1e-4, slack = 1e-3;
+  double ghmm_eps = 1e-4, slack = 1e-3, tolerance = 1e-6;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--help" || a == "-h") return usage(), 0;
@@ -97,20 +103,54 @@ int main(int argc, char** argv) {
     else if (a == "--ghmm-eps") ghmm_eps = std::atof(v);
     else if (a == "--heldout-slack") slack = std::atof(v);
     else if (a == "--timing-iterations") timing_iters = std::atoi(v);
+    else if (a == "--study") study_label = v;
+    else if (a == "--tolerance") tolerance = std::atof(v);
+    else if (a == "--held-participant") held_participant = v;
     else return usage();
   }
   if (states < 1 || states > model::kMaxStates || n_train < 1 || n_held < 1 || min_len < static_cast<size_t>(states) ||
       max_len < min_len)
     return usage();
 
-  const model::ClassHmm t = truth(states, 0.5 * (min_len + max_len));
-  std::mt19937_64 rng(seed);
   std::vector<hmm::FeatureSequence> train, held;
   size_t n_samples = 0;
-  for (int i = 0; i < n_train + n_held; ++i) {
-    const size_t T = min_len + rng() % (max_len - min_len + 1);
-    (i < n_train ? train : held).push_back(hmm::sample(t, T, rng));
-    if (i < n_train) n_samples += T;
+  if (!study_label.empty()) {
+    // The measured study: one outcome's trials in the model's scaled features, one participant
+    // held out. Exit 77 (ctest: skipped) when shared/data is absent.
+    const auto dir = study_dir();
+    if (dir.empty()) {
+      std::puts("shared/data (the study) is not present: skipped");
+      return 77;
+    }
+    const Dataset ds = import_study(dir);
+    std::vector<const HapticSequence*> all;
+    for (const auto& tr : ds.trials) all.push_back(&tr);
+    const auto fc = hmm::fit_feature_scaling(all);
+    for (const auto& tr : ds.trials) {
+      if (!tr.label || outcome_name(*tr.label) != study_label) continue;
+      auto f = hmm::features_of(tr, fc);
+      if (tr.participant == held_participant) {
+        held.push_back(std::move(f));
+      } else {
+        n_samples += f.size();
+        train.push_back(std::move(f));
+      }
+    }
+    n_train = static_cast<int>(train.size());
+    n_held = static_cast<int>(held.size());
+    if (train.empty() || held.empty()) {
+      std::printf("study: no '%s' trials to train on or none of participant %s\n", study_label.c_str(), held_participant.c_str());
+      return 2;
+    }
+    std::printf("measured study, label '%s', participant %s held out\n", study_label.c_str(), held_participant.c_str());
+  } else {
+    const model::ClassHmm t = truth(states, 0.5 * (min_len + max_len));
+    std::mt19937_64 rng(seed);
+    for (int i = 0; i < n_train + n_held; ++i) {
+      const size_t T = min_len + rng() % (max_len - min_len + 1);
+      (i < n_train ? train : held).push_back(hmm::sample(t, T, rng));
+      if (i < n_train) n_samples += T;
+    }
   }
   hmm::TrainOptions opt;
   opt.n_states = states;
@@ -157,6 +197,7 @@ int main(int argc, char** argv) {
 
   // 3. Both trained to their own stop rules.
   opt.max_iterations = 500;
+  opt.tolerance = tolerance;
   auto t0 = std::chrono::steady_clock::now();
   const hmm::TrainResult ours = hmm::train(init, train, opt);
   const double t_ours = seconds_since(t0);

@@ -100,7 +100,8 @@ def main():
     ax.set_zlabel("z_W")
     ax.view_init(elev=20, azim=-60)
     ax.set_title("3-D (arm axis green)")
-    fig.suptitle(f"placed gown: {len(x)} vertices, {len(tri)} triangles; {s['frame']}")
+    state = s.get("state", "placed")
+    fig.suptitle(f"gown {state}: {len(x)} vertices, {len(tri)} triangles; {s['frame']}")
     fig.tight_layout()
     fig.savefig(sys.argv[2], dpi=90)
 

@@ -70,6 +70,29 @@ def draw(ax, sc, frame, title):
     ax.set_title(title, fontsize=9)
 
 
+def side(ax, sc, frame):
+    """Side view (x-z), the arm as circles and outlines, the gripper as its jaw box."""
+    X = np.array(frame["x"]).reshape(-1, 3)
+    tris = np.array(sc["tris"])
+    ax.triplot(X[:, 0], X[:, 2], tris, color=(0.3, 0.45, 0.7), linewidth=0.15)
+    for c in sc["arm"]:
+        for p, r in ((c["a"], c["ra"]), (c["b"], c["rb"])):
+            ax.add_patch(plt.Circle((p[0], p[2]), r, fill=False, color="peru", linewidth=1.5))
+        ax.plot([c["a"][0], c["b"][0]], [c["a"][2] + c["ra"], c["b"][2] + c["rb"]], color="peru")
+        ax.plot([c["a"][0], c["b"][0]], [c["a"][2] - c["ra"], c["b"][2] - c["rb"]], color="peru")
+    op = np.array(sc["opening"], dtype=int)
+    if len(op):
+        ax.plot(X[op, 0], X[op, 2], ".", color="red", markersize=3)
+    g = np.array(sc["grip"]) + np.array([frame["travel"], 0, 0])
+    h = np.array(sc["jaw_half"])
+    ax.add_patch(plt.Rectangle((g[0] - h[0], g[2] - h[2]), 2 * h[0], 2 * h[2], color="k"))
+    ax.set_aspect("equal")
+    ax.set_xlim(-1.0, 1.0)
+    ax.set_ylim(-1.0, 0.45)
+    ax.set_xlabel("x (motion) [m]")
+    ax.set_ylabel("z [m]")
+
+
 def main():
     if len(sys.argv) != 3:
         sys.exit(__doc__)
@@ -88,10 +111,11 @@ def main():
     else:
         contact = later[len(later) // 2] if later else start
     end = frames[-1]
-    fig = plt.figure(figsize=(16, 5.5))
+    fig = plt.figure(figsize=(16, 10))
     for k, (f, name) in enumerate([(start, "start of the pull"), (contact, "contact"), (end, "end")]):
-        ax = fig.add_subplot(1, 3, k + 1, projection="3d")
+        ax = fig.add_subplot(2, 3, k + 1, projection="3d")
         draw(ax, sc, f, f"{name}: t = {f['t']:.2f} s, travel = {f['travel']:.3f} m")
+        side(fig.add_subplot(2, 3, k + 4), sc, f)
     fig.suptitle(f"simulated trial, {sc['height']} arm (offset {sc['arm_offset']:+.3f} m): "
                  f"{sc['label']}, travel {sc['travel']:.3f} m, d_max {sc['d_max']:.3f} m")
     fig.tight_layout()

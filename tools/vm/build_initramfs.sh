@@ -26,7 +26,7 @@ root=$(mktemp -d)
 trap 'rm -rf "$root"' EXIT
 mkdir -p "$root"/{bin,sbin,usr/bin,lib,lib64,proc,sys,dev,tmp,data,modules,etc}
 cp "$BUSYBOX" "$root/bin/busybox"
-for app in $("$BUSYBOX" --list); do ln -sf busybox "$root/bin/$app"; done
+for app in $("$BUSYBOX" --list); do [ "$app" = busybox ] || ln -sf busybox "$root/bin/$app"; done
 
 # Binaries and their shared libraries (ldd), at the same paths as on the host.
 copy_with_libs() {

@@ -1,0 +1,292 @@
+#!/usr/bin/python3
+"""The SocketCAN test: boots Debian's kernel (PREEMPT_RT flavour) in qemu-system-x86_64 once and
+runs every scenario of tools/vm/vm_tests.sh on a real kernel CAN stack (vcan0), then decodes the
+recorded frames and asserts on them by their payloads' counters (logical time):
+
+  clean     every caught trial is stopped for "caught" before the rig's 10 N limit (margin
+            reported), no good or missed trial is stopped, the isolated-fault trial is not
+            stopped, the corrupted burst is a bad_frames stop, and the daemon's counters (in its
+            status frames and its shutdown log) count every injected fault exactly;
+  hardlimit the hard limit stops at the first sample above 10 N;
+  gap       a silent sensor is a sensor_timeout stop, one deadline after the last sample;
+  nomodel   a model that does not load refuses the trial;
+  latency   end to end through the kernel (probe send -> stop frame received), a histogram.
+Every scenario ends with SIGTERM: the daemon must exit 0.
+
+  run_vm_tests.py --build BUILD_DIR --source SOURCE_DIR --model MODEL.dgm [--cache DIR] [--kvm]
+
+Exit 0 pass, 1 fail, 77 skip (no qemu, no busybox-static, or the kernel package cannot be had).
+"""
+import argparse
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+SKIP = 77
+SENSOR_TIMEOUT_S = 0.200   # the deadline vm_tests.sh gives the daemon (the VM's clock jumps)
+TICK_S = 0.001             # its timer
+VM_SLACK_S = 0.100         # emulated CPU (TCG) scheduling: not a real-time measurement
+
+
+def crc8_h2f(data):
+    crc = 0xFF
+    for b in data:
+        crc ^= b
+        for _ in range(8):
+            crc = ((crc << 1) ^ 0x2F) & 0xFF if crc & 0x80 else (crc << 1) & 0xFF
+    return crc ^ 0xFF
+
+
+def parse_frame(line):
+    m = re.match(r"\((\d+)\.(\d{6})\) (\S+) ([0-9A-Fa-f]{3})#([0-9A-Fa-f]*)", line.strip())
+    if not m:
+        return None
+    t = int(m.group(1)) + int(m.group(2)) / 1e6
+    return t, int(m.group(4), 16), bytes.fromhex(m.group(5))
+
+
+def e2e_ok(can_id, data):
+    if len(data) != 8:
+        return False
+    did = 0xD000 | can_id
+    return crc8_h2f(bytes([did & 0xFF, did >> 8]) + data[1:]) == data[0]
+
+
+def i16(d, o):
+    return int.from_bytes(d[o:o + 2], "little", signed=True)
+
+
+def u16(d, o):
+    return int.from_bytes(d[o:o + 2], "little")
+
+
+STOP_REASONS = {1: "caught", 2: "hard_limit", 3: "sensor_timeout", 4: "bad_frames", 5: "model_error", 6: "shutdown"}
+COUNTERS = ["corrupted", "repeated", "wrong_sequence", "lost_frames", "late", "bad_length", "kernel_drops",
+            "timeouts", "tx_retries", "tx_errors", "samples", "stops"]
+
+
+def log_facts(path):
+    """Trial id, samples per TrialEnd, first sample above 10 N (identity mount) of a test log."""
+    facts = {"trial": None, "samples": None, "first_over": None}
+    index = -1
+    with open(path) as f:
+        for line in f:
+            fr = parse_frame(line)
+            if not fr:
+                continue
+            _, cid, d = fr
+            if cid == 0x180:
+                facts["trial"] = u16(d, 2)
+            elif cid == 0x181:
+                facts["samples"] = u16(d, 4)
+            elif cid == 0x100:
+                index += 1
+                if facts["first_over"] is None and (abs(i16(d, 2)) > 1000 or abs(i16(d, 6)) > 1000):
+                    facts["first_over"] = index
+    return facts
+
+
+def sections(console):
+    out = {}
+    for m in re.finditer(r"DG-VM-BEGIN (\S+)\r?\n(.*?)DG-VM-END \1", console, re.S):
+        out[m.group(1)] = m.group(2).replace("\r", "")
+    return out
+
+
+def stops_in(rec):
+    stops = []
+    for line in rec.splitlines():
+        fr = parse_frame(line)
+        if fr and fr[1] == 0x080:
+            t, _, d = fr
+            stops.append({"t": t, "ok": e2e_ok(0x080, d), "reason": STOP_REASONS.get(d[2], str(d[2])),
+                          "p_caught": d[3] / 255.0, "trial": u16(d, 4), "sample": u16(d, 6)})
+    return stops
+
+
+def first_stop_per_trial(stops):
+    out = {}
+    for s in stops:
+        out.setdefault(s["trial"], s)
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--build", required=True)
+    ap.add_argument("--source", required=True)
+    ap.add_argument("--model", required=True)
+    ap.add_argument("--cache", default=None)
+    ap.add_argument("--timeout", type=int, default=300)
+    ap.add_argument("--kvm", action="store_true", help="use KVM instead of software emulation (TCG); needs working (nested) KVM: on the build VM it hangs")
+    ap.add_argument("--keep-console", default=None, help="write the VM's console output here")
+    args = ap.parse_args()
+    qemu = shutil.which("qemu-system-x86_64")
+    if not qemu:
+        print("SKIP: qemu-system-x86_64 is not installed (tools/install-deps.sh installs qemu-system-x86)")
+        return SKIP
+    cache = args.cache or os.path.join(args.source, "build", "vm")
+    logs_dir = os.path.join(args.source, "tests", "data", "robot")
+    bins = [os.path.join(args.build, "predictor", "daemon", "dressguard-predictor"),
+            os.path.join(args.build, "tools", "bench", "bench_predictor")]
+    for b in bins:
+        if not os.path.exists(b):
+            print(f"FAIL: {b} not built")
+            return 1
+    fails = []
+
+    def check(cond, what):
+        print(("  ok    " if cond else "  FAIL  ") + what)
+        if not cond:
+            fails.append(what)
+
+    with tempfile.TemporaryDirectory() as tmp:
+        data = os.path.join(tmp, "data")
+        os.makedirs(os.path.join(data, "logs"))
+        for f in sorted(os.listdir(logs_dir)):
+            shutil.copy(os.path.join(logs_dir, f), os.path.join(data, "logs", f))
+        shutil.copy(args.model, os.path.join(data, "model.dgm"))
+        initrd = os.path.join(cache, "initramfs.gz")
+        cmd = [os.path.join(args.source, "tools", "vm", "build_initramfs.sh"), "--cache", cache, "--out", initrd,
+               "--data", data, "--script", os.path.join(args.source, "tools", "vm", "vm_tests.sh")]
+        for b in bins:
+            cmd += ["--bin", b]
+        t0 = time.time()
+        r = subprocess.run(cmd, capture_output=True, text=True)
+        if r.returncode == SKIP:
+            print("SKIP: " + (r.stderr.strip() or "no kernel package"))
+            return SKIP
+        if r.returncode != 0:
+            print("FAIL: initramfs build failed:\n" + r.stderr)
+            return 1
+        kernel = r.stdout.strip().splitlines()[-1]
+        print(f"initramfs built in {time.time() - t0:.1f} s; kernel {os.path.basename(kernel)}")
+        accel = ["-accel", "kvm", "-cpu", "host"] if args.kvm else ["-accel", "tcg"]
+        qcmd = [qemu, "-m", "768", "-smp", "2", "-nographic", "-no-reboot", *accel, "-kernel", kernel, "-initrd", initrd,
+                "-append", "console=ttyS0 panic=-1 quiet loglevel=3"]
+        t0 = time.time()
+        try:
+            q = subprocess.run(qcmd, capture_output=True, text=True, timeout=args.timeout, errors="replace")
+            console = q.stdout
+        except subprocess.TimeoutExpired as e:
+            console = (e.stdout or b"").decode(errors="replace") if isinstance(e.stdout, bytes) else (e.stdout or "")
+            fails.append(f"VM did not finish within {args.timeout} s")
+        boot_s = time.time() - t0
+    if args.keep_console:
+        with open(args.keep_console, "w") as f:
+            f.write(console)
+    print(f"VM ran {boot_s:.1f} s ({'KVM' if args.kvm else 'software emulation'})")
+    m = re.search(r"DG-VM: kernel (\S+) (.*)", console)
+    check(m is not None, "the VM booted Debian's kernel: " + (m.group(1) + " " + m.group(2).strip() if m else "no"))
+    check("DG-VM: done" in console, "the in-VM script ran to its end")
+    check("DG-VM: insmod" not in console, "can, can-raw, can-dev, vcan loaded")
+    sec = sections(console)
+    for name in ("clean", "hardlimit", "gap", "nomodel", "latency"):
+        m = re.search(rf"DG-VM: \[[\d.]+\] scenario {name} daemon_exit (\d+)", console)
+        check(m is not None and m.group(1) == "0", f"{name}: the daemon exited 0 on SIGTERM")
+        check("shutting down" in sec.get(f"{name}.log", ""), f"{name}: clean shutdown logged")
+
+    facts = {f: log_facts(os.path.join(logs_dir, f)) for f in os.listdir(logs_dir)}
+
+    # --- clean trials and isolated faults ---
+    rec = sec.get("clean.rec", "")
+    check(rec.count("#") > 100, f"clean: the bus was recorded ({rec.count('#')} frames)")
+    stops = stops_in(rec)
+    check(all(s["ok"] for s in stops), f"clean: every stop frame passes its E2E CRC ({len(stops)} frames)")
+    first = first_stop_per_trial(stops)
+    margins = []
+    for f, fa in sorted(facts.items()):
+        if not f.startswith("syn2-") and not f.startswith("fault-isolated") and not f.startswith("fault-burst"):
+            continue
+        s = first.get(fa["trial"])
+        if f.endswith("-caught.log"):
+            ok = s is not None and s["reason"] == "caught" and s["sample"] < fa["samples"]
+            margin = (fa["samples"] - s["sample"]) * 0.01 if s else float("nan")
+            margins.append(margin)
+            check(ok, f"{f}: stopped ({s['reason'] if s else 'none'}) at sample {s['sample'] if s else '-'}, "
+                      f"{margin:.2f} s before the 10 N limit (sample {fa['samples']})")
+        elif f.endswith("-expect-bad_frames.log"):
+            check(s is not None and s["reason"] == "bad_frames", f"{f}: bad_frames stop ({s['reason'] if s else 'none'})")
+        else:
+            check(s is None, f"{f}: not stopped" + (f" (stopped: {s['reason']} at {s['sample']})" if s else ""))
+    if margins:
+        print(f"  caught trials: smallest margin before the 10 N limit {min(margins):.2f} s, largest {max(margins):.2f} s")
+    # Counters from the daemon's shutdown line and from its status frames' pages.
+    m = re.search(r"shutting down: (.*)", sec.get("clean.log", ""))
+    counters = dict((k, int(v)) for k, v in re.findall(r"(\w+)=(\d+)", m.group(1))) if m else {}
+    pages = {}
+    for line in rec.splitlines():
+        fr = parse_frame(line)
+        if fr and fr[1] == 0x300 and e2e_ok(0x300, fr[2]):
+            d = fr[2]
+            pages[d[2]] = (u16(d, 4), u16(d, 6))
+    status = {}
+    check(len(pages) == 6, f"clean: all 6 status pages seen ({sorted(pages)})")
+    for p, (v0, v1) in pages.items():
+        if 2 * p + 1 < len(COUNTERS):
+            status[COUNTERS[2 * p]], status[COUNTERS[2 * p + 1]] = v0, v1
+    print(f"  daemon counters: {counters}")
+    # Injected: isolated log --corrupt 50,300 (2 frames each) --drop 120 --repeat 200 --delay 250:2;
+    # burst log --corrupt 100..107 (2 frames each). See tools/vm/make_test_logs.sh.
+    expected = {"corrupted": 4 + 16, "repeated": 2, "late": 2, "wrong_sequence": 2, "lost_frames": 8 + 16,
+                "bad_length": 0, "timeouts": 0, "stops": 4}
+    for k, v in expected.items():
+        check(counters.get(k) == v, f"clean: counter {k} = {counters.get(k)} (injected: {v})")
+        check(status.get(k) == counters.get(k), f"clean: status frames report {k} = {status.get(k)}")
+    drops = re.findall(r"DROPCOUNT: rx (\d+)", rec)
+    print(f"  candump -d drop reports: {len(drops)}; kernel drops counted by the daemon: {counters.get('kernel_drops')}")
+
+    # --- hard limit ---
+    rec = sec.get("hardlimit.rec", "")
+    hl = [f for f in facts if "expect-hard_limit" in f][0]
+    s = first_stop_per_trial(stops_in(rec)).get(facts[hl]["trial"])
+    check(s is not None and s["reason"] == "hard_limit" and s["sample"] == facts[hl]["first_over"],
+          f"hardlimit: stop at the first sample above 10 N ({facts[hl]['first_over']}): "
+          f"{(s['reason'], s['sample']) if s else 'none'}")
+    # Kernel timestamps (candump) of the deciding force frame and the stop frame.
+    frames = [parse_frame(l) for l in rec.splitlines()]
+    forces = [fr for fr in frames if fr and fr[1] == 0x100]
+    if s and s["sample"] < len(forces):
+        print(f"  hardlimit: deciding frame in -> stop frame out on vcan0 (candump timestamps): "
+              f"{(s['t'] - forces[s['sample']][0]) * 1e6:.0f} us")
+
+    # --- silent sensor ---
+    rec = sec.get("gap.rec", "")
+    gp = [f for f in facts if "expect-sensor_timeout" in f][0]
+    s = first_stop_per_trial(stops_in(rec)).get(facts[gp]["trial"])
+    frames = [parse_frame(l) for l in rec.splitlines()]
+    forces = [fr for fr in frames if fr and fr[1] == 0x100]
+    check(s is not None and s["reason"] == "sensor_timeout" and s["sample"] == 150,
+          f"gap: sensor_timeout stop at sample 150: {(s['reason'], s['sample']) if s else 'none'}")
+    if s:
+        before = [fr for fr in forces if fr[0] <= s["t"]]
+        silent = s["t"] - before[-1][0] if before else float("nan")
+        check(SENSOR_TIMEOUT_S <= silent <= SENSOR_TIMEOUT_S + TICK_S + VM_SLACK_S,
+              f"gap: stop {silent * 1e3:.1f} ms after the last sample (deadline {SENSOR_TIMEOUT_S * 1e3:.0f} ms, "
+              f"+{VM_SLACK_S * 1e3:.0f} ms allowed for the emulated CPU)")
+
+    # --- no model ---
+    s = stops_in(sec.get("nomodel.rec", ""))
+    check(len(s) >= 1 and s[0]["reason"] == "model_error", f"nomodel: model_error stop ({s[0]['reason'] if s else 'none'})")
+
+    # --- latency ---
+    lat = sec.get("latency.out", "")
+    print("  " + "\n  ".join(l for l in lat.splitlines() if l.strip()))
+    check("0 without a stop" in lat, "latency: every probe trial got its stop frame")
+    m = re.search(r"processing latency \(frame read to decision\): n=(\d+) median=(\d+) ns p99.9=(\d+) ns", sec.get("clean.log", ""))
+    if m:
+        print(f"  daemon processing in the VM (clean scenario): n={m.group(1)} median={m.group(2)} ns p99.9={m.group(3)} ns")
+
+    print(f"{len(fails)} failure(s)")
+    if fails and not args.keep_console:
+        print("---- console tail ----")
+        print(console[-4000:])
+    return 1 if fails else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
