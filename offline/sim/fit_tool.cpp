@@ -21,7 +21,7 @@
 
 #include "dataset.h"
 #include "files.h"
-#include "objective.h"
+#include "objective.h"  // offline/calib: the paper's eq. 3-5
 #include "params.h"
 #include "trial.h"
 
@@ -132,7 +132,7 @@ int main(int argc, char** argv) {
             const TrialResult rm = simulate_trial(scene, cp, spec_for(ArmHeight::Low, miss_speed, o));
             char buf[256];
             std::snprintf(buf, sizeof buf, "%s,%.5f,%.5f,%s,%.4f,%s,%.4f,%.4f", p.key().c_str(),
-                          paper_objective(rg.seq.samples, good), paper_objective(rm.seq.samples, miss),
+                          calib::area_objective(rg.seq.samples, good), calib::area_objective(rm.seq.samples, miss),
                           std::string(outcome_name(rg.outcome)).c_str(), rg.travel,
                           std::string(outcome_name(rm.outcome)).c_str(), rm.travel,
                           rm.seq.samples.empty() ? 0.0 : rm.seq.samples.back().f_motion);
@@ -161,9 +161,9 @@ int main(int argc, char** argv) {
   write_file_atomic(out / "best_params.txt", format_params(cp));
   std::printf("best: friction %.3f stretch %.3f bend %.3f offset %.3f: L_good %.3f (%s, travel %.3f vs measured %.3f), "
               "L_miss %.3f (%s, final drag %.2f vs measured %.2f N)\n",
-              best_p.friction, best_p.stretch, best_p.bend, best_p.offset, paper_objective(rg.seq.samples, good),
+              best_p.friction, best_p.stretch, best_p.bend, best_p.offset, calib::area_objective(rg.seq.samples, good),
               std::string(outcome_name(rg.outcome)).c_str(), rg.travel, good.back().travel,
-              paper_objective(rm.seq.samples, miss), std::string(outcome_name(rm.outcome)).c_str(),
+              calib::area_objective(rm.seq.samples, miss), std::string(outcome_name(rm.outcome)).c_str(),
               rm.seq.samples.empty() ? 0.0 : rm.seq.samples.back().f_motion, miss.back().f_motion);
   return 0;
 }

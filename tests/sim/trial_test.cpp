@@ -89,21 +89,6 @@ TEST(SimTrial, LabelRule) {
   EXPECT_EQ(label_outcome(false, 0.0701), Outcome::Caught);
 }
 
-// Eq. 3-5 against hand-computed values.
-TEST(SimObjective, KnownAnswers) {
-  std::vector<HapticSample> r, s;
-  for (int i = 0; i <= 10; ++i) r.push_back({0.01 * i, 0.001 * i, -1.0, 0.0, 0.5});
-  EXPECT_DOUBLE_EQ(paper_objective(r, r), 0.0);
-  s = r;
-  for (auto& x : s) x.f_motion += 2.0;  // 2 N over 0.01 m of travel: area 0.02 N m
-  EXPECT_NEAR(curve_error(s, r, Axis::Motion), 0.02, 1e-12);
-  EXPECT_NEAR(curve_error(s, r, Axis::Vertical), 0.0, 1e-12);
-  // The simulation runs 5 samples longer at the same forces plus 1 N: w dx |s_i - r_n| each.
-  s = r;
-  for (int i = 11; i <= 15; ++i) s.push_back({0.01 * i, 0.001 * i, 0.0, 0.0, 0.5});
-  EXPECT_NEAR(curve_error(s, r, Axis::Motion), 20 * 5 * 0.001 * 1.0, 1e-12);
-}
-
 TEST(SimParams, ParseFormats) {
   const ClothParams a = parse_params("friction 0.3\n# comment\nstretch = 0.7\n", "x");
   EXPECT_DOUBLE_EQ(a.friction, 0.3);
@@ -171,7 +156,7 @@ TEST(SimTrial, PlausibleAgainstMeasuredParticipant4) {
       sg.speed = estimate_speed(good);
       sm.speed = estimate_speed(miss);
       TrialResult g = simulate_trial(coarse_scene(), p, sg), m = simulate_trial(coarse_scene(), p, sm);
-      const double l = paper_objective(g.seq.samples, good) + paper_objective(m.seq.samples, miss);
+      const double l = calib::area_objective(g.seq.samples, good) + calib::area_objective(m.seq.samples, miss);
       std::printf("friction %.2f stretch %.2f: L %.3f (high: %.3f m, low: %s %.3f m, %.2f N)\n", friction, stretch, l,
                   g.travel, std::string(outcome_name(m.outcome)).c_str(), m.travel, m.seq.samples.back().f_motion);
       if (m.outcome == Outcome::Missed && l < best) best = l, best_g = std::move(g), best_m = std::move(m);
