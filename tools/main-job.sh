@@ -31,3 +31,39 @@ fi
   "$sim/trial-middle.csv=sim middle" "$sim/trial-low.csv=sim low" "${measured[@]}" \
   --title "simulated trials (default parameters) against travel"
 echo "main-job: simulated trials, pictures and force curves in $sim"
+
+# Synthesis and training (offline/calib, offline/hmm): a small labelled set from the simulator's
+# default parameters (models/default-simulator.json; `dressguard calibrate` makes one for a
+# person), the three outcome HMMs, and, where the measured trials are present, their
+# classification with the accuracy against travel.
+model="$out/model"
+mkdir -p "$model"
+"$dg" synthesize --calibration models/default-simulator.json --out "$model/synth" \
+  --per-height "${MAIN_JOB_PER_HEIGHT:-4}" --gown "${MAIN_JOB_GOWN:-reduced}" --seed 1
+"$dg" train --data "$model/synth" --out "$model/stc.dgm"
+"$dg" model show "$model/stc.dgm" | head -8
+if [ -f "$out/measured/manifest.csv" ]; then
+  # The measured trials against the model just trained and against the shipped default model
+  # (models/default.dgm: the same pipeline with 20 reduced-gown trials per height).
+  for m in "$model/stc.dgm" models/default.dgm; do
+    name=$(basename "$m" .dgm)
+    echo "main-job: the measured trials classified by $m"
+    "$dg" classify --model "$m" --data "$out/measured" | tail -5
+    "$dg" classify --model "$m" --data "$out/measured" --sweep 0.05:0.85:0.05 \
+      --sweep-out "$model/accuracy-vs-travel-$name" >/dev/null
+  done
+fi
+echo "main-job: synthesized data, model and evaluation in $model"
+
+# Robot side (predictor/): the simulated trials as CAN traffic, and what the predictor would do
+# on each with the default model (models/default.dgm, or the model just trained).
+robot="$out/robot"
+mkdir -p "$robot"
+predictor_model=models/default.dgm
+[ -f "$predictor_model" ] || predictor_model="$model/stc.dgm"
+for h in high middle low; do
+  "$dg" export-candump --trial "$sim/trial-$h.csv" --out "$robot/trial-$h.log" >/dev/null
+  printf 'replay of the simulated %-6s trial:' "$h"
+  "$dg" replay --model "$predictor_model" --log "$robot/trial-$h.log" | sed -n 2p
+done
+echo "main-job: candump logs and replays in $robot"

@@ -3,6 +3,7 @@
 // trial stops for "caught" before the rig's 10 N limit (the margin is printed), no good or missed
 // trial stops, and each fault log is handled as the protocol says. Plus `dressguard replay --json`
 // and the measured trials of the study when shared/data is present.
+#include <algorithm>
 #include <gtest/gtest.h>
 
 #include <array>
@@ -167,9 +168,14 @@ TEST(ReplayLogs, DefaultModelRunsTheFaultLogsAndReportsTheCleanOnes) {
   const fs::path def = fs::path(DRESSGUARD_SOURCE_DIR) / "models/default.dgm";
   if (!fs::exists(def)) GTEST_SKIP() << "models/default.dgm not present yet";
   const auto m = model::read_model(def);
-  for (const auto& entry : fs::directory_iterator(kLogs)) {
-    const std::string name = entry.path().filename().string();
-    const auto frames = load(entry.path());
+  std::vector<fs::path> logs;  // the candump logs only (the folder also holds its README), in name order
+  for (const auto& entry : fs::directory_iterator(kLogs))
+    if (entry.path().extension() == ".log") logs.push_back(entry.path());
+  std::sort(logs.begin(), logs.end());
+  ASSERT_FALSE(logs.empty());
+  for (const auto& log : logs) {
+    const std::string name = log.filename().string();
+    const auto frames = load(log);
     const auto pos = name.find("-expect-");
     PredictorConfig cfg;
     if (pos != std::string::npos) cfg.stop_consecutive = 100000;
