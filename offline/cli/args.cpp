@@ -2,8 +2,18 @@
 
 #include <charconv>
 #include <cmath>
+#include <sstream>
 
 namespace dressguard::cli {
+
+std::set<std::string> split_list(const std::string& s) {
+  std::set<std::string> out;
+  std::stringstream in(s);
+  std::string item;
+  while (std::getline(in, item, ','))
+    if (!item.empty()) out.insert(item);
+  return out;
+}
 
 Args::Args(int argc, char** argv, std::set<std::string> flags) {
   for (int i = 0; i < argc; ++i) {

@@ -18,6 +18,9 @@ class UsageError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// "a,b,,c" -> {"a", "b", "c"}: the comma-separated lists of options like --participant 1,4.
+std::set<std::string> split_list(const std::string& s);
+
 class Args {
  public:
   // `flags`: names that take no value (e.g. "json", "help"); every other "--name" takes one.

@@ -64,15 +64,6 @@ std::filesystem::path find_plot_script() {
   return {};
 }
 
-std::set<std::string> split_list(const std::string& s) {
-  std::set<std::string> out;
-  std::stringstream in(s);
-  std::string item;
-  while (std::getline(in, item, ','))
-    if (!item.empty()) out.insert(item);
-  return out;
-}
-
 }  // namespace
 
 int run_classify(int argc, char** argv) {
