@@ -5,8 +5,11 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ "$(id -u)" -eq 0 ]; then
   ./tools/install-deps.sh
+elif command -v sudo >/dev/null 2>&1; then
+  sudo ./tools/install-deps.sh
 else
-  echo "setup-and-run.sh: not root, so not installing packages (run tools/install-deps.sh as root first)" >&2
+  echo "setup-and-run.sh: installing packages needs root: run it as root, or install sudo" >&2
+  exit 1
 fi
 cmake --preset release >/dev/null
 cmake --build --preset release
