@@ -196,6 +196,18 @@ std::vector<Eigen::VectorXd> Cmaes::ask() {
   return x_repaired_;
 }
 
+void Cmaes::step(const Objective& f) {
+  const std::vector<Eigen::VectorXd> xs = ask();
+  std::vector<double> v;
+  v.reserve(xs.size());
+  for (const auto& x : xs) v.push_back(f(x));
+  tell(v);
+}
+
+void Cmaes::minimize(const Objective& f) {
+  while (!stopped()) step(f);
+}
+
 void Cmaes::tell(const std::vector<double>& f_in) {
   if (!asked_) throw std::logic_error("cmaes: tell() without a matching ask()");
   const int n = state_.n;

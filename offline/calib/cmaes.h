@@ -19,6 +19,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -103,6 +104,13 @@ class Cmaes {
   std::vector<Eigen::VectorXd> ask();
   // Objective values of the candidates from the last ask(). NaN or inf counts as worst.
   void tell(const std::vector<double>& f);
+
+  // The serial driver for a cheap objective on one thread: step() is one ask, f at every
+  // candidate in order, tell; minimize() steps until a stopping criterion fires. Calibration
+  // uses ask/tell itself, to spread a generation over threads and MPI ranks and checkpoint it.
+  using Objective = std::function<double(const Eigen::VectorXd&)>;
+  void step(const Objective& f);
+  void minimize(const Objective& f);
 
   bool stopped() const { return state_.stopped != StopReason::None; }
   StopReason stop_reason() const { return state_.stopped; }

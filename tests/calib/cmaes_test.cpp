@@ -11,7 +11,7 @@
 namespace dressguard::calib {
 namespace {
 
-using Fn = std::function<double(const Eigen::VectorXd&)>;
+using Fn = Cmaes::Objective;
 
 // Evaluations until the best value is <= 1e-8, counted in whole generations as purecma does;
 // -1 when the budget runs out first (counted as a failure, i.e. +infinity in the median).
@@ -23,12 +23,7 @@ long evaluations_to_target(const Fn& f, int n, std::uint64_t seed, long budget) 
   s.target_f = 1e-8;
   s.max_evaluations = budget;
   Cmaes es(s);
-  while (!es.stopped()) {
-    auto xs = es.ask();
-    std::vector<double> v;
-    for (const auto& x : xs) v.push_back(f(x));
-    es.tell(v);
-  }
+  es.minimize(f);
   return es.stop_reason() == StopReason::TargetReached ? es.state().evaluations : -1;
 }
 
@@ -78,12 +73,7 @@ TEST(Cmaes, SameSeedSameBitsDifferentSeedDifferentRun) {
     s.seed = seed;
     s.max_generations = 40;
     Cmaes es(s);
-    while (!es.stopped()) {
-      auto xs = es.ask();
-      std::vector<double> v;
-      for (auto& x : xs) v.push_back(rosenbrock(x));
-      es.tell(v);
-    }
+    es.minimize(rosenbrock);
     return es.save_state();
   };
   EXPECT_EQ(run(7), run(7));
@@ -95,19 +85,13 @@ TEST(Cmaes, CheckpointRestoreContinuesBitIdentically) {
   s.x0 = Eigen::VectorXd::Constant(5, 0.3);
   s.seed = 3;
   s.max_generations = 60;
-  auto step = [](Cmaes& es) {
-    auto xs = es.ask();
-    std::vector<double> v;
-    for (auto& x : xs) v.push_back(ellipsoid(x));
-    es.tell(v);
-  };
   Cmaes a(s);
-  for (int g = 0; g < 25; ++g) step(a);
+  for (int g = 0; g < 25; ++g) a.step(ellipsoid);
   const std::string saved = a.save_state();
   Cmaes b(s);
   b.restore_state(saved);
-  while (!a.stopped()) step(a);
-  while (!b.stopped()) step(b);
+  a.minimize(ellipsoid);
+  b.minimize(ellipsoid);
   EXPECT_EQ(a.save_state(), b.save_state());
   EXPECT_EQ(a.best_f(), b.best_f());
 }
@@ -140,15 +124,10 @@ TEST(Cmaes, BoundsRepairKeepsPointsFeasibleAndFindsFaceOptimum) {
   Eigen::VectorXd target(n);
   target << -1.0, 0.3, 0.6, 0.9;
   Cmaes es(s);
-  while (!es.stopped()) {
-    auto xs = es.ask();
-    std::vector<double> v;
-    for (auto& x : xs) {
-      EXPECT_TRUE((x.array() >= 0.0).all() && (x.array() <= 1.0).all());
-      v.push_back((x - target).squaredNorm());
-    }
-    es.tell(v);
-  }
+  es.minimize([&](const Eigen::VectorXd& x) {
+    EXPECT_TRUE((x.array() >= 0.0).all() && (x.array() <= 1.0).all());
+    return (x - target).squaredNorm();
+  });
   EXPECT_NEAR(es.best_x()[0], 0.0, 1e-4);
   EXPECT_NEAR(es.best_x()[1], 0.3, 1e-4);
   EXPECT_NEAR(es.best_x()[3], 0.9, 1e-4);
@@ -176,12 +155,7 @@ double run_rastrigin(Restarts r, std::uint64_t seed) {
   s.tol_fun = 1e-10;
   s.target_f = 1e-8;
   Cmaes es(s);
-  while (!es.stopped()) {
-    auto xs = es.ask();
-    std::vector<double> v;
-    for (auto& x : xs) v.push_back(rastrigin(x));
-    es.tell(v);
-  }
+  es.minimize(rastrigin);
   return es.best_f();
 }
 

@@ -49,12 +49,7 @@ long ours(Fn f, int n, unsigned seed) {
   s.target_f = 1e-8;
   s.max_evaluations = kBudget;
   Cmaes es(s);
-  while (!es.stopped()) {
-    auto xs = es.ask();
-    std::vector<double> v;
-    for (auto& x : xs) v.push_back(f(x));
-    es.tell(v);
-  }
+  es.minimize(f);
   return es.best_f() <= 1e-8 ? es.state().evaluations : -1;
 }
 
