@@ -32,7 +32,7 @@ namespace dressguard::calib {
 struct ClothValues {
   double stretch = 0.8;        // isotropic stretch stiffness (vertical = horizontal)
   double shear = 0.5;
-  double bend = 0.5;
+  double bend = 0.7;
   double friction = 0.5;       // cloth-arm
   double self_friction = 0.2;  // cloth-cloth
 };

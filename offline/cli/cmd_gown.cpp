@@ -93,14 +93,16 @@ int run_gown(int argc, char** argv) {
   Args args(argc - 1, argv + 1, {"help", "json", "parametric", "hang", "in-world"});
   if (args.has("help")) {
     std::puts(
-        "usage: dressguard gown [--obj FILE [--scale S] [--in-world] | --parametric] [--reduced N] [--hang]\n"
-        "                       [--out MESH.obj] [--dump SCENE.json] [--picture GOWN.png] [--json]\n"
+        "usage: dressguard gown [--obj FILE [--scale S] [--in-world] [--placement P] | --parametric] [--reduced N]\n"
+        "                       [--hang] [--out MESH.obj] [--dump SCENE.json] [--picture GOWN.png] [--json]\n"
         "  Loads the gown the simulator runs on, placed in the world frame W (z up, gripper moves +x)\n"
-        "  like the paper's simulator, and prints its statistics.\n"
+        "  with the paper's gripper and arm, and prints its statistics.\n"
         "  --obj FILE      mesh to load (default: shared/data/gown/fullgown.obj when present,\n"
         "                  else the project's parametric gown)\n"
         "  --scale S       file units -> metres (default 1.679, the paper's)\n"
         "  --in-world      the OBJ is already placed in W (as --out writes it; use --scale 1)\n"
+        "  --placement P   opening (default: the jaws hold the sleeve's top 4 cm behind its rim, the\n"
+        "                  opening facing the fist) or paper (the paper's code's transform, as read)\n"
         "  --parametric    use the parametric gown even when the measured one is present\n"
         "  --reduced N     reduce to about N triangles (quadric edge collapse), e.g. 5000\n"
         "  --hang          let the gown hang 3 s from the jaws in a crude check (edges only, no\n"
@@ -112,7 +114,8 @@ int run_gown(int argc, char** argv) {
         "  --json          print a machine-readable summary");
     return 0;
   }
-  args.allow_only({"help", "json", "parametric", "hang", "in-world", "obj", "scale", "reduced", "out", "dump", "picture"});
+  args.allow_only({"help", "json", "parametric", "hang", "in-world", "obj", "scale", "reduced", "out", "dump", "picture",
+                  "placement"});
   if (args.has("parametric") && args.has("obj")) throw UsageError("--parametric and --obj exclude each other");
   gown::GownOptions opt;
   opt.scale = args.number("scale", 1.679);
@@ -121,6 +124,14 @@ int run_gown(int argc, char** argv) {
   if (reduced < 0 || (reduced > 0 && reduced < 100)) throw UsageError("--reduced wants 0 (full) or at least 100 triangles");
   opt.target_triangles = static_cast<int>(reduced);
   if (auto obj = args.get("obj")) opt.obj = *obj;
+  if (auto p = args.get("placement")) {
+    if (*p == "opening")
+      opt.placement = gown::GownPlacement::Opening;
+    else if (*p == "paper")
+      opt.placement = gown::GownPlacement::Paper;
+    else
+      throw UsageError("--placement wants opening or paper, not '" + *p + "'");
+  }
 
   const auto t0 = std::chrono::steady_clock::now();
   opt.parametric = args.has("parametric");

@@ -26,7 +26,12 @@ GownMesh load_gown(const GownOptions& options) {
     mesh = make_parametric_gown();
   } else {
     mesh = read_obj(path, options.scale);
-    if (!options.already_in_W) place_like_paper(mesh, options.scene);
+    if (!options.already_in_W) {
+      if (options.placement == GownPlacement::Opening)
+        place_at_opening(mesh, options.scene);
+      else
+        place_like_paper(mesh, options.scene);
+    }
   }
   mesh.areal_density = options.areal_density;
   if (mesh.boundary_loops.size() < 2)

@@ -6,7 +6,9 @@
 // W is the paper's public-simulator frame P (y up, gripper moving toward -x) rotated:
 //   x_W = -x_P,  y_W = z_P,  z_W = y_P      (a proper rotation, det = +1)
 // The scene constants of that simulator (gripper jaws, arm spheres, gown transform) are in
-// placement.h (`PaperScene`), so that gown and sim use the same numbers.
+// placement.h (`PaperScene`), so that gown and sim use the same numbers. A file's gown is placed
+// by default with its sleeve opening held by the jaws and facing the fist (`place_at_opening`,
+// GownPlacement::Opening); the paper's code's own transform is GownPlacement::Paper.
 //
 // How the simulator uses it:
 //   GownOptions opt;                       // defaults: measured gown if present, scale 1.679
@@ -53,6 +55,7 @@ struct GownOptions {
   bool already_in_W = false;  // the file is already placed in W (as `dressguard gown --out` writes
                               // it, scale 1): skip the paper's transform
   PaperScene scene{};         // placement of a file's mesh and the grasp box that picks the sleeve
+  GownPlacement placement = GownPlacement::Opening;  // how a file's mesh is placed (placement.h)
 };
 
 // shared/data/gown/fullgown.obj when shared/data is present, else empty.

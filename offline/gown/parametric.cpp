@@ -25,8 +25,8 @@
 // sleeve's top seam 3 cm above the lower jaw's starting face, so the closing jaws pick up the
 // top of the sleeve (both layers, about 8 cm behind the rim) and lift it to the upper jaw; the
 // opening then hangs open below the jaws, spanning the fist at the high setting (checked by a
-// crude hang in tests/gown/placement_test.cpp). The measured gown is gripped differently (near
-// the sleeve's root, 0.2 m from its rim): this is our choice, not the paper's.
+// crude hang in tests/gown/placement_test.cpp). The measured gown is placed the same way by
+// place_at_opening (placement.h); the paper's code grips it near the sleeve's root instead.
 #include <algorithm>
 #include <array>
 #include <cmath>

@@ -1,9 +1,12 @@
-// Placement of the gown like the paper's public simulator, and the sleeve labelling.
+// Placement of the gown (ours at the opening, or the paper's public simulator's), and the sleeve
+// labelling.
 #include "placement.h"
 
 #include <algorithm>
 #include <limits>
 #include <stdexcept>
+
+#include <Eigen/Eigenvalues>
 
 #include "gown.h"
 
@@ -13,6 +16,56 @@ void place_like_paper(GownMesh& mesh, const PaperScene& scene) {
   const Eigen::Matrix3d R = scene.rotation_WF();
   const Eigen::Vector3d t = scene.translation_W();
   for (auto& p : mesh.x) p = R * p + t;
+}
+
+void place_at_opening(GownMesh& mesh, const PaperScene& scene, double grip_depth, int loop_index) {
+  if (loop_index < 0) {
+    // The sleeve: the paper's placement decides which of the two openings the arm enters.
+    GownMesh paper = mesh;
+    place_like_paper(paper, scene);
+    label_sleeve(paper, scene);
+    loop_index = paper.sleeve_loop;
+  }
+  if (loop_index >= static_cast<int>(mesh.boundary_loops.size()))
+    throw std::runtime_error("place_at_opening: boundary loop " + std::to_string(loop_index) + " does not exist");
+  const std::vector<int>& loop = mesh.boundary_loops[loop_index];
+  const Eigen::Vector3d c = loop_centroid(mesh, loop_index);
+  // Best-fit plane of the loop: its normal is the eigenvector of the smallest eigenvalue of the
+  // loop's scatter matrix (the opening of a sleeve is a roughly planar ring).
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (int v : loop) scatter += (mesh.x[v] - c) * (mesh.x[v] - c).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(scatter);
+  Eigen::Vector3d into = eig.eigenvectors().col(0);
+  // Into the sleeve: the side where the loop's neighbours off the loop lie.
+  std::vector<char> on_loop(mesh.x.size(), 0);
+  for (int v : loop) on_loop[v] = 1;
+  double side = 0;
+  for (const auto& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k)
+      if (on_loop[t[k]])
+        for (int j = 0; j < 3; ++j)
+          if (!on_loop[t[j]]) side += (mesh.x[t[j]] - c).dot(into);
+  if (side < 0) into = -into;
+  // Down: toward the gown's centroid, normal to the sleeve's axis.
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const auto& p : mesh.x) centroid += p;
+  centroid /= static_cast<double>(mesh.x.size());
+  Eigen::Vector3d down = (centroid - c) - (centroid - c).dot(into) * into;
+  if (down.norm() < 1e-9) down = into.unitOrthogonal();
+  down.normalize();
+  // Rows: the file-frame directions that become +x_W, +y_W, +z_W (e_y = e_z x e_x: det R = +1).
+  const Eigen::Vector3d ex = -into, ez = -down, ey = ez.cross(ex);
+  Eigen::Matrix3d R;
+  R.row(0) = ex.transpose();
+  R.row(1) = ey.transpose();
+  R.row(2) = ez.transpose();
+  for (auto& p : mesh.x) p = R * (p - c);
+  int top = loop.front();
+  for (int v : loop)
+    if (mesh.x[v].z() > mesh.x[top].z()) top = v;
+  const Eigen::Vector3d shift =
+      Eigen::Vector3d(opening_rim_x_W(scene, kOpeningRimAhead), scene.upper_jaw_center_W.y(), sleeve_top_z_W(scene, grip_depth)) - mesh.x[top];
+  for (auto& p : mesh.x) p += shift;
 }
 
 void label_sleeve(GownMesh& mesh, const PaperScene& scene) {

@@ -4,9 +4,12 @@
 
 #include <cmath>
 #include <cstring>
+#include <thread>
+#include <vector>
 
 #include "dataset.h"
 #include "files.h"
+#include "gown.h"
 #include "model.h"
 #include "objective.h"
 #include "params.h"
@@ -107,22 +110,39 @@ TEST(SimParams, ParseFormats) {
   }
 }
 
-// The three outcomes from the arm height alone (issue 5): sweeping the arm from high to low with
-// the default parameters gives good, then caught, then missed, each at least once, in that order.
-// NOT YET HOLDING (disabled so the suite stays green; run with --gtest_also_run_disabled_tests):
-// on the measured gown placed as the gown module reads the paper's code, the jaws hold the
-// sleeve about 0.25 m from its opening, which trails the gripper; the high arm stops at 10 N
-// near the measured good travel (0.62 m) but with the opening's lower half ~0.2 m short of the
-// elbow, so the paper's rule labels it caught; the middle and low arms miss. See
-// offline/sim/README.md.
-TEST(SimTrial, DISABLED_ThreeOutcomesFromArmHeightAlone) {
+// The three outcomes from the arm height alone (issue 5): sweeping the arm from the high setting
+// down past the low one (5 cm steps) with the default parameters gives good, then caught, then
+// missed, each at least once and in that order (a return to an earlier outcome fails). On the
+// reduced measured gown: the coarse gown's 5 cm edges cannot hold a 0.47 m opening in shape
+// (its sweep mixes the outcomes), and the label rule's 7 cm is finer than they are. What the
+// sweep shows physically: at the high setting the fist enters the opening and the sleeve's rim
+// ends against the upper arm (d_max ~ 6 cm); a few cm lower the fist meets the rim's lower edge
+// or the sleeve rides over the forearm and jams at the elbow (caught); lower still the gown
+// slides over the arm to the end of travel (missed). The trials run on two threads
+// (simulate_trial is thread-safe; each result is the same bits on any thread).
+TEST(SimTrial, ThreeOutcomesFromArmHeightAlone) {
+  if (gown::measured_gown_path().empty())
+    GTEST_SKIP() << "shared/data/gown/fullgown.obj is not present: the sweep is a property of the measured gown";
+  const Scene scene = make_default_scene(GownResolution::Reduced);
+  const std::vector<double> offsets = {0.0, -0.05, -0.10, -0.15, -0.20, -0.25};
+  std::vector<TrialResult> results(offsets.size());
+  auto run = [&](size_t first) {
+    for (size_t k = first; k < offsets.size(); k += 2) {
+      TrialSpec spec;
+      spec.height = ArmHeight::High;
+      spec.arm_offset = offsets[k];
+      results[k] = simulate_trial(scene, ClothParams{}, spec);
+    }
+  };
+  std::thread other(run, 1);
+  run(0);
+  other.join();
   std::vector<Outcome> seen;
-  for (double dz = 0.05; dz >= -0.30; dz -= 0.05) {
-    TrialSpec spec;
-    spec.height = ArmHeight::High;
-    spec.arm_offset = dz;
-    const Outcome o = simulate_trial(coarse_scene(), ClothParams{}, spec).outcome;
-    if (seen.empty() || seen.back() != o) seen.push_back(o);
+  for (size_t k = 0; k < offsets.size(); ++k) {
+    const TrialResult& r = results[k];
+    std::printf("arm offset %+.2f m: %-7s travel %.3f m, d_max %.3f m\n", offsets[k], std::string(outcome_name(r.outcome)).c_str(), r.travel,
+                r.d_max);
+    if (seen.empty() || seen.back() != r.outcome) seen.push_back(r.outcome);
   }
   const std::vector<Outcome> want = {Outcome::Good, Outcome::Caught, Outcome::Missed};
   EXPECT_EQ(seen, want);
