@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "constraints.h"
+#include "kernels.h"
 #include "model.h"
 
 namespace dressguard::sim {
@@ -19,6 +20,8 @@ void detect_arm(const GownModel& m, GownState& s) {
   const double base = sc.opt.contact_offset + 0.01;
   const int n = static_cast<int>(s.x.size());
   const int shapes = static_cast<int>(m.arm.size());
+  const bool planes = !sc.planes.empty();
+  s.contact_count = 0;
   for (int i = 0; i < n; ++i) {
     ArmCandidates c;
     if (!sc.grasped[i] && shapes > 0) {
@@ -41,6 +44,7 @@ void detect_arm(const GownModel& m, GownState& s) {
     }
     s.cand[i] = c;
     if (c.c[0] < 0) s.anchored[i] = 0;
+    if (!sc.grasped[i] && (c.c[0] >= 0 || planes)) s.contact_list[s.contact_count++] = i;
   }
 }
 
@@ -118,67 +122,82 @@ void detect_self(const GownModel& m, GownState& s) {
 }
 
 // Integration: the grasped vertices follow the gripper, the others move under gravity, the
-// perturbation and velocity damping (symplectic Euler prediction of XPBD).
+// perturbation and velocity damping (symplectic Euler prediction of XPBD). With `velocities`,
+// first v = (x - p) / h, the velocity update that ends the previous substep (update_velocities()):
+// one pass over the vertices instead of two.
+template <bool velocities>
 void integrate(const GownModel& m, GownState& s, V3 grip) {
   const SceneData& sc = *m.scene;
   const int n = static_cast<int>(s.x.size());
-  const double h = m.h, decay = m.damping_factor;
+  const double h = m.h, inv_h = 1.0 / m.h, decay = m.damping_factor;
+  const uint8_t* grasped = sc.grasped.data();
+  const double* w = m.w.data();
+  V3 *x = s.x.data(), *p = s.p.data(), *vel = s.v.data();
   for (int i = 0; i < n; ++i) {
-    s.p[i] = s.x[i];
-    if (sc.grasped[i]) {
-      s.x[i] = sc.rest[i] + s.jaw_closed * (sc.grasp_target[i] - sc.rest[i]) + grip;
+    if constexpr (velocities) vel[i] = inv_h * (x[i] - p[i]);
+    p[i] = x[i];
+    if (grasped[i]) {
+      x[i] = sc.rest[i] + s.jaw_closed * (sc.grasp_target[i] - sc.rest[i]) + grip;
       continue;
     }
-    V3 v = decay * s.v[i];
-    v += h * (m.gravity + m.w[i] * s.ext_force[i]);
-    s.v[i] = v;
-    s.x[i] += h * v;
+    V3 v = decay * vel[i];
+    v += h * (m.gravity + w[i] * s.ext_force[i]);
+    vel[i] = v;
+    x[i] += h * v;
   }
 }
 
-// Distance constraints in list order (fixed Gauss-Seidel order); the force they exert on
-// grasped vertices is added to `force` (XPBD: f = grad C lambda / h^2).
-void solve_links(const GownModel& m, GownState& s, const std::vector<DistanceLink>& links, double alpha_t,
-                 double alpha_c, double inv_h2, V3& force) {
-  const uint8_t* grasped = m.scene->grasped.data();
-  V3* x = s.x.data();
-  const double* w = m.w.data();
-  for (const DistanceLink& l : links) {
+// The scalar kernels: a block lane by lane through the constraint functions of constraints.h
+// (the AVX2 kernels of solver_avx2.cpp mirror them). The force that constraints touching grasped
+// vertices exert on them is added to `force` (XPBD: f = grad C lambda / h^2).
+
+void stretch_scalar(const StretchBlock& b, V3* x, const uint8_t* grasped, double inv_h2, V3& force) {
+  for (int l = 0; l < 4; ++l) {
+    const int i = b.i[l], j = b.j[l];
+    if (i < 0) break;
     V3 nrm;
-    const double dl = distance_constraint(x[l.i], x[l.j], w[l.i], w[l.j], l.rest, alpha_t, alpha_c, &nrm);
-    if (grasped[l.i] | grasped[l.j]) {
-      if (grasped[l.i]) force += (dl * inv_h2) * nrm;
-      if (grasped[l.j]) force -= (dl * inv_h2) * nrm;
-    }
+    const double dl = distance_constraint(x[i], x[j], b.wi[l], b.wj[l], b.rest[l], b.inv_t[l], b.inv_c[l], &nrm);
+    stretch_force(i, j, dl, nrm, grasped, inv_h2, force);
   }
 }
 
-// In-plane shear per triangle; alpha_shear / A per triangle (see shear_constraint()).
-void solve_shear(const GownModel& m, GownState& s, double inv_h2, V3& force) {
-  const uint8_t* grasped = m.scene->grasped.data();
-  V3* x = s.x.data();
-  const double* w = m.w.data();
-  const double at = m.alpha_shear * inv_h2;
-  for (const ShearTri& t : m.scene->shear) {
+void shear_scalar(const ShearBlock& b, V3* x, const uint8_t* grasped, double inv_h2, V3& force) {
+  for (int l = 0; l < 4; ++l) {
+    const int v[3] = {b.v[0][l], b.v[1][l], b.v[2][l]};
+    if (v[0] < 0) break;
+    const double dm[4] = {b.a[l], b.b[l], b.c[l], b.d[l]};
     V3 g[3];
-    const double dl = shear_constraint(x[t.v[0]], x[t.v[1]], x[t.v[2]], w[t.v[0]], w[t.v[1]], w[t.v[2]], t.dm_inv,
-                                       at / t.area, g);
-    if (grasped[t.v[0]] | grasped[t.v[1]] | grasped[t.v[2]])
-      for (int a = 0; a < 3; ++a)
-        if (grasped[t.v[a]]) force += (dl * inv_h2) * g[a];
+    const double dl = shear_constraint(x[v[0]], x[v[1]], x[v[2]], b.w0[l], b.w1[l], b.w2[l], dm, b.alpha_t[l], g);
+    shear_force(v, dl, g, grasped, inv_h2, force);
   }
 }
 
-void solve_bending(const GownModel& m, GownState& s, double alpha_t, double inv_h2, V3& force) {
+void bend_scalar(const BendBlock& b, V3* x, const uint8_t* grasped, double inv_h2, V3& force) {
+  for (int l = 0; l < 4; ++l) {
+    const int v[4] = {b.v[0][l], b.v[1][l], b.v[2][l], b.v[3][l]};
+    if (v[0] < 0) break;
+    const double k[4] = {b.k[0][l], b.k[1][l], b.k[2][l], b.k[3][l]};
+    const double wk[4] = {b.wk[0][l], b.wk[1][l], b.wk[2][l], b.wk[3][l]};
+    const V3 dl = bending_constraint(x[v[0]], x[v[1]], x[v[2]], x[v[3]], k, wk, b.neg_inv_denom[l]);
+    bend_force(v, k, dl, grasped, inv_h2, force);
+  }
+}
+
+// One constraint kind, colour group by colour group: the free blocks, then the careful ones.
+template <class Block, class Scalar, class Free, class Careful>
+void solve_kind(const GownModel& m, GownState& s, const std::vector<Block>& blocks, const std::vector<BlockSpan>& spans,
+                Scalar scalar, Free free, Careful careful, double inv_h2, V3& force) {
   const uint8_t* grasped = m.scene->grasped.data();
   V3* x = s.x.data();
-  const double* w = m.w.data();
-  for (const BendStencil& b : m.scene->bend) {
-    const double w4[4] = {w[b.v[0]], w[b.v[1]], w[b.v[2]], w[b.v[3]]};
-    const V3 dl = bending_constraint(x[b.v[0]], x[b.v[1]], x[b.v[2]], x[b.v[3]], w4, b.k, alpha_t);
-    if (grasped[b.v[0]] | grasped[b.v[1]] | grasped[b.v[2]] | grasped[b.v[3]])
-      for (int a = 0; a < 4; ++a)
-        if (grasped[b.v[a]]) force += (b.k[a] * inv_h2) * dl;
+  const Block* bl = blocks.data();
+  if (m.path == KernelPath::Avx2) {
+    for (const BlockSpan& sp : spans) {
+      free(bl + sp.begin, bl + sp.simd_end, x);
+      careful(bl + sp.simd_end, bl + sp.end, x, grasped, inv_h2, force);
+    }
+  } else {
+    for (const BlockSpan& sp : spans)
+      for (int32_t k = sp.begin; k < sp.end; ++k) scalar(bl[k], x, grasped, inv_h2, force);
   }
 }
 
@@ -203,12 +222,9 @@ inline void collide_static(const GownModel& m, GownState& s, int i, double phi, 
 // each vertex (paper eq. 2: f = m dx_col / h^2) is accumulated for the per-vertex contact map.
 void solve_contacts(const GownModel& m, GownState& s, double inv_h2) {
   const SceneData& sc = *m.scene;
-  const int n = static_cast<int>(s.x.size());
   const double off = sc.opt.contact_offset;
-  const bool planes = !sc.planes.empty();
-  for (int i = 0; i < n; ++i) {
-    if (s.cand[i].c[0] < 0 && !planes) continue;
-    if (sc.grasped[i]) continue;
+  for (size_t q = 0; q < s.contact_count; ++q) {
+    const int i = s.contact_list[q];
     const V3 before = s.x[i];
     const double dn_before = s.contact_dn[i];
     for (int k = 0; k < 2; ++k) {
@@ -262,7 +278,7 @@ void solve_self(const GownModel& m, GownState& s, double inv_h2, V3& force) {
   }
 }
 
-// v = (x - p) / h.
+// v = (x - p) / h, after the last substep (integrate<true> does it for the others).
 void update_velocities(const GownModel& m, GownState& s) {
   const int n = static_cast<int>(s.x.size());
   const double inv_h = 1.0 / m.h;
@@ -277,17 +293,23 @@ void stock_friction(const GownModel& m, GownState& s) {
     if (s.contact_dn[i] > 0) friction_velocity(s.v[i], s.contact_n[i], s.contact_dn[i], m.friction, m.h);
 }
 
-void substep(const GownModel& m, GownState& s, V3 grip, V3 grip_accel) {
+// One substep; `first`: the step's first substep (the velocities are current), else the
+// previous substep's velocity update is fused into the integration.
+void substep(const GownModel& m, GownState& s, V3 grip, V3 grip_accel, bool first) {
   const SceneData& sc = *m.scene;
   const double inv_h2 = 1.0 / (m.h * m.h);
-  integrate(m, s, grip);
+  if (first) {
+    integrate<false>(m, s, grip);
+  } else {
+    integrate<true>(m, s, grip);
+  }
   V3 force{0, 0, 0};  // of the gown on the gripper, this substep
-  solve_links(m, s, sc.stretch, m.alpha_stretch * inv_h2, m.alpha_compress * inv_h2, inv_h2, force);
-  solve_shear(m, s, inv_h2, force);
-  solve_bending(m, s, m.alpha_bend * inv_h2, inv_h2, force);
+  solve_kind(m, s, m.stretch_blocks, m.stretch_spans, stretch_scalar, stretch_free_avx2, stretch_careful_avx2, inv_h2,
+             force);
+  solve_kind(m, s, m.shear_blocks, m.shear_spans, shear_scalar, shear_free_avx2, shear_careful_avx2, inv_h2, force);
+  solve_kind(m, s, m.bend_blocks, m.bend_spans, bend_scalar, bend_free_avx2, bend_careful_avx2, inv_h2, force);
   solve_contacts(m, s, inv_h2);
   if (m.self_collision) solve_self(m, s, inv_h2, force);
-  update_velocities(m, s);
   // The grasped vertices' own weight and inertia also load the gripper.
   for (int g : sc.grasp_list) force += m.mass[g] * (m.gravity - grip_accel);
   s.force_acc += force;
@@ -304,8 +326,9 @@ void step(const GownModel& m, GownState& s, V3 grip_from, V3 grip_to, V3 grip_ac
     const double f = static_cast<double>(k + 1) / m.substeps;
     const V3 grip = grip_from + f * (grip_to - grip_from);
     s.grip_offset = grip;
-    substep(m, s, grip, grip_accel);
+    substep(m, s, grip, grip_accel, k == 0);
   }
+  update_velocities(m, s);
   if (m.scheme == FrictionScheme::Stock) stock_friction(m, s);
 }
 
