@@ -432,6 +432,8 @@ GownState make_state(const GownModel& m) {
   s.cell_start.assign(table + 1, 0);
   s.cell_sorted.assign(n, 0);
   s.cell_of.assign(n, 0);
+  s.cell_x.assign(n, {});
+  s.self_scratch.assign(n + 8, 0);
   const size_t cap = m.self_collision ? 16 * n : 0;
   s.pairs.resize(cap);
   return s;

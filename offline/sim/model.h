@@ -192,6 +192,8 @@ struct GownState {
   // Self-collision: spatial hash and pair list, capacities fixed in make_state().
   std::vector<int32_t> cell_start, cell_sorted;
   std::vector<uint32_t> cell_of;
+  std::vector<V3> cell_x;             // positions in cell_sorted's order
+  std::vector<int32_t> self_scratch;  // one vertex's candidates (n + 8)
   std::vector<SelfPair> pairs;
   size_t pair_count = 0;
   long pairs_dropped = 0;

@@ -48,6 +48,13 @@ void detect_arm(const GownModel& m, GownState& s) {
   }
 }
 
+// floor(v) as an integer without a library call (std::floor is one without SSE4.1); exact for
+// |v| < 2^63, far beyond any cell coordinate here.
+inline int64_t floor_i64(double v) {
+  const int64_t t = static_cast<int64_t>(v);
+  return t - (static_cast<double>(t) > v);
+}
+
 inline uint32_t hash_cell(int64_t ix, int64_t iy, int64_t iz, uint32_t mask) {
   const uint64_t h = static_cast<uint64_t>(ix) * 73856093ULL ^ static_cast<uint64_t>(iy) * 19349663ULL ^
                      static_cast<uint64_t>(iz) * 83492791ULL;
@@ -75,76 +82,99 @@ void detect_self(const GownModel& m, GownState& s) {
   std::fill(s.cell_start.begin(), s.cell_start.end(), 0);
   for (int i = 0; i < n; ++i) {
     const V3 q = s.x[i];
-    const uint32_t h = hash_cell(static_cast<int64_t>(std::floor(q.x * inv)), static_cast<int64_t>(std::floor(q.y * inv)),
-                                 static_cast<int64_t>(std::floor(q.z * inv)), mask);
+    const uint32_t h = hash_cell(floor_i64(q.x * inv), floor_i64(q.y * inv), floor_i64(q.z * inv), mask);
     s.cell_of[i] = h;
     s.cell_start[h + 1]++;
   }
   for (uint32_t k = 0; k < table; ++k) s.cell_start[k + 1] += s.cell_start[k];
-  // Scatter in vertex order using cell_start as cursors, then restore the starts.
-  for (int i = 0; i < n; ++i) s.cell_sorted[s.cell_start[s.cell_of[i]]++] = i;
+  // Scatter in vertex order using cell_start as cursors, then restore the starts. The positions
+  // are copied in cell order too, so that the candidate loop below reads them in sequence.
+  for (int i = 0; i < n; ++i) {
+    const int32_t a = s.cell_start[s.cell_of[i]]++;
+    s.cell_sorted[a] = i;
+    s.cell_x[a] = s.x[i];
+  }
   for (uint32_t k = table; k > 0; --k) s.cell_start[k] = s.cell_start[k - 1];
   s.cell_start[0] = 0;
   const double r2 = r * r, excl2 = r2;
   const size_t cap = s.pairs.size();
+  const int32_t* sorted = s.cell_sorted.data();
+  const V3* cx_sorted = s.cell_x.data();
+  int32_t* slots = s.self_scratch.data();
   for (int i = 0; i < n; ++i) {
     const V3 q = s.x[i];
     const double fx = q.x * inv, fy = q.y * inv, fz = q.z * inv;
-    const int64_t cx = static_cast<int64_t>(std::floor(fx)), cy = static_cast<int64_t>(std::floor(fy)),
-                  cz = static_cast<int64_t>(std::floor(fz));
+    const int64_t cx = floor_i64(fx), cy = floor_i64(fy), cz = floor_i64(fz);
     const int64_t bx = cx - (fx - cx < 0.5), by = cy - (fy - cy < 0.5), bz = cz - (fz - cz < 0.5);
-    uint32_t seen[8];
-    int nseen = 0;
-    for (int dx = 0; dx <= 1; ++dx)
-      for (int dy = 0; dy <= 1; ++dy)
-        for (int dz = 0; dz <= 1; ++dz) {
-          const uint32_t h = hash_cell(bx + dx, by + dy, bz + dz, mask);
-          bool dup = false;
-          for (int k = 0; k < nseen; ++k) dup |= seen[k] == h;
-          if (dup) continue;
-          seen[nseen++] = h;
-          for (int32_t a = s.cell_start[h]; a < s.cell_start[h + 1]; ++a) {
-            const int j = s.cell_sorted[a];
-            if (j <= i) continue;
-            if (sc.grasped[i] && sc.grasped[j]) continue;
-            const V3 d = s.x[j] - q;
-            if (dot(d, d) >= r2) continue;
-            const V3 dr = sc.rest[j] - sc.rest[i];
-            if (dot(dr, dr) < excl2) continue;
-            if (s.pair_count < cap) {
-              s.pairs[s.pair_count++] = {i, j};
-            } else {
-              s.pairs_dropped++;
-            }
-          }
-        }
+    uint32_t hs[8];
+    for (int k = 0; k < 8; ++k) hs[k] = hash_cell(bx + (k >> 2), by + ((k >> 1) & 1), bz + (k & 1), mask);
+    // The candidates' slots (positions in cell order), bucket after bucket. Short buckets are
+    // listed with a fixed count of 8 writes and the list advanced by their size: a loop whose
+    // length varied with each bucket would mispredict its exit at every bucket, which cost more
+    // than the candidates themselves. A bucket hashed twice is visited once. The buckets are
+    // distinct, so at most n slots plus 8 written beyond (self_scratch holds n + 8).
+    int nslots = 0;
+    for (int k = 0; k < 8; ++k) {
+      const uint32_t h = hs[k];
+      bool dup = false;
+      for (int c = 0; c < k; ++c) dup |= hs[c] == h;
+      if (dup) continue;
+      const int32_t a0 = s.cell_start[h], count = s.cell_start[h + 1] - a0;
+      if (count <= 8) {
+        for (int t = 0; t < 8; ++t) slots[nslots + t] = a0 + t;
+        nslots += count;
+      } else {
+        for (int t = 0; t < count; ++t) slots[nslots++] = a0 + t;
+      }
+    }
+    // The close later vertices, compacted in place without a branch per candidate (the order
+    // test would go either way at random): each is written, and kept by advancing the count.
+    int nclose = 0;
+    for (int c = 0; c < nslots; ++c) {
+      const int32_t a = slots[c];
+      const V3 d = cx_sorted[a] - q;
+      const int j = sorted[a];
+      slots[nclose] = j;
+      nclose += (dot(d, d) < r2) & (j > i);
+    }
+    for (int c = 0; c < nclose; ++c) {
+      const int j = slots[c];
+      if (sc.grasped[i] && sc.grasped[j]) continue;
+      const V3 dr = sc.rest[j] - sc.rest[i];
+      if (dot(dr, dr) < excl2) continue;
+      if (s.pair_count < cap) {
+        s.pairs[s.pair_count++] = {i, j};
+      } else {
+        s.pairs_dropped++;
+      }
+    }
   }
 }
 
 // Integration: the grasped vertices follow the gripper, the others move under gravity, the
 // perturbation and velocity damping (symplectic Euler prediction of XPBD). With `velocities`,
 // first v = (x - p) / h, the velocity update that ends the previous substep (update_velocities()):
-// one pass over the vertices instead of two.
+// one pass over the vertices instead of two. The pass treats every vertex as free (no branch per
+// vertex), then the grasped ones are placed; their velocity is not read until the step's final
+// update_velocities() sets it from their motion.
 template <bool velocities>
 void integrate(const GownModel& m, GownState& s, V3 grip) {
   const SceneData& sc = *m.scene;
   const int n = static_cast<int>(s.x.size());
   const double h = m.h, inv_h = 1.0 / m.h, decay = m.damping_factor;
-  const uint8_t* grasped = sc.grasped.data();
   const double* w = m.w.data();
+  const V3 g = m.gravity;
   V3 *x = s.x.data(), *p = s.p.data(), *vel = s.v.data();
+  const V3* f = s.ext_force.data();
   for (int i = 0; i < n; ++i) {
     if constexpr (velocities) vel[i] = inv_h * (x[i] - p[i]);
     p[i] = x[i];
-    if (grasped[i]) {
-      x[i] = sc.rest[i] + s.jaw_closed * (sc.grasp_target[i] - sc.rest[i]) + grip;
-      continue;
-    }
     V3 v = decay * vel[i];
-    v += h * (m.gravity + w[i] * s.ext_force[i]);
+    v += h * (g + w[i] * f[i]);
     vel[i] = v;
     x[i] += h * v;
   }
+  for (int i : sc.grasp_list) x[i] = sc.rest[i] + s.jaw_closed * (sc.grasp_target[i] - sc.rest[i]) + grip;
 }
 
 // The scalar kernels: a block lane by lane through the constraint functions of constraints.h
