@@ -286,7 +286,8 @@ namespace {
 // remainder and the constraints touching a grasped vertex, whose force the gripper reads) follow
 // in list order in "careful" blocks. Every block's constraints share no vertex (checked here, not
 // assumed: colour 63 may hold dependent ones), so its lanes can be solved at once. Mesh order
-// (no colours): one group of careful blocks of one constraint each, solved in list order.
+// (no colours): one group of careful blocks in list order, for the scalar kernels only (which
+// solve a block's lanes one after another, so they may share vertices there).
 template <class Block, class C, class VertsOf, class Fill, class Empty>
 void pack_blocks(const std::vector<C>& cs, const std::vector<int32_t>& colours, const std::vector<uint8_t>& grasped,
                  VertsOf verts, Fill fill, Empty empty, std::vector<Block>& blocks, std::vector<BlockSpan>& spans) {
@@ -335,10 +336,11 @@ void pack_blocks(const std::vector<C>& cs, const std::vector<int32_t>& colours, 
     for (size_t r = full; r < free_list.size(); ++r) rest_list.push_back(free_list[r]);
     sp.simd_end = static_cast<int32_t>(blocks.size());
     std::sort(rest_list.begin(), rest_list.end());  // list order within the careful share
-    // Careful blocks: up to 4 consecutive constraints with distinct vertices (one in mesh order).
+    // Careful blocks: up to 4 consecutive constraints with distinct vertices. In mesh order
+    // (scalar kernels only, lane after lane) any 4 consecutive ones.
     for (size_t r = 0; r < rest_list.size();) {
       size_t e = r + 1;
-      while (!mesh_order && e < rest_list.size() && e - r < 4 && distinct(rest_list, r, e + 1)) ++e;
+      while (e < rest_list.size() && e - r < 4 && (mesh_order || distinct(rest_list, r, e + 1))) ++e;
       put(rest_list, r, e);
       r = e;
     }
