@@ -166,13 +166,17 @@ void integrate(const GownModel& m, GownState& s, V3 grip) {
   const V3 g = m.gravity;
   V3 *x = s.x.data(), *p = s.p.data(), *vel = s.v.data();
   const V3* f = s.ext_force.data();
-  for (int i = 0; i < n; ++i) {
-    if constexpr (velocities) vel[i] = inv_h * (x[i] - p[i]);
-    p[i] = x[i];
-    V3 v = decay * vel[i];
-    v += h * (g + w[i] * f[i]);
-    vel[i] = v;
-    x[i] += h * v;
+  if (m.path == KernelPath::Avx2) {
+    integrate_avx2(n, velocities, h, inv_h, decay, g, w, f, x, p, vel);
+  } else {
+    for (int i = 0; i < n; ++i) {
+      if constexpr (velocities) vel[i] = inv_h * (x[i] - p[i]);
+      p[i] = x[i];
+      V3 v = decay * vel[i];
+      v += h * (g + w[i] * f[i]);
+      vel[i] = v;
+      x[i] += h * v;
+    }
   }
   for (int i : sc.grasp_list) x[i] = sc.rest[i] + s.jaw_closed * (sc.grasp_target[i] - sc.rest[i]) + grip;
 }

@@ -235,6 +235,20 @@ DG_AVX2 void bend_careful_avx2(const BendBlock* b, const BendBlock* e, V3* x, co
     }
 }
 
+DG_AVX2 void integrate_avx2(int n, bool velocities, double h, double inv_h, double decay, V3 g, const double* w,
+                            const V3* f, V3* x, V3* p, V3* v) {
+  const __m256d vh = _mm256_set1_pd(h), vinv_h = _mm256_set1_pd(inv_h), vdecay = _mm256_set1_pd(decay);
+  const __m256d vg = _mm256_load_pd(&g.x);
+  for (int i = 0; i < n; ++i) {
+    const __m256d xi = _mm256_load_pd(&x[i].x);
+    __m256d vi = velocities ? mul(vinv_h, sub(xi, _mm256_load_pd(&p[i].x))) : _mm256_load_pd(&v[i].x);
+    _mm256_store_pd(&p[i].x, xi);
+    vi = add(mul(vdecay, vi), mul(vh, add(vg, mul(_mm256_broadcast_sd(&w[i]), _mm256_load_pd(&f[i].x)))));
+    _mm256_store_pd(&v[i].x, vi);
+    _mm256_store_pd(&x[i].x, add(xi, mul(vh, vi)));
+  }
+}
+
 }  // namespace dressguard::sim
 
 #else  // not x86-64: cpu_has_avx2() is false and these are never called.
@@ -246,6 +260,7 @@ void bend_free_avx2(const BendBlock*, const BendBlock*, V3*) {}
 void stretch_careful_avx2(const StretchBlock*, const StretchBlock*, V3*, const uint8_t*, double, V3&) {}
 void shear_careful_avx2(const ShearBlock*, const ShearBlock*, V3*, const uint8_t*, double, V3&) {}
 void bend_careful_avx2(const BendBlock*, const BendBlock*, V3*, const uint8_t*, double, V3&) {}
+void integrate_avx2(int, bool, double, double, double, V3, const double*, const V3*, V3*, V3*, V3*) {}
 }  // namespace dressguard::sim
 
 #endif
