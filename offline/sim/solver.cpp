@@ -183,7 +183,9 @@ void integrate(const GownModel& m, GownState& s, V3 grip) {
 
 // The scalar kernels: a block lane by lane through the constraint functions of constraints.h
 // (the AVX2 kernels of solver_avx2.cpp mirror them). The force that constraints touching grasped
-// vertices exert on them is added to `force` (XPBD: f = grad C lambda / h^2).
+// vertices exert on them is added to `force` (XPBD: f = grad C lambda / h^2). Only for those:
+// the other constraints' terms are +-0, and adding them would not change a sum that starts at +0
+// (x + (+-0) = x for x != 0 and for x = +0), so both paths give the same bits.
 
 void stretch_scalar(const StretchBlock& b, V3* x, const uint8_t* grasped, double inv_h2, V3& force) {
   for (int l = 0; l < 4; ++l) {
@@ -191,7 +193,7 @@ void stretch_scalar(const StretchBlock& b, V3* x, const uint8_t* grasped, double
     if (i < 0) break;
     V3 nrm;
     const double dl = distance_constraint(x[i], x[j], b.wi[l], b.wj[l], b.rest[l], b.inv_t[l], b.inv_c[l], &nrm);
-    stretch_force(i, j, dl, nrm, grasped, inv_h2, force);
+    if (grasped[i] | grasped[j]) stretch_force(i, j, dl, nrm, grasped, inv_h2, force);
   }
 }
 
@@ -202,7 +204,7 @@ void shear_scalar(const ShearBlock& b, V3* x, const uint8_t* grasped, double inv
     const double dm[4] = {b.a[l], b.b[l], b.c[l], b.d[l]};
     V3 g[3];
     const double dl = shear_constraint(x[v[0]], x[v[1]], x[v[2]], b.w0[l], b.w1[l], b.w2[l], dm, b.alpha_t[l], g);
-    shear_force(v, dl, g, grasped, inv_h2, force);
+    if (grasped[v[0]] | grasped[v[1]] | grasped[v[2]]) shear_force(v, dl, g, grasped, inv_h2, force);
   }
 }
 
@@ -213,7 +215,7 @@ void bend_scalar(const BendBlock& b, V3* x, const uint8_t* grasped, double inv_h
     const double k[4] = {b.k[0][l], b.k[1][l], b.k[2][l], b.k[3][l]};
     const double wk[4] = {b.wk[0][l], b.wk[1][l], b.wk[2][l], b.wk[3][l]};
     const V3 dl = bending_constraint(x[v[0]], x[v[1]], x[v[2]], x[v[3]], k, wk, b.neg_inv_denom[l]);
-    bend_force(v, k, dl, grasped, inv_h2, force);
+    if (grasped[v[0]] | grasped[v[1]] | grasped[v[2]] | grasped[v[3]]) bend_force(v, k, dl, grasped, inv_h2, force);
   }
 }
 
