@@ -238,7 +238,7 @@ DG_AVX2 void bend_careful_avx2(const BendBlock* b, const BendBlock* e, V3* x, co
 DG_AVX2 void integrate_avx2(int n, bool velocities, double h, double inv_h, double decay, V3 g, const double* w,
                             const V3* f, V3* x, V3* p, V3* v) {
   const __m256d vh = _mm256_set1_pd(h), vinv_h = _mm256_set1_pd(inv_h), vdecay = _mm256_set1_pd(decay);
-  const __m256d vg = _mm256_load_pd(&g.x);
+  const __m256d vg = _mm256_loadu_pd(&g.x);  // (a by-value argument: no alignment assumed)
   for (int i = 0; i < n; ++i) {
     const __m256d xi = _mm256_load_pd(&x[i].x);
     __m256d vi = velocities ? mul(vinv_h, sub(xi, _mm256_load_pd(&p[i].x))) : _mm256_load_pd(&v[i].x);
