@@ -39,7 +39,7 @@ void bend_careful_avx2(const BendBlock* b, const BendBlock* e, V3* x, const uint
 
 // The free-vertex integration of integrate() (solver.cpp) with one register per vertex, for all
 // n vertices: with `velocities` first v = inv_h (x - p); then p = x, v = decay v + h (g + w f),
-// x += h v.
+// x += h v. f may be null: no external force (g + w 0 = g exactly, so the same bits).
 void integrate_avx2(int n, bool velocities, double h, double inv_h, double decay, V3 g, const double* w, const V3* f,
                     V3* x, V3* p, V3* v);
 

@@ -189,6 +189,7 @@ struct GownState {
   std::vector<double> contact_dn;     // sum of normal corrections over the output step [m]
   std::vector<V3> contact_acc;        // sum over substeps of the contact force on each vertex
   std::vector<V3> ext_force;          // per-vertex external force (the perturbation)
+  bool ext_force_on = false;          // any non-zero ext_force this output step (set by step())
   // Self-collision: spatial hash and pair list, capacities fixed in make_state().
   std::vector<int32_t> cell_start, cell_sorted;
   std::vector<uint32_t> cell_of;

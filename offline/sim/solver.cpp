@@ -28,8 +28,15 @@ void detect_arm(const GownModel& m, GownState& s) {
       const double margin = base + 2.0 * norm(s.v[i]) * m.dt;
       double best[2] = {1e300, 1e300};
       for (int k = 0; k < shapes; ++k) {
+        // A bounding sphere first: every point of a round cone lies within len / 2 + max(ra, rb)
+        // of its axis' midpoint, so phi >= |x - mid| - that. A vertex beyond it by the margin
+        // (and 1e-9 m against rounding) skips the exact distance, which would reject it too.
+        const RoundCone& cone = m.arm[k];
+        const V3 d = s.x[i] - 0.5 * (cone.a + cone.b);
+        const double reach = 0.5 * cone.len + std::max(cone.ra, cone.rb) + margin + 1e-9;
+        if (dot(d, d) > reach * reach) continue;
         V3 nrm;
-        const double phi = round_cone_distance(m.arm[k], s.x[i], &nrm);
+        const double phi = round_cone_distance(cone, s.x[i], &nrm);
         if (phi >= margin) continue;
         if (phi < best[0]) {
           best[1] = best[0];
@@ -165,7 +172,8 @@ void integrate(const GownModel& m, GownState& s, V3 grip) {
   const double* w = m.w.data();
   const V3 g = m.gravity;
   V3 *x = s.x.data(), *p = s.p.data(), *vel = s.v.data();
-  const V3* f = s.ext_force.data();
+  // Without a perturbation the force array is not read (g + w 0 = g exactly: the same bits).
+  const V3* f = s.ext_force_on ? s.ext_force.data() : nullptr;
   if (m.path == KernelPath::Avx2) {
     integrate_avx2(n, velocities, h, inv_h, decay, g, w, f, x, p, vel);
   } else {
@@ -173,7 +181,7 @@ void integrate(const GownModel& m, GownState& s, V3 grip) {
       if constexpr (velocities) vel[i] = inv_h * (x[i] - p[i]);
       p[i] = x[i];
       V3 v = decay * vel[i];
-      v += h * (g + w[i] * f[i]);
+      v += h * (f ? g + w[i] * f[i] : g);
       vel[i] = v;
       x[i] += h * v;
     }
@@ -355,6 +363,8 @@ void substep(const GownModel& m, GownState& s, V3 grip, V3 grip_accel, bool firs
 }  // namespace
 
 void step(const GownModel& m, GownState& s, V3 grip_from, V3 grip_to, V3 grip_accel) {
+  s.ext_force_on = false;
+  for (const V3& f : s.ext_force) s.ext_force_on |= (f.x != 0) | (f.y != 0) | (f.z != 0);
   detect_arm(m, s);
   if (m.self_collision) detect_self(m, s);
   std::fill(s.contact_dn.begin(), s.contact_dn.end(), 0.0);

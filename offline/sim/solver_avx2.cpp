@@ -243,7 +243,8 @@ DG_AVX2 void integrate_avx2(int n, bool velocities, double h, double inv_h, doub
     const __m256d xi = _mm256_load_pd(&x[i].x);
     __m256d vi = velocities ? mul(vinv_h, sub(xi, _mm256_load_pd(&p[i].x))) : _mm256_load_pd(&v[i].x);
     _mm256_store_pd(&p[i].x, xi);
-    vi = add(mul(vdecay, vi), mul(vh, add(vg, mul(_mm256_broadcast_sd(&w[i]), _mm256_load_pd(&f[i].x)))));
+    const __m256d acc = f ? add(vg, mul(_mm256_broadcast_sd(&w[i]), _mm256_load_pd(&f[i].x))) : vg;
+    vi = add(mul(vdecay, vi), mul(vh, acc));
     _mm256_store_pd(&v[i].x, vi);
     _mm256_store_pd(&x[i].x, add(xi, mul(vh, vi)));
   }
