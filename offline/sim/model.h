@@ -7,9 +7,9 @@
 // Precision: double. A substep is 1/6000 s, so gravity moves a vertex by g h^2 = 2.7e-7 m per
 // substep, only about 4 ulps of a float at 1 m from the origin: float positions would round the
 // physics away. Layout: positions as an array of xyz structs padded to 32 bytes, because the
-// constraint solvers gather vertices by index: one vertex is one aligned AVX2 load (a 4 x 4
-// transpose turns four of them into x, y, z lanes), and a vertex stored by one colour group is
-// forwarded whole to the next group's load.
+// constraint solvers gather vertices by index: one vertex is one aligned AVX2 register (the
+// bending and integration kernels work on it as it is), or two 16-byte halves that the stretch
+// and shear kernels transpose into x, y, z lanes of four vertices (solver_avx2.cpp).
 #pragma once
 
 #include <cmath>
@@ -85,7 +85,7 @@ struct SceneData {
   std::vector<BendStencil> bend;     // one per interior edge
   // Colour groups of the three lists (SceneOptions::colour_order): group g is
   // [colours[g], colours[g + 1]); no two constraints of a group share a vertex (checked again
-  // per SIMD block by make_model). Mesh order: one group, flagged dependent.
+  // per block by make_model). Empty in mesh order (colour_order off).
   std::vector<int32_t> stretch_colours, shear_colours, bend_colours;
   std::vector<uint8_t> grasped;      // 1 when held by the gripper (kinematic)
   std::vector<int32_t> grasp_list;
@@ -108,7 +108,8 @@ struct SceneData {
 struct alignas(32) StretchBlock {  // distance_constraint()
   int32_t i[4], j[4];
   double rest[4], wi[4], wj[4];
-  double inv_t[4], inv_c[4];  // 1 / (wi + wj + alpha_t) in tension, the same with alpha_c in compression (0 if not positive)
+  // 1 / (wi + wj + alpha_t) in tension, the same with alpha_c in compression (0 if not positive)
+  double inv_t[4], inv_c[4];
 };
 struct alignas(32) ShearBlock {  // shear_constraint()
   int32_t v[3][4];

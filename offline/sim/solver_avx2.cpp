@@ -1,8 +1,10 @@
-// The AVX2 constraint kernels (kernels.h): each solves the 4 constraints of a block at once, one
-// lane each. They mirror the scalar constraint functions of constraints.h operation for operation
-// (same order, no FMA), so a lane's result has the same bits as the scalar function's. The 4
-// constraints of a block share no vertex (one colour group, checked by make_model), so solving
-// them together equals solving them one after another.
+// The AVX2 kernels (kernels.h). Stretch and shear solve the 4 constraints of a block at once, one
+// lane each (vertices transposed into x, y, z lanes); bending, linear in x, solves them one after
+// another with one register per vertex (x, y, z, pad), as does the integration. They mirror the
+// scalar functions of constraints.h and solver.cpp operation for operation (same order, no FMA),
+// so each result has the same bits as the scalar function's. The 4 constraints of a block share
+// no vertex (one colour group, checked by make_model), so solving them together equals solving
+// them one after another.
 //
 // Compiled for every x86-64 (function-level target attributes, no -mavx2 for the file): the
 // inline helpers of the headers used here are inlined into the AVX2 functions, and nothing with
