@@ -16,22 +16,24 @@ namespace dressguard::sim {
 
 // Stretch along a mesh edge, a distance constraint:
 //   C = |x_i - x_j| - L,   grad_i C = n = (x_i - x_j) / |x_i - x_j|,   grad_j C = -n,
+//   dlambda = -C / (w_i + w_j + alpha),
 // with compliance alpha_t in tension and alpha_c (softer) in compression: woven fabric buckles
 // under almost no compressive load, so a sleeve tube must not stand up like a straw (PhysX's
-// cloth has a separate, soft compression stiffness for the same reason).
-// Writes n (the gradient on i); returns dlambda (0 if degenerate or both vertices fixed).
-inline double distance_constraint(V3& xi, V3& xj, double wi, double wj, double rest, double alpha_t, double alpha_c,
+// cloth has a separate, soft compression stiffness for the same reason). The two inverse
+// denominators are constant per trial and come precomputed (inv_t, inv_c; 0 when both vertices
+// are fixed). Writes n (the gradient on i); returns dlambda (0 if degenerate).
+// Mirrored over 4 lanes by stretch_kernel() (solver_avx2.cpp), operation for operation.
+inline double distance_constraint(V3& xi, V3& xj, double wi, double wj, double rest, double inv_t, double inv_c,
                                   V3* n_out) {
   const V3 d = xi - xj;
-  const double len = norm(d);
-  const double denom = wi + wj + (len < rest ? alpha_c : alpha_t);
-  if (len < 1e-12 || denom <= 0) {
+  const double len = std::sqrt(dot(d, d));
+  if (len < 1e-12) {
     *n_out = {0, 0, 0};
     return 0;
   }
   const double inv_len = 1.0 / len;
   const V3 n = inv_len * d;
-  const double dl = -(len - rest) / denom;
+  const double dl = (rest - len) * (len < rest ? inv_c : inv_t);
   xi += (wi * dl) * n;
   xj -= (wj * dl) * n;
   *n_out = n;
@@ -47,7 +49,10 @@ inline double distance_constraint(V3& xi, V3& xj, double wi, double wj, double r
 // Energy (1/2) C^2 / alpha per triangle, alpha = 1 / (G A) for shear modulus G [N/m]: the caller
 // passes alpha_t = alpha_shear / (A h^2). Purely in-plane: it neither resists bending nor
 // remembers a curved rest shape (a cross-edge distance would do both).
-inline double shear_constraint(V3& x0, V3& x1, V3& x2, double w0, double w1, double w2, const double dm_inv[4],
+// Mirrored over 4 lanes by shear_kernel() (solver_avx2.cpp), operation for operation. Always
+// inlined: out of line, the caller's gradient array had to be zeroed first (V3 has initialisers)
+// and that zeroing took a quarter of the scalar solver's time.
+[[gnu::always_inline]] inline double shear_constraint(V3& x0, V3& x1, V3& x2, double w0, double w1, double w2, const double dm_inv[4],
                                double alpha_t, V3 g_out[3]) {
   const double a = dm_inv[0], b = dm_inv[1], c = dm_inv[2], d = dm_inv[3];
   const V3 e1 = x1 - x0, e2 = x2 - x0;
@@ -78,15 +83,17 @@ inline double shear_constraint(V3& x0, V3& x1, V3& x2, double w0, double w1, dou
 // (the scalar |K x| has one, and its flipping direction chatters):
 //   dlambda = -(K x) / (sum_i w_i k_i^2 + alpha_t),   dx_i = w_i k_i dlambda.
 // alpha = 1 / bending stiffness [1/(N m)]. The rest state is flat (cloth has no rest curvature:
-// a sewn sleeve is flat fabric), and K is constant. Returns the vector dlambda.
-inline V3 bending_constraint(V3& x0, V3& x1, V3& x2, V3& x3, const double w[4], const double k[4], double alpha_t) {
+// a sewn sleeve is flat fabric), and K is constant, so the denominator is constant per trial:
+// the caller passes wk_i = w_i k_i and neg_inv_denom = -1 / (alpha_t + sum_i w_i k_i^2).
+// Returns the vector dlambda. Mirrored over 4 lanes by bend_kernel() (solver_avx2.cpp).
+inline V3 bending_constraint(V3& x0, V3& x1, V3& x2, V3& x3, const double k[4], const double wk[4],
+                             double neg_inv_denom) {
   const V3 kx = k[0] * x0 + k[1] * x1 + k[2] * x2 + k[3] * x3;
-  const double denom = alpha_t + w[0] * k[0] * k[0] + w[1] * k[1] * k[1] + w[2] * k[2] * k[2] + w[3] * k[3] * k[3];
-  const V3 dl = (-1.0 / denom) * kx;
-  x0 += (w[0] * k[0]) * dl;
-  x1 += (w[1] * k[1]) * dl;
-  x2 += (w[2] * k[2]) * dl;
-  x3 += (w[3] * k[3]) * dl;
+  const V3 dl = neg_inv_denom * kx;
+  x0 += wk[0] * dl;
+  x1 += wk[1] * dl;
+  x2 += wk[2] * dl;
+  x3 += wk[3] * dl;
   return dl;
 }
 

@@ -1,6 +1,7 @@
 // Building the constant model (SceneData, GownModel) and the preallocated state.
 #include "model.h"
 
+#include <array>
 #include <algorithm>
 #include <stdexcept>
 #include <string>
@@ -68,9 +69,11 @@ double cot(V3 a, V3 b) {
 // Reorders constraints by a greedy graph colouring (no two constraints of one colour share a
 // vertex), stable within a colour. This is still one fixed Gauss-Seidel order (deterministic),
 // but consecutive constraints no longer wait for each other's writes, so the CPU overlaps them
-// (measured: about 2x on the solve).
+// (measured: about 2x on the solve), and a group's constraints can be solved 4 at a time (SIMD).
+// Returns the groups' starts and the list's end. Colour 63 takes whatever does not fit in 63
+// colours and may share vertices; make_model() checks every SIMD block anyway.
 template <class C, class VertsOf>
-void colour_order(std::vector<C>& cs, int n_vertices, VertsOf verts) {
+std::vector<int32_t> colour_order(std::vector<C>& cs, int n_vertices, VertsOf verts) {
   std::vector<uint64_t> used(n_vertices, 0);
   std::vector<int> colour(cs.size(), 0);
   for (size_t k = 0; k < cs.size(); ++k) {
@@ -86,8 +89,14 @@ void colour_order(std::vector<C>& cs, int n_vertices, VertsOf verts) {
   std::stable_sort(idx.begin(), idx.end(), [&](size_t a, size_t b) { return colour[a] < colour[b]; });
   std::vector<C> out;
   out.reserve(cs.size());
-  for (size_t k : idx) out.push_back(cs[k]);
+  std::vector<int32_t> starts;
+  for (size_t r = 0; r < idx.size(); ++r) {
+    if (r == 0 || colour[idx[r]] != colour[idx[r - 1]]) starts.push_back(static_cast<int32_t>(r));
+    out.push_back(cs[idx[r]]);
+  }
+  starts.push_back(static_cast<int32_t>(cs.size()));
   cs.swap(out);
+  return starts;
 }
 
 struct HalfEdge {
@@ -187,9 +196,11 @@ Scene make_scene(const ClothMesh& mesh, const SceneOptions& opt) {
     k = e;
   }
   if (opt.colour_order) {
-  colour_order(d->stretch, n, [](const DistanceLink& l) { return std::array<int, 2>{l.i, l.j}; });
-  colour_order(d->shear, n, [](const ShearTri& t) { return std::array<int, 3>{t.v[0], t.v[1], t.v[2]}; });
-  colour_order(d->bend, n, [](const BendStencil& b) { return std::array<int, 4>{b.v[0], b.v[1], b.v[2], b.v[3]}; });
+    d->stretch_colours = colour_order(d->stretch, n, [](const DistanceLink& l) { return std::array<int, 2>{l.i, l.j}; });
+    d->shear_colours =
+        colour_order(d->shear, n, [](const ShearTri& t) { return std::array<int, 3>{t.v[0], t.v[1], t.v[2]}; });
+    d->bend_colours = colour_order(
+        d->bend, n, [](const BendStencil& b) { return std::array<int, 4>{b.v[0], b.v[1], b.v[2], b.v[3]}; });
   }
   // Grasp: the given vertices, else those inside the jaw box around the grasp point.
   d->grasped.assign(n, 0);
@@ -263,7 +274,144 @@ GownModel make_model(const SceneData& s, const ClothParams& p, FrictionScheme sc
     c.b.z += arm_dz;
   }
   m.elbow = s.elbow + V3{0, 0, arm_dz};
+  refresh_constraints(m);
   return m;
+}
+
+namespace {
+
+// Packs one constraint list into blocks, colour group by colour group (BlockSpan). `fill(block,
+// lane, c)` writes constraint c into a lane; `empty(block, lane)` marks a lane unused. A group's
+// constraints that touch no grasped vertex fill full "free" blocks in list order; the rest (the
+// remainder and the constraints touching a grasped vertex, whose force the gripper reads) follow
+// in list order in "careful" blocks. Every block's constraints share no vertex (checked here, not
+// assumed: colour 63 may hold dependent ones), so its lanes can be solved at once. Mesh order
+// (no colours): one group of careful blocks in list order, for the scalar kernels only (which
+// solve a block's lanes one after another, so they may share vertices there).
+template <class Block, class C, class VertsOf, class Fill, class Empty>
+void pack_blocks(const std::vector<C>& cs, const std::vector<int32_t>& colours, const std::vector<uint8_t>& grasped,
+                 VertsOf verts, Fill fill, Empty empty, std::vector<Block>& blocks, std::vector<BlockSpan>& spans) {
+  blocks.clear();
+  spans.clear();
+  const bool mesh_order = colours.empty();
+  const std::vector<int32_t> starts = mesh_order ? std::vector<int32_t>{0, static_cast<int32_t>(cs.size())} : colours;
+  std::vector<size_t> free_list, rest_list;
+  std::vector<int> vs;
+  auto distinct = [&](const std::vector<size_t>& list, size_t from, size_t to) {
+    vs.clear();
+    for (size_t r = from; r < to; ++r)
+      for (int v : verts(cs[list[r]])) vs.push_back(v);
+    std::sort(vs.begin(), vs.end());
+    return std::adjacent_find(vs.begin(), vs.end()) == vs.end();
+  };
+  auto put = [&](const std::vector<size_t>& list, size_t from, size_t to) {
+    Block blk{};
+    for (int l = 0; l < 4; ++l) {
+      if (from + l < to) {
+        fill(blk, l, cs[list[from + l]]);
+      } else {
+        empty(blk, l);
+      }
+    }
+    blocks.push_back(blk);
+  };
+  for (size_t g = 0; g + 1 < starts.size(); ++g) {
+    free_list.clear();
+    rest_list.clear();
+    for (int32_t c = starts[g]; c < starts[g + 1]; ++c) {
+      bool held = false;
+      for (int v : verts(cs[c])) held |= grasped[v] != 0;
+      (!mesh_order && !held ? free_list : rest_list).push_back(static_cast<size_t>(c));
+    }
+    BlockSpan sp{};
+    sp.begin = static_cast<int32_t>(blocks.size());
+    const size_t full = free_list.size() / 4 * 4;
+    for (size_t r = 0; r < full; r += 4) {
+      if (distinct(free_list, r, r + 4)) {
+        put(free_list, r, r + 4);
+      } else {
+        for (size_t q = r; q < r + 4; ++q) rest_list.push_back(free_list[q]);
+      }
+    }
+    for (size_t r = full; r < free_list.size(); ++r) rest_list.push_back(free_list[r]);
+    sp.simd_end = static_cast<int32_t>(blocks.size());
+    std::sort(rest_list.begin(), rest_list.end());  // list order within the careful share
+    // Careful blocks: up to 4 consecutive constraints with distinct vertices. In mesh order
+    // (scalar kernels only, lane after lane) any 4 consecutive ones.
+    for (size_t r = 0; r < rest_list.size();) {
+      size_t e = r + 1;
+      while (e < rest_list.size() && e - r < 4 && (mesh_order || distinct(rest_list, r, e + 1))) ++e;
+      put(rest_list, r, e);
+      r = e;
+    }
+    sp.end = static_cast<int32_t>(blocks.size());
+    spans.push_back(sp);
+  }
+}
+
+}  // namespace
+
+bool cpu_has_avx2() {
+#if defined(__x86_64__) || defined(__i386__)
+  return __builtin_cpu_supports("avx2");
+#else
+  return false;
+#endif
+}
+
+void refresh_constraints(GownModel& m) {
+  const SceneData& s = *m.scene;
+  const double inv_h2 = 1.0 / (m.h * m.h);
+  const double* w = m.w.data();
+  // Mesh order (the benchmark's baseline) stays scalar. The scalar kernels run the same blocks
+  // as the AVX2 ones: the same Gauss-Seidel order on both paths.
+  const bool simd = s.opt.simd && s.opt.colour_order && cpu_has_avx2();
+  m.path = simd ? KernelPath::Avx2 : KernelPath::Scalar;
+  const double at = m.alpha_stretch * inv_h2, ac = m.alpha_compress * inv_h2;
+  auto inv_pos = [](double d) { return d > 0 ? 1.0 / d : 0.0; };
+  pack_blocks<StretchBlock>(
+      s.stretch, s.stretch_colours, s.grasped, [](const DistanceLink& l) { return std::array<int, 2>{l.i, l.j}; },
+      [&](StretchBlock& b, int k, const DistanceLink& l) {
+        b.i[k] = l.i;
+        b.j[k] = l.j;
+        b.rest[k] = l.rest;
+        b.wi[k] = w[l.i];
+        b.wj[k] = w[l.j];
+        b.inv_t[k] = inv_pos(w[l.i] + w[l.j] + at);
+        b.inv_c[k] = inv_pos(w[l.i] + w[l.j] + ac);
+      },
+      [](StretchBlock& b, int k) { b.i[k] = b.j[k] = -1; }, m.stretch_blocks, m.stretch_spans);
+  const double as = m.alpha_shear * inv_h2;
+  pack_blocks<ShearBlock>(
+      s.shear, s.shear_colours, s.grasped,
+      [](const ShearTri& t) { return std::array<int, 3>{t.v[0], t.v[1], t.v[2]}; },
+      [&](ShearBlock& b, int k, const ShearTri& t) {
+        for (int a = 0; a < 3; ++a) b.v[a][k] = t.v[a];
+        b.a[k] = t.dm_inv[0];
+        b.b[k] = t.dm_inv[1];
+        b.c[k] = t.dm_inv[2];
+        b.d[k] = t.dm_inv[3];
+        b.w0[k] = w[t.v[0]];
+        b.w1[k] = w[t.v[1]];
+        b.w2[k] = w[t.v[2]];
+        b.alpha_t[k] = as / t.area;
+      },
+      [](ShearBlock& b, int k) { b.v[0][k] = b.v[1][k] = b.v[2][k] = -1; }, m.shear_blocks, m.shear_spans);
+  const double ab = m.alpha_bend * inv_h2;
+  pack_blocks<BendBlock>(
+      s.bend, s.bend_colours, s.grasped,
+      [](const BendStencil& b) { return std::array<int, 4>{b.v[0], b.v[1], b.v[2], b.v[3]}; },
+      [&](BendBlock& b, int k, const BendStencil& st) {
+        double denom = ab;
+        for (int a = 0; a < 4; ++a) {
+          b.v[a][k] = st.v[a];
+          b.k[a][k] = st.k[a];
+          b.wk[a][k] = w[st.v[a]] * st.k[a];
+          denom += b.wk[a][k] * st.k[a];
+        }
+        b.neg_inv_denom[k] = -1.0 / denom;
+      },
+      [](BendBlock& b, int k) { b.v[0][k] = b.v[1][k] = b.v[2][k] = b.v[3][k] = -1; }, m.bend_blocks, m.bend_spans);
 }
 
 GownState make_state(const GownModel& m) {
@@ -276,6 +424,7 @@ GownState make_state(const GownModel& m) {
   s.anchor.assign(n, {});
   s.anchored.assign(n, 0);
   s.cand.assign(n, {});
+  s.contact_list.assign(n, 0);
   s.contact_n.assign(n, {});
   s.contact_dn.assign(n, 0.0);
   s.contact_acc.assign(n, {});
@@ -285,6 +434,8 @@ GownState make_state(const GownModel& m) {
   s.cell_start.assign(table + 1, 0);
   s.cell_sorted.assign(n, 0);
   s.cell_of.assign(n, 0);
+  s.cell_x.assign(n, {});
+  s.self_scratch.assign(n + 8, 0);
   const size_t cap = m.self_collision ? 16 * n : 0;
   s.pairs.resize(cap);
   return s;

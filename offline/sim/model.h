@@ -6,9 +6,10 @@
 //
 // Precision: double. A substep is 1/6000 s, so gravity moves a vertex by g h^2 = 2.7e-7 m per
 // substep, only about 4 ulps of a float at 1 m from the origin: float positions would round the
-// physics away. Layout: positions as an array of xyz structs, because the constraint solvers
-// gather vertices in mesh order (one cache line per vertex), while no loop would vectorise over
-// separate x/y/z arrays anyway.
+// physics away. Layout: positions as an array of xyz structs padded to 32 bytes, because the
+// constraint solvers gather vertices by index: one vertex is one aligned AVX2 register (the
+// bending and integration kernels work on it as it is), or two 16-byte halves that the stretch
+// and shear kernels transpose into x, y, z lanes of four vertices (solver_avx2.cpp).
 #pragma once
 
 #include <cmath>
@@ -19,8 +20,10 @@
 
 namespace dressguard::sim {
 
-struct V3 {
+// A 3-vector padded to 32 bytes (pad stays 0; no arithmetic reads it), see the layout above.
+struct alignas(32) V3 {
   double x = 0, y = 0, z = 0;
+  double pad = 0;
 };
 inline V3 operator+(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 inline V3 operator-(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
@@ -80,6 +83,10 @@ struct SceneData {
   std::vector<DistanceLink> stretch; // every mesh edge
   std::vector<ShearTri> shear;       // one per triangle
   std::vector<BendStencil> bend;     // one per interior edge
+  // Colour groups of the three lists (SceneOptions::colour_order): group g is
+  // [colours[g], colours[g + 1]); no two constraints of a group share a vertex (checked again
+  // per block by make_model). Empty in mesh order (colour_order off).
+  std::vector<int32_t> stretch_colours, shear_colours, bend_colours;
   std::vector<uint8_t> grasped;      // 1 when held by the gripper (kinematic)
   std::vector<int32_t> grasp_list;
   std::vector<V3> grasp_target;      // where the closed jaws hold each vertex (rest elsewhere)
@@ -90,6 +97,42 @@ struct SceneData {
   std::vector<HalfSpace> planes;
   V3 elbow;                          // elbow centre at the High height
 };
+
+// The constraint lists as the solver reads them, built by make_model() (refresh_constraints())
+// from SceneData and the trial's masses and compliances, with what is constant per trial
+// precomputed (inverse masses per vertex, inverse denominators). AoSoA: 4 constraints a block,
+// one AVX2 iteration per block, each field a 4-lane row (index -1: an empty lane); a block's
+// constraints share no vertex. Per colour group, the first blocks are "free": full, touching no
+// grasped vertex; the rest are "careful": the group's remainder and every constraint touching a
+// grasped vertex, whose force the gripper reads (summed lane by lane in one order on every path).
+struct alignas(32) StretchBlock {  // distance_constraint()
+  int32_t i[4], j[4];
+  double rest[4], wi[4], wj[4];
+  // 1 / (wi + wj + alpha_t) in tension, the same with alpha_c in compression (0 if not positive)
+  double inv_t[4], inv_c[4];
+};
+struct alignas(32) ShearBlock {  // shear_constraint()
+  int32_t v[3][4];
+  int32_t unused[4];
+  double a[4], b[4], c[4], d[4];  // Dm^-1 = [[a, b], [c, d]]
+  double w0[4], w1[4], w2[4];
+  double alpha_t[4];              // alpha_shear / (A h^2)
+};
+struct alignas(32) BendBlock {  // bending_constraint()
+  int32_t v[4][4];
+  double k[4][4];                 // k[a][lane]
+  double wk[4][4];                // w_a k_a
+  double neg_inv_denom[4];        // -1 / (alpha_t + sum_a w_a k_a^2)
+};
+// The blocks of one colour group: [begin, simd_end) free, [simd_end, end) careful.
+struct BlockSpan {
+  int32_t begin, simd_end, end;
+};
+
+// Which constraint kernels run (SceneOptions::simd; both give the same bits, see README).
+enum class KernelPath : uint8_t { Scalar, Avx2 };
+// True when this CPU runs the AVX2 kernels.
+bool cpu_has_avx2();
 
 // The per-trial constant model: compliances and masses for one ClothParams.
 struct GownModel {
@@ -108,12 +151,22 @@ struct GownModel {
   std::vector<RoundCone> arm;         // placed at the trial's height
   V3 elbow;
   V3 gravity{0, 0, -9.81};
+  // Derived by refresh_constraints() (call it again after changing mass, w or a compliance).
+  KernelPath path = KernelPath::Scalar;
+  std::vector<StretchBlock> stretch_blocks;
+  std::vector<ShearBlock> shear_blocks;
+  std::vector<BendBlock> bend_blocks;
+  std::vector<BlockSpan> stretch_spans, shear_spans, bend_spans;
 };
 
 // Compliance from a stiffness in [0, 1]: log-linear between alpha_soft (k = 0) and alpha_stiff.
 double compliance_of(double k, double alpha_soft, double alpha_stiff);
 GownModel make_model(const SceneData& s, const ClothParams& p, FrictionScheme scheme, bool self_collision,
                      double arm_dz);
+// Rebuilds the solver's blocks from the model's masses, inverse masses and compliances (make_model
+// calls it; a test that edits w afterwards calls it again). Chooses the kernel path: AVX2 when
+// SceneOptions::simd is set and the CPU has it, else scalar.
+void refresh_constraints(GownModel& m);
 
 // Up to two arm colliders near a vertex, found once per output step.
 struct ArmCandidates {
@@ -129,13 +182,20 @@ struct GownState {
   std::vector<V3> anchor;             // Constraint friction: stick point of each arm contact
   std::vector<uint8_t> anchored;
   std::vector<ArmCandidates> cand;
+  // The free vertices with an arm candidate (or all free vertices when there are planes), in
+  // vertex order, listed once per output step so that the substeps' contact pass skips the rest.
+  std::vector<int32_t> contact_list;
+  size_t contact_count = 0;
   std::vector<V3> contact_n;          // last contact normal of the output step (Stock friction)
   std::vector<double> contact_dn;     // sum of normal corrections over the output step [m]
   std::vector<V3> contact_acc;        // sum over substeps of the contact force on each vertex
   std::vector<V3> ext_force;          // per-vertex external force (the perturbation)
+  bool ext_force_on = false;          // any non-zero ext_force this output step (set by step())
   // Self-collision: spatial hash and pair list, capacities fixed in make_state().
   std::vector<int32_t> cell_start, cell_sorted;
   std::vector<uint32_t> cell_of;
+  std::vector<V3> cell_x;             // positions in cell_sorted's order
+  std::vector<int32_t> self_scratch;  // one vertex's candidates (n + 8)
   std::vector<SelfPair> pairs;
   size_t pair_count = 0;
   long pairs_dropped = 0;

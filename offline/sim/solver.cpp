@@ -2,10 +2,14 @@
 // once, then `substeps` x (integrate, solve each constraint once in a fixed Gauss-Seidel order,
 // resolve contacts with friction, update velocities). Allocation-free: every buffer lives in
 // GownState. Deterministic: fixed orders everywhere (constraint lists, hash buckets, pairs).
+// Speed: the constraints are solved colour group by colour group in blocks of 4 (model.h), by
+// the AVX2 kernels (solver_avx2.cpp) when the CPU has AVX2, else by the scalar ones here; both
+// give the same bits (kernels.h).
 #include <algorithm>
 #include <cmath>
 
 #include "constraints.h"
+#include "kernels.h"
 #include "model.h"
 
 namespace dressguard::sim {
@@ -13,20 +17,30 @@ namespace {
 
 // Arm candidates of every free vertex within a margin of the surface: the exact distance is
 // re-evaluated every substep against these (at most two round cones per vertex, enough at the
-// elbow where the forearm and upper arm meet).
+// elbow where the forearm and upper arm meet). The vertices with candidates (all free ones when
+// there are planes) are listed for solve_contacts().
 void detect_arm(const GownModel& m, GownState& s) {
   const SceneData& sc = *m.scene;
   const double base = sc.opt.contact_offset + 0.01;
   const int n = static_cast<int>(s.x.size());
   const int shapes = static_cast<int>(m.arm.size());
+  const bool planes = !sc.planes.empty();
+  s.contact_count = 0;
   for (int i = 0; i < n; ++i) {
     ArmCandidates c;
     if (!sc.grasped[i] && shapes > 0) {
       const double margin = base + 2.0 * norm(s.v[i]) * m.dt;
       double best[2] = {1e300, 1e300};
       for (int k = 0; k < shapes; ++k) {
+        // A bounding sphere first: every point of a round cone lies within len / 2 + max(ra, rb)
+        // of its axis' midpoint, so phi >= |x - mid| - that. A vertex beyond it by the margin
+        // (and 1e-9 m against rounding) skips the exact distance, which would reject it too.
+        const RoundCone& cone = m.arm[k];
+        const V3 d = s.x[i] - 0.5 * (cone.a + cone.b);
+        const double reach = 0.5 * cone.len + std::max(cone.ra, cone.rb) + margin + 1e-9;
+        if (dot(d, d) > reach * reach) continue;
         V3 nrm;
-        const double phi = round_cone_distance(m.arm[k], s.x[i], &nrm);
+        const double phi = round_cone_distance(cone, s.x[i], &nrm);
         if (phi >= margin) continue;
         if (phi < best[0]) {
           best[1] = best[0];
@@ -41,7 +55,15 @@ void detect_arm(const GownModel& m, GownState& s) {
     }
     s.cand[i] = c;
     if (c.c[0] < 0) s.anchored[i] = 0;
+    if (!sc.grasped[i] && (c.c[0] >= 0 || planes)) s.contact_list[s.contact_count++] = i;
   }
+}
+
+// floor(v) as an integer without a library call (std::floor is one without SSE4.1); exact for
+// |v| < 2^63, far beyond any cell coordinate here.
+inline int64_t floor_i64(double v) {
+  const int64_t t = static_cast<int64_t>(v);
+  return t - (static_cast<double>(t) > v);
 }
 
 inline uint32_t hash_cell(int64_t ix, int64_t iy, int64_t iz, uint32_t mask) {
@@ -71,114 +93,159 @@ void detect_self(const GownModel& m, GownState& s) {
   std::fill(s.cell_start.begin(), s.cell_start.end(), 0);
   for (int i = 0; i < n; ++i) {
     const V3 q = s.x[i];
-    const uint32_t h = hash_cell(static_cast<int64_t>(std::floor(q.x * inv)), static_cast<int64_t>(std::floor(q.y * inv)),
-                                 static_cast<int64_t>(std::floor(q.z * inv)), mask);
+    const uint32_t h = hash_cell(floor_i64(q.x * inv), floor_i64(q.y * inv), floor_i64(q.z * inv), mask);
     s.cell_of[i] = h;
     s.cell_start[h + 1]++;
   }
   for (uint32_t k = 0; k < table; ++k) s.cell_start[k + 1] += s.cell_start[k];
-  // Scatter in vertex order using cell_start as cursors, then restore the starts.
-  for (int i = 0; i < n; ++i) s.cell_sorted[s.cell_start[s.cell_of[i]]++] = i;
+  // Scatter in vertex order using cell_start as cursors, then restore the starts. The positions
+  // are copied in cell order too, so that the candidate loop below reads them in sequence.
+  for (int i = 0; i < n; ++i) {
+    const int32_t a = s.cell_start[s.cell_of[i]]++;
+    s.cell_sorted[a] = i;
+    s.cell_x[a] = s.x[i];
+  }
   for (uint32_t k = table; k > 0; --k) s.cell_start[k] = s.cell_start[k - 1];
   s.cell_start[0] = 0;
   const double r2 = r * r, excl2 = r2;
   const size_t cap = s.pairs.size();
+  const int32_t* sorted = s.cell_sorted.data();
+  const V3* cx_sorted = s.cell_x.data();
+  int32_t* slots = s.self_scratch.data();
   for (int i = 0; i < n; ++i) {
     const V3 q = s.x[i];
     const double fx = q.x * inv, fy = q.y * inv, fz = q.z * inv;
-    const int64_t cx = static_cast<int64_t>(std::floor(fx)), cy = static_cast<int64_t>(std::floor(fy)),
-                  cz = static_cast<int64_t>(std::floor(fz));
+    const int64_t cx = floor_i64(fx), cy = floor_i64(fy), cz = floor_i64(fz);
     const int64_t bx = cx - (fx - cx < 0.5), by = cy - (fy - cy < 0.5), bz = cz - (fz - cz < 0.5);
-    uint32_t seen[8];
-    int nseen = 0;
-    for (int dx = 0; dx <= 1; ++dx)
-      for (int dy = 0; dy <= 1; ++dy)
-        for (int dz = 0; dz <= 1; ++dz) {
-          const uint32_t h = hash_cell(bx + dx, by + dy, bz + dz, mask);
-          bool dup = false;
-          for (int k = 0; k < nseen; ++k) dup |= seen[k] == h;
-          if (dup) continue;
-          seen[nseen++] = h;
-          for (int32_t a = s.cell_start[h]; a < s.cell_start[h + 1]; ++a) {
-            const int j = s.cell_sorted[a];
-            if (j <= i) continue;
-            if (sc.grasped[i] && sc.grasped[j]) continue;
-            const V3 d = s.x[j] - q;
-            if (dot(d, d) >= r2) continue;
-            const V3 dr = sc.rest[j] - sc.rest[i];
-            if (dot(dr, dr) < excl2) continue;
-            if (s.pair_count < cap) {
-              s.pairs[s.pair_count++] = {i, j};
-            } else {
-              s.pairs_dropped++;
-            }
-          }
-        }
+    uint32_t hs[8];
+    for (int k = 0; k < 8; ++k) hs[k] = hash_cell(bx + (k >> 2), by + ((k >> 1) & 1), bz + (k & 1), mask);
+    // The candidates' slots (positions in cell order), bucket after bucket. Short buckets are
+    // listed with a fixed count of 8 writes and the list advanced by their size: a loop whose
+    // length varied with each bucket would mispredict its exit at every bucket, which cost more
+    // than the candidates themselves. A bucket hashed twice is visited once. The buckets are
+    // distinct, so at most n slots plus 8 written beyond (self_scratch holds n + 8).
+    int nslots = 0;
+    for (int k = 0; k < 8; ++k) {
+      const uint32_t h = hs[k];
+      bool dup = false;
+      for (int c = 0; c < k; ++c) dup |= hs[c] == h;
+      if (dup) continue;
+      const int32_t a0 = s.cell_start[h], count = s.cell_start[h + 1] - a0;
+      if (count <= 8) {
+        for (int t = 0; t < 8; ++t) slots[nslots + t] = a0 + t;
+        nslots += count;
+      } else {
+        for (int t = 0; t < count; ++t) slots[nslots++] = a0 + t;
+      }
+    }
+    // The close later vertices, compacted in place without a branch per candidate (the order
+    // test would go either way at random): each is written, and kept by advancing the count.
+    int nclose = 0;
+    for (int c = 0; c < nslots; ++c) {
+      const int32_t a = slots[c];
+      const V3 d = cx_sorted[a] - q;
+      const int j = sorted[a];
+      slots[nclose] = j;
+      nclose += (dot(d, d) < r2) & (j > i);
+    }
+    for (int c = 0; c < nclose; ++c) {
+      const int j = slots[c];
+      if (sc.grasped[i] && sc.grasped[j]) continue;
+      const V3 dr = sc.rest[j] - sc.rest[i];
+      if (dot(dr, dr) < excl2) continue;
+      if (s.pair_count < cap) {
+        s.pairs[s.pair_count++] = {i, j};
+      } else {
+        s.pairs_dropped++;
+      }
+    }
   }
 }
 
 // Integration: the grasped vertices follow the gripper, the others move under gravity, the
-// perturbation and velocity damping (symplectic Euler prediction of XPBD).
+// perturbation and velocity damping (symplectic Euler prediction of XPBD). With `velocities`,
+// first v = (x - p) / h, the velocity update that ends the previous substep (update_velocities()):
+// one pass over the vertices instead of two. The pass treats every vertex as free (no branch per
+// vertex), then the grasped ones are placed; their velocity is not read until the step's final
+// update_velocities() sets it from their motion.
+template <bool velocities>
 void integrate(const GownModel& m, GownState& s, V3 grip) {
   const SceneData& sc = *m.scene;
   const int n = static_cast<int>(s.x.size());
-  const double h = m.h, decay = m.damping_factor;
-  for (int i = 0; i < n; ++i) {
-    s.p[i] = s.x[i];
-    if (sc.grasped[i]) {
-      s.x[i] = sc.rest[i] + s.jaw_closed * (sc.grasp_target[i] - sc.rest[i]) + grip;
-      continue;
+  const double h = m.h, inv_h = 1.0 / m.h, decay = m.damping_factor;
+  const double* w = m.w.data();
+  const V3 g = m.gravity;
+  V3 *x = s.x.data(), *p = s.p.data(), *vel = s.v.data();
+  // Without a perturbation the force array is not read (g + w 0 = g exactly: the same bits).
+  const V3* f = s.ext_force_on ? s.ext_force.data() : nullptr;
+  if (m.path == KernelPath::Avx2) {
+    integrate_avx2(n, velocities, h, inv_h, decay, g, w, f, x, p, vel);
+  } else {
+    for (int i = 0; i < n; ++i) {
+      if constexpr (velocities) vel[i] = inv_h * (x[i] - p[i]);
+      p[i] = x[i];
+      V3 v = decay * vel[i];
+      v += h * (f ? g + w[i] * f[i] : g);
+      vel[i] = v;
+      x[i] += h * v;
     }
-    V3 v = decay * s.v[i];
-    v += h * (m.gravity + m.w[i] * s.ext_force[i]);
-    s.v[i] = v;
-    s.x[i] += h * v;
   }
+  for (int i : sc.grasp_list) x[i] = sc.rest[i] + s.jaw_closed * (sc.grasp_target[i] - sc.rest[i]) + grip;
 }
 
-// Distance constraints in list order (fixed Gauss-Seidel order); the force they exert on
-// grasped vertices is added to `force` (XPBD: f = grad C lambda / h^2).
-void solve_links(const GownModel& m, GownState& s, const std::vector<DistanceLink>& links, double alpha_t,
-                 double alpha_c, double inv_h2, V3& force) {
-  const uint8_t* grasped = m.scene->grasped.data();
-  V3* x = s.x.data();
-  const double* w = m.w.data();
-  for (const DistanceLink& l : links) {
+// The scalar kernels: a block lane by lane through the constraint functions of constraints.h
+// (the AVX2 kernels of solver_avx2.cpp mirror them). The force that constraints touching grasped
+// vertices exert on them is added to `force` (XPBD: f = grad C lambda / h^2). Only for those:
+// the other constraints' terms are +-0, and adding them would not change a sum that starts at +0
+// (x + (+-0) = x for x != 0 and for x = +0), so both paths give the same bits.
+
+void stretch_scalar(const StretchBlock& b, V3* x, const uint8_t* grasped, double inv_h2, V3& force) {
+  for (int l = 0; l < 4; ++l) {
+    const int i = b.i[l], j = b.j[l];
+    if (i < 0) break;
     V3 nrm;
-    const double dl = distance_constraint(x[l.i], x[l.j], w[l.i], w[l.j], l.rest, alpha_t, alpha_c, &nrm);
-    if (grasped[l.i] | grasped[l.j]) {
-      if (grasped[l.i]) force += (dl * inv_h2) * nrm;
-      if (grasped[l.j]) force -= (dl * inv_h2) * nrm;
-    }
+    const double dl = distance_constraint(x[i], x[j], b.wi[l], b.wj[l], b.rest[l], b.inv_t[l], b.inv_c[l], &nrm);
+    if (grasped[i] | grasped[j]) stretch_force(i, j, dl, nrm, grasped, inv_h2, force);
   }
 }
 
-// In-plane shear per triangle; alpha_shear / A per triangle (see shear_constraint()).
-void solve_shear(const GownModel& m, GownState& s, double inv_h2, V3& force) {
-  const uint8_t* grasped = m.scene->grasped.data();
-  V3* x = s.x.data();
-  const double* w = m.w.data();
-  const double at = m.alpha_shear * inv_h2;
-  for (const ShearTri& t : m.scene->shear) {
+void shear_scalar(const ShearBlock& b, V3* x, const uint8_t* grasped, double inv_h2, V3& force) {
+  for (int l = 0; l < 4; ++l) {
+    const int v[3] = {b.v[0][l], b.v[1][l], b.v[2][l]};
+    if (v[0] < 0) break;
+    const double dm[4] = {b.a[l], b.b[l], b.c[l], b.d[l]};
     V3 g[3];
-    const double dl = shear_constraint(x[t.v[0]], x[t.v[1]], x[t.v[2]], w[t.v[0]], w[t.v[1]], w[t.v[2]], t.dm_inv,
-                                       at / t.area, g);
-    if (grasped[t.v[0]] | grasped[t.v[1]] | grasped[t.v[2]])
-      for (int a = 0; a < 3; ++a)
-        if (grasped[t.v[a]]) force += (dl * inv_h2) * g[a];
+    const double dl = shear_constraint(x[v[0]], x[v[1]], x[v[2]], b.w0[l], b.w1[l], b.w2[l], dm, b.alpha_t[l], g);
+    if (grasped[v[0]] | grasped[v[1]] | grasped[v[2]]) shear_force(v, dl, g, grasped, inv_h2, force);
   }
 }
 
-void solve_bending(const GownModel& m, GownState& s, double alpha_t, double inv_h2, V3& force) {
+void bend_scalar(const BendBlock& b, V3* x, const uint8_t* grasped, double inv_h2, V3& force) {
+  for (int l = 0; l < 4; ++l) {
+    const int v[4] = {b.v[0][l], b.v[1][l], b.v[2][l], b.v[3][l]};
+    if (v[0] < 0) break;
+    const double k[4] = {b.k[0][l], b.k[1][l], b.k[2][l], b.k[3][l]};
+    const double wk[4] = {b.wk[0][l], b.wk[1][l], b.wk[2][l], b.wk[3][l]};
+    const V3 dl = bending_constraint(x[v[0]], x[v[1]], x[v[2]], x[v[3]], k, wk, b.neg_inv_denom[l]);
+    if (grasped[v[0]] | grasped[v[1]] | grasped[v[2]] | grasped[v[3]]) bend_force(v, k, dl, grasped, inv_h2, force);
+  }
+}
+
+// One constraint kind, colour group by colour group: the free blocks, then the careful ones.
+template <class Block, class Scalar, class Free, class Careful>
+void solve_kind(const GownModel& m, GownState& s, const std::vector<Block>& blocks, const std::vector<BlockSpan>& spans,
+                Scalar scalar, Free free, Careful careful, double inv_h2, V3& force) {
   const uint8_t* grasped = m.scene->grasped.data();
   V3* x = s.x.data();
-  const double* w = m.w.data();
-  for (const BendStencil& b : m.scene->bend) {
-    const double w4[4] = {w[b.v[0]], w[b.v[1]], w[b.v[2]], w[b.v[3]]};
-    const V3 dl = bending_constraint(x[b.v[0]], x[b.v[1]], x[b.v[2]], x[b.v[3]], w4, b.k, alpha_t);
-    if (grasped[b.v[0]] | grasped[b.v[1]] | grasped[b.v[2]] | grasped[b.v[3]])
-      for (int a = 0; a < 4; ++a)
-        if (grasped[b.v[a]]) force += (b.k[a] * inv_h2) * dl;
+  const Block* bl = blocks.data();
+  if (m.path == KernelPath::Avx2) {
+    for (const BlockSpan& sp : spans) {
+      free(bl + sp.begin, bl + sp.simd_end, x);
+      careful(bl + sp.simd_end, bl + sp.end, x, grasped, inv_h2, force);
+    }
+  } else {
+    for (const BlockSpan& sp : spans)
+      for (int32_t k = sp.begin; k < sp.end; ++k) scalar(bl[k], x, grasped, inv_h2, force);
   }
 }
 
@@ -199,16 +266,14 @@ inline void collide_static(const GownModel& m, GownState& s, int i, double phi, 
   }
 }
 
-// Contacts with the arm's candidate round cones and the test planes; the collision force on
-// each vertex (paper eq. 2: f = m dx_col / h^2) is accumulated for the per-vertex contact map.
+// Contacts with the arm's candidate round cones and the test planes, for the vertices listed by
+// detect_arm(); the collision force on each vertex (paper eq. 2: f = m dx_col / h^2) is
+// accumulated for the per-vertex contact map.
 void solve_contacts(const GownModel& m, GownState& s, double inv_h2) {
   const SceneData& sc = *m.scene;
-  const int n = static_cast<int>(s.x.size());
   const double off = sc.opt.contact_offset;
-  const bool planes = !sc.planes.empty();
-  for (int i = 0; i < n; ++i) {
-    if (s.cand[i].c[0] < 0 && !planes) continue;
-    if (sc.grasped[i]) continue;
+  for (size_t q = 0; q < s.contact_count; ++q) {
+    const int i = s.contact_list[q];
     const V3 before = s.x[i];
     const double dn_before = s.contact_dn[i];
     for (int k = 0; k < 2; ++k) {
@@ -262,7 +327,7 @@ void solve_self(const GownModel& m, GownState& s, double inv_h2, V3& force) {
   }
 }
 
-// v = (x - p) / h.
+// v = (x - p) / h, after the last substep (integrate<true> does it for the others).
 void update_velocities(const GownModel& m, GownState& s) {
   const int n = static_cast<int>(s.x.size());
   const double inv_h = 1.0 / m.h;
@@ -277,17 +342,23 @@ void stock_friction(const GownModel& m, GownState& s) {
     if (s.contact_dn[i] > 0) friction_velocity(s.v[i], s.contact_n[i], s.contact_dn[i], m.friction, m.h);
 }
 
-void substep(const GownModel& m, GownState& s, V3 grip, V3 grip_accel) {
+// One substep; `first`: the step's first substep (the velocities are current), else the
+// previous substep's velocity update is fused into the integration.
+void substep(const GownModel& m, GownState& s, V3 grip, V3 grip_accel, bool first) {
   const SceneData& sc = *m.scene;
   const double inv_h2 = 1.0 / (m.h * m.h);
-  integrate(m, s, grip);
+  if (first) {
+    integrate<false>(m, s, grip);
+  } else {
+    integrate<true>(m, s, grip);
+  }
   V3 force{0, 0, 0};  // of the gown on the gripper, this substep
-  solve_links(m, s, sc.stretch, m.alpha_stretch * inv_h2, m.alpha_compress * inv_h2, inv_h2, force);
-  solve_shear(m, s, inv_h2, force);
-  solve_bending(m, s, m.alpha_bend * inv_h2, inv_h2, force);
+  solve_kind(m, s, m.stretch_blocks, m.stretch_spans, stretch_scalar, stretch_free_avx2, stretch_careful_avx2, inv_h2,
+             force);
+  solve_kind(m, s, m.shear_blocks, m.shear_spans, shear_scalar, shear_free_avx2, shear_careful_avx2, inv_h2, force);
+  solve_kind(m, s, m.bend_blocks, m.bend_spans, bend_scalar, bend_free_avx2, bend_careful_avx2, inv_h2, force);
   solve_contacts(m, s, inv_h2);
   if (m.self_collision) solve_self(m, s, inv_h2, force);
-  update_velocities(m, s);
   // The grasped vertices' own weight and inertia also load the gripper.
   for (int g : sc.grasp_list) force += m.mass[g] * (m.gravity - grip_accel);
   s.force_acc += force;
@@ -297,6 +368,8 @@ void substep(const GownModel& m, GownState& s, V3 grip, V3 grip_accel) {
 }  // namespace
 
 void step(const GownModel& m, GownState& s, V3 grip_from, V3 grip_to, V3 grip_accel) {
+  s.ext_force_on = false;
+  for (const V3& f : s.ext_force) s.ext_force_on |= (f.x != 0) | (f.y != 0) | (f.z != 0);
   detect_arm(m, s);
   if (m.self_collision) detect_self(m, s);
   std::fill(s.contact_dn.begin(), s.contact_dn.end(), 0.0);
@@ -304,8 +377,9 @@ void step(const GownModel& m, GownState& s, V3 grip_from, V3 grip_to, V3 grip_ac
     const double f = static_cast<double>(k + 1) / m.substeps;
     const V3 grip = grip_from + f * (grip_to - grip_from);
     s.grip_offset = grip;
-    substep(m, s, grip, grip_accel);
+    substep(m, s, grip, grip_accel, k == 0);
   }
+  update_velocities(m, s);
   if (m.scheme == FrictionScheme::Stock) stock_friction(m, s);
 }
 

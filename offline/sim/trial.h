@@ -163,6 +163,7 @@ struct SceneOptions {
   int jaw_close_steps = 60;
   bool with_arm = true;
   bool colour_order = true;       // false: constraints in mesh order (the benchmark's baseline)
+  bool simd = true;               // false: scalar constraint kernels even where AVX2 runs (same bits; tests, benchmark)
   bool require_grasp = true;      // false: no jaw box; only ClothMesh::grasp is held (physics tests)
   std::vector<std::array<double, 4>> planes;  // test colliders {p : n.p >= d} as (n.x, n.y, n.z, d)
 };

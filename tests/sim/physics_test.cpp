@@ -164,6 +164,7 @@ double capstan_slip(const Capstan& cap, FrictionScheme scheme, double mu, double
     for (int v : {0, 1}) m.mass[v] = 0.5 * m1;
     for (int v : {last, last + 1}) m.mass[v] = 0.5 * m1 * r;
     for (int v : {0, 1, last, last + 1}) m.w[v] = 1.0 / m.mass[v];
+    refresh_constraints(m);  // the solver's blocks carry the inverse masses
   };
   set_masses(1.0);
   GownState s = make_state(m);

@@ -10,6 +10,7 @@
 #include "dataset.h"
 #include "files.h"
 #include "gown.h"
+#include "gown_scene.h"
 #include "model.h"
 #include "objective.h"
 #include "params.h"
@@ -42,6 +43,37 @@ TEST(SimTrial, DeterministicBits) {
   spec.seed = 8;
   const TrialResult c = simulate_trial(coarse_scene(), ClothParams{}, spec);
   EXPECT_NE(a.seq.samples.back().f_motion, c.seq.samples.back().f_motion) << "the seed must matter";
+}
+
+// The AVX2 constraint kernels mirror the scalar constraint functions operation for operation
+// (kernels.h), and the gripper's force is summed in one order on both paths: a trial with arm
+// contact, self-collision, grasp and perturbation gives the same bits on both (exact: any
+// difference means a kernel strayed from its scalar function). Both paths are exercised
+// whatever the CPU: the scalar one always; the AVX2 one where the CPU has it (else skipped).
+TEST(SimTrial, Avx2AndScalarKernelsGiveTheSameBits) {
+  if (!cpu_has_avx2()) GTEST_SKIP() << "this CPU has no AVX2: only the scalar kernels run here";
+  gown::GownOptions go;
+  go.target_triangles = target_triangles(GownResolution::Coarse);
+  const gown::GownMesh mesh = gown::load_gown(go);
+  SceneOptions opt;
+  opt.self_distance = 0.02;  // as make_default_scene(Coarse)
+  const Scene simd = make_scene(mesh, gown::PaperScene{}, opt);
+  opt.simd = false;
+  const Scene scalar = make_scene(mesh, gown::PaperScene{}, opt);
+  EXPECT_EQ(make_model(simd.data(), ClothParams{}, FrictionScheme::Improved, true, 0).path, KernelPath::Avx2);
+  EXPECT_EQ(make_model(scalar.data(), ClothParams{}, FrictionScheme::Improved, true, 0).path, KernelPath::Scalar);
+  TrialSpec spec;
+  spec.height = ArmHeight::Middle;  // the arm catches the sleeve: contacts and friction run
+  spec.gown_noise = true;
+  spec.seed = 3;
+  spec.max_travel = 0.3;
+  const TrialResult a = simulate_trial(simd, ClothParams{}, spec);
+  const TrialResult b = simulate_trial(scalar, ClothParams{}, spec);
+  ASSERT_EQ(a.seq.samples.size(), b.seq.samples.size());
+  ASSERT_FALSE(a.seq.samples.empty());
+  EXPECT_FALSE(a.contacts.empty()) << "the trial should touch the arm";
+  EXPECT_EQ(0, std::memcmp(a.seq.samples.data(), b.seq.samples.data(), a.seq.samples.size() * sizeof(HapticSample)));
+  EXPECT_EQ(a.area_ratio, b.area_ratio);
 }
 
 // No explosion: a trial that ends at the 10 N stop (the gown caught on the arm) keeps every

@@ -4,10 +4,12 @@
 // arm collision on, it reports the wall time per second of simulated time for the pull alone
 // and for the whole trial (grasp, settling, pull at the high arm), the whole trial's wall time,
 // and the peak memory of one simulation (each configuration runs in its own child process, so
-// ru_maxrss is that simulation's). The baseline, measured in the same run on the same scene: the
-// same solver with its constraints in mesh order (no colouring), 0.5 s of settling each, so the
-// ratio shows what the fixed colour order buys. Goals (issue 5): full >= 1x real time, whole
-// trial < 15 s, reduced >= 8x real time, < 100 MB.
+// ru_maxrss is that simulation's). Baselines, measured in the same run on the same scene over the
+// same window (0.5 s of settling): the solver with its constraints in mesh order (no colouring,
+// scalar: the solver as it was before the colour order), and the colour-ordered solver with the
+// scalar kernels (SceneOptions::simd off), so the ratios show what the colour order and the AVX2
+// kernels each buy. The trial itself runs the default path (AVX2 where the CPU has it).
+// Goals (issue 5): full >= 1x real time, whole trial < 15 s, reduced >= 8x real time, < 100 MB.
 //
 // Usage: bench_sim [--quick]   (--quick: the reduced gown only and a 0.2 m pull)
 #include <sys/resource.h>
@@ -33,7 +35,8 @@ struct Figures {
   int vertices = 0, triangles = 0;
   double load_s = 0;
   double settle_wall = 0, settle_sim = 0, pull_wall = 0, pull_sim = 0;
-  double base_wall = 0, fast_wall = 0, window_sim = 0;  // baseline vs colour order, same window
+  double base_wall = 0, scalar_wall = 0, fast_wall = 0, window_sim = 0;  // mesh order, scalar, default path
+  bool avx2 = false;
   double trial_cpu = 0;   // CPU seconds of the whole trial
   double trial_wall = 0;  // wall seconds of the whole trial (the machine is shared: wall >= CPU)
   char label[16] = {};
@@ -71,10 +74,15 @@ Figures run(GownResolution res, double max_travel) {
   SceneOptions naive = opt;
   naive.colour_order = false;
   const Scene baseline = make_scene(mesh, gown::PaperScene{}, naive);
+  SceneOptions scalar_opt = opt;
+  scalar_opt.simd = false;
+  const Scene scalar = make_scene(mesh, gown::PaperScene{}, scalar_opt);
   f.load_s = seconds_since(t0);
   f.vertices = scene.vertex_count();
   f.triangles = scene.triangle_count();
+  f.avx2 = make_model(scene.data(), ClothParams{}, FrictionScheme::Improved, true, 0).path == KernelPath::Avx2;
   f.base_wall = settle_window(baseline);
+  f.scalar_wall = settle_window(scalar);
   f.fast_wall = settle_window(scene);
   f.window_sim = 0.5;
   // The low arm: the hand misses the sleeve and the pull runs its full travel.
@@ -130,8 +138,11 @@ int main(int argc, char** argv) {
   std::printf("bench_sim: one core, 300 Hz x %d substeps, bending + self-collision + arm collision on\n",
               SceneOptions{}.substeps);
   std::printf("times are CPU seconds of this process (one core); the trial's wall time is shown too\n");
-  std::printf("%-8s %6s %6s | %-22s | %-22s | %-17s | %-26s | %7s | %s\n", "gown", "verts", "tris", "pull: s per sim s (x RT)",
-              "trial: s per sim s (x RT)", "trial CPU (wall) s", "baseline (mesh order) ratio", "peak MB", "outcome");
+  std::printf("window: CPU s per simulated s over 0.5 s of settling, for the mesh-order scalar solver, the\n"
+              "colour-ordered scalar kernels and the default path, and the default path's speedup over each\n");
+  std::printf("%-8s %6s %6s | %-24s | %-24s | %-18s | %-41s | %7s | %s\n", "gown", "verts", "tris", "pull: s per sim s (x RT)",
+              "trial: s per sim s (x RT)", "trial CPU (wall) s", "window: mesh / scalar / default, speedups",
+              "peak MB", "outcome");
   for (GownResolution res : {GownResolution::Reduced, GownResolution::Full}) {
     if (quick && res == GownResolution::Full) continue;
     Figures f;
@@ -141,10 +152,11 @@ int main(int argc, char** argv) {
       return 1;
     }
     const double pull = f.pull_wall / f.pull_sim, trial = (f.settle_wall + f.pull_wall) / (f.settle_sim + f.pull_sim);
-    std::printf("%-8s %6d %6d | %8.3f (%5.2fx RT)      | %8.3f (%5.2fx RT)      | %7.1f (%7.1f) | %6.3f vs %6.3f s/s: %4.2fx | %7.1f | %s at %.3f m (load %.1f s)\n",
+    std::printf("%-8s %6d %6d | %8.3f (%6.2fx RT)      | %8.3f (%6.2fx RT)      | %7.1f (%7.1f)  | %6.3f / %6.3f / %6.3f %-6s %5.2fx %5.2fx | %7.1f | %s at %.3f m (load %.1f s)\n",
                 res == GownResolution::Full ? "full" : "reduced", f.vertices, f.triangles, pull, 1 / pull, trial, 1 / trial,
-                f.trial_cpu, f.trial_wall, f.base_wall / f.window_sim, f.fast_wall / f.window_sim,
-                f.base_wall / f.fast_wall, mb, f.label, f.travel, f.load_s);
+                f.trial_cpu, f.trial_wall, f.base_wall / f.window_sim, f.scalar_wall / f.window_sim,
+                f.fast_wall / f.window_sim, f.avx2 ? "(avx2)" : "(scal)", f.base_wall / f.fast_wall,
+                f.scalar_wall / f.fast_wall, mb, f.label, f.travel, f.load_s);
     std::fflush(stdout);
   }
   return 0;
