@@ -63,8 +63,9 @@ void place_at_opening(GownMesh& mesh, const PaperScene& scene, double grip_depth
   int top = loop.front();
   for (int v : loop)
     if (mesh.x[v].z() > mesh.x[top].z()) top = v;
-  const Eigen::Vector3d shift =
-      Eigen::Vector3d(opening_rim_x_W(scene, kOpeningRimAhead), scene.upper_jaw_center_W.y(), sleeve_top_z_W(scene, grip_depth)) - mesh.x[top];
+  const Eigen::Vector3d rim_top(opening_rim_x_W(scene, kOpeningRimAhead), scene.upper_jaw_center_W.y(),
+                                sleeve_top_z_W(scene, grip_depth));
+  const Eigen::Vector3d shift = rim_top - mesh.x[top];
   for (auto& p : mesh.x) p += shift;
 }
 
