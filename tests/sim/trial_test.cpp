@@ -78,11 +78,18 @@ TEST(SimTrial, Avx2AndScalarKernelsGiveTheSameBits) {
 
 // No explosion: a trial that ends at the 10 N stop (the gown caught on the arm) keeps every
 // position and force finite and the gown's area within 5% of its rest area (the bound;
-// the stretch constraints at default stiffness hold it within about 1%).
+// the stretch constraints at default stiffness hold it within about 1%). Which arm height
+// catches the gown depends on the gown (the measured one: middle; the parametric one, without
+// shared/data: high), so the first height whose trial is labelled caught is checked.
 TEST(SimTrial, NoExplosionAtTheTenNewtonStop) {
-  TrialSpec spec;
-  spec.height = ArmHeight::Middle;
-  const TrialResult r = simulate_trial(coarse_scene(), ClothParams{}, spec);
+  TrialResult r;
+  for (ArmHeight h : {ArmHeight::Middle, ArmHeight::High, ArmHeight::Low}) {
+    TrialSpec spec;
+    spec.height = h;
+    r = simulate_trial(coarse_scene(), ClothParams{}, spec);
+    if (r.outcome == Outcome::Caught) break;
+  }
+  ASSERT_EQ(r.outcome, Outcome::Caught) << "no arm height caught the gown";
   ASSERT_TRUE(r.stopped_by_force) << "expected the 10 N stop; ended at travel " << r.travel;
   EXPECT_TRUE(r.finite);
   EXPECT_NEAR(r.area_ratio, 1.0, 0.05);
