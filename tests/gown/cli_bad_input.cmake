@@ -15,6 +15,10 @@ execute_process(COMMAND ${DG} gown --sclae 2 RESULT_VARIABLE rc ERROR_VARIABLE e
 if(NOT rc EQUAL 2 OR NOT err MATCHES "--sclae")
   message(FATAL_ERROR "unknown option not named: rc=${rc} ${err}")
 endif()
+execute_process(COMMAND ${DG} gown --placement sideways RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "--placement" OR NOT err MATCHES "sideways")
+  message(FATAL_ERROR "bad --placement not named: rc=${rc} ${err}")
+endif()
 # The parametric gown always works (no shared data needed) and --json is one JSON object.
 execute_process(COMMAND ${DG} gown --parametric --json RESULT_VARIABLE rc OUTPUT_VARIABLE out)
 if(NOT rc EQUAL 0 OR NOT out MATCHES "^{\"source\": \"parametric\".*\"sleeve_loop\": [0-9]+")
