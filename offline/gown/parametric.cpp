@@ -43,8 +43,11 @@ constexpr int kWb = 56, kHb = 93, kWs = 19, kLs = 17, kNeck = 22, kSlit = 2;
 constexpr double kBulge = 0.03;      // half the front-back separation in the body [m]
 constexpr double kSleeveBulge = 0.0326;  // half-thickness of the sleeve's lens cross-section [m]
 constexpr double kBlend = 0.08;      // sleeve length over which the flat start opens up [m]
-constexpr double kCuffX_W = -0.12;   // x_W of the cuff: 1 cm ahead of the grasp box (x_W -0.21..-0.13) [m]
-constexpr double kTopSeamZ_W = 0.085;  // z_W of the sleeve's top seam: 3 cm above the lower jaw's start [m]
+// Where the sleeve sits relative to the jaws (placement.h, the rule the measured gown's Opening
+// placement follows too): the cuff 1 cm ahead of the grasp box, the top seam 3 cm above the lower
+// jaw's start, so the jaws pick up both layers of this flattened sleeve.
+constexpr double kCuffAhead = 0.01;   // [m]
+constexpr double kGripDepth = 0.03;   // [m]
 
 double smoothstep(double t) {
   t = std::clamp(t, 0.0, 1.0);
@@ -125,9 +128,12 @@ GownMesh make_parametric_gown() {
           add(b, c, d);
         }
       }
-  // Pattern -> W: X -> x, Y -> z, Z -> -y; the right cuff at kCuffX_W, its top seam at kTopSeamZ_W.
+  // Pattern -> W: X -> x, Y -> z, Z -> -y; the right cuff and the sleeve's top seam where the
+  // jaws of the paper's scene find them.
+  const PaperScene scene;
   const double cuff_x = (kWb + kLs) * kCell, top_y = kHb * kCell;
-  for (auto& p : mesh.x) p = Eigen::Vector3d(p.x() - cuff_x + kCuffX_W, -p.z(), p.y() - top_y + kTopSeamZ_W);
+  const double cuff_W = opening_rim_x_W(scene, kCuffAhead), top_W = sleeve_top_z_W(scene, kGripDepth);
+  for (auto& p : mesh.x) p = Eigen::Vector3d(p.x() - cuff_x + cuff_W, -p.z(), p.y() - top_y + top_W);
   mesh.boundary_loops = find_boundary_loops(mesh.triangles, static_cast<int>(mesh.x.size()));
   label_sleeve(mesh);
   return mesh;
