@@ -9,7 +9,7 @@
 #               build/default-model-data/, resumable: a rerun keeps the trials already there)
 #   DRESSGUARD  the dressguard binary (default: build/release/offline/cli/dressguard)
 # Environment: STATES (default 10, the paper's), CREATED (creation time to record; the shipped
-#   model used CREATED=2026-11-22T03:00:00Z, so the same data give the same bytes).
+#   model used CREATED=2026-11-22T05:00:00Z, so the same data give the same bytes).
 # Takes about 6 minutes on two cores (60 simulated trials, then training).
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)

@@ -103,11 +103,13 @@ int run_simulate(int argc, char** argv) {
                 "\"noise\": %s, \"gown\": \"%s\", \"friction\": \"%s\", \"travel\": %.6f, \"d_max\": %.6f, "
                 "\"stopped_by_force\": %s, \"contact_travel\": %.6f, \"samples\": %zu, \"f_motion\": %.6f, "
                 "\"f_lateral\": %.6f, \"f_vertical\": %.6f, \"weight\": %.6f, \"area_ratio\": %.6f, "
+                "\"settle_s\": %.4f, \"settle_speed\": %.6f, \"settled\": %s, "
                 "\"out\": \"%s\", \"params\": %s}",
                 std::string(outcome_name(r.outcome)).c_str(), hs.c_str(), r.arm_offset, spec.speed,
                 static_cast<unsigned long long>(spec.seed), spec.gown_noise ? "true" : "false", gs.c_str(), fr.c_str(),
                 r.travel, r.d_max, r.stopped_by_force ? "true" : "false", r.contact_travel, r.seq.samples.size(),
-                last.f_motion, last.f_lateral, last.f_vertical, r.weight, r.area_ratio, out.c_str(),
+                last.f_motion, last.f_lateral, last.f_vertical, r.weight, r.area_ratio, r.settle_time,
+                r.settle_speed, r.settled ? "true" : "false", out.c_str(),
                 sim::params_json(params).c_str());
   std::filesystem::path meta = out;
   meta.replace_extension(".json");

@@ -65,7 +65,7 @@ TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const 
   if (spec.arm_noise)
     arm_offset += spec.height == ArmHeight::Middle ? uniform(rng, -0.06, 0.0) : uniform(rng, -0.015, 0.015);
   const double arm_dz = sc.opt.arm.z_rel[hi] - sc.opt.arm.z_rel[0] + arm_offset;
-  const GownModel m = make_model(sc, params, spec.friction_scheme, spec.self_collision, arm_dz);
+  GownModel m = make_model(sc, params, spec.friction_scheme, spec.self_collision, arm_dz);
   GownState s = make_state(m);
   TrialResult r;
   r.arm_offset = arm_offset;
@@ -85,24 +85,72 @@ TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const 
   };
 
   // Perturbation (paper V-A): one random horizontal force, uniform in X and lateral up to 6 N,
-  // spread equally over all vertices for 0.5 s (output steps 180-330), then settling.
+  // spread equally over all vertices for 0.5 s (output steps 180-330), then settling until the
+  // gown is at rest (TrialSpec::settle_speed).
   const auto clock0 = std::chrono::steady_clock::now();
   const int perturb_from = 180, perturb_to = 330;
+  constexpr int kWindow = 30;  // 0.1 s: the rest check's window and period
+  const bool adaptive = spec.settle_speed > 0;
+  const int min_steps = std::max(spec.settle_steps, spec.gown_noise ? perturb_to + kWindow : 0);
+  const int max_steps = adaptive ? std::max(min_steps, spec.settle_max_steps) : min_steps;
+  const double cloth_decay = m.damping_factor;
+  const double settle_decay = std::min(cloth_decay, std::exp(-std::max(0.0, spec.settle_damping) * m.h));
   const V3 zero{0, 0, 0};
-  for (int k = 0; k < spec.settle_steps; ++k) {
+  // Settling's frames: the pull's start is known only at the end, so snapshots every 15 steps
+  // (0.05 s) as far back as the earliest requested negative time are kept and matched then.
+  const double earliest = frame_times.empty() ? 0.0 : std::min(0.0, frame_times.front());
+  const size_t keep_snaps = spec.keep_frames ? static_cast<size_t>(-earliest / (15 * m.dt)) + 2 : 0;
+  std::vector<std::pair<int, Frame>> snaps;  // (steps done, positions)
+  std::vector<V3> x_window = s.x;
+  int k = 0;
+  for (;;) {
     const bool on = spec.gown_noise && k >= perturb_from && k < perturb_to;
     const bool was_on = spec.gown_noise && k - 1 >= perturb_from && k - 1 < perturb_to;
     if (on != was_on)
       for (int i = 0; i < n; ++i) s.ext_force[i] = on ? V3{fx / n, fy / n, 0} : zero;
-    if ((spec.settle_steps - k) % 3 == 0) {  // the bias sample is the last 3 steps before the pull
+    m.damping_factor = on ? cloth_decay : settle_decay;
+    if (k % 3 == 0) {  // the bias sample is the last 3 steps before the pull (settling ends on k % 3 == 0)
       s.force_acc = zero;
       s.force_count = 0;
     }
     const int close = sc.opt.jaw_close_steps;
     s.jaw_closed = close > 0 ? std::min(1.0, (k + 1.0) / close) : 1.0;
     step(m, s, zero, zero, zero);
-    maybe_frame((k + 1 - spec.settle_steps) * m.dt, 0.0);
+    ++k;
+    if (keep_snaps > 0 && k % 15 == 0) {
+      if (snaps.size() == keep_snaps) snaps.erase(snaps.begin());
+      snaps.emplace_back(k, make_frame(s, 0.0, 0.0));
+    }
+    if (k % kWindow == 0) {
+      double v2 = 0;
+      long free_count = 0;
+      for (int i = 0; i < n; ++i)
+        if (m.w[i] > 0) {
+          const V3 d = s.x[i] - x_window[i];
+          v2 += dot(d, d), ++free_count;
+        }
+      r.settle_speed = free_count ? std::sqrt(v2 / free_count) / (kWindow * m.dt) : 0.0;
+      x_window = s.x;
+    }
+    if (k < min_steps || k % 3 != 0) continue;
+    if (!adaptive) break;
+    if (k % kWindow == 0 && (r.settle_speed <= spec.settle_speed || k >= max_steps)) break;
   }
+  r.settle_steps = k;
+  r.settle_time = k * m.dt;
+  r.settled = !adaptive || r.settle_speed <= spec.settle_speed;
+  m.damping_factor = cloth_decay;
+  for (; next_frame < frame_times.size() && frame_times[next_frame] < -1e-9; ++next_frame) {
+    // The snapshot nearest to the requested time before the pull.
+    const double want = frame_times[next_frame];
+    const std::pair<int, Frame>* best = nullptr;
+    for (const auto& sn : snaps)
+      if (!best || std::abs((sn.first - k) * m.dt - want) < std::abs((best->first - k) * m.dt - want)) best = &sn;
+    if (!best) continue;
+    r.frames.push_back(best->second);
+    r.frames.back().t = (best->first - k) * m.dt;
+  }
+  maybe_frame(0.0, 0.0);
   for (int i = 0; i < n; ++i) s.ext_force[i] = zero;
   // The sensor is biased at the start of the trial (data README): the settled gown's force,
   // mainly its weight, is removed from every sample.

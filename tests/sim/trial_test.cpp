@@ -121,8 +121,8 @@ TEST(SimTrial, SamplesFollowTheRig) {
     EXPECT_NEAR(r.seq.samples[k].travel, std::min(s, 0.03), 1e-9);
   }
   EXPECT_EQ(r.outcome, Outcome::Missed) << "full (short) travel is labelled missed";
-  // The bias is the settled gown's weight (about; it may still sway a little): raw F_z ~ -m g.
-  EXPECT_NEAR(-r.bias[2], r.weight, 0.1 * r.weight);
+  // The bias is the settled gown's weight: raw F_z = -m g (1%: HangingGownWeightOnTheGripper).
+  EXPECT_NEAR(-r.bias[2], r.weight, 0.01 * r.weight);
 }
 
 TEST(SimTrial, LabelRule) {
@@ -232,6 +232,7 @@ TEST(SimTrial, ArmHeightNoiseRanges) {
   TrialSpec spec;
   spec.arm_noise = true;
   spec.settle_steps = 3;
+  spec.settle_speed = 0;  // exactly 3 steps: only the drawn offset is checked
   spec.max_travel = 1e-4;
   std::vector<double> seen;
   for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low})
@@ -253,14 +254,40 @@ TEST(SimTrial, ArmHeightNoiseRanges) {
 
 // The default gown (measured when present) hanging still from the closed jaws, the arm out of
 // the way: before the bias removal the gripper's vertical force is the gown's weight within 1%
-// (the tolerance) and its horizontal force vanishes, once it has settled (3000 steps,
-// 10 s: the gown bounces slowly on its edges; at the trial's 500 steps it is within about 10%).
+// (the tolerance) and its horizontal force vanishes. The trial's own settling is used
+// (TrialSpec::settle_speed): the bias it takes is what every trial subtracts.
 TEST(SimTrial, HangingGownWeightOnTheGripper) {
   TrialSpec spec;
-  spec.settle_steps = 3000;
   spec.max_travel = 1e-4;
   spec.arm_offset = -2.0;
   const TrialResult r = simulate_trial(coarse_scene(), ClothParams{}, spec);
+  ASSERT_TRUE(r.settled) << "RMS speed " << r.settle_speed << " m/s after " << r.settle_time << " s";
   EXPECT_NEAR(-r.bias[2], r.weight, 0.01 * r.weight);
   EXPECT_NEAR(std::hypot(r.bias[0], r.bias[1]), 0.0, 0.01 * r.weight);
+}
+
+// Paper V-A: after the perturbation the robot waits for the gown to settle before it pulls. With
+// the push (two seeds) the gown is at rest when the pull starts (RMS vertex speed <= 5 mm/s, the
+// settling's criterion) and, on the low arm that it does not touch in the first 3 cm, the first
+// samples carry only the rig's start: the grasped gown's inertia, m a = 0.23 kg * 1 m/s^2, in
+// motion, and nothing in the vertical, so |F_motion| <= 0.5 N and |F_vertical| <= 0.2 N. The
+// fixed 1.7 s settling of session 1 left the gown swinging at about 2 m/s RMS and these samples
+// at 0.7-2.3 N.
+TEST(SimTrial, GownAtRestWhenThePullStarts) {
+  for (uint64_t seed : {1u, 2u}) {
+    TrialSpec spec;
+    spec.height = ArmHeight::Low;
+    spec.gown_noise = true;
+    spec.seed = seed;
+    spec.max_travel = 0.03;
+    const TrialResult r = simulate_trial(coarse_scene(), ClothParams{}, spec);
+    EXPECT_TRUE(r.settled) << "seed " << seed;
+    EXPECT_LE(r.settle_speed, spec.settle_speed) << "seed " << seed;
+    EXPECT_GT(r.settle_time, 330 / 300.0) << "settling ends after the push";
+    ASSERT_FALSE(r.seq.samples.empty());
+    for (const HapticSample& q : r.seq.samples) {
+      EXPECT_LE(std::abs(q.f_motion), 0.5) << "seed " << seed << " travel " << q.travel;
+      EXPECT_LE(std::abs(q.f_vertical), 0.2) << "seed " << seed << " travel " << q.travel;
+    }
+  }
 }
