@@ -133,15 +133,11 @@ TrialRequest request_for(const HapticSequence& input, const std::array<double, 3
   r.speed = input.speed;
   r.seed = 0;
   r.gown_noise = false;
-  if (!stopped_by_force(input) && !input.samples.empty()) r.max_travel = input.samples.back().travel;
+  r.max_travel = rig_end_of_travel(input.samples, r.max_travel);
   return r;
 }
 
-bool stopped_by_force(const HapticSequence& s) {
-  if (s.samples.empty()) return false;
-  const HapticSample& last = s.samples.back();
-  return std::abs(last.f_motion) >= 9.5 || std::abs(last.f_vertical) >= 9.5;
-}
+bool stopped_by_force(const HapticSequence& s) { return ended_at_force_limit(s.samples); }
 
 double rig_travel_of(const std::vector<HapticSequence>& inputs) {
   double travel = 0;

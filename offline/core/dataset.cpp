@@ -188,6 +188,15 @@ double estimate_speed(const std::vector<HapticSample>& s) {
   return std::fabs(v - 0.1) <= std::fabs(v - 0.15) ? 0.1 : 0.15;
 }
 
+bool ended_at_force_limit(const std::vector<HapticSample>& s) {
+  if (s.empty()) return false;
+  return std::abs(s.back().f_motion) >= 9.5 || std::abs(s.back().f_vertical) >= 9.5;
+}
+
+double rig_end_of_travel(const std::vector<HapticSample>& s, double full) {
+  return s.empty() || ended_at_force_limit(s) ? full : s.back().travel;
+}
+
 Dataset import_study(const fs::path& study) {
   struct Folder { const char* name; ArmHeight height; Outcome label; const char* tag; };
   static constexpr Folder folders[] = {

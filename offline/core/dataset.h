@@ -46,4 +46,14 @@ std::filesystem::path study_dir();
 // Pull speed estimated from the travel's steady slope, snapped to the nearer of 0.1 and 0.15 m/s.
 double estimate_speed(const std::vector<HapticSample>& samples);
 
+// True when a measured trial ended at the force threshold (|F| >= 9.5 N on motion or vertical at
+// its last sample; the rig's limit is 10 N, the last sample may sit just under it).
+bool ended_at_force_limit(const std::vector<HapticSample>& samples);
+
+// Where the rig stopped a measured trial that did not end at the force limit: its last travel
+// (the study's rig did not always run the full 0.85 m; participant 4's miss/2 ends at 0.72 m).
+// A simulation of that trial must stop there too, or the paper's objective charges the extra
+// length with w = 20 (eq. 5). `full` for a trial that ended at the force limit (or is empty).
+double rig_end_of_travel(const std::vector<HapticSample>& samples, double full = 0.85);
+
 }  // namespace dressguard

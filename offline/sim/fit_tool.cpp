@@ -47,11 +47,14 @@ struct Point {
   }
 };
 
-TrialSpec spec_for(ArmHeight h, double speed, double offset) {
+// The measured trial's conditions; the simulation stops where the rig stopped it (as calibration
+// does, calib::request_for), so that the objective compares the same stretch of travel.
+TrialSpec spec_for(ArmHeight h, const std::vector<HapticSample>& measured, double offset) {
   TrialSpec s;
   s.height = h;
-  s.speed = speed;
+  s.speed = estimate_speed(measured);
   s.arm_offset = offset;
+  s.max_travel = rig_end_of_travel(measured, s.max_travel);
   return s;
 }
 
@@ -88,7 +91,6 @@ int main(int argc, char** argv) {
   const auto st = list(a.count("stretch") ? a["stretch"] : "0.5,0.9");
   const auto be = list(a.count("bend") ? a["bend"] : "0.2");
   const auto of = list(a.count("offsets") ? a["offsets"] : "0,-0.02");
-  const double good_speed = estimate_speed(good), miss_speed = estimate_speed(miss);
 
   // Resume: the points already in grid.csv.
   std::map<std::string, std::string> done;
@@ -128,8 +130,8 @@ int main(int argc, char** argv) {
             cp.friction = f;
             cp.stretch = s;
             cp.bend = b;
-            const TrialResult rg = simulate_trial(scene, cp, spec_for(ArmHeight::High, good_speed, o));
-            const TrialResult rm = simulate_trial(scene, cp, spec_for(ArmHeight::Low, miss_speed, o));
+            const TrialResult rg = simulate_trial(scene, cp, spec_for(ArmHeight::High, good, o));
+            const TrialResult rm = simulate_trial(scene, cp, spec_for(ArmHeight::Low, miss, o));
             char buf[256];
             std::snprintf(buf, sizeof buf, "%s,%.5f,%.5f,%s,%.4f,%s,%.4f,%.4f", p.key().c_str(),
                           calib::area_objective(rg.seq.samples, good), calib::area_objective(rm.seq.samples, miss),
@@ -154,8 +156,8 @@ int main(int argc, char** argv) {
   cp.friction = best_p.friction;
   cp.stretch = best_p.stretch;
   cp.bend = best_p.bend;
-  const TrialResult rg = simulate_trial(scene, cp, spec_for(ArmHeight::High, good_speed, best_p.offset));
-  const TrialResult rm = simulate_trial(scene, cp, spec_for(ArmHeight::Low, miss_speed, best_p.offset));
+  const TrialResult rg = simulate_trial(scene, cp, spec_for(ArmHeight::High, good, best_p.offset));
+  const TrialResult rm = simulate_trial(scene, cp, spec_for(ArmHeight::Low, miss, best_p.offset));
   write_file_atomic(out / "best_good.csv", format_trial_csv(rg.seq.samples));
   write_file_atomic(out / "best_miss.csv", format_trial_csv(rm.seq.samples));
   write_file_atomic(out / "best_params.txt", format_params(cp));

@@ -122,3 +122,28 @@ TEST(Study, ImportsAllTwentyTwoTrialsWithLabelsAndSpeeds) {
   EXPECT_EQ(middle_miss, 6);
   EXPECT_EQ(fast, 1);  // the README: one trial at about 0.15 m/s
 }
+
+// Where the rig stopped a measured trial: at the force limit (|F| >= 9.5 N at the last sample,
+// either axis) the simulation may run the rig's full travel; otherwise it ends at the trial's
+// last travel. Every good trial of the study ends at the force limit and every missed one does
+// not, where the study is present.
+TEST(Study, RigEndOfTravel) {
+  std::vector<HapticSample> s = {{0.01, 0.001, 0, 0, 0}, {0.02, 0.72, -3.99, 0.1, -0.5}};
+  EXPECT_FALSE(ended_at_force_limit(s));
+  EXPECT_DOUBLE_EQ(rig_end_of_travel(s), 0.72);
+  s.back().f_vertical = 9.6;
+  EXPECT_TRUE(ended_at_force_limit(s));
+  EXPECT_DOUBLE_EQ(rig_end_of_travel(s), 0.85);
+  s.back().f_vertical = 0;
+  s.back().f_motion = -9.5;
+  EXPECT_DOUBLE_EQ(rig_end_of_travel(s, 0.9), 0.9);
+  EXPECT_DOUBLE_EQ(rig_end_of_travel({}), 0.85);
+  const fs::path study = study_dir();
+  if (study.empty()) GTEST_SKIP() << "shared/data not present: the study's trials are checked in CI, where it is";
+  for (const auto& t : import_study(study).trials) {
+    EXPECT_EQ(ended_at_force_limit(t.samples), t.label == Outcome::Good) << t.id;
+    if (t.label != Outcome::Good) {
+      EXPECT_LE(rig_end_of_travel(t.samples), 0.85 + 1e-9) << t.id;
+    }
+  }
+}
