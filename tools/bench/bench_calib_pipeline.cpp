@@ -159,6 +159,7 @@ int run_eval(const std::map<std::string, std::string>& a) {
     cal.participant = p;
     cal.cloth = r.cloth;
     cal.offsets = r.offsets;
+    for (ArmHeight h : space.offset_heights) cal.offset_calibrated[static_cast<int>(h)] = true;
     cal.objective = r.objective;
     cal.fits = r.fits;
     cal.gown = gown;
