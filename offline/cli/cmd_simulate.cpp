@@ -36,11 +36,14 @@ int run_simulate(int argc, char** argv) {
         "  Simulates one sleeve-pulling trial (XPBD cloth, 300 Hz x 20 substeps) and writes its\n"
         "  100 Hz haptic samples as a trial CSV (t,travel,f_motion,f_lateral,f_vertical; the rig's\n"
         "  signs), a summary FILE.json (label, travel, d_max, final forces, parameters) and, for\n"
-        "  pictures, FILE.scene.json (mesh, arm, frames) read by tools/plot/sim_scene.py.\n"
+        "  pictures, FILE.scene.json (mesh, arm, frames, contact forces on the arm at the end) read\n"
+        "  by tools/plot/sim_scene.py.\n"
         "  --arm-offset M    [m] added to the height's arm height (default 0)\n"
         "  --speed V         [m/s] pull speed, 0.1 or 0.15 (default 0.1)\n"
         "  --params FILE     cloth parameters ('name value' lines or flat JSON; see offline/sim/params.h)\n"
         "  --seed S          seed of the noise models (default 0)\n"
+        "  --max-travel M    [m] where the rig stops if the force limit does not stop it first\n"
+        "                    (default 0.85; a measured trial's own end: rig_end_of_travel)\n"
         "  --noise           the paper's gown perturbation (random force up to 6 N for 0.5 s)\n"
         "  --arm-noise       the paper's arm-height noise (+-1.5 cm high/low, -6..0 cm middle)\n"
         "  --gown G          full | reduced | coarse (default reduced): the measured gown at ~20k, 5k,\n"
@@ -53,7 +56,7 @@ int run_simulate(int argc, char** argv) {
         "  --json            print the summary as JSON");
     return 0;
   }
-  args.allow_only({"help", "json", "noise", "arm-noise", "no-self-collision", "height", "arm-offset", "speed", "params", "seed",
+  args.allow_only({"help", "json", "noise", "arm-noise", "no-self-collision", "height", "arm-offset", "max-travel", "speed", "params", "seed",
                    "gown", "friction", "out", "frames", "parametric"});
   sim::TrialSpec spec;
   const std::string hs = args.require("height");
@@ -67,6 +70,9 @@ int run_simulate(int argc, char** argv) {
   const long seed = args.integer("seed", 0);
   if (seed < 0) throw UsageError("--seed must be non-negative");
   spec.seed = static_cast<uint64_t>(seed);
+  spec.max_travel = args.number("max-travel", 0.85);
+  if (!(spec.max_travel > 0.0 && spec.max_travel <= 0.85))
+    throw UsageError("--max-travel must be in (0, 0.85] m (the rig's travel)");
   spec.gown_noise = args.has("noise");
   spec.arm_noise = args.has("arm-noise");
   spec.self_collision = !args.has("no-self-collision");

@@ -110,6 +110,12 @@ std::string scene_json(const Scene& scene, const TrialSpec& spec, const TrialRes
     const HapticSample& s = r.seq.samples[k];
     o << (k ? "," : "") << '[' << s.t << ',' << s.travel << ',' << s.f_motion << ',' << s.f_lateral << ',' << s.f_vertical << ']';
   }
+  // Paper eq. 2: the cloth's force on the arm per vertex over the last sample, [vertex, fx, fy, fz].
+  o << "],\n\"contacts\": [";
+  for (size_t k = 0; k < r.contacts.size(); ++k) {
+    const ContactForce& c = r.contacts[k];
+    o << (k ? "," : "") << '[' << c.vertex << ',' << c.force[0] << ',' << c.force[1] << ',' << c.force[2] << ']';
+  }
   o << "]}\n";
   return o.str();
 }

@@ -12,6 +12,22 @@ execute_process(COMMAND ${DG} simulate --height high --params ${TMP}/bad_params.
 if(NOT rc EQUAL 2 OR NOT err MATCHES "bad_params.txt:2")
   message(FATAL_ERROR "bad params file line not named: rc=${rc} ${err}")
 endif()
+execute_process(COMMAND ${DG} simulate --height high --max-travel 2 --out /tmp/dg_sim_never.csv RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "--max-travel")
+  message(FATAL_ERROR "bad --max-travel not named: rc=${rc} ${err}")
+endif()
 if(EXISTS /tmp/dg_sim_never.csv)
   message(FATAL_ERROR "a failed simulate wrote its output")
+endif()
+
+# --max-travel stops the rig there (a measured trial's own end of travel), and the scene file
+# carries the contact forces on the arm at the end (paper eq. 2).
+execute_process(COMMAND ${DG} simulate --gown coarse --height low --max-travel 0.05 --frames 0 --out ${TMP}/short.csv --json
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "\"travel\": 0.050000" OR NOT out MATCHES "\"label\": \"missed\"")
+  message(FATAL_ERROR "--max-travel 0.05 did not end the trial at 0.05 m: rc=${rc} ${out} ${err}")
+endif()
+file(READ ${TMP}/short.scene.json scene)
+if(NOT scene MATCHES "\"contacts\": \\[")
+  message(FATAL_ERROR "the scene file has no contacts list")
 endif()
