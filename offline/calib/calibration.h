@@ -60,6 +60,13 @@ struct SimulatedTrial {
 
 // Must be deterministic and callable from several threads at once.
 using TrialSimulator = std::function<SimulatedTrial(const ClothValues&, const TrialRequest&)>;
+// One cloth's trials at once, results in the requests' order, each the same as the one-trial
+// simulator's: a simulator may share work between them (the cloth simulator settles the gown
+// once for all arm heights, sim::simulate_trials). The same rules as TrialSimulator.
+using TrialBatchSimulator =
+    std::function<std::vector<SimulatedTrial>(const ClothValues&, const std::vector<TrialRequest>&)>;
+// The batch form of a one-trial simulator: its trials one after another.
+TrialBatchSimulator one_by_one(TrialSimulator sim);
 
 // ---- parameter space and bounds ------------------------------------------------------------------
 
@@ -145,9 +152,14 @@ struct CalibrationResult {
 
 // Runs (or resumes from options.checkpoint) the calibration. Every rank of `comm` must call it
 // with the same arguments; they evaluate shares of each generation and end with identical
-// results; only rank 0 writes the checkpoint and calls `progress`.
+// results; only rank 0 writes the checkpoint and calls `progress`. A generation's tasks are its
+// candidates, each simulating all input sequences with one batch call; a one-trial simulator
+// runs them one after another (one_by_one). The result does not depend on which is given.
 CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const ParameterSpace& space,
                             const TrialSimulator& sim, const CalibrationOptions& options, const Comm& comm,
+                            const std::function<void(const GenerationProgress&)>& progress = {});
+CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const ParameterSpace& space,
+                            const TrialBatchSimulator& sim, const CalibrationOptions& options, const Comm& comm,
                             const std::function<void(const GenerationProgress&)>& progress = {});
 
 // The request that reproduces a measured input sequence with candidate offsets (no gown noise,

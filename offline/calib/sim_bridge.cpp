@@ -10,34 +10,59 @@ namespace dressguard::calib {
 
 bool cloth_simulator_available() { return true; }
 
-TrialSimulator make_cloth_simulator(const std::string& gown) {
+namespace {
+
+sim::ClothParams params_of(const ClothValues& c) {
+  sim::ClothParams p;  // damping and density keep the simulator's defaults (not calibrated, paper IV-B.2)
+  p.stretch = c.stretch;
+  p.shear = c.shear;
+  p.bend = c.bend;
+  p.friction = c.friction;
+  p.self_friction = c.self_friction;
+  return p;
+}
+
+sim::TrialSpec spec_of(const TrialRequest& r) {
+  sim::TrialSpec spec;
+  spec.height = r.height;
+  spec.arm_offset = r.arm_offset;
+  spec.speed = r.speed;
+  spec.seed = r.seed;
+  spec.gown_noise = r.gown_noise;
+  spec.max_travel = r.max_travel;
+  return spec;
+}
+
+SimulatedTrial simulated(sim::TrialResult&& res) {
+  SimulatedTrial out;
+  out.samples = std::move(res.seq.samples);
+  out.outcome = res.outcome;
+  out.finite = res.finite;
+  return out;
+}
+
+}  // namespace
+
+ClothSimulator make_cloth_simulator(const std::string& gown) {
   sim::GownResolution res;
   if (gown == "full") res = sim::GownResolution::Full;
   else if (gown == "reduced") res = sim::GownResolution::Reduced;
   else if (gown == "coarse") res = sim::GownResolution::Coarse;
   else throw std::invalid_argument("unknown gown '" + gown + "' (expected full, reduced or coarse)");
   auto scene = std::make_shared<const sim::Scene>(sim::make_default_scene(res));
-  return [scene](const ClothValues& c, const TrialRequest& r) {
-    sim::ClothParams p;  // damping and density keep the simulator's defaults (not calibrated, paper IV-B.2)
-    p.stretch = c.stretch;
-    p.shear = c.shear;
-    p.bend = c.bend;
-    p.friction = c.friction;
-    p.self_friction = c.self_friction;
-    sim::TrialSpec spec;
-    spec.height = r.height;
-    spec.arm_offset = r.arm_offset;
-    spec.speed = r.speed;
-    spec.seed = r.seed;
-    spec.gown_noise = r.gown_noise;
-    spec.max_travel = r.max_travel;
-    sim::TrialResult res = sim::simulate_trial(*scene, p, spec);
-    SimulatedTrial out;
-    out.samples = std::move(res.seq.samples);
-    out.outcome = res.outcome;
-    out.finite = res.finite;
+  ClothSimulator cs;
+  cs.trial = [scene](const ClothValues& c, const TrialRequest& r) {
+    return simulated(sim::simulate_trial(*scene, params_of(c), spec_of(r)));
+  };
+  cs.trials = [scene](const ClothValues& c, const std::vector<TrialRequest>& rs) {
+    std::vector<sim::TrialSpec> specs;
+    for (const TrialRequest& r : rs) specs.push_back(spec_of(r));
+    std::vector<sim::TrialResult> res = sim::simulate_trials(*scene, params_of(c), specs);
+    std::vector<SimulatedTrial> out;
+    for (sim::TrialResult& r : res) out.push_back(simulated(std::move(r)));
     return out;
   };
+  return cs;
 }
 
 }  // namespace dressguard::calib

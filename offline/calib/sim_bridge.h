@@ -8,11 +8,18 @@
 
 namespace dressguard::calib {
 
+// The cloth simulator in both forms, over one Scene (constant model) built once and shared by
+// every call; sim::simulate_trial() and simulate_trials() keep their mutable state per call, so
+// both functions may run on any number of threads. `trials` settles a cloth once for all its
+// arm heights where that is exact (sim::simulate_trials) and gives the same bits as `trial`.
+struct ClothSimulator {
+  TrialSimulator trial;
+  TrialBatchSimulator trials;
+};
+
 // "full" (the measured 20k-triangle gown), "reduced" (the default for calibration and synthesis)
 // or "coarse" (small, for tests). Throws std::invalid_argument for another name.
-// The Scene (constant model) is built once here and shared by every call; simulate_trial() keeps
-// its mutable state per call, so the returned function may run on any number of threads.
-TrialSimulator make_cloth_simulator(const std::string& gown);
+ClothSimulator make_cloth_simulator(const std::string& gown);
 
 // True (this file is only compiled with dg_sim); lets tests ask without the macro.
 bool cloth_simulator_available();

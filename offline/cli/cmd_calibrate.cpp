@@ -95,14 +95,14 @@ int run_calibrate(int argc, char** argv) {
   throw UsageError("this dressguard was built without the cloth simulator (offline/sim); calibrate needs it");
 #else
   const Comm& comm = Comm::world();
-  const TrialSimulator sim = make_cloth_simulator(gown);
+  const ClothSimulator sim = make_cloth_simulator(gown);
   if (comm.is_root()) {
     std::fprintf(stderr, "calibrate: participant %s, %zu sequences (", participant.c_str(), inputs.size());
     for (std::size_t k = 0; k < inputs.size(); ++k) std::fprintf(stderr, "%s%s", k ? ", " : "", inputs[k].id.c_str());
     std::fprintf(stderr, "), %d parameters, %d x %d, %d rank(s) x %d thread(s), gown %s\n", space.dimension(),
                  o.generations, o.population, comm.size(), thread_count(o.threads), gown.c_str());
   }
-  const CalibrationResult r = calibrate(inputs, space, sim, o, comm, [&](const GenerationProgress& p) {
+  const CalibrationResult r = calibrate(inputs, space, sim.trials, o, comm, [&](const GenerationProgress& p) {
     std::fprintf(stderr, "generation %d/%d  best L %.4f  (this generation %.4f)  elapsed %s  ETA %s\n", p.generation,
                  p.generations, p.best, p.generation_best, minutes(p.elapsed_s).c_str(), minutes(p.eta_s).c_str());
   });
@@ -150,7 +150,9 @@ int run_calibrate(int argc, char** argv) {
   // The best candidate's curves, simulated again (deterministic: the same as during the search).
   std::vector<SimulatedTrial> curves(inputs.size());
   if (comm.is_root()) {
-    for (std::size_t k = 0; k < inputs.size(); ++k) curves[k] = sim(r.cloth, request_for(inputs[k], r.offsets));
+    std::vector<TrialRequest> requests;
+    for (std::size_t k = 0; k < inputs.size(); ++k) requests.push_back(request_for(inputs[k], r.offsets));
+    curves = sim.trials(r.cloth, requests);
     write_calibration(out, cal);
     write_file_atomic(out + ".curves.csv",
                       overlay_csv(inputs, curves, args.has("no-arm-offset") ? "simulated-no-offset" : "simulated"));

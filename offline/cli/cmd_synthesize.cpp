@@ -36,7 +36,7 @@ SynthesisSummary run_synthesis(const Calibration& cal, const std::string& gown, 
   throw UsageError("this dressguard was built without the cloth simulator (offline/sim); synthesis needs it");
 #else
   const Comm& comm = Comm::world();
-  const TrialSimulator sim = make_cloth_simulator(gown);
+  const TrialSimulator sim = make_cloth_simulator(gown).trial;
   int last = -1;
   return synthesize(cal, sim, o, out, comm, [&](const SynthesisProgress& p) {
     const int pct = 100 * p.done / std::max(1, p.total);

@@ -268,12 +268,7 @@ GownModel make_model(const SceneData& s, const ClothParams& p, FrictionScheme sc
   m.damping_factor = std::exp(-std::max(0.0, p.damping) * m.h);
   m.scheme = scheme;
   m.self_collision = self_collision;
-  m.arm = s.arm;
-  for (auto& c : m.arm) {
-    c.a.z += arm_dz;
-    c.b.z += arm_dz;
-  }
-  m.elbow = s.elbow + V3{0, 0, arm_dz};
+  place_arm(m, arm_dz);
   refresh_constraints(m);
   return m;
 }

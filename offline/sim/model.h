@@ -213,6 +213,15 @@ GownState make_state(const GownModel& m);
 // (linearly interpolated over the substeps), `grip_accel` its acceleration.
 void step(const GownModel& m, GownState& s, V3 grip_from, V3 grip_to, V3 grip_accel);
 
+// The arm of the scene moved by arm_dz along z (the trial's height): m.arm and m.elbow.
+void place_arm(GownModel& m, double arm_dz);
+
+// Whether the arm, moved by dz along z from where m has it, would give any free vertex an arm
+// candidate in the next step() (the same margin as step()'s own detection, 1 um wider). While it
+// is false at every step, the arm cannot have changed the gown: simulate_trials() shares a
+// settling between arm heights only then.
+bool arm_in_reach(const GownModel& m, const GownState& s, double dz);
+
 // Total triangle area of the current positions.
 double current_area(const GownModel& m, const GownState& s);
 

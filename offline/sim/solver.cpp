@@ -15,44 +15,47 @@
 namespace dressguard::sim {
 namespace {
 
-// Arm candidates of every free vertex within a margin of the surface: the exact distance is
-// re-evaluated every substep against these (at most two round cones per vertex, enough at the
-// elbow where the forearm and upper arm meet). The vertices with candidates (all free ones when
-// there are planes) are listed for solve_contacts().
+// The arm candidates of a vertex at `x` moving at `v`: up to two round cones whose surface is
+// within the margin (contact offset + 1 cm + twice this step's travel); the exact distance is
+// re-evaluated every substep against these (two are enough at the elbow where the forearm and
+// upper arm meet). `extra` widens the margin (arm_in_reach()).
+ArmCandidates arm_candidates(const GownModel& m, V3 x, V3 v, double extra) {
+  ArmCandidates c;
+  const double margin = m.scene->opt.contact_offset + 0.01 + 2.0 * norm(v) * m.dt + extra;
+  double best[2] = {1e300, 1e300};
+  for (int k = 0; k < static_cast<int>(m.arm.size()); ++k) {
+    // A bounding sphere first: every point of a round cone lies within len / 2 + max(ra, rb)
+    // of its axis' midpoint, so phi >= |x - mid| - that. A vertex beyond it by the margin
+    // (and 1e-9 m against rounding) skips the exact distance, which would reject it too.
+    const RoundCone& cone = m.arm[k];
+    const V3 d = x - 0.5 * (cone.a + cone.b);
+    const double reach = 0.5 * cone.len + std::max(cone.ra, cone.rb) + margin + 1e-9;
+    if (dot(d, d) > reach * reach) continue;
+    V3 nrm;
+    const double phi = round_cone_distance(cone, x, &nrm);
+    if (phi >= margin) continue;
+    if (phi < best[0]) {
+      best[1] = best[0];
+      c.c[1] = c.c[0];
+      best[0] = phi;
+      c.c[0] = static_cast<int8_t>(k);
+    } else if (phi < best[1]) {
+      best[1] = phi;
+      c.c[1] = static_cast<int8_t>(k);
+    }
+  }
+  return c;
+}
+
+// Arm candidates of every free vertex, found once per output step. The vertices with candidates
+// (all free ones when there are planes) are listed for solve_contacts().
 void detect_arm(const GownModel& m, GownState& s) {
   const SceneData& sc = *m.scene;
-  const double base = sc.opt.contact_offset + 0.01;
   const int n = static_cast<int>(s.x.size());
-  const int shapes = static_cast<int>(m.arm.size());
   const bool planes = !sc.planes.empty();
   s.contact_count = 0;
   for (int i = 0; i < n; ++i) {
-    ArmCandidates c;
-    if (!sc.grasped[i] && shapes > 0) {
-      const double margin = base + 2.0 * norm(s.v[i]) * m.dt;
-      double best[2] = {1e300, 1e300};
-      for (int k = 0; k < shapes; ++k) {
-        // A bounding sphere first: every point of a round cone lies within len / 2 + max(ra, rb)
-        // of its axis' midpoint, so phi >= |x - mid| - that. A vertex beyond it by the margin
-        // (and 1e-9 m against rounding) skips the exact distance, which would reject it too.
-        const RoundCone& cone = m.arm[k];
-        const V3 d = s.x[i] - 0.5 * (cone.a + cone.b);
-        const double reach = 0.5 * cone.len + std::max(cone.ra, cone.rb) + margin + 1e-9;
-        if (dot(d, d) > reach * reach) continue;
-        V3 nrm;
-        const double phi = round_cone_distance(cone, s.x[i], &nrm);
-        if (phi >= margin) continue;
-        if (phi < best[0]) {
-          best[1] = best[0];
-          c.c[1] = c.c[0];
-          best[0] = phi;
-          c.c[0] = static_cast<int8_t>(k);
-        } else if (phi < best[1]) {
-          best[1] = phi;
-          c.c[1] = static_cast<int8_t>(k);
-        }
-      }
-    }
+    const ArmCandidates c = sc.grasped[i] || m.arm.empty() ? ArmCandidates{} : arm_candidates(m, s.x[i], s.v[i], 0.0);
     s.cand[i] = c;
     if (c.c[0] < 0) s.anchored[i] = 0;
     if (!sc.grasped[i] && (c.c[0] >= 0 || planes)) s.contact_list[s.contact_count++] = i;
@@ -366,6 +369,24 @@ void substep(const GownModel& m, GownState& s, V3 grip, V3 grip_accel, bool firs
 }
 
 }  // namespace
+
+bool arm_in_reach(const GownModel& m, const GownState& s, double dz) {
+  const SceneData& sc = *m.scene;
+  // The arm moved by dz is the vertex moved by -dz; 1 um more margin covers the rounding of
+  // that move, so that "not in reach" here is never "a candidate" in detect_arm().
+  for (size_t i = 0; i < s.x.size(); ++i)
+    if (!sc.grasped[i] && arm_candidates(m, s.x[i] - V3{0, 0, dz}, s.v[i], 1e-6).c[0] >= 0) return true;
+  return false;
+}
+
+void place_arm(GownModel& m, double arm_dz) {
+  m.arm = m.scene->arm;
+  for (auto& c : m.arm) {
+    c.a.z += arm_dz;
+    c.b.z += arm_dz;
+  }
+  m.elbow = m.scene->elbow + V3{0, 0, arm_dz};
+}
 
 void step(const GownModel& m, GownState& s, V3 grip_from, V3 grip_to, V3 grip_accel) {
   s.ext_force_on = false;

@@ -55,34 +55,52 @@ Outcome label_outcome(bool full_travel, double d_max) {
   return d_max <= 0.07 ? Outcome::Good : Outcome::Caught;
 }
 
-TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const TrialSpec& spec) {
-  const SceneData& sc = scene.data();
-  const int hi = static_cast<int>(spec.height);
-  // One random stream per trial: the perturbation force first, then the arm-height noise.
+namespace {
+
+// The random draws of a trial, in the stream's order: the perturbation force first, then the
+// arm-height noise (one random stream per trial).
+struct TrialDraws {
+  double fx = 0, fy = 0;  // [N] the perturbation (used only with gown_noise)
+  double arm_offset = 0;  // [m] spec.arm_offset plus the arm noise
+};
+TrialDraws draw(const TrialSpec& spec) {
   std::mt19937_64 rng(spec.seed);
-  const double fx = uniform(rng, -6.0, 6.0), fy = uniform(rng, -6.0, 6.0);
-  double arm_offset = spec.arm_offset;
+  TrialDraws d;
+  d.fx = uniform(rng, -6.0, 6.0);
+  d.fy = uniform(rng, -6.0, 6.0);
+  d.arm_offset = spec.arm_offset;
   if (spec.arm_noise)
-    arm_offset += spec.height == ArmHeight::Middle ? uniform(rng, -0.06, 0.0) : uniform(rng, -0.015, 0.015);
-  const double arm_dz = sc.opt.arm.z_rel[hi] - sc.opt.arm.z_rel[0] + arm_offset;
-  GownModel m = make_model(sc, params, spec.friction_scheme, spec.self_collision, arm_dz);
-  GownState s = make_state(m);
-  TrialResult r;
-  r.arm_offset = arm_offset;
+    d.arm_offset += spec.height == ArmHeight::Middle ? uniform(rng, -0.06, 0.0) : uniform(rng, -0.015, 0.015);
+  return d;
+}
+
+double arm_dz_of(const SceneData& sc, const TrialSpec& spec, double arm_offset) {
+  const int hi = static_cast<int>(spec.height);
+  return sc.opt.arm.z_rel[hi] - sc.opt.arm.z_rel[0] + arm_offset;
+}
+
+// What the settling leaves for the pull besides the state and r's settle_* fields.
+struct Settled {
+  V3 bias{0, 0, 0};             // the raw gripper force at rest (the sensor's bias)
+  std::vector<int32_t> lower;   // the lower half of the sleeve opening as it hangs
+  bool arm_reached = false;     // the arm (or one of the probed arms) came within contact reach
+};
+
+// Grasp, gravity, the optional perturbation and settling until the gown is at rest (see
+// TrialSpec). Fills r's settle_* fields, weight, bias, wall_settle and the frames before the
+// pull. `probe_dz`: other arm placements (relative to m's) checked with arm_in_reach() before
+// every step; Settled::arm_reached is set if any of them, or m's own arm, could touch the gown.
+Settled settle(GownModel& m, GownState& s, const TrialSpec& spec, const TrialDraws& d,
+               const std::vector<double>& probe_dz, TrialResult& r) {
+  const SceneData& sc = *m.scene;
+  const int n = static_cast<int>(s.x.size());
+  Settled out;
   double total_mass = 0;
   for (double q : m.mass) total_mass += q;
   r.weight = total_mass * 9.81;
-  const int n = static_cast<int>(s.x.size());
 
   std::vector<double> frame_times = spec.frame_times;
   std::sort(frame_times.begin(), frame_times.end());
-  size_t next_frame = 0;
-  auto maybe_frame = [&](double t, double travel) {
-    while (spec.keep_frames && next_frame < frame_times.size() && frame_times[next_frame] <= t + 1e-9) {
-      r.frames.push_back(make_frame(s, t, travel));
-      ++next_frame;
-    }
-  };
 
   // Perturbation (paper V-A): one random horizontal force, uniform in X and lateral up to 6 N,
   // spread equally over all vertices for 0.5 s (output steps 180-330), then settling until the
@@ -102,12 +120,13 @@ TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const 
   const size_t keep_snaps = spec.keep_frames ? static_cast<size_t>(-earliest / (15 * m.dt)) + 2 : 0;
   std::vector<std::pair<int, Frame>> snaps;  // (steps done, positions)
   std::vector<V3> x_window = s.x;
+  const bool own_arm_probe = sc.planes.empty();  // with planes every free vertex is a contact
   int k = 0;
   for (;;) {
     const bool on = spec.gown_noise && k >= perturb_from && k < perturb_to;
     const bool was_on = spec.gown_noise && k - 1 >= perturb_from && k - 1 < perturb_to;
     if (on != was_on)
-      for (int i = 0; i < n; ++i) s.ext_force[i] = on ? V3{fx / n, fy / n, 0} : zero;
+      for (int i = 0; i < n; ++i) s.ext_force[i] = on ? V3{d.fx / n, d.fy / n, 0} : zero;
     m.damping_factor = on ? cloth_decay : settle_decay;
     if (k % 3 == 0) {  // the bias sample is the last 3 steps before the pull (settling ends on k % 3 == 0)
       s.force_acc = zero;
@@ -115,7 +134,14 @@ TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const 
     }
     const int close = sc.opt.jaw_close_steps;
     s.jaw_closed = close > 0 ? std::min(1.0, (k + 1.0) / close) : 1.0;
+    if (!out.arm_reached)
+      for (double dz : probe_dz)
+        if (arm_in_reach(m, s, dz)) {
+          out.arm_reached = true;
+          break;
+        }
     step(m, s, zero, zero, zero);
+    if (!own_arm_probe || s.contact_count > 0) out.arm_reached = true;
     ++k;
     if (keep_snaps > 0 && k % 15 == 0) {
       if (snaps.size() == keep_snaps) snaps.erase(snaps.begin());
@@ -126,8 +152,8 @@ TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const 
       long free_count = 0;
       for (int i = 0; i < n; ++i)
         if (m.w[i] > 0) {
-          const V3 d = s.x[i] - x_window[i];
-          v2 += dot(d, d), ++free_count;
+          const V3 dx = s.x[i] - x_window[i];
+          v2 += dot(dx, dx), ++free_count;
         }
       r.settle_speed = free_count ? std::sqrt(v2 / free_count) / (kWindow * m.dt) : 0.0;
       x_window = s.x;
@@ -140,9 +166,9 @@ TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const 
   r.settle_time = k * m.dt;
   r.settled = !adaptive || r.settle_speed <= spec.settle_speed;
   m.damping_factor = cloth_decay;
-  for (; next_frame < frame_times.size() && frame_times[next_frame] < -1e-9; ++next_frame) {
+  for (size_t f = 0; f < frame_times.size() && frame_times[f] < -1e-9; ++f) {
     // The snapshot nearest to the requested time before the pull.
-    const double want = frame_times[next_frame];
+    const double want = frame_times[f];
     const std::pair<int, Frame>* best = nullptr;
     for (const auto& sn : snaps)
       if (!best || std::abs((sn.first - k) * m.dt - want) < std::abs((best->first - k) * m.dt - want)) best = &sn;
@@ -150,24 +176,41 @@ TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const 
     r.frames.push_back(best->second);
     r.frames.back().t = (best->first - k) * m.dt;
   }
-  maybe_frame(0.0, 0.0);
   for (int i = 0; i < n; ++i) s.ext_force[i] = zero;
   // The sensor is biased at the start of the trial (data README): the settled gown's force,
   // mainly its weight, is removed from every sample.
-  const V3 bias = s.force_count ? (1.0 / s.force_count) * s.force_acc : zero;
-  r.bias = {bias.x, bias.y, bias.z};
+  out.bias = s.force_count ? (1.0 / s.force_count) * s.force_acc : zero;
+  r.bias = {out.bias.x, out.bias.y, out.bias.z};
   // The lower half of the sleeve opening as it hangs after settling (paper Fig. 3b, red dots).
-  std::vector<int32_t> lower;
   if (!sc.opening.empty()) {
     double zmean = 0;
     for (int v : sc.opening) zmean += s.x[v].z;
     zmean /= sc.opening.size();
     for (int v : sc.opening)
-      if (s.x[v].z <= zmean) lower.push_back(v);
+      if (s.x[v].z <= zmean) out.lower.push_back(v);
   }
+  r.wall_settle = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count();
+  return out;
+}
+
+// The pull from the settled state until max_travel or the force limit, and the label.
+void pull(const GownModel& m, GownState& s, const TrialSpec& spec, const Settled& at_rest, TrialResult& r) {
+  const int n = static_cast<int>(s.x.size());
+  const V3 zero{0, 0, 0};
+  std::vector<double> frame_times;
+  for (double t : spec.frame_times)
+    if (t >= -1e-9) frame_times.push_back(t);
+  std::sort(frame_times.begin(), frame_times.end());
+  size_t next_frame = 0;
+  auto maybe_frame = [&](double t, double travel) {
+    while (spec.keep_frames && next_frame < frame_times.size() && frame_times[next_frame] <= t + 1e-9) {
+      r.frames.push_back(make_frame(s, t, travel));
+      ++next_frame;
+    }
+  };
+  maybe_frame(0.0, 0.0);
 
   const auto clock1 = std::chrono::steady_clock::now();
-  r.wall_settle = std::chrono::duration<double>(clock1 - clock0).count();
   const Profile prof{spec.acceleration, spec.speed, spec.max_travel};
   r.seq.height = spec.height;
   r.seq.speed = spec.speed;
@@ -187,7 +230,7 @@ TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const 
       t = t1;
       maybe_frame(t, g1.x);
     }
-    const V3 f = (1.0 / s.force_count) * s.force_acc - bias;
+    const V3 f = (1.0 / s.force_count) * s.force_acc - at_rest.bias;
     const double travel = prof.travel(t);
     r.seq.samples.push_back({t, travel, f.x, f.y, f.z});
     r.finite = all_finite(s);
@@ -212,11 +255,11 @@ TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const 
   r.self_pairs_dropped = s.pairs_dropped;
   r.d_max = 0;
   if (!full) {
-    for (int v : lower) r.d_max = std::max(r.d_max, std::abs(s.x[v].x - m.elbow.x));
+    for (int v : at_rest.lower) r.d_max = std::max(r.d_max, std::abs(s.x[v].x - m.elbow.x));
   }
   r.outcome = label_outcome(full, r.d_max);
   r.seq.label = r.outcome;
-  r.area_ratio = current_area(m, s) / sc.rest_area;
+  r.area_ratio = current_area(m, s) / m.scene->rest_area;
   // Contact force of the cloth on the arm per vertex, averaged over the last sample.
   if (s.force_count > 0)
     for (int i = 0; i < n; ++i) {
@@ -224,7 +267,79 @@ TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const 
       if (c.x != 0 || c.y != 0 || c.z != 0) r.contacts.push_back({i, {c.x, c.y, c.z}});
     }
   if (spec.keep_frames && (r.frames.empty() || r.frames.back().t < t - 1e-9)) r.frames.push_back(make_frame(s, t, r.travel));
+}
+
+// Whether two trials' settlings are the same computation up to the arm's height.
+bool same_settling(const TrialSpec& a, const TrialDraws& da, const TrialSpec& b, const TrialDraws& db) {
+  if (a.keep_frames || b.keep_frames) return false;  // frames are kept per trial
+  return a.gown_noise == b.gown_noise && (!a.gown_noise || (da.fx == db.fx && da.fy == db.fy)) &&
+         a.friction_scheme == b.friction_scheme && a.self_collision == b.self_collision &&
+         a.settle_steps == b.settle_steps && a.settle_max_steps == b.settle_max_steps &&
+         a.settle_speed == b.settle_speed && a.settle_damping == b.settle_damping;
+}
+
+}  // namespace
+
+TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const TrialSpec& spec) {
+  const SceneData& sc = scene.data();
+  const TrialDraws d = draw(spec);
+  GownModel m = make_model(sc, params, spec.friction_scheme, spec.self_collision, arm_dz_of(sc, spec, d.arm_offset));
+  GownState s = make_state(m);
+  TrialResult r;
+  r.arm_offset = d.arm_offset;
+  const Settled at_rest = settle(m, s, spec, d, {}, r);
+  pull(m, s, spec, at_rest, r);
   return r;
+}
+
+std::vector<TrialResult> simulate_trials(const Scene& scene, const ClothParams& params,
+                                         const std::vector<TrialSpec>& specs) {
+  const SceneData& sc = scene.data();
+  std::vector<TrialResult> out(specs.size());
+  std::vector<TrialDraws> draws;
+  for (const TrialSpec& sp : specs) draws.push_back(draw(sp));
+  std::vector<uint8_t> done(specs.size(), 0);
+  for (size_t a = 0; a < specs.size(); ++a) {
+    if (done[a]) continue;
+    // The trials after `a` that settle the same way, and their arms relative to a's.
+    const double dz_a = arm_dz_of(sc, specs[a], draws[a].arm_offset);
+    std::vector<size_t> group;
+    std::vector<double> probe;
+    for (size_t b = a + 1; b < specs.size(); ++b)
+      if (!done[b] && same_settling(specs[a], draws[a], specs[b], draws[b])) {
+        group.push_back(b);
+        probe.push_back(arm_dz_of(sc, specs[b], draws[b].arm_offset) - dz_a);
+      }
+    GownModel m = make_model(sc, params, specs[a].friction_scheme, specs[a].self_collision, dz_a);
+    GownState s = make_state(m);
+    TrialResult& r = out[a];
+    r.arm_offset = draws[a].arm_offset;
+    const Settled at_rest = settle(m, s, specs[a], draws[a], probe, r);
+    done[a] = 1;
+    if (!group.empty() && !at_rest.arm_reached) {
+      // No arm came near the gown while it settled, so every trial of the group would have
+      // settled to these same bits: start each pull from a copy.
+      const GownState rest_state = s;
+      for (size_t b : group) {
+        TrialResult& rb = out[b];
+        rb.arm_offset = draws[b].arm_offset;
+        rb.weight = r.weight;
+        rb.bias = r.bias;
+        rb.settle_steps = r.settle_steps;
+        rb.settle_time = r.settle_time;
+        rb.settle_speed = r.settle_speed;
+        rb.settled = r.settled;
+        rb.settle_shared = true;
+        GownModel mb = m;
+        place_arm(mb, arm_dz_of(sc, specs[b], draws[b].arm_offset));
+        GownState sb = rest_state;
+        pull(mb, sb, specs[b], at_rest, rb);
+        done[b] = 1;
+      }
+    }
+    pull(m, s, specs[a], at_rest, r);
+  }
+  return out;
 }
 
 }  // namespace dressguard::sim

@@ -138,6 +138,7 @@ struct TrialResult {
   std::vector<Frame> frames;
   long self_pairs_dropped = 0;      // self-collision pairs beyond the preallocated capacity
   double wall_settle = 0, wall_pull = 0;  // [s] wall time of grasp+settling and of the pull
+  bool settle_shared = false;       // simulate_trials(): began from another trial's settling (wall_settle 0)
 };
 
 // The arm (data README; paper IV: capsules, fixed, uniform friction). Spheres fist, wrist,
@@ -220,6 +221,17 @@ Scene make_default_scene(GownResolution res = GownResolution::Reduced, bool para
 // 180-330, i.e. 0.5 s) until the gown is at rest, then the pull until max_travel or the force limit. Deterministic: the
 // same inputs give the same bits (single thread, no fast-math).
 TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const TrialSpec& spec);
+
+// Several trials with one cloth, the same bits as simulate_trial() on each, in the order of
+// `specs`, but each settling done once where it can be: trials that settle alike (the same
+// perturbation, friction scheme, self-collision and settling settings; the arm height is free;
+// no frames kept) start their pulls from one settled gown when no arm of theirs came within
+// contact reach of the gown while it settled (arm_in_reach(), checked every step). The arm is
+// fixed, and without a candidate it acts on no vertex, so each of those trials would have
+// settled to those same bits on its own. In calibration, where one cloth is pulled over
+// 2-3 arm heights, that saves all settlings but one (TrialResult::settle_shared).
+std::vector<TrialResult> simulate_trials(const Scene& scene, const ClothParams& params,
+                                         const std::vector<TrialSpec>& specs);
 
 // The label rule of paper V-A from the final state; exposed for tests.
 Outcome label_outcome(bool full_travel, double d_max);

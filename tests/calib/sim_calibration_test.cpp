@@ -14,7 +14,8 @@ namespace {
 // and once more on this thread gives the same samples, bit for bit (calibration's independence
 // of the thread count rests on this).
 TEST(SimCalibration, BridgeIsDeterministicAcrossThreads) {
-  const TrialSimulator sim = make_cloth_simulator("coarse");
+  const ClothSimulator both = make_cloth_simulator("coarse");
+  const TrialSimulator& sim = both.trial;
   TrialRequest r;
   r.height = ArmHeight::Low;
   r.max_travel = 0.3;  // short: this test checks identity, not physics
@@ -32,6 +33,17 @@ TEST(SimCalibration, BridgeIsDeterministicAcrossThreads) {
     EXPECT_EQ(a.samples[i].f_vertical, c.samples[i].f_vertical);
   }
   EXPECT_NEAR(a.samples.back().travel, 0.3, 0.002);  // the travel limit reaches the simulator
+  // The batch form (one settling for both heights) gives each trial the one-trial form's bits.
+  TrialRequest high = r;
+  high.height = ArmHeight::High;
+  const std::vector<SimulatedTrial> ab = both.trials(ClothValues{}, {r, high});
+  const SimulatedTrial h = sim(ClothValues{}, high);
+  ASSERT_EQ(ab.size(), 2u);
+  ASSERT_EQ(ab[0].samples.size(), a.samples.size());
+  ASSERT_EQ(ab[1].samples.size(), h.samples.size());
+  for (std::size_t i = 0; i < a.samples.size(); ++i) EXPECT_EQ(ab[0].samples[i].f_motion, a.samples[i].f_motion);
+  for (std::size_t i = 0; i < h.samples.size(); ++i) EXPECT_EQ(ab[1].samples[i].f_vertical, h.samples[i].f_vertical);
+  EXPECT_EQ(ab[1].outcome, h.outcome);
 }
 
 // One generation on participant 4's sequences (the paper's public code calibrated on the same
@@ -47,7 +59,7 @@ TEST(SimCalibration, OneGenerationOnParticipant4) {
   CalibrationOptions o;
   o.generations = 1;
   o.population = 4;
-  const auto r = calibrate(inputs, space, make_cloth_simulator("coarse"), o, Comm::world());
+  const auto r = calibrate(inputs, space, make_cloth_simulator("coarse").trials, o, Comm::world());
   std::printf("  participant 4, one generation of 4 on the coarse gown: L = %.4f\n", r.objective);
   EXPECT_TRUE(std::isfinite(r.objective));
   double sum = 0;

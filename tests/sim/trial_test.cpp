@@ -11,6 +11,7 @@
 #include "files.h"
 #include "gown.h"
 #include "gown_scene.h"
+#include "meshes.h"
 #include "model.h"
 #include "objective.h"
 #include "params.h"
@@ -314,5 +315,86 @@ TEST(SimTrial, GownAtRestWhenThePullStarts) {
       EXPECT_LE(std::abs(q.f_motion), 0.5) << "seed " << seed << " travel " << q.travel;
       EXPECT_LE(std::abs(q.f_vertical), 0.2) << "seed " << seed << " travel " << q.travel;
     }
+  }
+}
+
+namespace {
+
+void expect_same_trial(const TrialResult& a, const TrialResult& b, const char* what) {
+  ASSERT_EQ(a.seq.samples.size(), b.seq.samples.size()) << what;
+  ASSERT_FALSE(a.seq.samples.empty()) << what;
+  EXPECT_EQ(0, std::memcmp(a.seq.samples.data(), b.seq.samples.data(), a.seq.samples.size() * sizeof(HapticSample)))
+      << what;
+  EXPECT_EQ(a.bias, b.bias) << what;
+  EXPECT_EQ(a.settle_steps, b.settle_steps) << what;
+  EXPECT_EQ(a.outcome, b.outcome) << what;
+  EXPECT_EQ(a.d_max, b.d_max) << what;
+  EXPECT_EQ(a.arm_offset, b.arm_offset) << what;
+}
+
+}  // namespace
+
+// simulate_trials() settles one cloth once for the three arm heights (the arm is far from the
+// hanging gown until the pull) and still gives each trial the bits of its own simulate_trial():
+// the sharing is exact, not an approximation. With the perturbation and arm noise of one seed the
+// settling is shared too (same push; the arm noise moves only the arm); a different seed's push
+// is not.
+TEST(SimTrial, SharedSettlingGivesEachTrialItsOwnBits) {
+  std::vector<TrialSpec> specs;
+  for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
+    TrialSpec s;
+    s.height = h;
+    s.max_travel = 0.12;
+    specs.push_back(s);
+  }
+  TrialSpec pushed = specs[0];
+  pushed.gown_noise = true;
+  pushed.arm_noise = true;
+  pushed.seed = 5;
+  specs.push_back(pushed);
+  pushed.height = ArmHeight::Low;
+  specs.push_back(pushed);
+  pushed.seed = 6;
+  specs.push_back(pushed);
+  const std::vector<TrialResult> together = simulate_trials(coarse_scene(), ClothParams{}, specs);
+  ASSERT_EQ(together.size(), specs.size());
+  for (size_t i = 0; i < specs.size(); ++i) {
+    const TrialResult alone = simulate_trial(coarse_scene(), ClothParams{}, specs[i]);
+    expect_same_trial(together[i], alone, ("trial " + std::to_string(i)).c_str());
+  }
+  EXPECT_FALSE(together[0].settle_shared);
+  EXPECT_TRUE(together[1].settle_shared) << "middle should start from high's settling";
+  EXPECT_TRUE(together[2].settle_shared) << "low should start from high's settling";
+  EXPECT_FALSE(together[3].settle_shared) << "a pushed gown settles differently from an unpushed one";
+  EXPECT_TRUE(together[4].settle_shared) << "the same seed pushes the same way";
+  EXPECT_FALSE(together[5].settle_shared) << "another seed pushes another way";
+}
+
+// Where an arm touches the gown while it settles, no settling is shared, whether it is the
+// first trial's own arm or another trial's arm found by the probe (arm_in_reach()): a tube held
+// at one end falls onto a fist placed under the grasp at the high height; the low arm is far
+// below it. Each order gives every trial its own bits.
+TEST(SimTrial, NoSharedSettlingWhereAnArmTouchesTheGown) {
+  ClothMesh mesh = tube(0.075, -0.4, 0.0, 16, 20);
+  const int top = 19 * 16 + 4;
+  mesh.grasp = {top - 1, top, top + 1};
+  SceneOptions opt;
+  opt.jaw_close_steps = 0;
+  opt.arm.fist_x = 0.0;                    // the fist right under the grasp
+  opt.arm.z_rel = {-0.25, -1.0, -2.0};     // high: inside the hanging tube; low: 2 m below
+  const Scene scene = make_scene(mesh, opt);
+  TrialSpec high, low;
+  high.height = ArmHeight::High;
+  low.height = ArmHeight::Low;
+  high.max_travel = low.max_travel = 0.05;
+  const TrialResult h = simulate_trial(scene, ClothParams{}, high);
+  const TrialResult l = simulate_trial(scene, ClothParams{}, low);
+  ASSERT_NE(h.bias, l.bias) << "the fist should hold part of the tube while it settles";
+  for (const auto& order : {std::vector<TrialSpec>{high, low}, std::vector<TrialSpec>{low, high}}) {
+    const std::vector<TrialResult> r = simulate_trials(scene, ClothParams{}, order);
+    const bool high_first = order[0].height == ArmHeight::High;
+    expect_same_trial(r[0], high_first ? h : l, "first");
+    expect_same_trial(r[1], high_first ? l : h, "second");
+    EXPECT_FALSE(r[0].settle_shared || r[1].settle_shared);
   }
 }

@@ -130,7 +130,7 @@ int run_eval(const std::map<std::string, std::string>& a) {
   so.threads = co.threads;
   const std::string gown = get(a, "gown", "reduced");
   const fs::path work = get(a, "work", "calib-eval");
-  const TrialSimulator sim = make_cloth_simulator(gown);
+  const ClothSimulator sim = make_cloth_simulator(gown);
   std::printf("evaluation: %zu participants, calibration %d x %d, %d trials per height, gown %s\n", chosen.size(),
               co.generations, co.population, so.per_height, gown.c_str());
 
@@ -154,7 +154,7 @@ int run_eval(const std::map<std::string, std::string>& a) {
     for (const auto& s : inputs) space.offset_heights.push_back(s.height);
     auto o = co;
     o.checkpoint = work / ("p" + p + ".ckpt");
-    const CalibrationResult r = calibrate(inputs, space, sim, o, Comm::world());
+    const CalibrationResult r = calibrate(inputs, space, sim.trials, o, Comm::world());
     Calibration cal;
     cal.participant = p;
     cal.cloth = r.cloth;
@@ -165,11 +165,12 @@ int run_eval(const std::map<std::string, std::string>& a) {
     cal.gown = gown;
     cal.rig_travel = rig_travel_of(inputs);
     write_calibration(work / ("cal" + p + ".json"), cal);
-    std::vector<SimulatedTrial> curves;
-    for (const auto& s : inputs) curves.push_back(sim(r.cloth, request_for(s, r.offsets)));
+    std::vector<TrialRequest> requests;
+    for (const auto& s : inputs) requests.push_back(request_for(s, r.offsets));
+    const std::vector<SimulatedTrial> curves = sim.trials(r.cloth, requests);
     write_file_atomic(work / ("cal" + p + ".json.curves.csv"), overlay_csv(inputs, curves, "simulated"));
     const fs::path synth = work / ("synth" + p);
-    synthesize(cal, sim, so, synth, Comm::world());
+    synthesize(cal, sim.trial, so, synth, Comm::world());
     const Dataset sd = load_dataset(synth);
     std::vector<const HapticSequence*> strain, btrain, test;
     for (const auto& t : sd.trials) strain.push_back(&t);
@@ -253,17 +254,27 @@ int run_timing(const std::map<std::string, std::string>& a) {
   o.population = std::stoi(get(a, "population", "4"));
   o.threads = std::stoi(get(a, "threads", "0"));
   auto t0 = std::chrono::steady_clock::now();
-  const TrialSimulator sim = make_cloth_simulator(gown);
+  const ClothSimulator sim = make_cloth_simulator(gown);
   const double scene_s = seconds_since(t0);
   t0 = std::chrono::steady_clock::now();
-  const SimulatedTrial one = sim(ClothValues{}, request_for(inputs[0], {}));
+  const SimulatedTrial one = sim.trial(ClothValues{}, request_for(inputs[0], {}));
   const double one_s = seconds_since(t0);
   ParameterSpace space;
   space.bounds = default_bounds();
   for (const auto& s : inputs) space.offset_heights.push_back(s.height);
   t0 = std::chrono::steady_clock::now();
-  const CalibrationResult r = calibrate(inputs, space, sim, o, Comm::world());
+  const CalibrationResult r = calibrate(inputs, space, sim.trials, o, Comm::world());
   const double cal_s = seconds_since(t0);
+  // Baseline in the same run (--baseline 1): every trial settled on its own, as before
+  // simulate_trials; the same result, bit for bit, is required.
+  double base_s = 0;
+  bool same = true;
+  if (get(a, "baseline", "0") == "1") {
+    t0 = std::chrono::steady_clock::now();
+    const CalibrationResult b = calibrate(inputs, space, one_by_one(sim.trial), o, Comm::world());
+    base_s = seconds_since(t0);
+    same = b.objective == r.objective && b.best_unit == r.best_unit;
+  }
   const double sims = static_cast<double>(o.generations) * o.population * inputs.size();
   const double full_sims = 50.0 * 32 * inputs.size();
   if (!Comm::world().is_root()) return 0;
@@ -273,6 +284,9 @@ int run_timing(const std::map<std::string, std::string>& a) {
   std::printf("calibration of participant 4 (%zu sequences), %d x %d = %.0f simulations on %d thread(s): %.1f s "
               "wall, %.2f s per simulation; final L = %.4f\n", inputs.size(), o.generations, o.population, sims,
               thread_count(o.threads), cal_s, cal_s / sims, r.objective);
+  if (base_s > 0)
+    std::printf("baseline, each trial settled on its own: %.1f s wall, %.2f s per simulation; shared settling is "
+                "%.2fx faster; same result: %s\n", base_s, base_s / sims, base_s / cal_s, same ? "yes" : "NO");
   std::printf("projection to the paper's 50 x 32 (%.0f simulations) at this pace: %.1f h wall on this machine\n",
               full_sims, cal_s / sims * full_sims / 3600.0);
   return 0;
