@@ -9,7 +9,8 @@
 //     travel. Next to them, the 1-nearest-neighbour baseline on force curves trained on the other
 //     people's real trials (leave-one-participant-out over the whole study; the reference:
 //     71%, 83%, 94%, 100% at the four cuts). Prints one row per participant and the means, and
-//     writes DIR/eval.json.
+//     writes DIR/eval.json after each participant (plot: tools/plot/calib_eval.py); a rerun with
+//     the same DIR resumes from the calibration checkpoints and synthesized trials.
 //   bench_calib_pipeline timing [--gown ...] [--generations G --population N] [--threads T]
 //     Wall time per simulation and of a G x N calibration of participant 4, with the final
 //     objective, and the projection to the paper's 50 x 32 budget from the measured pace. Under
@@ -142,8 +143,22 @@ int run_eval(const std::map<std::string, std::string>& a) {
               "(reference 71/83/94/100%%)\n", 100 * nn[0], 100 * nn[1], 100 * nn[2], 100 * nn[3]);
   std::printf("%-4s %-8s %-28s | %-33s | %-33s\n", "P", "L", "parameters (str sh bd fr sf)",
               "STC whole/.15/.20/.25/.30", "BC whole/.15/.20/.25/.30");
-  Json out = Json::object();
   Json rows = Json::array();
+  // DIR/eval.json, rewritten after every participant (atomically), so that a run cut short keeps
+  // the rows it finished; a rerun resumes each participant from its calibration checkpoint and
+  // its synthesized trials.
+  auto write_eval = [&] {
+    Json out = Json::object();
+    out.set("participants", rows);
+    Json jn = Json::array();
+    for (double v : nn) jn.push(v);
+    out.set("one_nn_accuracy_at_cuts", jn);
+    out.set("generations", co.generations);
+    out.set("population", co.population);
+    out.set("per_height", so.per_height);
+    out.set("gown", gown);
+    write_file_atomic(work / "eval.json", out.dump() + "\n");
+  };
   double sum_stc[5] = {}, sum_bc[5] = {};
   int n = 0;
   for (const auto& p : chosen) {
@@ -220,6 +235,7 @@ int run_eval(const std::map<std::string, std::string>& a) {
     for (int k = 0; k < kOutcomeCount; ++k) jl.set(std::string(outcome_name(static_cast<Outcome>(k))), synth_labels[k]);
     row.set("synthesized_labels", jl);
     rows.push(row);
+    write_eval();
     for (int c = 0; c < 5; ++c) sum_stc[c] += stc[c], sum_bc[c] += bc[c];
     ++n;
   }
@@ -228,15 +244,7 @@ int run_eval(const std::map<std::string, std::string>& a) {
                 100 * sum_stc[1] / n, 100 * sum_stc[2] / n, 100 * sum_stc[3] / n, 100 * sum_stc[4] / n,
                 100 * sum_bc[0] / n, 100 * sum_bc[1] / n, 100 * sum_bc[2] / n, 100 * sum_bc[3] / n,
                 100 * sum_bc[4] / n);
-  out.set("participants", rows);
-  Json jn = Json::array();
-  for (double v : nn) jn.push(v);
-  out.set("one_nn_accuracy_at_cuts", jn);
-  out.set("generations", co.generations);
-  out.set("population", co.population);
-  out.set("per_height", so.per_height);
-  out.set("gown", gown);
-  write_file_atomic(work / "eval.json", out.dump() + "\n");
+  write_eval();
   return 0;
 }
 

@@ -1,0 +1,71 @@
+#!/usr/bin/python3
+"""Accuracy against travel distance of the calibration evaluation (issue 4, paper Fig. 10-11):
+each participant's STC and BC on the other participants' measured trials, their means, and the
+1-nearest-neighbour baseline on force curves with the issue's reference figures.
+
+usage: calib_eval.py OUT.png EVAL.json [EVAL2.json ...]
+EVAL.json is what `bench_calib_pipeline eval` writes (DIR/eval.json); several runs (e.g. the
+participants split over two processes) are merged, a participant appearing twice keeps its last
+row. "whole" is drawn at the right end, after the cuts.
+"""
+import json
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+
+CUTS = [0.15, 0.20, 0.25, 0.30]
+ONE_NN_REFERENCE = [71, 83, 94, 100]
+WHOLE_X = 0.35  # where "whole sequence" is drawn
+
+
+def main(argv):
+    if len(argv) < 3:
+        sys.stderr.write(__doc__)
+        return 2
+    rows, one_nn = {}, None
+    for path in argv[2:]:
+        with open(path) as f:
+            d = json.load(f)
+        for r in d["participants"]:
+            rows[r["participant"]] = r
+        one_nn = [100 * v for v in d["one_nn_accuracy_at_cuts"]]
+    if not rows:
+        sys.stderr.write("no participants in the given files\n")
+        return 1
+    xs = CUTS + [WHOLE_X]
+
+    def series(r, key):  # the file holds whole first, then the cuts
+        v = [100 * a for a in r[key]]
+        return v[1:] + v[:1]
+
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), sharey=True)
+    for ax, key, name in ((axes[0], "stc_accuracy_whole_and_cuts", "STC (trained on simulation)"),
+                          (axes[1], "bc_accuracy_whole_and_cuts", "BC (trained on the 2-3 measured inputs)")):
+        mean = [0.0] * len(xs)
+        for p in sorted(rows, key=int):
+            ys = series(rows[p], key)
+            mean = [m + y / len(rows) for m, y in zip(mean, ys)]
+            ax.plot(xs, ys, color="0.75", lw=1)
+            ax.annotate(p, (xs[-1], ys[-1]), fontsize=7, color="0.5", xytext=(3, 0), textcoords="offset points")
+        ax.plot(xs, mean, marker="o", color="tab:blue", lw=2, label=f"mean of {len(rows)} participants")
+        if one_nn:
+            ax.plot(CUTS, one_nn, marker="s", color="tab:green", label="1-NN on measured curves (here)")
+        ax.plot(CUTS, ONE_NN_REFERENCE, ls="--", color="tab:green", alpha=0.6, label="1-NN, issue's reference")
+        ax.set_xticks(xs)
+        ax.set_xticklabels([f"{c:.2f}" for c in CUTS] + ["whole"])
+        ax.set_xlabel("travel distance of the end effector [m]")
+        ax.set_title(name)
+        ax.grid(True, alpha=0.3)
+        ax.set_ylim(0, 102)
+    axes[0].set_ylabel("accuracy on the other participants' trials [%]")
+    axes[0].legend(loc="lower right", fontsize=8)
+    fig.tight_layout()
+    fig.savefig(argv[1], dpi=120)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
