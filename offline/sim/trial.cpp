@@ -321,14 +321,10 @@ std::vector<TrialResult> simulate_trials(const Scene& scene, const ClothParams& 
       // settled to these same bits: start each pull from a copy.
       const GownState rest_state = s;
       for (size_t b : group) {
-        TrialResult& rb = out[b];
+        // r holds only what the settling wrote (weight, bias, settle_*; no frames in a group).
+        TrialResult& rb = out[b] = r;
         rb.arm_offset = draws[b].arm_offset;
-        rb.weight = r.weight;
-        rb.bias = r.bias;
-        rb.settle_steps = r.settle_steps;
-        rb.settle_time = r.settle_time;
-        rb.settle_speed = r.settle_speed;
-        rb.settled = r.settled;
+        rb.wall_settle = 0;
         rb.settle_shared = true;
         GownModel mb = m;
         place_arm(mb, arm_dz_of(sc, specs[b], draws[b].arm_offset));
