@@ -101,9 +101,11 @@ void check_covariance(const GaussianEmission& e, const std::string& source, cons
 }
 
 void check_features(const FeatureConvention& f, const std::string& source) {
+  if (f.axis[0] == kAxisNone && f.axis[1] == kAxisNone) fail(source, "both features are 'none' (axis 3)");
   for (int k = 0; k < kFeatures; ++k) {
     const std::string w = "feature " + std::to_string(k);
-    if (f.axis[k] < 0 || f.axis[k] > 2) fail(source, w + " axis " + std::to_string(f.axis[k]) + " is not 0, 1 or 2");
+    if (f.axis[k] < 0 || f.axis[k] > kAxisNone)
+      fail(source, w + " axis " + std::to_string(f.axis[k]) + " is not 0, 1, 2 or 3 (none)");
     if (f.sign[k] != 1.0 && f.sign[k] != -1.0) fail(source, w + " sign is not +1 or -1");
     check_finite(f.offset[k], source, w + " offset");
     check_finite(f.scale[k], source, w + " scale");
@@ -217,11 +219,17 @@ void validate_model(const OutcomeModel& m, const std::string& source) {
     if (s->size() > kMaxString) fail(source, "a metadata string is longer than 65536 bytes");
 }
 
+uint32_t format_version_of(const OutcomeModel& m) noexcept {
+  for (int k = 0; k < kFeatures; ++k)
+    if (m.features.axis[k] == kAxisNone) return 2;
+  return 1;
+}
+
 std::vector<uint8_t> encode_model(const OutcomeModel& m) {
   validate_model(m, "model to encode");
   Writer w;
   w.bytes(kMagic, 8);
-  w.u32(kFormatVersion);
+  w.u32(format_version_of(m));
   w.u32(0);  // total size, patched below
   w.str(m.tool_version);
   w.str(m.created);
@@ -264,8 +272,8 @@ OutcomeModel decode_model(const uint8_t* data, size_t size, const std::string& s
   if (std::memcmp(data, kMagic, 8) != 0) fail(source, "wrong magic: not a dressguard model file (.dgm)");
   Reader head(data, size, 8, source);
   const uint32_t version = head.u32("format version");
-  if (version != kFormatVersion)
-    fail(source, "unsupported format version " + std::to_string(version) + " (this build reads version " +
+  if (version < 1 || version > kFormatVersion)
+    fail(source, "unsupported format version " + std::to_string(version) + " (this build reads versions 1 to " +
                      std::to_string(kFormatVersion) + ")");
   const uint32_t total = head.u32("file size");
   if (total > size) fail(source, "truncated: header says " + std::to_string(total) + " bytes, file has " + std::to_string(size));
@@ -288,6 +296,8 @@ OutcomeModel decode_model(const uint8_t* data, size_t size, const std::string& s
   m.training_summary = r.str("training summary");
   for (int k = 0; k < kFeatures; ++k) {
     m.features.axis[k] = r.i32("feature axis");
+    if (version < 2 && m.features.axis[k] == kAxisNone)
+      fail(source, "feature " + std::to_string(k) + " axis 3 (none) needs format version 2, the file says 1");
     m.features.sign[k] = r.f64("feature sign");
     m.features.offset[k] = r.f64("feature offset");
     m.features.scale[k] = r.f64("feature scale");
@@ -360,11 +370,16 @@ void write_model(const std::filesystem::path& path, const OutcomeModel& m) {
 std::string describe_model(const OutcomeModel& m) {
   std::ostringstream o;
   char buf[256];
-  o << "dressguard outcome model (format " << kFormatVersion << ")\n";
+  o << "dressguard outcome model (format " << format_version_of(m) << ")\n";
   o << "  tool:     " << m.tool_version << "\n  created:  " << m.created << "\n  source:   " << m.source_dataset << "\n";
   o << "  training: " << m.training_summary << "\n";
-  static const char* kAxis[] = {"f_motion", "f_lateral", "f_vertical"};
+  static const char* kAxis[] = {"f_motion", "f_lateral", "f_vertical", "none"};
   for (int k = 0; k < kFeatures; ++k) {
+    if (m.features.axis[k] == kAxisNone) {
+      std::snprintf(buf, sizeof buf, "  feature %d = none (not used: 0 for every sample)\n", k);
+      o << buf;
+      continue;
+    }
     std::snprintf(buf, sizeof buf, "  feature %d = (%s%s - %.6g) / %.6g\n", k, m.features.sign[k] < 0 ? "-" : "+",
                   kAxis[m.features.axis[k]], m.features.offset[k], m.features.scale[k]);
     o << buf;

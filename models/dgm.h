@@ -22,7 +22,10 @@ inline constexpr int kFeatures = 2;
 // Limits the loader enforces; they bound the predictor's fixed storage.
 inline constexpr int kMaxStates = 32, kMaxClasses = 8;
 // Raw sample axes, in the rig's convention (offline/core/haptic.h): drag negative, up positive.
-inline constexpr int kAxisMotion = 0, kAxisLateral = 1, kAxisVertical = 2;
+// kAxisNone: a feature the model does not use; it is 0 for every sample, so its emission factor
+// is the same constant for every state of every class and changes no likelihood ratio (a model
+// trained on simulated data whose vertical force the simulator gets wrong, offline/calib/stc.h).
+inline constexpr int kAxisMotion = 0, kAxisLateral = 1, kAxisVertical = 2, kAxisNone = 3;
 
 // How one raw sample (f_motion, f_lateral, f_vertical) in the rig's convention becomes the
 // feature vector x the HMMs model:
@@ -32,14 +35,14 @@ inline constexpr int kAxisMotion = 0, kAxisLateral = 1, kAxisVertical = 2;
 // (not of the raw forces); the Jacobian 1/(scale0*scale1) is the same for every class and does not
 // change any classification.
 struct FeatureConvention {
-  int axis[kFeatures] = {kAxisMotion, kAxisVertical};  // 0 motion, 1 lateral, 2 vertical
+  int axis[kFeatures] = {kAxisMotion, kAxisVertical};  // 0 motion, 1 lateral, 2 vertical, 3 none
   double sign[kFeatures] = {1.0, 1.0};                 // +1 or -1
   double offset[kFeatures] = {0.0, 0.0};               // [N], subtracted after the sign
   double scale[kFeatures] = {1.0, 1.0};                // [N], > 0
 
-  // The feature vector of one raw sample (formula above).
+  // The feature vector of one raw sample (formula above; raw[kAxisNone] = 0).
   void apply(double f_motion, double f_lateral, double f_vertical, double x[kFeatures]) const noexcept {
-    const double raw[3] = {f_motion, f_lateral, f_vertical};
+    const double raw[4] = {f_motion, f_lateral, f_vertical, 0.0};
     for (int k = 0; k < kFeatures; ++k) x[k] = (sign[k] * raw[axis[k]] - offset[k]) / scale[k];
   }
 };
@@ -114,7 +117,10 @@ inline constexpr double kStochasticTolerance = 1e-9;
 
 // The file format's identity (FORMAT.md).
 inline constexpr char kMagic[8] = {'D', 'G', 'M', 'O', 'D', 'E', 'L', '\0'};
-inline constexpr uint32_t kFormatVersion = 1;
+// Version 2 (2026-11-23) only adds the axis value kAxisNone; the writer writes version 1 for a
+// model without it, so that readers of version 1 still read every model they can understand.
+inline constexpr uint32_t kFormatVersion = 2;
+uint32_t format_version_of(const OutcomeModel& m) noexcept;  // 1, or 2 when a feature is kAxisNone
 
 // CRC-32 (IEEE 802.3, reflected, polynomial 0xEDB88320, init and final xor 0xFFFFFFFF), the one
 // zlib and PNG use: crc32("123456789") == 0xCBF43926.

@@ -337,9 +337,26 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   r.cloth = space.cloth(r.best_unit);
   r.offsets = space.offsets(r.best_unit);
   for (int k = 0; k < K; ++k)
-    r.fits.push_back({inputs[k].id, inputs[k].height, inputs[k].speed, best_fits[k]});
+    r.fits.push_back({inputs[k].id, inputs[k].height, inputs[k].speed, best_fits[k], {}, {}});
   r.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
+}
+
+void measure_axis_fits(std::vector<SequenceFit>& fits, const std::vector<HapticSequence>& inputs,
+                       const std::vector<SimulatedTrial>& curves) {
+  if (fits.size() != inputs.size() || curves.size() != inputs.size())
+    throw std::invalid_argument("measure_axis_fits: fits, inputs and curves differ in number");
+  for (std::size_t k = 0; k < inputs.size(); ++k) {
+    const auto& measured = inputs[k].samples;
+    const auto& sim = curves[k].samples;
+    if (measured.empty() || sim.empty() || !curves[k].finite) continue;
+    // The zero curve over the travel both cover: the measured samples with no force.
+    std::vector<HapticSample> zero(measured.begin(), measured.begin() + std::min(measured.size(), sim.size()));
+    for (auto& z : zero) z.f_motion = z.f_lateral = z.f_vertical = 0.0;
+    fits[k].motion = {area_error(sim, measured, ForceAxis::Motion, 0.0), area_error(zero, measured, ForceAxis::Motion, 0.0)};
+    fits[k].vertical = {area_error(sim, measured, ForceAxis::Vertical, 0.0),
+                        area_error(zero, measured, ForceAxis::Vertical, 0.0)};
+  }
 }
 
 // ---- the calibration file -------------------------------------------------------------------------
@@ -368,6 +385,12 @@ Json calibration_to_json(const Calibration& c) {
     e.set("height", std::string(arm_height_name(f.height)));
     e.set("speed", f.speed);
     e.set("objective", f.objective);
+    if (f.motion.measured() && f.vertical.measured()) {
+      e.set("motion_error", f.motion.error);
+      e.set("motion_zero", f.motion.zero);
+      e.set("vertical_error", f.vertical.error);
+      e.set("vertical_zero", f.vertical.zero);
+    }
     fits.push(e);
   }
   j.set("sequences", fits);
@@ -404,6 +427,13 @@ Calibration calibration_from_json(const Json& j, const std::filesystem::path& so
       f.height = *h;
       f.speed = e.at("speed").number();
       f.objective = e.at("objective").number();
+      if (e.has("vertical_error")) {  // absent in files written before 2026-11-23
+        f.motion = {e.at("motion_error").number(), e.at("motion_zero").number()};
+        f.vertical = {e.at("vertical_error").number(), e.at("vertical_zero").number()};
+        if (!f.motion.measured() || !f.vertical.measured() || f.motion.error < 0 || f.vertical.error < 0 ||
+            f.motion.zero < 0 || f.vertical.zero < 0)
+          throw std::runtime_error("sequence " + f.trial_id + ": an axis fit is negative or not finite");
+      }
       c.fits.push_back(f);
     }
     c.gown = j.at("gown").string();

@@ -8,10 +8,12 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -131,12 +133,28 @@ struct GenerationProgress {
   bool resumed = false;
 };
 
+// How well the calibrated simulator predicts one force axis of one input: eq. 3 with w = 0 (the
+// area between the simulated and the measured curve over the travel both cover, N m) next to the
+// same for a zero force (the area under the measured curve there). Where the simulation is
+// further from the measurement than zero is, its sequences carry no information about that axis
+// into a classifier trained on them (stc.h: choose_stc_axes). NaN: not measured (older files).
+struct AxisFit {
+  double error = std::numeric_limits<double>::quiet_NaN();
+  double zero = std::numeric_limits<double>::quiet_NaN();
+  bool measured() const { return std::isfinite(error) && std::isfinite(zero); }
+};
+
 struct SequenceFit {
   std::string trial_id;
   ArmHeight height = ArmHeight::High;
   double speed = 0.1;
   double objective = 0;      // this sequence's share of L
+  AxisFit motion, vertical;  // filled by measure_axis_fits()
 };
+
+// Fills fits[k].motion and .vertical from inputs[k] and the calibrated simulator's curve of it.
+void measure_axis_fits(std::vector<SequenceFit>& fits, const std::vector<HapticSequence>& inputs,
+                       const std::vector<SimulatedTrial>& curves);
 
 struct CalibrationResult {
   bool complete = false;          // false: stopped by stop_after_generations (resume later)

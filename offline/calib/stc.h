@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "calibration.h"
 #include "dataset.h"
 #include "dgm.h"
 
@@ -14,8 +15,22 @@ namespace dressguard::calib {
 struct StcOptions {
   int states = 10;             // paper VI: bivariate HMMs with 10 hidden states
   bool uniform_priors = true;  // paper V-B: the class whose HMM has the highest likelihood
+  bool use_vertical = true;    // false: F_motion alone (the second feature is model::kAxisNone)
   std::string source;          // written into the model's metadata
 };
+
+// Which forces an STC should model, from its calibration: F_vertical only where the calibrated
+// simulator predicts it better than a zero force does over the calibration's own sequences (sum
+// of AxisFit::error < sum of AxisFit::zero, calibration.h). The paper's HMMs are bivariate, but
+// a force the simulator gets wrong (our sleeve-pulling gown hangs on the arm and lifts the
+// gripper where the measured vertical force stays near 0; offline/calib/README.md) teaches the
+// classifier a difference between simulation and reality instead of one between outcomes.
+// Both forces when the fits were not measured (a calibration file written before 2026-11-23).
+struct StcAxes {
+  bool use_vertical = true;
+  std::string reason;  // one line for the terminal and the model's metadata
+};
+StcAxes choose_stc_axes(const std::vector<SequenceFit>& fits);
 
 // Trains the HMMs of every outcome present among the labelled trials.
 model::OutcomeModel build_outcome_model(const std::vector<const HapticSequence*>& trials, const StcOptions& o);

@@ -41,10 +41,16 @@ TrialRequest synthesis_request(const Calibration& cal, ArmHeight height, int ind
 
 namespace {
 
+// What the synthesized trials depend on, and only that: a calibration file rewritten with more
+// diagnostics (axis fits, provenance) still resumes its synthesis. Version 2 of the record
+// (2026-11-23; version 1 held the whole calibration file, and a folder with it is refused).
 std::string settings_record(const Calibration& cal, const SynthesisOptions& o) {
+  const Json full = calibration_to_json(cal);
+  Json c = Json::object();
+  for (const char* key : {"participant", "cloth", "arm_offsets", "gown", "rig_travel_m"}) c.set(key, full.at(key));
   Json j = Json::object();
-  j.set("format", "dressguard-synthesis 1");
-  j.set("calibration", calibration_to_json(cal));
+  j.set("format", "dressguard-synthesis 2");
+  j.set("calibration", c);
   j.set("per_height", o.per_height);
   j.set("gown_noise", o.gown_noise);
   j.set("arm_noise", o.arm_noise);

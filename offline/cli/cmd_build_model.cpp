@@ -1,6 +1,8 @@
 // dressguard build-model: the simulation-trained classifier (STC) from a calibration (synthesize,
 // then train three HMMs) or from an existing dataset (paper V-B).
 #include <cstdio>
+#include <optional>
+#include <vector>
 
 #include "args.h"
 #include "calibration.h"
@@ -30,19 +32,26 @@ int run_build_model(int argc, char** argv) {
         "  left-right bivariate HMM per outcome (paper V-B) and writes the model file.\n"
         "  With --data: trains on the labelled trials of an existing dataset.\n"
         "  --states N   hidden states per HMM (default 10, paper VI)\n"
+        "  --forces F   auto | both | motion: which forces the HMMs model (default auto: with\n"
+        "               --calibration, F_vertical only where the calibrated simulator predicts it\n"
+        "               better than a zero force on the calibration's sequences; with --data, both)\n"
         "  --per-height N --no-gown-noise --no-arm-noise --seed S --threads N --gown G  (synthesis)\n"
         "  --json       machine-readable summary");
     return 0;
   }
   args.allow_only({"help", "json", "no-gown-noise", "no-arm-noise", "calibration", "data", "out", "synth-dir",
-                   "states", "per-height", "seed", "gown", "threads"});
+                   "states", "per-height", "seed", "gown", "threads", "forces"});
   const std::string out = args.require("out");
   if (args.has("calibration") == args.has("data")) throw UsageError("give exactly one of --calibration and --data");
   const int states = static_cast<int>(args.integer("states", 10));
   if (states < 1 || states > 32) throw UsageError("--states must be in 1..32");
+  const std::string forces = args.get("forces").value_or("auto");
+  if (forces != "auto" && forces != "both" && forces != "motion") throw UsageError("--forces must be auto, both or motion");
   std::string data;
+  std::optional<std::vector<SequenceFit>> calibration_fits;
   if (args.has("calibration")) {
     const Calibration cal = read_calibration(*args.get("calibration"));
+    calibration_fits = cal.fits;
     data = args.get("synth-dir").value_or(out + ".synth");
     run_synthesis(cal, args.get("gown").value_or(cal.gown), synthesis_options_from(args), data);
   } else {
@@ -55,20 +64,26 @@ int run_build_model(int argc, char** argv) {
   const Dataset ds = load_dataset(data);
   std::vector<const HapticSequence*> trials;
   for (const auto& t : ds.trials) trials.push_back(&t);
+  StcAxes axes{forces != "motion", forces == "auto" ? "F_motion and F_vertical (training data given directly)"
+                                                    : "F_motion" + std::string(forces == "both" ? " and F_vertical" : " alone") +
+                                                          " (--forces " + forces + ")"};
+  if (forces == "auto" && calibration_fits) axes = choose_stc_axes(*calibration_fits);
   StcOptions so;
   so.states = states;
-  so.source = data;
+  so.source = data + "; forces: " + axes.reason;
+  so.use_vertical = axes.use_vertical;
   const model::OutcomeModel m = build_outcome_model(trials, so);
   model::write_model(out, m);
   const double acc = accuracy(m, trials, std::numeric_limits<double>::infinity());
   if (args.has("json")) {
-    std::printf("{\"model\": \"%s\", \"classes\": %zu, \"training_trials\": %zu, \"training_accuracy\": %.4f}\n",
-                out.c_str(), m.classes.size(), trials.size(), acc);
+    std::printf("{\"model\": \"%s\", \"classes\": %zu, \"training_trials\": %zu, \"training_accuracy\": %.4f, "
+                "\"forces\": \"%s\"}\n",
+                out.c_str(), m.classes.size(), trials.size(), acc, axes.use_vertical ? "motion,vertical" : "motion");
   } else {
     std::printf("wrote %s: %zu classes (", out.c_str(), m.classes.size());
     for (std::size_t i = 0; i < m.classes.size(); ++i) std::printf("%s%s", i ? ", " : "", m.classes[i].name.c_str());
-    std::printf(") from %zu trials of %s; accuracy on its own training data %.1f%%\n", trials.size(), data.c_str(),
-                100 * acc);
+    std::printf(") from %zu trials of %s; accuracy on its own training data %.1f%%\nforces modelled: %s\n",
+                trials.size(), data.c_str(), 100 * acc, axes.reason.c_str());
   }
   return 0;
 #endif

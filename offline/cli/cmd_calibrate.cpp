@@ -153,6 +153,7 @@ int run_calibrate(int argc, char** argv) {
     std::vector<TrialRequest> requests;
     for (std::size_t k = 0; k < inputs.size(); ++k) requests.push_back(request_for(inputs[k], r.offsets));
     curves = sim.trials(r.cloth, requests);
+    measure_axis_fits(cal.fits, inputs, curves);
     write_calibration(out, cal);
     write_file_atomic(out + ".curves.csv",
                       overlay_csv(inputs, curves, args.has("no-arm-offset") ? "simulated-no-offset" : "simulated"));
@@ -162,8 +163,10 @@ int run_calibrate(int argc, char** argv) {
     } else {
       std::printf("participant %s: L = %.4f after %d generations (%ld evaluations, %s)\n", participant.c_str(),
                   r.objective, r.generations_done, r.evaluations, minutes(r.elapsed_s).c_str());
-      for (const auto& f : r.fits) std::printf("  %-18s %-6s L = %.4f\n", f.trial_id.c_str(),
-                                               std::string(arm_height_name(f.height)).c_str(), f.objective);
+      for (const auto& f : cal.fits)
+        std::printf("  %-18s %-6s L = %.4f; over the common travel F_motion %.3f (zero force %.3f), F_vertical %.3f "
+                    "(zero force %.3f) N m\n", f.trial_id.c_str(), std::string(arm_height_name(f.height)).c_str(),
+                    f.objective, f.motion.error, f.motion.zero, f.vertical.error, f.vertical.zero);
       for (int i = 0; i < kClothParams; ++i) std::printf("  %-13s %.4f\n", kClothParamNames[i], cloth_value(r.cloth, i));
       for (ArmHeight h : space.offset_heights)
         std::printf("  arm offset %-6s %+.4f m\n", std::string(arm_height_name(h)).c_str(), r.offsets[static_cast<int>(h)]);

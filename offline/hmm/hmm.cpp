@@ -504,8 +504,13 @@ FeatureSequence features_of(const HapticSequence& trial, const model::FeatureCon
   return s;
 }
 
-model::FeatureConvention fit_feature_scaling(const std::vector<const HapticSequence*>& trials) {
-  model::FeatureConvention fc;  // axes motion and vertical, sign +1
+model::FeatureConvention fit_feature_scaling(const std::vector<const HapticSequence*>& trials,
+                                             const model::FeatureConvention& axes) {
+  model::FeatureConvention fc;
+  for (int k = 0; k < kFeatures; ++k) {
+    fc.axis[k] = axes.axis[k];
+    fc.sign[k] = axes.sign[k];
+  }
   double n = 0.0, sum[kFeatures] = {}, sq[kFeatures] = {};
   for (const auto* tr : trials)
     for (const auto& smp : tr->samples) {
@@ -530,7 +535,7 @@ model::OutcomeModel train_outcome_model(const std::vector<const HapticSequence*>
     if (t->label) labelled.push_back(t);
   if (labelled.empty()) throw std::invalid_argument("no labelled trials to train on");
   model::OutcomeModel m;
-  m.features = fit_feature_scaling(labelled);
+  m.features = fit_feature_scaling(labelled, opt.features);
   m.source_dataset = opt.source_dataset;
   std::string summary;
   std::vector<int> counts;

@@ -107,12 +107,15 @@ FeatureSequence sample(const ClassHmm& hmm, size_t T, std::mt19937_64& rng, std:
 FeatureSequence features_of(const HapticSequence& trial, const model::FeatureConvention& fc,
                             double truncate_at = std::numeric_limits<double>::infinity());
 
-// F_motion and F_vertical, sign +1, offset/scale = mean/standard deviation over every sample of
-// the trials (scale 1 when a feature is constant).
-model::FeatureConvention fit_feature_scaling(const std::vector<const HapticSequence*>& trials);
+// The axes and signs of `axes` (default F_motion and F_vertical, sign +1), offset/scale = mean/
+// standard deviation over every sample of the trials (scale 1 when a feature is constant); a
+// feature with axis model::kAxisNone gets offset 0 and scale 1.
+model::FeatureConvention fit_feature_scaling(const std::vector<const HapticSequence*>& trials,
+                                             const model::FeatureConvention& axes = {});
 
 struct ModelOptions {
   TrainOptions hmm;
+  model::FeatureConvention features;  // the axes and signs to model; offset and scale are fitted
   bool uniform_priors = false;  // log_prior = -log(classes) instead of the training counts
   std::string source_dataset;   // written into the model's metadata
 };

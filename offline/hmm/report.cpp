@@ -45,7 +45,7 @@ std::string model_json(const model::OutcomeModel& m) {
   o << "{\"format_version\": " << model::kFormatVersion << ", \"tool_version\": " << json_string(m.tool_version)
     << ", \"created\": " << json_string(m.created) << ", \"source_dataset\": " << json_string(m.source_dataset)
     << ", \"training_summary\": " << json_string(m.training_summary) << ", \"features\": [";
-  static const char* kAxis[] = {"f_motion", "f_lateral", "f_vertical"};
+  static const char* kAxis[] = {"f_motion", "f_lateral", "f_vertical", "none"};
   for (int k = 0; k < model::kFeatures; ++k)
     o << (k ? ", " : "") << "{\"axis\": " << json_string(kAxis[m.features.axis[k]]) << ", \"sign\": "
       << json_number(m.features.sign[k]) << ", \"offset\": " << json_number(m.features.offset[k])

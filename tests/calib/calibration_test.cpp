@@ -12,6 +12,9 @@
 #include "fake_sim.h"
 #include "files.h"
 #include "synthesis.h"
+#ifdef DRESSGUARD_HAVE_HMM
+#include "stc.h"
+#endif
 
 namespace dressguard::calib {
 namespace {
@@ -196,7 +199,8 @@ TEST(Calibration, CalibrationFileRoundTripAndErrors) {
   c.offsets = {-0.02, 0.0, 0.011};
   c.offset_calibrated = {true, false, true};
   c.objective = 0.4567;
-  c.fits = {{"s4-good-3", ArmHeight::High, 0.1, 0.22}, {"s4-miss-2", ArmHeight::Low, 0.15, 0.2367}};
+  c.fits = {{"s4-good-3", ArmHeight::High, 0.1, 0.22, {0.5, 1.25}, {0.375, 0.0625}},
+            {"s4-miss-2", ArmHeight::Low, 0.15, 0.2367, {}, {}}};  // the second without axis fits (older file)
   c.rig_travel = 0.72;
   c.provenance.set("seed", "1");
   const fs::path dir = temp_dir("calfile");
@@ -208,6 +212,9 @@ TEST(Calibration, CalibrationFileRoundTripAndErrors) {
   EXPECT_FALSE(d.offset_calibrated[1]);
   ASSERT_EQ(d.fits.size(), 2u);
   EXPECT_EQ(d.fits[1].speed, 0.15);
+  EXPECT_EQ(d.fits[0].motion.zero, 1.25);
+  EXPECT_EQ(d.fits[0].vertical.error, 0.375);
+  EXPECT_FALSE(d.fits[1].vertical.measured());
   EXPECT_EQ(d.rig_travel, 0.72);
   write_file_atomic(dir / "bad.json", "{\"format\": \"dressguard-calibration 1\",\n \"participant\": 4}");
   EXPECT_THROW(read_calibration(dir / "bad.json"), InputError);
@@ -220,6 +227,53 @@ TEST(Calibration, CalibrationFileRoundTripAndErrors) {
   }
   fs::remove_all(dir);
 }
+
+namespace {
+// A sequence of n + 1 samples 1 mm apart with constant forces.
+HapticSequence flat(int n, double f_motion, double f_vertical) {
+  HapticSequence s;
+  for (int i = 0; i <= n; ++i) s.samples.push_back({0.01 * i, 0.001 * i, f_motion, 0.0, f_vertical});
+  return s;
+}
+}  // namespace
+
+// The axis fits in closed form: measured F_motion -2 N and F_vertical 0 over 0.5 m, simulated
+// -1.5 N and +1 N stopping at 0.3 m: over the 0.3 m both cover, F_motion 0.5 N x 0.3 m = 0.15 N m
+// from the measurement (a zero force 0.6), F_vertical 0.3 (zero force 0); the part beyond 0.3 m
+// does not count (w = 0). A simulation that blew up gets no fit.
+TEST(Calibration, AxisFitsAreTheAreasOverTheCommonTravel) {
+  const std::vector<HapticSequence> inputs = {flat(500, -2.0, 0.0), flat(500, -2.0, -1.0)};
+  std::vector<SimulatedTrial> curves(2);
+  curves[0].samples = flat(300, -1.5, 1.0).samples;
+  curves[1].samples = flat(300, -1.5, -0.8).samples;
+  curves[1].finite = false;
+  std::vector<SequenceFit> fits(2);
+  measure_axis_fits(fits, inputs, curves);
+  EXPECT_NEAR(fits[0].motion.error, 0.15, 1e-12);
+  EXPECT_NEAR(fits[0].motion.zero, 0.6, 1e-12);
+  EXPECT_NEAR(fits[0].vertical.error, 0.3, 1e-12);
+  EXPECT_EQ(fits[0].vertical.zero, 0.0);
+  EXPECT_FALSE(fits[1].vertical.measured());
+  curves.pop_back();
+  EXPECT_THROW(measure_axis_fits(fits, inputs, curves), std::invalid_argument);
+}
+
+#ifdef DRESSGUARD_HAVE_HMM
+// The STC's forces: F_vertical only where the simulation is closer to the measured vertical force
+// than a zero force, summed over the calibration's sequences; both when nothing was measured.
+TEST(Calibration, StcModelsVerticalForceOnlyWhereTheSimulatorPredictsIt) {
+  std::vector<SequenceFit> fits(2);
+  EXPECT_TRUE(choose_stc_axes(fits).use_vertical);  // older calibration file: no axis fits
+  fits[0].vertical = {0.06, 0.3};
+  fits[1].vertical = {0.5, 0.05};
+  fits[0].motion = fits[1].motion = {0.1, 1.0};
+  const StcAxes a = choose_stc_axes(fits);  // 0.56 against 0.35: worse than zero
+  EXPECT_FALSE(a.use_vertical);
+  EXPECT_NE(a.reason.find("F_motion alone"), std::string::npos) << a.reason;
+  fits[1].vertical = {0.2, 0.05};  // 0.26 against 0.35
+  EXPECT_TRUE(choose_stc_axes(fits).use_vertical);
+}
+#endif
 
 // Synthesis with the stand-in: counts, speeds and noise ranges of paper V-A, labels from the
 // simulator, independence of the thread count, resume after a partial run, switches.
@@ -286,7 +340,15 @@ TEST(Synthesis, DatasetIsIndependentOfThreadsAndResumes) {
     EXPECT_EQ(da.trials[i].label, db.trials[i].label);
     EXPECT_EQ(read_file(a / (da.trials[i].id + ".csv")), read_file(b / (db.trials[i].id + ".csv")));
   }
-  // Other settings into the same folder are refused.
+  // The calibration file rewritten with diagnostics that do not change the trials (axis fits,
+  // provenance) still resumes; other settings or another cloth into the same folder are refused.
+  Calibration annotated = cal;
+  annotated.fits.push_back({"s4-good-3", ArmHeight::High, 0.1, 0.22, {0.5, 1.25}, {0.375, 0.0625}});
+  annotated.provenance.set("note", "re-measured");
+  EXPECT_EQ(synthesize(annotated, testing::fake_simulate, o, b, Comm::world()).resumed, 30);
+  Calibration stiffer = cal;
+  stiffer.cloth.stretch += 0.1;
+  EXPECT_THROW(synthesize(stiffer, testing::fake_simulate, o, b, Comm::world()), InputError);
   o.seed = 2;
   EXPECT_THROW(synthesize(cal, testing::fake_simulate, o, b, Comm::world()), InputError);
   fs::remove_all(a);

@@ -76,6 +76,20 @@ TEST(ForwardFilter, AgreesWithOfflineOnEveryPrefixFiveStatesBandTwo) {
   expect_prefix_agreement(m, fx::pointers(test));
 }
 
+// A model of F_motion alone (feature 1 none, format version 2), read back from its file as the
+// predictor reads it: the online filter agrees with the offline forward pass on every prefix.
+TEST(ForwardFilter, MotionOnlyModelFromItsFileAgrees) {
+  const Dataset train = fx::synthetic_dataset(15, 300, 600, 35, 5);
+  const Dataset test = fx::synthetic_dataset(5, 300, 600, 36, 5);
+  hmm::ModelOptions opt;
+  opt.hmm.n_states = 5;
+  opt.features.axis[1] = model::kAxisNone;
+  const auto bytes = model::encode_model(hmm::train_outcome_model(fx::pointers(train), opt));
+  const auto m = model::decode_model(bytes.data(), bytes.size(), "motion-only");
+  EXPECT_EQ(m.features.axis[1], model::kAxisNone);
+  expect_prefix_agreement(m, fx::pointers(test));
+}
+
 // Any topology: an ergodic model (A_10 > 0) takes the general path and still agrees.
 TEST(ForwardFilter, GeneralTopologyAgrees) {
   const Dataset train = fx::synthetic_dataset(10, 300, 400, 35, 4);

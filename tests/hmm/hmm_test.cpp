@@ -303,6 +303,43 @@ TEST(HmmOutcomeModel, TrainsAndClassifiesSyntheticClasses) {
   EXPECT_EQ(early.total, 30);
 }
 
+// A model of F_motion alone (feature 1 = none), the STC's answer to a simulator that gets the
+// vertical force wrong (offline/calib/stc.h): trained on data whose "good" class carries a
+// vertical offset that the test data do not have (+1.5 N, as our simulated good trials lift the
+// gripper where the measured ones do not), the bivariate model sends most good test trials
+// elsewhere while the F_motion model classifies nearly all of them right; its likelihoods do
+// not depend on the vertical force at all (same bits for any vertical force).
+TEST(HmmOutcomeModel, MotionOnlyModelIgnoresAVerticalForceThatDiffersFromTraining) {
+  Dataset train = fx::synthetic_dataset(20, 300, 500, 31);
+  for (auto& t : train.trials)
+    if (t.label == Outcome::Good)
+      for (auto& s : t.samples) s.f_vertical += 1.5;
+  const Dataset test = fx::synthetic_dataset(10, 300, 500, 32);
+  hmm::ModelOptions both;
+  both.hmm.n_states = 5;
+  hmm::ModelOptions motion = both;
+  motion.features.axis[1] = model::kAxisNone;
+  const auto mb = hmm::train_outcome_model(fx::pointers(train), both);
+  const auto mm = hmm::train_outcome_model(fx::pointers(train), motion);
+  EXPECT_EQ(mm.features.axis[1], model::kAxisNone);
+  EXPECT_EQ(mm.features.offset[1], 0.0);
+  EXPECT_EQ(mm.features.scale[1], 1.0);
+  EXPECT_NO_THROW(model::validate_model(mm, "motion-only"));
+  std::vector<const HapticSequence*> good;
+  for (const auto& t : test.trials)
+    if (t.label == Outcome::Good) good.push_back(&t);
+  const auto eb = hmm::evaluate(mb, good), em = hmm::evaluate(mm, good);
+  EXPECT_LE(eb.correct, 3) << "the bivariate model should be misled by the vertical offset";
+  EXPECT_GE(em.correct, 9);
+  // Invariance: another vertical force, the same log-likelihoods to the bit.
+  HapticSequence shifted = *good[0];
+  for (auto& s : shifted.samples) s.f_vertical = -7.0 + 0.01 * s.t;
+  const auto a = hmm::classify(mm, hmm::features_of(*good[0], mm.features));
+  const auto b = hmm::classify(mm, hmm::features_of(shifted, mm.features));
+  ASSERT_EQ(a.log_likelihood.size(), b.log_likelihood.size());
+  for (size_t c = 0; c < a.log_likelihood.size(); ++c) EXPECT_EQ(a.log_likelihood[c], b.log_likelihood[c]);
+}
+
 // Determinism: the same data trains the same bits.
 TEST(HmmTrain, Deterministic) {
   const auto truth = fx::known_left_right(5, 0.95);

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <string>
 
 #include "dgm.h"
 
@@ -146,10 +147,43 @@ TEST(ModelFileRejects, WrongMagic) {
 }
 
 TEST(ModelFileRejects, WrongVersion) {
-  auto b = encode_model(sample_model());
-  b[8] = 2;
-  fix_crc(b);
-  expect_rejected(b, "unsupported format version 2");
+  for (uint8_t v : {uint8_t{0}, uint8_t{3}}) {
+    auto b = encode_model(sample_model());
+    b[8] = v;
+    fix_crc(b);
+    expect_rejected(b, "unsupported format version " + std::to_string(v));
+  }
+}
+
+// A feature the model does not use (axis 3, none): it is 0 whatever the sample, the file says
+// version 2 (a model without it stays version 1, readable by version-1 readers), and it
+// round-trips; a version-1 file with axis 3 is refused.
+TEST(ModelFile, UnusedFeatureIsZeroAndNeedsVersion2) {
+  auto m = sample_model();
+  EXPECT_EQ(encode_model(m)[8], 1);
+  m.features.axis[1] = kAxisNone;
+  m.features.offset[1] = 0.0;
+  m.features.scale[1] = 1.0;
+  double x[kFeatures], y[kFeatures];
+  m.features.apply(-3.0, 0.5, 2.0, x);
+  m.features.apply(-3.0, -7.0, -9.0, y);
+  EXPECT_EQ(x[1], 0.0);
+  EXPECT_EQ(y[1], 0.0);
+  EXPECT_EQ(x[0], y[0]);
+  EXPECT_DOUBLE_EQ(x[0], (-3.0 + 2.5) / 1.75);
+  const auto b = encode_model(m);
+  EXPECT_EQ(b[8], 2);
+  const auto d = decode_model(b.data(), b.size(), "mem");
+  EXPECT_EQ(d.features.axis[1], kAxisNone);
+  EXPECT_EQ(encode_model(d), b);
+  EXPECT_NE(describe_model(d).find("feature 1 = none"), std::string::npos) << describe_model(d);
+  auto v1 = b;
+  v1[8] = 1;
+  fix_crc(v1);
+  expect_rejected(v1, "needs format version 2");
+  auto both = m;
+  both.features.axis[0] = kAxisNone;
+  EXPECT_THROW(encode_model(both), ModelError);
 }
 
 TEST(ModelFileRejects, BadCrc) {

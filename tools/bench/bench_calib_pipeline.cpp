@@ -6,7 +6,8 @@
 //     the STC; train the baseline classifier BC on the same measured sequences directly (paper
 //     VI-B.1; the study folder holds no caught trial, so BC has good and missed only); classify
 //     every measured trial of the other participants, whole and cut at 0.15/0.20/0.25/0.30 m of
-//     travel. Next to them, the 1-nearest-neighbour baseline on force curves trained on the other
+//     travel. The STC models the forces its calibration supports (stc.h: choose_stc_axes); the
+//     bivariate STC of the paper is printed beside it. Next to them, the 1-nearest-neighbour baseline on force curves trained on the other
 //     people's real trials (leave-one-participant-out over the whole study; the reference:
 //     71%, 83%, 94%, 100% at the four cuts). Prints one row per participant and the means, and
 //     writes DIR/eval.json after each participant (plot: tools/plot/calib_eval.py); a rerun with
@@ -141,8 +142,8 @@ int run_eval(const std::map<std::string, std::string>& a) {
   for (int c = 0; c < 4; ++c) nn[c] = one_nn_accuracy(all, kCuts[c]);
   std::printf("1-NN on force curves (leave one participant out): %.0f%% %.0f%% %.0f%% %.0f%% at 0.15/0.20/0.25/0.30 m "
               "(reference 71/83/94/100%%)\n", 100 * nn[0], 100 * nn[1], 100 * nn[2], 100 * nn[3]);
-  std::printf("%-4s %-8s %-28s | %-33s | %-33s\n", "P", "L", "parameters (str sh bd fr sf)",
-              "STC whole/.15/.20/.25/.30", "BC whole/.15/.20/.25/.30");
+  std::printf("%-4s %-8s %-28s | %-33s | %-33s | %-33s\n", "P", "L", "parameters (str sh bd fr sf)",
+              "STC whole/.15/.20/.25/.30", "STC both forces", "BC whole/.15/.20/.25/.30");
   Json rows = Json::array();
   // DIR/eval.json, rewritten after every participant (atomically), so that a run cut short keeps
   // the rows it finished; a rerun resumes each participant from its calibration checkpoint and
@@ -159,7 +160,7 @@ int run_eval(const std::map<std::string, std::string>& a) {
     out.set("gown", gown);
     write_file_atomic(work / "eval.json", out.dump() + "\n");
   };
-  double sum_stc[5] = {}, sum_bc[5] = {};
+  double sum_stc[5] = {}, sum_stc2[5] = {}, sum_bc[5] = {};
   int n = 0;
   for (const auto& p : chosen) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -179,10 +180,11 @@ int run_eval(const std::map<std::string, std::string>& a) {
     cal.fits = r.fits;
     cal.gown = gown;
     cal.rig_travel = rig_travel_of(inputs);
-    write_calibration(work / ("cal" + p + ".json"), cal);
     std::vector<TrialRequest> requests;
     for (const auto& s : inputs) requests.push_back(request_for(s, r.offsets));
     const std::vector<SimulatedTrial> curves = sim.trials(r.cloth, requests);
+    measure_axis_fits(cal.fits, inputs, curves);
+    write_calibration(work / ("cal" + p + ".json"), cal);
     write_file_atomic(work / ("cal" + p + ".json.curves.csv"), overlay_csv(inputs, curves, "simulated"));
     const fs::path synth = work / ("synth" + p);
     synthesize(cal, sim.trial, so, synth, Comm::world());
@@ -192,15 +194,24 @@ int run_eval(const std::map<std::string, std::string>& a) {
     for (const auto& t : inputs) btrain.push_back(&t);
     for (const auto& t : ds.trials)
       if (t.participant != p) test.push_back(&t);
-    StcOptions stc_o;
-    stc_o.source = synth.string();
-    double stc[5] = {}, bc[5] = {};
+    // The STC with the forces its calibration supports (stc.h: choose_stc_axes, the default of
+    // `dressguard build-model`), and with both forces (the paper's bivariate HMMs) beside it.
+    const StcAxes axes = choose_stc_axes(cal.fits);
+    double stc[5] = {}, stc2[5] = {}, bc[5] = {};
     std::string stc_error, bc_error, stc_classes;
     try {
-      const auto m = build_outcome_model(strain, stc_o);
-      for (const auto& c : m.classes) stc_classes += (stc_classes.empty() ? "" : "+") + c.name;
-      stc[0] = accuracy(m, test, std::numeric_limits<double>::infinity());
-      for (int c = 0; c < 4; ++c) stc[c + 1] = accuracy(m, test, kCuts[c]);
+      StcOptions stc_o;
+      stc_o.source = synth.string();
+      for (bool vertical : {axes.use_vertical, true}) {
+        stc_o.use_vertical = vertical;
+        double* acc = vertical == axes.use_vertical ? stc : stc2;
+        const auto m = build_outcome_model(strain, stc_o);
+        if (stc_classes.empty())
+          for (const auto& c : m.classes) stc_classes += (stc_classes.empty() ? "" : "+") + c.name;
+        acc[0] = accuracy(m, test, std::numeric_limits<double>::infinity());
+        for (int c = 0; c < 4; ++c) acc[c + 1] = accuracy(m, test, kCuts[c]);
+      }
+      if (axes.use_vertical) std::copy(stc, stc + 5, stc2);
     } catch (const std::exception& e) {
       stc_error = e.what();
     }
@@ -216,16 +227,21 @@ int run_eval(const std::map<std::string, std::string>& a) {
     char params[64];
     std::snprintf(params, sizeof params, "%.2f %.2f %.2f %.2f %.2f", r.cloth.stretch, r.cloth.shear, r.cloth.bend,
                   r.cloth.friction, r.cloth.self_friction);
-    std::printf("%-4s %-8.3f %-28s | %5.0f %5.0f %5.0f %5.0f %5.0f   | %5.0f %5.0f %5.0f %5.0f %5.0f  (%.0f s) STC classes %s%s%s\n",
+    std::printf("%-4s %-8.3f %-28s | %5.0f %5.0f %5.0f %5.0f %5.0f   | %5.0f %5.0f %5.0f %5.0f %5.0f   | %5.0f %5.0f %5.0f "
+                "%5.0f %5.0f  (%.0f s) STC classes %s, forces %s%s%s\n",
                 p.c_str(), r.objective, params, 100 * stc[0], 100 * stc[1], 100 * stc[2], 100 * stc[3], 100 * stc[4],
+                100 * stc2[0], 100 * stc2[1], 100 * stc2[2], 100 * stc2[3], 100 * stc2[4],
                 100 * bc[0], 100 * bc[1], 100 * bc[2], 100 * bc[3], 100 * bc[4], seconds_since(t0),
-                stc_classes.c_str(), stc_error.empty() ? "" : (" STC failed: " + stc_error).c_str(),
+                stc_classes.c_str(), axes.reason.c_str(), stc_error.empty() ? "" : (" STC failed: " + stc_error).c_str(),
                 bc_error.empty() ? "" : (" BC failed: " + bc_error).c_str());
     std::fflush(stdout);
     Json row = calibration_to_json(cal);
-    Json js = Json::array(), jb = Json::array();
-    for (int c = 0; c < 5; ++c) js.push(stc[c]), jb.push(bc[c]);
+    Json js = Json::array(), js2 = Json::array(), jb = Json::array();
+    for (int c = 0; c < 5; ++c) js.push(stc[c]), js2.push(stc2[c]), jb.push(bc[c]);
     row.set("stc_accuracy_whole_and_cuts", js);
+    row.set("stc_forces", axes.use_vertical ? "motion,vertical" : "motion");
+    row.set("stc_forces_reason", axes.reason);
+    row.set("stc_both_forces_accuracy_whole_and_cuts", js2);
     row.set("bc_accuracy_whole_and_cuts", jb);
     row.set("seconds", seconds_since(t0));
     row.set("stc_classes", stc_classes);
@@ -236,14 +252,15 @@ int run_eval(const std::map<std::string, std::string>& a) {
     row.set("synthesized_labels", jl);
     rows.push(row);
     write_eval();
-    for (int c = 0; c < 5; ++c) sum_stc[c] += stc[c], sum_bc[c] += bc[c];
+    for (int c = 0; c < 5; ++c) sum_stc[c] += stc[c], sum_stc2[c] += stc2[c], sum_bc[c] += bc[c];
     ++n;
   }
   if (n > 0)
-    std::printf("mean %-37s | %5.0f %5.0f %5.0f %5.0f %5.0f   | %5.0f %5.0f %5.0f %5.0f %5.0f\n", "", 100 * sum_stc[0] / n,
-                100 * sum_stc[1] / n, 100 * sum_stc[2] / n, 100 * sum_stc[3] / n, 100 * sum_stc[4] / n,
-                100 * sum_bc[0] / n, 100 * sum_bc[1] / n, 100 * sum_bc[2] / n, 100 * sum_bc[3] / n,
-                100 * sum_bc[4] / n);
+    std::printf("mean %-37s | %5.0f %5.0f %5.0f %5.0f %5.0f   | %5.0f %5.0f %5.0f %5.0f %5.0f   | %5.0f %5.0f %5.0f %5.0f "
+                "%5.0f\n", "", 100 * sum_stc[0] / n, 100 * sum_stc[1] / n, 100 * sum_stc[2] / n, 100 * sum_stc[3] / n,
+                100 * sum_stc[4] / n, 100 * sum_stc2[0] / n, 100 * sum_stc2[1] / n, 100 * sum_stc2[2] / n,
+                100 * sum_stc2[3] / n, 100 * sum_stc2[4] / n, 100 * sum_bc[0] / n, 100 * sum_bc[1] / n,
+                100 * sum_bc[2] / n, 100 * sum_bc[3] / n, 100 * sum_bc[4] / n);
   write_eval();
   return 0;
 }
