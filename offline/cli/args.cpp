@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <ctime>
 #include <sstream>
 
 namespace dressguard::cli {
@@ -73,6 +74,15 @@ long Args::integer(const std::string& name, long fallback) const {
 void Args::allow_only(const std::set<std::string>& known) const {
   for (const auto& [k, v] : values_) if (!known.count(k)) throw UsageError("unknown option --" + k);
   for (const auto& k : flags_set_) if (!known.count(k)) throw UsageError("unknown option --" + k);
+}
+
+std::string utc_now() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);  // thread-safe, unlike std::gmtime
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
 }
 
 }  // namespace dressguard::cli

@@ -41,4 +41,7 @@ class Args {
   std::vector<std::string> positional_;
 };
 
+// The current time, UTC, ISO-8601 to the second ("2026-11-23T16:20:00Z"), for files' provenance.
+std::string utc_now();
+
 }  // namespace dressguard::cli

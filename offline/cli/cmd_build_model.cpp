@@ -72,7 +72,9 @@ int run_build_model(int argc, char** argv) {
   so.states = states;
   so.source = data + "; forces: " + axes.reason;
   so.use_vertical = axes.use_vertical;
-  const model::OutcomeModel m = build_outcome_model(trials, so);
+  model::OutcomeModel m = build_outcome_model(trials, so);
+  m.tool_version = "dressguard 0.1.0 build-model";
+  m.created = utc_now();
   model::write_model(out, m);
   const double acc = accuracy(m, trials, std::numeric_limits<double>::infinity());
   if (args.has("json")) {

@@ -19,13 +19,6 @@ using namespace dressguard::calib;
 
 namespace {
 
-[[maybe_unused]] std::string utc_now() {
-  const std::time_t t = std::time(nullptr);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
-  return buf;
-}
-
 [[maybe_unused]] std::string minutes(double s) {
   char buf[32];
   if (s < 120) std::snprintf(buf, sizeof buf, "%.0f s", s);

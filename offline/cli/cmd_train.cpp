@@ -14,17 +14,6 @@
 
 namespace dressguard::cli {
 
-namespace {
-std::string utc_now() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
-}
-}  // namespace
-
 int run_train(int argc, char** argv) {
   Args args(argc - 1, argv + 1, {"help", "json", "uniform-priors"});
   if (args.has("help")) {
