@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """Accuracy against travel distance of the calibration evaluation (issue 4, paper Fig. 10-11):
-each participant's STC and BC on the other participants' measured trials, their means, and the
+each participant's STC (with the forces its calibration supports, and with both forces when the
+file holds it) and BC on the other participants' measured trials, their means, and the
 1-nearest-neighbour baseline on force curves with the issue's reference figures.
 
 usage: calib_eval.py OUT.png EVAL.json [EVAL2.json ...]
@@ -41,9 +42,16 @@ def main(argv):
         v = [100 * a for a in r[key]]
         return v[1:] + v[:1]
 
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), sharey=True)
-    for ax, key, name in ((axes[0], "stc_accuracy_whole_and_cuts", "STC (trained on simulation)"),
-                          (axes[1], "bc_accuracy_whole_and_cuts", "BC (trained on the 2-3 measured inputs)")):
+    panels = [("stc_accuracy_whole_and_cuts", "STC (trained on simulation)"),
+              ("bc_accuracy_whole_and_cuts", "BC (trained on the 2-3 measured inputs)")]
+    # Files since session 5 also hold the bivariate STC beside the one with the forces its
+    # calibration supports (stc_forces); files from before hold one STC.
+    if all("stc_both_forces_accuracy_whole_and_cuts" in r for r in rows.values()):
+        panels = [("stc_accuracy_whole_and_cuts", "STC, forces its calibration supports"),
+                  ("stc_both_forces_accuracy_whole_and_cuts", "STC, F_motion and F_vertical (paper)"),
+                  panels[1]]
+    fig, axes = plt.subplots(1, len(panels), figsize=(5.5 * len(panels), 4.2), sharey=True)
+    for ax, (key, name) in zip(axes, panels):
         mean = [0.0] * len(xs)
         for p in sorted(rows, key=int):
             ys = series(rows[p], key)
