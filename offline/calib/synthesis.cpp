@@ -43,19 +43,39 @@ namespace {
 
 // What the synthesized trials depend on, and only that: a calibration file rewritten with more
 // diagnostics (axis fits, provenance) still resumes its synthesis. Version 2 of the record
-// (2026-11-23; version 1 held the whole calibration file, and a folder with it is refused).
-std::string settings_record(const Calibration& cal, const SynthesisOptions& o) {
-  const Json full = calibration_to_json(cal);
+// (2026-11-23); version 1 held the whole calibration file and is read through the same fields.
+std::string settings_record_of(const Json& calibration, const Json& per_height, const Json& gown_noise,
+                               const Json& arm_noise, const Json& seed) {
   Json c = Json::object();
-  for (const char* key : {"participant", "cloth", "arm_offsets", "gown", "rig_travel_m"}) c.set(key, full.at(key));
+  for (const char* key : {"participant", "cloth", "arm_offsets", "gown", "rig_travel_m"})
+    c.set(key, calibration.at(key));
   Json j = Json::object();
   j.set("format", "dressguard-synthesis 2");
   j.set("calibration", c);
-  j.set("per_height", o.per_height);
-  j.set("gown_noise", o.gown_noise);
-  j.set("arm_noise", o.arm_noise);
-  j.set("seed", std::to_string(o.seed));
+  j.set("per_height", per_height);
+  j.set("gown_noise", gown_noise);
+  j.set("arm_noise", arm_noise);
+  j.set("seed", seed);
   return j.dump() + "\n";
+}
+
+std::string settings_record(const Calibration& cal, const SynthesisOptions& o) {
+  return settings_record_of(calibration_to_json(cal), Json(o.per_height), Json(o.gown_noise), Json(o.arm_noise),
+                            Json(std::to_string(o.seed)));
+}
+
+// A folder's record in version 2, whichever version it was written in ("" when unreadable).
+std::string stored_record(const fs::path& path) {
+  const std::string text = read_file(path);
+  try {
+    const Json j = Json::parse(text, path);
+    if (j.at("format").string() == "dressguard-synthesis 1")
+      return settings_record_of(j.at("calibration"), j.at("per_height"), j.at("gown_noise"), j.at("arm_noise"),
+                                j.at("seed"));
+  } catch (const std::exception&) {
+    return "";
+  }
+  return text;
 }
 
 fs::path marker_path(const fs::path& out, const std::string& id) { return out / ".synth" / (id + ".done"); }
@@ -70,7 +90,7 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
   // A folder holds one synthesis: resuming with other settings would mix two datasets.
   const std::string record = settings_record(cal, options);
   const fs::path record_path = out / "synthesis.json";
-  if (fs::exists(record_path) && read_file(record_path) != record)
+  if (fs::exists(record_path) && stored_record(record_path) != record)
     throw_input_error(record_path, 0,
                       "this folder holds a synthesis with other settings (calibration, count, noise or seed); "
                       "choose another --out or remove it");

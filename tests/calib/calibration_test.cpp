@@ -351,6 +351,20 @@ TEST(Synthesis, DatasetIsIndependentOfThreadsAndResumes) {
   EXPECT_THROW(synthesize(stiffer, testing::fake_simulate, o, b, Comm::world()), InputError);
   o.seed = 2;
   EXPECT_THROW(synthesize(cal, testing::fake_simulate, o, b, Comm::world()), InputError);
+  // A folder written before 2026-11-23 (record format 1: the whole calibration file) resumes
+  // with the settings it was made with and refuses others.
+  o.seed = 1;
+  Json v1 = Json::object();
+  v1.set("format", "dressguard-synthesis 1");
+  v1.set("calibration", calibration_to_json(cal));
+  v1.set("per_height", o.per_height);
+  v1.set("gown_noise", o.gown_noise);
+  v1.set("arm_noise", o.arm_noise);
+  v1.set("seed", std::to_string(o.seed));
+  write_file_atomic(b / "synthesis.json", v1.dump() + "\n");
+  EXPECT_EQ(synthesize(cal, testing::fake_simulate, o, b, Comm::world()).resumed, 30);
+  write_file_atomic(b / "synthesis.json", v1.dump() + "\n");
+  EXPECT_THROW(synthesize(stiffer, testing::fake_simulate, o, b, Comm::world()), InputError);
   fs::remove_all(a);
   fs::remove_all(b);
 }
