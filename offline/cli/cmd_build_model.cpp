@@ -64,10 +64,10 @@ int run_build_model(int argc, char** argv) {
   const Dataset ds = load_dataset(data);
   std::vector<const HapticSequence*> trials;
   for (const auto& t : ds.trials) trials.push_back(&t);
-  StcAxes axes{forces != "motion", forces == "auto" ? "F_motion and F_vertical (training data given directly)"
-                                                    : "F_motion" + std::string(forces == "both" ? " and F_vertical" : " alone") +
-                                                          " (--forces " + forces + ")"};
-  if (forces == "auto" && calibration_fits) axes = choose_stc_axes(*calibration_fits);
+  StcAxes axes{true, "F_motion and F_vertical (training data given directly)"};
+  if (forces == "both") axes = {true, "F_motion and F_vertical (--forces both)"};
+  else if (forces == "motion") axes = {false, "F_motion alone (--forces motion)"};
+  else if (calibration_fits) axes = choose_stc_axes(*calibration_fits);
   StcOptions so;
   so.states = states;
   so.source = data + "; forces: " + axes.reason;
