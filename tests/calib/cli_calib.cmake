@@ -23,6 +23,7 @@ file(WRITE ${WORK}/bad.json "{\"format\": \"dressguard-calibration 1\",\n\"parti
 expect_fail("synthesize with a bad calibration file" "bad.json" synthesize --calibration ${WORK}/bad.json --out ${WORK}/s)
 expect_fail("synthesize with --per-height 1" "--per-height" synthesize --calibration ${WORK}/bad.json --out ${WORK}/s --per-height 1)
 expect_fail("build-model with both inputs" "exactly one" build-model --calibration ${WORK}/bad.json --data ${WORK} --out ${WORK}/m.dgm)
+expect_fail("build-model with unknown forces" "--forces" build-model --data ${WORK} --forces lateral --out ${WORK}/m.dgm)
 
 if(STUDY)
   execute_process(COMMAND ${DG} import --study ${STUDY} --out ${WORK}/study RESULT_VARIABLE rc)
@@ -35,6 +36,14 @@ if(STUDY)
                     RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
     if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/m.dgm OR NOT out MATCHES "\"classes\": 2")
       message(FATAL_ERROR "build-model --data failed (${rc}):\n${out}\n${err}")
+    endif()
+    # F_motion alone: a model of format 2 whose second feature is none, shown as such.
+    execute_process(COMMAND ${DG} build-model --data ${WORK}/study --out ${WORK}/m1.dgm --states 5 --forces motion --json
+                    RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+    execute_process(COMMAND ${DG} model show ${WORK}/m1.dgm RESULT_VARIABLE rc2 OUTPUT_VARIABLE shown ERROR_VARIABLE err2)
+    if(NOT rc EQUAL 0 OR NOT out MATCHES "\"forces\": \"motion\"" OR NOT rc2 EQUAL 0
+       OR NOT shown MATCHES "format 2" OR NOT shown MATCHES "feature 1 = none")
+      message(FATAL_ERROR "build-model --forces motion (${rc}, ${rc2}):\n${out}\n${err}\n${shown}\n${err2}")
     endif()
   endif()
 endif()
