@@ -69,16 +69,22 @@ inline int64_t floor_i64(double v) {
   return t - (static_cast<double>(t) > v);
 }
 
-inline uint32_t hash_cell(int64_t ix, int64_t iy, int64_t iz, uint32_t mask) {
-  const uint64_t h = static_cast<uint64_t>(ix) * 73856093ULL ^ static_cast<uint64_t>(iy) * 19349663ULL ^
-                     static_cast<uint64_t>(iz) * 83492791ULL;
-  return static_cast<uint32_t>(h) & mask;
+// The hash slot of a row of cells, (iy, iz), with cell ix of the row at slot (row + ix) & mask:
+// the cells of a row are consecutive slots, so the 3 cells ix - 1 .. ix + 1 are one range of
+// the counting sort. The row's slot is 4 G with G's low 4 bits (iy mod 4, iz mod 4): two rows of
+// one 3 x 3 neighbourhood (|dy|, |dz| <= 2) differ there, so their G differ modulo the table / 4
+// (at least 16 slots), their slots by a nonzero multiple of 4 modulo the table, and the 3-slot
+// windows of the 9 rows never overlap: every vertex is a candidate once.
+inline uint64_t row_slot(int64_t iy, int64_t iz) {
+  const uint64_t p = static_cast<uint64_t>(iy) * 19349663ULL ^ static_cast<uint64_t>(iz) * 83492791ULL;
+  return ((p << 4) | ((static_cast<uint64_t>(iy) & 3) << 2) | (static_cast<uint64_t>(iz) & 3)) << 2;
 }
 
-// Self-collision candidates (paper IV-A.3): a spatial hash of the vertices with cells as wide as
-// the search radius, built once per output step by a counting sort; pairs closer than the search
-// radius, excluding pairs whose rest distance is within the search radius (mesh neighbours) and
-// pairs of two grasped vertices.
+// Self-collision candidates (paper IV-A.3): a spatial hash of the vertices, built once per output
+// step by a counting sort; pairs closer than the search radius, excluding pairs whose rest
+// distance is within the search radius (mesh neighbours) and pairs of two grasped vertices.
+// The pairs are listed in (i, j) order, i < j: the order of the Gauss-Seidel pass of solve_self()
+// does not depend on the hash, only on the pair set.
 void detect_self(const GownModel& m, GownState& s) {
   const SceneData& sc = *m.scene;
   s.pair_count = 0;
@@ -88,15 +94,19 @@ void detect_self(const GownModel& m, GownState& s) {
   // per output step (1.8 m/s relative at 12 mm, 300 Hz) are caught. It must stay below the mesh
   // edge: vertices nearer than that at rest are mesh neighbours, never self-collision pairs.
   const double r = 1.5 * ds;
-  // Cells twice the search radius: the neighbours within r of a point lie in the 2 x 2 x 2 block
-  // of cells on the side of its cell that the point is nearer to (8 lookups instead of 27).
-  const double inv = 0.5 / r;
+  // Cells as wide as the search radius (1e-9 wider, so that two points nearer than r never have
+  // cell coordinates 2 apart after the rounding of x / cell): the neighbours within r of a point
+  // lie in the 3 x 3 x 3 cells around its own, 9 rows of 3 (row_slot()). Against cells of 2 r
+  // and their 2 x 2 x 2 block: a 3 r instead of a 4 r cube around the point, about half the
+  // candidates on a surface.
+  const double inv = 1.0 / (r * (1 + 1e-9));
   const uint32_t table = static_cast<uint32_t>(s.cell_start.size() - 1);
   const uint32_t mask = table - 1;
   std::fill(s.cell_start.begin(), s.cell_start.end(), 0);
   for (int i = 0; i < n; ++i) {
     const V3 q = s.x[i];
-    const uint32_t h = hash_cell(floor_i64(q.x * inv), floor_i64(q.y * inv), floor_i64(q.z * inv), mask);
+    const uint32_t h = static_cast<uint32_t>(row_slot(floor_i64(q.y * inv), floor_i64(q.z * inv)) +
+                                             static_cast<uint64_t>(floor_i64(q.x * inv))) & mask;
     s.cell_of[i] = h;
     s.cell_start[h + 1]++;
   }
@@ -112,35 +122,38 @@ void detect_self(const GownModel& m, GownState& s) {
   s.cell_start[0] = 0;
   const double r2 = r * r, excl2 = r2;
   const size_t cap = s.pairs.size();
+  const int32_t* start = s.cell_start.data();
   const int32_t* sorted = s.cell_sorted.data();
   const V3* cx_sorted = s.cell_x.data();
   int32_t* slots = s.self_scratch.data();
   for (int i = 0; i < n; ++i) {
     const V3 q = s.x[i];
-    const double fx = q.x * inv, fy = q.y * inv, fz = q.z * inv;
-    const int64_t cx = floor_i64(fx), cy = floor_i64(fy), cz = floor_i64(fz);
-    const int64_t bx = cx - (fx - cx < 0.5), by = cy - (fy - cy < 0.5), bz = cz - (fz - cz < 0.5);
-    uint32_t hs[8];
-    for (int k = 0; k < 8; ++k) hs[k] = hash_cell(bx + (k >> 2), by + ((k >> 1) & 1), bz + (k & 1), mask);
-    // The candidates' slots (positions in cell order), bucket after bucket. Short buckets are
+    const int64_t cx = floor_i64(q.x * inv), cy = floor_i64(q.y * inv), cz = floor_i64(q.z * inv);
+    // The candidates' slots (positions in cell order), window after window. Short windows are
     // listed with a fixed count of 8 writes and the list advanced by their size: a loop whose
-    // length varied with each bucket would mispredict its exit at every bucket, which cost more
-    // than the candidates themselves. A bucket hashed twice is visited once. The buckets are
-    // distinct, so at most n slots plus 8 written beyond (self_scratch holds n + 8).
+    // length varied with each window would mispredict its exit at every window, which cost more
+    // than the candidates themselves. The windows are disjoint (row_slot()), so at most n slots
+    // plus 8 written beyond (self_scratch holds n + 8).
     int nslots = 0;
-    for (int k = 0; k < 8; ++k) {
-      const uint32_t h = hs[k];
-      bool dup = false;
-      for (int c = 0; c < k; ++c) dup |= hs[c] == h;
-      if (dup) continue;
-      const int32_t a0 = s.cell_start[h], count = s.cell_start[h + 1] - a0;
+    auto list = [&](int32_t a0, int32_t a1) {
+      const int32_t count = a1 - a0;
       if (count <= 8) {
         for (int t = 0; t < 8; ++t) slots[nslots + t] = a0 + t;
         nslots += count;
       } else {
         for (int t = 0; t < count; ++t) slots[nslots++] = a0 + t;
       }
-    }
+    };
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dz = -1; dz <= 1; ++dz) {
+        const uint32_t w = static_cast<uint32_t>(row_slot(cy + dy, cz + dz) + static_cast<uint64_t>(cx - 1)) & mask;
+        if (w + 3 <= table) {
+          list(start[w], start[w + 3]);
+        } else {  // the window wraps around the table's end
+          list(start[w], start[table]);
+          list(start[0], start[w + 3 - table]);
+        }
+      }
     // The close later vertices, compacted in place without a branch per candidate (the order
     // test would go either way at random): each is written, and kept by advancing the count.
     int nclose = 0;
@@ -150,6 +163,13 @@ void detect_self(const GownModel& m, GownState& s) {
       const int j = sorted[a];
       slots[nclose] = j;
       nclose += (dot(d, d) < r2) & (j > i);
+    }
+    // In vertex order (usually 0 to 2 of them): the pairs' order is then the hash's no more.
+    for (int c = 1; c < nclose; ++c) {
+      const int32_t j = slots[c];
+      int t = c;
+      for (; t > 0 && slots[t - 1] > j; --t) slots[t] = slots[t - 1];
+      slots[t] = j;
     }
     for (int c = 0; c < nclose; ++c) {
       const int j = slots[c];
