@@ -70,11 +70,11 @@ inline int64_t floor_i64(double v) {
 }
 
 // The hash slot of a row of cells, (iy, iz), with cell ix of the row at slot (row + ix) & mask:
-// the cells of a row are consecutive slots, so the 3 cells ix - 1 .. ix + 1 are one range of
-// the counting sort. The row's slot is 4 G with G's low 4 bits (iy mod 4, iz mod 4): two rows of
-// one 3 x 3 neighbourhood (|dy|, |dz| <= 2) differ there, so their G differ modulo the table / 4
-// (at least 16 slots), their slots by a nonzero multiple of 4 modulo the table, and the 3-slot
-// windows of the 9 rows never overlap: every vertex is a candidate once.
+// the cells of a row are consecutive slots, so up to 3 neighbouring cells of a row are one range
+// of the counting sort (a window). The row's slot is 4 G with G's low 4 bits (iy mod 4, iz mod 4):
+// two rows of one 3 x 3 neighbourhood (|dy|, |dz| <= 2) differ there, so their G differ modulo
+// the table / 4 (at least 16 slots), their slots by a nonzero multiple of 4 modulo the table, and
+// the windows of different rows never overlap: every vertex is a candidate once.
 inline uint64_t row_slot(int64_t iy, int64_t iz) {
   const uint64_t p = static_cast<uint64_t>(iy) * 19349663ULL ^ static_cast<uint64_t>(iz) * 83492791ULL;
   return ((p << 4) | ((static_cast<uint64_t>(iy) & 3) << 2) | (static_cast<uint64_t>(iz) & 3)) << 2;
@@ -84,7 +84,7 @@ inline uint64_t row_slot(int64_t iy, int64_t iz) {
 // step by a counting sort; pairs closer than the search radius, excluding pairs whose rest
 // distance is within the search radius (mesh neighbours) and pairs of two grasped vertices.
 // The pairs are listed in (i, j) order, i < j: the order of the Gauss-Seidel pass of solve_self()
-// does not depend on the hash, only on the pair set.
+// depends on the pair set only, not on the hash.
 void detect_self(const GownModel& m, GownState& s) {
   const SceneData& sc = *m.scene;
   s.pair_count = 0;
@@ -96,9 +96,11 @@ void detect_self(const GownModel& m, GownState& s) {
   const double r = 1.5 * ds;
   // Cells as wide as the search radius (1e-9 wider, so that two points nearer than r never have
   // cell coordinates 2 apart after the rounding of x / cell): the neighbours within r of a point
-  // lie in the 3 x 3 x 3 cells around its own, 9 rows of 3 (row_slot()). Against cells of 2 r
-  // and their 2 x 2 x 2 block: a 3 r instead of a 4 r cube around the point, about half the
-  // candidates on a surface.
+  // lie in the 3 x 3 x 3 cells around its own. Each pair is looked for once, from the vertex
+  // whose cell comes first in (z, y, x) order: a vertex visits its own cell (the later vertices
+  // there) and the 13 cells after it, as 5 windows of consecutive slots (row_slot()): the rows
+  // (y, z + 1), (y +- 1, z + 1), (y + 1, z) and cells x, x + 1 of its own row. Against cells of
+  // 2 r and their 2 x 2 x 2 block, from both sides: about a quarter of the candidates.
   const double inv = 1.0 / (r * (1 + 1e-9));
   const uint32_t table = static_cast<uint32_t>(s.cell_start.size() - 1);
   const uint32_t mask = table - 1;
@@ -129,11 +131,11 @@ void detect_self(const GownModel& m, GownState& s) {
   for (int i = 0; i < n; ++i) {
     const V3 q = s.x[i];
     const int64_t cx = floor_i64(q.x * inv), cy = floor_i64(q.y * inv), cz = floor_i64(q.z * inv);
-    // The candidates' slots (positions in cell order), window after window. Short windows are
-    // listed with a fixed count of 8 writes and the list advanced by their size: a loop whose
-    // length varied with each window would mispredict its exit at every window, which cost more
-    // than the candidates themselves. The windows are disjoint (row_slot()), so at most n slots
-    // plus 8 written beyond (self_scratch holds n + 8).
+    // The candidates' slots (positions in cell order), window after window, the own cell's slot
+    // first. Short windows are listed with a fixed count of 8 writes and the list advanced by
+    // their size: a loop whose length varied with each window would mispredict its exit at every
+    // window, which cost more than the candidates themselves. The windows are disjoint
+    // (row_slot()), so at most n slots plus 8 written beyond (self_scratch holds n + 8).
     int nslots = 0;
     auto list = [&](int32_t a0, int32_t a1) {
       const int32_t count = a1 - a0;
@@ -144,32 +146,32 @@ void detect_self(const GownModel& m, GownState& s) {
         for (int t = 0; t < count; ++t) slots[nslots++] = a0 + t;
       }
     };
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dz = -1; dz <= 1; ++dz) {
-        const uint32_t w = static_cast<uint32_t>(row_slot(cy + dy, cz + dz) + static_cast<uint64_t>(cx - 1)) & mask;
-        if (w + 3 <= table) {
-          list(start[w], start[w + 3]);
-        } else {  // the window wraps around the table's end
-          list(start[w], start[table]);
-          list(start[0], start[w + 3 - table]);
-        }
+    // Cells [x0, x0 + len) of row (y, z); a window may wrap around the table's end.
+    auto window = [&](int64_t y, int64_t z, int64_t x0, uint32_t len) {
+      const uint32_t w = static_cast<uint32_t>(row_slot(y, z) + static_cast<uint64_t>(x0)) & mask;
+      if (w + len <= table) {
+        list(start[w], start[w + len]);
+      } else {
+        list(start[w], start[table]);
+        list(start[0], start[w + len - table]);
       }
-    // The close later vertices, compacted in place without a branch per candidate (the order
-    // test would go either way at random): each is written, and kept by advancing the count.
+    };
+    window(cy, cz, cx, 1);
+    // The own cell's slot may hold other cells too (hash collisions), but none within r of q:
+    // those are in other windows' slots. Only its later vertices pair with i from here.
+    const int own = nslots;
+    window(cy, cz, cx + 1, 1);
+    window(cy + 1, cz, cx - 1, 3);
+    for (int dy = -1; dy <= 1; ++dy) window(cy + dy, cz + 1, cx - 1, 3);
+    // The close vertices, compacted in place without a branch per candidate (the tests would
+    // go either way at random): each is written, and kept by advancing the count.
     int nclose = 0;
     for (int c = 0; c < nslots; ++c) {
       const int32_t a = slots[c];
       const V3 d = cx_sorted[a] - q;
       const int j = sorted[a];
       slots[nclose] = j;
-      nclose += (dot(d, d) < r2) & (j > i);
-    }
-    // In vertex order (usually 0 to 2 of them): the pairs' order is then the hash's no more.
-    for (int c = 1; c < nclose; ++c) {
-      const int32_t j = slots[c];
-      int t = c;
-      for (; t > 0 && slots[t - 1] > j; --t) slots[t] = slots[t - 1];
-      slots[t] = j;
+      nclose += (dot(d, d) < r2) & ((j > i) | (c >= own));
     }
     for (int c = 0; c < nclose; ++c) {
       const int j = slots[c];
@@ -177,12 +179,17 @@ void detect_self(const GownModel& m, GownState& s) {
       const V3 dr = sc.rest[j] - sc.rest[i];
       if (dot(dr, dr) < excl2) continue;
       if (s.pair_count < cap) {
-        s.pairs[s.pair_count++] = {i, j};
+        s.pairs[s.pair_count++] = {std::min(i, j), std::max(i, j)};
       } else {
         s.pairs_dropped++;
       }
     }
   }
+  // (i, j) order (a few hundred pairs: well below a percent of the detection). Should the list
+  // ever be full, which pairs were dropped would depend on the hash (pairs_dropped counts them).
+  std::sort(s.pairs.begin(), s.pairs.begin() + static_cast<long>(s.pair_count), [](SelfPair a, SelfPair b) {
+    return a.i != b.i ? a.i < b.i : a.j < b.j;
+  });
 }
 
 // Integration: the grasped vertices follow the gripper, the others move under gravity, the
