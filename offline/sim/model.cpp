@@ -425,7 +425,7 @@ GownState make_state(const GownModel& m) {
   s.contact_acc.assign(n, {});
   s.ext_force.assign(n, {});
   size_t table = 1;
-  while (table < 2 * n) table <<= 1;
+  while (table < 2 * n || table < 64) table <<= 1;  // >= 64: detect_self()'s row_slot()
   s.cell_start.assign(table + 1, 0);
   s.cell_sorted.assign(n, 0);
   s.cell_of.assign(n, 0);

@@ -69,16 +69,22 @@ inline int64_t floor_i64(double v) {
   return t - (static_cast<double>(t) > v);
 }
 
-inline uint32_t hash_cell(int64_t ix, int64_t iy, int64_t iz, uint32_t mask) {
-  const uint64_t h = static_cast<uint64_t>(ix) * 73856093ULL ^ static_cast<uint64_t>(iy) * 19349663ULL ^
-                     static_cast<uint64_t>(iz) * 83492791ULL;
-  return static_cast<uint32_t>(h) & mask;
+// The hash slot of a row of cells, (iy, iz), with cell ix of the row at slot (row + ix) & mask:
+// the cells of a row are consecutive slots, so up to 3 neighbouring cells of a row are one range
+// of the counting sort (a window). The row's slot is 4 G with G's low 4 bits (iy mod 4, iz mod 4):
+// two rows of one 3 x 3 neighbourhood (|dy|, |dz| <= 2) differ there, so their G differ modulo
+// the table / 4 (at least 16 slots), their slots by a nonzero multiple of 4 modulo the table, and
+// the windows of different rows never overlap: every vertex is a candidate once.
+inline uint64_t row_slot(int64_t iy, int64_t iz) {
+  const uint64_t p = static_cast<uint64_t>(iy) * 19349663ULL ^ static_cast<uint64_t>(iz) * 83492791ULL;
+  return ((p << 4) | ((static_cast<uint64_t>(iy) & 3) << 2) | (static_cast<uint64_t>(iz) & 3)) << 2;
 }
 
-// Self-collision candidates (paper IV-A.3): a spatial hash of the vertices with cells as wide as
-// the search radius, built once per output step by a counting sort; pairs closer than the search
-// radius, excluding pairs whose rest distance is within the search radius (mesh neighbours) and
-// pairs of two grasped vertices.
+// Self-collision candidates (paper IV-A.3): a spatial hash of the vertices, built once per output
+// step by a counting sort; pairs closer than the search radius, excluding pairs whose rest
+// distance is within the search radius (mesh neighbours) and pairs of two grasped vertices.
+// The pairs are listed in (i, j) order, i < j: the order of the Gauss-Seidel pass of solve_self()
+// depends on the pair set only, not on the hash.
 void detect_self(const GownModel& m, GownState& s) {
   const SceneData& sc = *m.scene;
   s.pair_count = 0;
@@ -88,15 +94,21 @@ void detect_self(const GownModel& m, GownState& s) {
   // per output step (1.8 m/s relative at 12 mm, 300 Hz) are caught. It must stay below the mesh
   // edge: vertices nearer than that at rest are mesh neighbours, never self-collision pairs.
   const double r = 1.5 * ds;
-  // Cells twice the search radius: the neighbours within r of a point lie in the 2 x 2 x 2 block
-  // of cells on the side of its cell that the point is nearer to (8 lookups instead of 27).
-  const double inv = 0.5 / r;
+  // Cells as wide as the search radius (1e-9 wider, so that two points nearer than r never have
+  // cell coordinates 2 apart after the rounding of x / cell): the neighbours within r of a point
+  // lie in the 3 x 3 x 3 cells around its own. Each pair is looked for once, from the vertex
+  // whose cell comes first in (z, y, x) order: a vertex visits its own cell (the later vertices
+  // there) and the 13 cells after it, as 5 windows of consecutive slots (row_slot()): the rows
+  // (y, z + 1), (y +- 1, z + 1), (y + 1, z) and cells x, x + 1 of its own row. Against cells of
+  // 2 r and their 2 x 2 x 2 block, from both sides: about a quarter of the candidates.
+  const double inv = 1.0 / (r * (1 + 1e-9));
   const uint32_t table = static_cast<uint32_t>(s.cell_start.size() - 1);
   const uint32_t mask = table - 1;
   std::fill(s.cell_start.begin(), s.cell_start.end(), 0);
   for (int i = 0; i < n; ++i) {
     const V3 q = s.x[i];
-    const uint32_t h = hash_cell(floor_i64(q.x * inv), floor_i64(q.y * inv), floor_i64(q.z * inv), mask);
+    const uint32_t h = static_cast<uint32_t>(row_slot(floor_i64(q.y * inv), floor_i64(q.z * inv)) +
+                                             static_cast<uint64_t>(floor_i64(q.x * inv))) & mask;
     s.cell_of[i] = h;
     s.cell_start[h + 1]++;
   }
@@ -112,44 +124,54 @@ void detect_self(const GownModel& m, GownState& s) {
   s.cell_start[0] = 0;
   const double r2 = r * r, excl2 = r2;
   const size_t cap = s.pairs.size();
+  const int32_t* start = s.cell_start.data();
   const int32_t* sorted = s.cell_sorted.data();
   const V3* cx_sorted = s.cell_x.data();
   int32_t* slots = s.self_scratch.data();
   for (int i = 0; i < n; ++i) {
     const V3 q = s.x[i];
-    const double fx = q.x * inv, fy = q.y * inv, fz = q.z * inv;
-    const int64_t cx = floor_i64(fx), cy = floor_i64(fy), cz = floor_i64(fz);
-    const int64_t bx = cx - (fx - cx < 0.5), by = cy - (fy - cy < 0.5), bz = cz - (fz - cz < 0.5);
-    uint32_t hs[8];
-    for (int k = 0; k < 8; ++k) hs[k] = hash_cell(bx + (k >> 2), by + ((k >> 1) & 1), bz + (k & 1), mask);
-    // The candidates' slots (positions in cell order), bucket after bucket. Short buckets are
-    // listed with a fixed count of 8 writes and the list advanced by their size: a loop whose
-    // length varied with each bucket would mispredict its exit at every bucket, which cost more
-    // than the candidates themselves. A bucket hashed twice is visited once. The buckets are
-    // distinct, so at most n slots plus 8 written beyond (self_scratch holds n + 8).
+    const int64_t cx = floor_i64(q.x * inv), cy = floor_i64(q.y * inv), cz = floor_i64(q.z * inv);
+    // The candidates' slots (positions in cell order), window after window, the own cell's slot
+    // first. Short windows are listed with a fixed count of 8 writes and the list advanced by
+    // their size: a loop whose length varied with each window would mispredict its exit at every
+    // window, which cost more than the candidates themselves. The windows are disjoint
+    // (row_slot()), so at most n slots plus 8 written beyond (self_scratch holds n + 8).
     int nslots = 0;
-    for (int k = 0; k < 8; ++k) {
-      const uint32_t h = hs[k];
-      bool dup = false;
-      for (int c = 0; c < k; ++c) dup |= hs[c] == h;
-      if (dup) continue;
-      const int32_t a0 = s.cell_start[h], count = s.cell_start[h + 1] - a0;
+    auto list = [&](int32_t a0, int32_t a1) {
+      const int32_t count = a1 - a0;
       if (count <= 8) {
         for (int t = 0; t < 8; ++t) slots[nslots + t] = a0 + t;
         nslots += count;
       } else {
         for (int t = 0; t < count; ++t) slots[nslots++] = a0 + t;
       }
-    }
-    // The close later vertices, compacted in place without a branch per candidate (the order
-    // test would go either way at random): each is written, and kept by advancing the count.
+    };
+    // Cells [x0, x0 + len) of row (y, z); a window may wrap around the table's end.
+    auto window = [&](int64_t y, int64_t z, int64_t x0, uint32_t len) {
+      const uint32_t w = static_cast<uint32_t>(row_slot(y, z) + static_cast<uint64_t>(x0)) & mask;
+      if (w + len <= table) {
+        list(start[w], start[w + len]);
+      } else {
+        list(start[w], start[table]);
+        list(start[0], start[w + len - table]);
+      }
+    };
+    window(cy, cz, cx, 1);
+    // The own cell's slot may hold other cells too (hash collisions), but none within r of q:
+    // those are in other windows' slots. Only its later vertices pair with i from here.
+    const int own = nslots;
+    window(cy, cz, cx + 1, 1);
+    window(cy + 1, cz, cx - 1, 3);
+    for (int dy = -1; dy <= 1; ++dy) window(cy + dy, cz + 1, cx - 1, 3);
+    // The close vertices, compacted in place without a branch per candidate (the tests would
+    // go either way at random): each is written, and kept by advancing the count.
     int nclose = 0;
     for (int c = 0; c < nslots; ++c) {
       const int32_t a = slots[c];
       const V3 d = cx_sorted[a] - q;
       const int j = sorted[a];
       slots[nclose] = j;
-      nclose += (dot(d, d) < r2) & (j > i);
+      nclose += (dot(d, d) < r2) & ((j > i) | (c >= own));
     }
     for (int c = 0; c < nclose; ++c) {
       const int j = slots[c];
@@ -157,12 +179,17 @@ void detect_self(const GownModel& m, GownState& s) {
       const V3 dr = sc.rest[j] - sc.rest[i];
       if (dot(dr, dr) < excl2) continue;
       if (s.pair_count < cap) {
-        s.pairs[s.pair_count++] = {i, j};
+        s.pairs[s.pair_count++] = {std::min(i, j), std::max(i, j)};
       } else {
         s.pairs_dropped++;
       }
     }
   }
+  // (i, j) order (a few hundred pairs: well below a percent of the detection). Should the list
+  // ever be full, which pairs were dropped would depend on the hash (pairs_dropped counts them).
+  std::sort(s.pairs.begin(), s.pairs.begin() + static_cast<long>(s.pair_count), [](SelfPair a, SelfPair b) {
+    return a.i != b.i ? a.i < b.i : a.j < b.j;
+  });
 }
 
 // Integration: the grasped vertices follow the gripper, the others move under gravity, the

@@ -401,3 +401,75 @@ TEST(SimTrial, NoSharedSettlingWhereAnArmTouchesTheGown) {
     EXPECT_FALSE(r[0].settle_shared || r[1].settle_shared);
   }
 }
+
+namespace {
+
+// The self-collision pairs that step() must find from positions x, by brute force over all
+// pairs, in (i, j) order: closer than the search radius r = 1.5 self_distance (with the same
+// arithmetic as detect_self()), not both grasped, and not within r of each other at rest.
+std::vector<SelfPair> brute_force_pairs(const GownModel& m, const std::vector<V3>& x) {
+  const SceneData& sc = *m.scene;
+  const double r = 1.5 * sc.opt.self_distance, r2 = r * r;
+  std::vector<SelfPair> out;
+  const int n = static_cast<int>(x.size());
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j) {
+      const V3 d = x[j] - x[i], dr = sc.rest[j] - sc.rest[i];
+      if (dot(d, d) < r2 && !(sc.grasped[i] && sc.grasped[j]) && dot(dr, dr) >= r2) out.push_back({i, j});
+    }
+  return out;
+}
+
+// One step() from positions x; its pair list (found from x, before the substeps move them).
+std::vector<SelfPair> detected_pairs(const GownModel& m, GownState& s, const std::vector<V3>& x) {
+  s.x = x;
+  s.p = x;
+  step(m, s, {}, {}, {});
+  EXPECT_EQ(s.pairs_dropped, 0);
+  return {s.pairs.begin(), s.pairs.begin() + static_cast<long>(s.pair_count)};
+}
+
+void expect_same_pairs(const std::vector<SelfPair>& got, const std::vector<SelfPair>& want, const char* what) {
+  ASSERT_EQ(got.size(), want.size()) << what;
+  for (size_t k = 0; k < got.size(); ++k) {
+    EXPECT_EQ(got[k].i, want[k].i) << what << ", pair " << k;
+    EXPECT_EQ(got[k].j, want[k].j) << what << ", pair " << k;
+  }
+}
+
+}  // namespace
+
+// The spatial hash of detect_self() finds exactly the pairs of the brute-force search, in (i, j)
+// order, whatever the hash: on the reduced gown settled against the arm (the folds of a hanging
+// gown, a few hundred pairs), and on a random cloud of the coarse gown's vertices in a 0.3 m box
+// around the origin (negative cell coordinates, a few neighbours per vertex, grasped vertices
+// among them, and some vertices on top of each other).
+TEST(SimSelfCollision, PairsAreTheBruteForceSet) {
+  {
+    const Scene scene = make_default_scene(GownResolution::Reduced);
+    const GownModel m = make_model(scene.data(), ClothParams{}, FrictionScheme::Improved, true, 0);
+    GownState s = make_state(m);
+    for (int k = 0; k < 150; ++k) step(m, s, {}, {}, {});
+    const std::vector<V3> x = s.x;
+    const std::vector<SelfPair> want = brute_force_pairs(m, x);
+    EXPECT_GT(want.size(), 50u) << "the settled gown should have folds";
+    expect_same_pairs(detected_pairs(m, s, x), want, "settled reduced gown");
+  }
+  {
+    const GownModel m = make_model(coarse_scene().data(), ClothParams{}, FrictionScheme::Improved, true, 0);
+    GownState s = make_state(m);
+    std::vector<V3> x(s.x.size());
+    uint64_t state = 12345;
+    auto uniform = [&state] {  // splitmix64, in [0, 1)
+      uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
+      z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+      z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+      return static_cast<double>((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
+    };
+    for (V3& q : x) q = {0.3 * uniform() - 0.15, 0.3 * uniform() - 0.15, 0.3 * uniform() - 0.15};
+    for (size_t i = 0; i + 1 < x.size(); i += 37) x[i + 1] = x[i];
+    const std::vector<SelfPair> want = brute_force_pairs(m, x);
+    EXPECT_GT(want.size(), x.size()) << "the cloud should be dense";
+    expect_same_pairs(detected_pairs(m, s, x), want, "random cloud");
+  }
+}
