@@ -369,7 +369,9 @@ TEST(SimTrial, SharedSettlingGivesEachTrialItsOwnBits) {
   // The same seed pushes the same way: on the measured gown the pushed gown stays out of both
   // arms' reach and the settling is shared. The parametric gown (no shared/data) swings within
   // the probe's reach of an arm after the push, so there the two settle apart (same bits still).
-  if (!gown::measured_gown_path().empty()) EXPECT_TRUE(together[4].settle_shared) << "the same seed pushes the same way";
+  if (!gown::measured_gown_path().empty()) {
+    EXPECT_TRUE(together[4].settle_shared) << "the same seed pushes the same way";
+  }
   EXPECT_FALSE(together[5].settle_shared) << "another seed pushes another way";
 }
 
