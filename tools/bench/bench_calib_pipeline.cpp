@@ -107,6 +107,12 @@ double one_nn_accuracy(const std::vector<const HapticSequence*>& all, double cut
   return static_cast<double>(right) / all.size();
 }
 
+// A model's accuracy on `test`, whole and at the four cuts: out[0] whole, out[1..4] kCuts.
+void accuracies(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& test, double out[5]) {
+  out[0] = accuracy(m, test, std::numeric_limits<double>::infinity());
+  for (int c = 0; c < 4; ++c) out[c + 1] = accuracy(m, test, kCuts[c]);
+}
+
 int run_eval(const std::map<std::string, std::string>& a) {
   const fs::path study = study_dir();
   if (study.empty()) {
@@ -202,25 +208,23 @@ int run_eval(const std::map<std::string, std::string>& a) {
     try {
       StcOptions stc_o;
       stc_o.source = synth.string();
-      for (bool vertical : {axes.use_vertical, true}) {
-        stc_o.use_vertical = vertical;
-        double* acc = vertical == axes.use_vertical ? stc : stc2;
-        const auto m = build_outcome_model(strain, stc_o);
-        if (stc_classes.empty())
-          for (const auto& c : m.classes) stc_classes += (stc_classes.empty() ? "" : "+") + c.name;
-        acc[0] = accuracy(m, test, std::numeric_limits<double>::infinity());
-        for (int c = 0; c < 4; ++c) acc[c + 1] = accuracy(m, test, kCuts[c]);
+      stc_o.use_vertical = axes.use_vertical;
+      const auto m = build_outcome_model(strain, stc_o);
+      for (const auto& c : m.classes) stc_classes += (stc_classes.empty() ? "" : "+") + c.name;
+      accuracies(m, test, stc);
+      if (axes.use_vertical) {
+        std::copy(stc, stc + 5, stc2);
+      } else {
+        stc_o.use_vertical = true;
+        accuracies(build_outcome_model(strain, stc_o), test, stc2);
       }
-      if (axes.use_vertical) std::copy(stc, stc + 5, stc2);
     } catch (const std::exception& e) {
       stc_error = e.what();
     }
     try {
       StcOptions bo;
       bo.source = "measured inputs of participant " + p;
-      const auto m = build_outcome_model(btrain, bo);
-      bc[0] = accuracy(m, test, std::numeric_limits<double>::infinity());
-      for (int c = 0; c < 4; ++c) bc[c + 1] = accuracy(m, test, kCuts[c]);
+      accuracies(build_outcome_model(btrain, bo), test, bc);
     } catch (const std::exception& e) {
       bc_error = e.what();
     }
