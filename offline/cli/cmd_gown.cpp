@@ -14,6 +14,7 @@
 #include "commands.h"
 #include "files.h"
 #include "gown.h"
+#include "grip_option.h"
 #include "placement.h"
 
 namespace dressguard::cli {
@@ -92,7 +93,7 @@ std::string shell_quote(const std::string& s) {
 int run_gown(int argc, char** argv) {
   Args args(argc - 1, argv + 1, {"help", "json", "parametric", "hang", "in-world"});
   if (args.has("help")) {
-    std::puts(
+    std::printf(
         "usage: dressguard gown [--obj FILE [--scale S] [--in-world] [--placement P] | --parametric] [--reduced N]\n"
         "                       [--hang] [--out MESH.obj] [--dump SCENE.json] [--picture GOWN.png] [--json]\n"
         "  Loads the gown the simulator runs on, placed in the world frame W (z up, gripper moves +x)\n"
@@ -105,17 +106,19 @@ int run_gown(int argc, char** argv) {
         "                  opening facing the fist) or paper (the paper's code's transform, as read)\n"
         "  --parametric    use the parametric gown even when the measured one is present\n"
         "  --reduced N     reduce to about N triangles (quadric edge collapse), e.g. 5000\n"
+        "%s"
         "  --hang          let the gown hang 3 s from the jaws in a crude check (edges only, no\n"
         "                  bending, no collisions; not the simulator) before reporting and drawing\n"
         "  --out MESH.obj  write the placed mesh (atomically)\n"
         "  --dump FILE     write the scene (mesh, grasp, loops, arm, gripper) as JSON for plotting\n"
         "  --picture PNG   draw the placed gown with grasp, sleeve opening and arm (needs python3 +\n"
         "                  matplotlib; tools/plot/gown.py)\n"
-        "  --json          print a machine-readable summary");
+        "  --json          print a machine-readable summary\n",
+        kGripHelp);
     return 0;
   }
   args.allow_only({"help", "json", "parametric", "hang", "in-world", "obj", "scale", "reduced", "out", "dump", "picture",
-                  "placement"});
+                  "placement", "grip-depth", "rim-ahead"});
   if (args.has("parametric") && args.has("obj")) throw UsageError("--parametric and --obj exclude each other");
   gown::GownOptions opt;
   opt.scale = args.number("scale", 1.679);
@@ -137,6 +140,9 @@ int run_gown(int argc, char** argv) {
   opt.parametric = args.has("parametric");
   opt.already_in_W = args.has("in-world");
   const fs::path measured = gown::measured_gown_path();
+  opt.grip = grip_option(args, opt.parametric || (opt.obj.empty() && measured.empty()));
+  if (opt.grip && (opt.already_in_W || opt.placement == gown::GownPlacement::Paper))
+    throw UsageError("--grip-depth and --rim-ahead place the sleeve at the jaws: not with --in-world or --placement paper");
   const std::string source =
       opt.parametric || (opt.obj.empty() && measured.empty()) ? "parametric" : (opt.obj.empty() ? measured : opt.obj).string();
   GownMesh mesh = gown::load_gown(opt);

@@ -7,6 +7,9 @@
 #include "commands.h"
 #include "dataset.h"
 #include "files.h"
+#include "gown.h"
+#include "gown_scene.h"
+#include "grip_option.h"
 #include "params.h"
 #include "trial.h"
 
@@ -31,7 +34,7 @@ std::vector<double> parse_times(const std::string& s) {
 int run_simulate(int argc, char** argv) {
   Args args(argc - 1, argv + 1, {"help", "json", "noise", "arm-noise", "no-self-collision", "parametric"});
   if (args.has("help")) {
-    std::puts(
+    std::printf(
         "usage: dressguard simulate --height high|middle|low --out FILE.csv [options]\n"
         "  Simulates one sleeve-pulling trial (XPBD cloth, 300 Hz x 20 substeps) and writes its\n"
         "  100 Hz haptic samples as a trial CSV (t,travel,f_motion,f_lateral,f_vertical; the rig's\n"
@@ -50,14 +53,16 @@ int run_simulate(int argc, char** argv) {
         "                    1.5k triangles (the gown module's parametric gown without shared/data)\n"
         "  --parametric      the gown module's parametric gown even when the measured one is present\n"
         "  --friction F      stock | improved | constraint (default improved)\n"
+        "%s"
         "  --no-self-collision\n"
         "  --frames T1,T2,.. [s] since the start of the pull (negative: settling) to keep the gown\n"
         "                    positions at; default every 0.25 s from -1.6 s\n"
-        "  --json            print the summary as JSON");
+        "  --json            print the summary as JSON\n",
+        kGripHelp);
     return 0;
   }
   args.allow_only({"help", "json", "noise", "arm-noise", "no-self-collision", "height", "arm-offset", "max-travel", "speed", "params", "seed",
-                   "gown", "friction", "out", "frames", "parametric"});
+                   "gown", "friction", "out", "frames", "parametric", "grip-depth", "rim-ahead"});
   sim::TrialSpec spec;
   const std::string hs = args.require("height");
   const auto h = parse_arm_height(hs);
@@ -97,7 +102,10 @@ int run_simulate(int argc, char** argv) {
     for (double t = -1.6; t < 12.0; t += 0.25) spec.frame_times.push_back(t);
   }
 
-  const sim::Scene scene = sim::make_default_scene(res, args.has("parametric"));
+  const bool parametric = args.has("parametric") || gown::measured_gown_path().empty();
+  const auto grip = grip_option(args, parametric);
+  const sim::Scene scene =
+      grip ? sim::make_default_scene(res, parametric, *grip) : sim::make_default_scene(res, parametric);
   const sim::TrialResult r = sim::simulate_trial(scene, params, spec);
   if (!r.finite) throw std::runtime_error("the simulation diverged (non-finite positions)");
 

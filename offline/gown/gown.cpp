@@ -23,12 +23,12 @@ GownMesh load_gown(const GownOptions& options) {
       options.parametric ? std::filesystem::path{} : (options.obj.empty() ? measured_gown_path() : options.obj);
   GownMesh mesh;
   if (path.empty()) {
-    mesh = make_parametric_gown();
+    mesh = options.grip ? make_parametric_gown(*options.grip) : make_parametric_gown();
   } else {
     mesh = read_obj(path, options.scale);
     if (!options.already_in_W) {
       if (options.placement == GownPlacement::Opening)
-        place_at_opening(mesh, options.scene);
+        place_at_opening(mesh, options.scene, options.grip.value_or(OpeningGrip{}));
       else
         place_like_paper(mesh, options.scene);
     }

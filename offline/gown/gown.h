@@ -25,6 +25,7 @@
 
 #include <array>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -56,6 +57,10 @@ struct GownOptions {
                               // it, scale 1): skip the paper's transform
   PaperScene scene{};         // placement of a file's mesh and the grasp box that picks the sleeve
   GownPlacement placement = GownPlacement::Opening;  // how a file's mesh is placed (placement.h)
+  // How the jaws hold the sleeve (placement.h): unset, each gown's own (kOpeningGripDepth and
+  // kOpeningRimAhead for a file's mesh, kParametricGrip for the parametric gown). Ignored with
+  // the Paper placement and for a mesh already in W (their grasp is wherever the box finds it).
+  std::optional<OpeningGrip> grip;
 };
 
 // shared/data/gown/fullgown.obj when shared/data is present, else empty.
@@ -75,7 +80,9 @@ GownMesh read_obj(const std::filesystem::path& path, double scale);
 // The project's own gown (no shared data needed): a body panel with a sleeve tube, the measured
 // gown's dimensions (area ~1.6 m^2, sleeve opening perimeter 0.47 m, ~1.4 cm mean edge), already
 // placed in W with its sleeve opening near the grasp box, loops found and the sleeve labelled.
-GownMesh make_parametric_gown();
+// Its sleeve is a flattened tube, so the jaws reach both layers (3 cm) with the cuff 1 cm ahead.
+inline constexpr OpeningGrip kParametricGrip{0.03, 0.01};
+GownMesh make_parametric_gown(const OpeningGrip& grip = kParametricGrip);
 
 // Quadric-error-metric edge collapse (Garland & Heckbert 1997) down to about `target_triangles`.
 // Boundary loops keep their shape (boundary vertices move only along the boundary, with a

@@ -43,11 +43,6 @@ constexpr int kWb = 56, kHb = 93, kWs = 19, kLs = 17, kNeck = 22, kSlit = 2;
 constexpr double kBulge = 0.03;      // half the front-back separation in the body [m]
 constexpr double kSleeveBulge = 0.0326;  // half-thickness of the sleeve's lens cross-section [m]
 constexpr double kBlend = 0.08;      // sleeve length over which the flat start opens up [m]
-// Where the sleeve sits relative to the jaws (placement.h, the rule the measured gown's Opening
-// placement follows too): the cuff 1 cm ahead of the grasp box, the top seam 3 cm above the lower
-// jaw's start, so the jaws pick up both layers of this flattened sleeve.
-constexpr double kCuffAhead = 0.01;   // [m]
-constexpr double kGripDepth = 0.03;   // [m]
 
 double smoothstep(double t) {
   t = std::clamp(t, 0.0, 1.0);
@@ -97,7 +92,8 @@ Eigen::Vector3d shape(int i, int j, int sigma) {
 
 }  // namespace
 
-GownMesh make_parametric_gown() {
+GownMesh make_parametric_gown(const OpeningGrip& grip) {
+  check_grip(grip);
   GownMesh mesh;
   std::map<std::array<int, 3>, int> index;  // (i, j, layer) -> vertex; seam points share layer 0
   auto vertex = [&](int i, int j, int sigma) {
@@ -132,7 +128,9 @@ GownMesh make_parametric_gown() {
   // jaws of the paper's scene find them.
   const PaperScene scene;
   const double cuff_x = (kWb + kLs) * kCell, top_y = kHb * kCell;
-  const double cuff_W = opening_rim_x_W(scene, kCuffAhead), top_W = sleeve_top_z_W(scene, kGripDepth);
+  // Where the sleeve sits relative to the jaws: the rule the measured gown's Opening placement
+  // follows too (placement.h), with the grip's depth and the cuff's lead.
+  const double cuff_W = opening_rim_x_W(scene, grip.rim_ahead), top_W = sleeve_top_z_W(scene, grip.depth);
   for (auto& p : mesh.x) p = Eigen::Vector3d(p.x() - cuff_x + cuff_W, -p.z(), p.y() - top_y + top_W);
   mesh.boundary_loops = find_boundary_loops(mesh.triangles, static_cast<int>(mesh.x.size()));
   label_sleeve(mesh);

@@ -18,7 +18,19 @@ void place_like_paper(GownMesh& mesh, const PaperScene& scene) {
   for (auto& p : mesh.x) p = R * p + t;
 }
 
-void place_at_opening(GownMesh& mesh, const PaperScene& scene, double grip_depth, int loop_index) {
+void check_grip(const OpeningGrip& grip, const PaperScene& scene) {
+  // The grasp box spans the lower jaw's travel up to the upper jaw: a deeper grip would put the
+  // sleeve's top under the lower jaw, which then grasps nothing of it.
+  const double box_depth = 2 * scene.grasp_box_half_extent_W().z();
+  if (!(grip.depth > 0 && grip.depth < box_depth))
+    throw std::invalid_argument("grip depth " + std::to_string(grip.depth) + " m outside (0, " +
+                                std::to_string(box_depth) + ") m, the depth of the grasp box");
+  if (!(grip.rim_ahead >= 0 && grip.rim_ahead <= 0.5))
+    throw std::invalid_argument("rim ahead of the jaws " + std::to_string(grip.rim_ahead) + " m outside [0, 0.5] m");
+}
+
+void place_at_opening(GownMesh& mesh, const PaperScene& scene, const OpeningGrip& grip, int loop_index) {
+  check_grip(grip, scene);
   if (loop_index < 0) {
     // The sleeve: the paper's placement decides which of the two openings the arm enters.
     GownMesh paper = mesh;
@@ -63,8 +75,8 @@ void place_at_opening(GownMesh& mesh, const PaperScene& scene, double grip_depth
   int top = loop.front();
   for (int v : loop)
     if (mesh.x[v].z() > mesh.x[top].z()) top = v;
-  const Eigen::Vector3d rim_top(opening_rim_x_W(scene, kOpeningRimAhead), scene.upper_jaw_center_W.y(),
-                                sleeve_top_z_W(scene, grip_depth));
+  const Eigen::Vector3d rim_top(opening_rim_x_W(scene, grip.rim_ahead), scene.upper_jaw_center_W.y(),
+                                sleeve_top_z_W(scene, grip.depth));
   const Eigen::Vector3d shift = rim_top - mesh.x[top];
   for (auto& p : mesh.x) p += shift;
 }

@@ -133,12 +133,24 @@ inline constexpr double kOpeningGripDepth = 0.015;
 // How far the sleeve opening's rim is ahead of the jaws in the Opening placement [m].
 inline constexpr double kOpeningRimAhead = 0.04;
 
+// How the jaws hold the sleeve in the Opening placement. The jaws pick up the top `depth` of the
+// sleeve over their 8 cm behind the rim and hold that cap flattened across their width: the
+// deeper the grip, the more of the opening's perimeter is held open across the jaws and the less
+// hangs below them (a loop of perimeter P with a flat top of width b hangs about (P - b) / 2 deep
+// when slack), so the opening is wider and shallower. `rim_ahead` is how far the opening's rim
+// is ahead of the jaws' front face. The study did not measure either; they are part of the scene
+// a calibration may search (offline/calib) or a user may set (`dressguard simulate --grip-depth`).
+struct OpeningGrip {
+  double depth = kOpeningGripDepth;     // [m] > 0
+  double rim_ahead = kOpeningRimAhead;  // [m] >= 0
+};
+
+// Throws std::invalid_argument unless 0 < depth < the grasp box's depth and 0 <= rim_ahead <= 0.5 m.
+void check_grip(const OpeningGrip& grip, const PaperScene& scene = {});
+
 // Where the Opening placement puts the sleeve (and where the parametric gown is built): the
-// opening's rim 1 cm ahead of the grasp box, and the sleeve's top `grip_depth` above the lower
-// jaw's starting face, so the closing jaws pick up the top `grip_depth` of the sleeve over the
-// first 8 cm behind the rim and lift it to the upper jaw. The jaws hold that cap flattened: the
-// deeper the grip, the more of the opening's perimeter is held open across the jaws and the
-// less hangs below them.
+// opening's rim `rim_ahead` ahead of the grasp box, and the sleeve's top `grip_depth` above the
+// lower jaw's starting face, so the closing jaws pick up the top `grip_depth` of the sleeve.
 inline double opening_rim_x_W(const PaperScene& s, double rim_ahead) {
   return s.grasp_box_center_W().x() + s.grasp_box_half_extent_W().x() + rim_ahead;
 }
@@ -152,11 +164,10 @@ inline double sleeve_top_z_W(const PaperScene& s, double grip_depth) {
 //   the opening's axis into the sleeve (the normal of its best-fit plane, pointing to the side
 //   where the loop's mesh neighbours lie)                                  -> -x_W,
 //   the direction from the opening to the gown's centroid, normal to that axis  -> -z_W,
-// then a translation puts the loop's highest vertex at x = opening_rim_x_W, y = the jaws' centre,
-// z = sleeve_top_z_W(grip_depth). Throws std::runtime_error when the mesh has fewer than two
-// boundary loops.
-void place_at_opening(GownMesh& mesh, const PaperScene& scene = {}, double grip_depth = kOpeningGripDepth,
-                      int loop = -1);
+// then a translation puts the loop's highest vertex at x = opening_rim_x_W(grip.rim_ahead),
+// y = the jaws' centre, z = sleeve_top_z_W(grip.depth). Throws std::runtime_error when the mesh
+// has fewer than two boundary loops, std::invalid_argument for a grip out of its range.
+void place_at_opening(GownMesh& mesh, const PaperScene& scene = {}, const OpeningGrip& grip = {}, int loop = -1);
 
 // Picks the sleeve opening: among the loops other than the longest (the hem), the one whose
 // centroid is nearest the grasp box centre; sets mesh.sleeve_loop and

@@ -2,10 +2,13 @@
 // paper's objective (eq. 3-5, w = 20) per trial and the fidelity checks of issue 5.
 //
 // Usage: dg_sim_fit [--gown coarse|reduced|full] [--parametric] [--good FILE] [--miss FILE]
-//                   [--friction a,b,..] [--stretch a,b,..] [--bend a,b,..] [--offsets a,b,..]
-//                   [--out DIR]
+//                   [--params FILE] [--friction a,b,..] [--stretch a,b,..] [--bend a,b,..]
+//                   [--offsets a,b,..] [--grips a,b,..] [--out DIR]
 // Defaults: participant 4 (good/subject4/3.txt, miss/subject4/2.txt, the paper's fidelity
 // anchor), friction 0.1,0.3,0.6, stretch 0.5,0.9, bend 0.2, arm offsets 0,-0.02, coarse gown.
+// --params: the other cloth parameters (shear, self-friction, ...; params.h), e.g. a calibration's.
+// --grips: the jaws' grip depths [m] to try (gown::OpeningGrip; default the gown's own), each its
+// own scene.
 // Every grid point's result is appended to DIR/grid.csv as soon as it is known; a rerun skips the
 // points already there (resumable). At the end the best point (smallest L_good + L_miss) is
 // re-simulated and its trials written as DIR/best_good.csv and DIR/best_miss.csv for plotting
@@ -20,6 +23,7 @@
 #include <vector>
 
 #include "dataset.h"
+#include "gown_scene.h"
 #include "files.h"
 #include "objective.h"  // offline/calib: the paper's eq. 3-5
 #include "params.h"
@@ -39,13 +43,16 @@ std::vector<double> list(const std::string& s) {
 }
 
 struct Point {
-  double friction, stretch, bend, offset;
+  double friction, stretch, bend, offset, grip;  // grip < 0: the gown's own
   std::string key() const {
-    char b[128];
-    std::snprintf(b, sizeof b, "%.4f,%.4f,%.4f,%.4f", friction, stretch, bend, offset);
+    char b[160];
+    std::snprintf(b, sizeof b, "%.4f,%.4f,%.4f,%.4f,%.4f", friction, stretch, bend, offset, grip);
     return b;
   }
 };
+
+constexpr const char* kGridHeader =
+    "friction,stretch,bend,offset,grip,L_good,L_miss,good_label,good_travel,miss_label,miss_travel,miss_final_drag";
 
 // The measured trial's conditions; the simulation stops where the rig stopped it (as calibration
 // does, calib::request_for), so that the objective compares the same stretch of travel.
@@ -84,13 +91,29 @@ int main(int argc, char** argv) {
   const auto miss = read_study_trial(miss_file);
   const std::string gs = a.count("gown") ? a["gown"] : "coarse";
   const GownResolution res = gs == "full" ? GownResolution::Full : gs == "reduced" ? GownResolution::Reduced : GownResolution::Coarse;
-  const Scene scene = make_default_scene(res, a.count("parametric") > 0);
+  const bool parametric = a.count("parametric") > 0;
+  std::map<double, Scene> scenes;  // one per grip depth
+  auto scene_for = [&](double grip) -> const Scene& {
+    auto it = scenes.find(grip);
+    if (it == scenes.end()) {
+      if (grip < 0) {
+        it = scenes.emplace(grip, make_default_scene(res, parametric)).first;
+      } else {
+        gown::OpeningGrip g = parametric ? gown::kParametricGrip : gown::OpeningGrip{};
+        g.depth = grip;
+        it = scenes.emplace(grip, make_default_scene(res, parametric, g)).first;
+      }
+    }
+    return it->second;
+  };
+  const ClothParams base = a.count("params") ? read_params(a["params"]) : ClothParams{};
   const std::filesystem::path out = a.count("out") ? a["out"] : "out/sim-fit";
   std::filesystem::create_directories(out);
   const auto fr = list(a.count("friction") ? a["friction"] : "0.1,0.3,0.6");
   const auto st = list(a.count("stretch") ? a["stretch"] : "0.5,0.9");
   const auto be = list(a.count("bend") ? a["bend"] : "0.2");
   const auto of = list(a.count("offsets") ? a["offsets"] : "0,-0.02");
+  const auto gr = a.count("grips") ? list(a["grips"]) : std::vector<double>{-1.0};
 
   // Resume: the points already in grid.csv.
   std::map<std::string, std::string> done;
@@ -98,35 +121,48 @@ int main(int argc, char** argv) {
   {
     std::ifstream in(grid_file);
     std::string line;
+    int n = 0;
     while (std::getline(in, line)) {
-      if (line.empty() || line[0] == 'f') continue;
+      ++n;
+      if (n == 1) {
+        if (line != kGridHeader) {
+          std::fprintf(stderr, "dg_sim_fit: %s:1: not this tool's grid header (an older grid?); use another --out\n",
+                       grid_file.c_str());
+          return 2;
+        }
+        continue;
+      }
+      if (line.empty()) continue;
       std::istringstream ls(line);
-      std::string f[4];
+      std::string f[5];
       for (auto& x : f) std::getline(ls, x, ',');
-      done[f[0] + "," + f[1] + "," + f[2] + "," + f[3]] = line;
+      done[f[0] + "," + f[1] + "," + f[2] + "," + f[3] + "," + f[4]] = line;
     }
   }
-  std::string csv = "friction,stretch,bend,offset,L_good,L_miss,good_label,good_travel,miss_label,miss_travel,miss_final_drag\n";
+  std::string csv = std::string(kGridHeader) + "\n";
   for (auto& [k, v] : done) csv += v + "\n";
   std::printf("grid on the %s gown (%d triangles): measured good ends at %.3f m, miss at %.3f m with F_motion %.2f N\n",
-              gs.c_str(), scene.triangle_count(), good.back().travel, miss.back().travel, miss.back().f_motion);
-  std::printf("%8s %8s %6s %7s | %7s %7s | %-7s %6s | %-7s %6s %7s\n", "friction", "stretch", "bend", "offset", "L_good", "L_miss",
-              "good", "travel", "miss", "travel", "drag");
+              gs.c_str(), scene_for(gr.front()).triangle_count(), good.back().travel, miss.back().travel,
+              miss.back().f_motion);
+  std::printf("%8s %8s %6s %7s %6s | %7s %7s | %-7s %6s | %-7s %6s %7s\n", "friction", "stretch", "bend", "offset", "grip",
+              "L_good", "L_miss", "good", "travel", "miss", "travel", "drag");
   double best = 1e300;
   Point best_p{};
-  const size_t total = fr.size() * st.size() * be.size() * of.size();
+  const size_t total = fr.size() * st.size() * be.size() * of.size() * gr.size();
   size_t count = 0;
+  for (double g : gr)
   for (double f : fr)
     for (double s : st)
       for (double b : be)
         for (double o : of) {
-          const Point p{f, s, b, o};
+          const Point p{f, s, b, o, g};
+          const Scene& scene = scene_for(g);
           ++count;
           std::string line;
           if (done.count(p.key())) {
             line = done[p.key()];
           } else {
-            ClothParams cp;
+            ClothParams cp = base;
             cp.friction = f;
             cp.stretch = s;
             cp.bend = b;
@@ -146,24 +182,25 @@ int main(int argc, char** argv) {
           std::vector<std::string> c;
           std::string x;
           while (std::getline(ls, x, ',')) c.push_back(x);
-          const double lg = std::atof(c[4].c_str()), lm = std::atof(c[5].c_str());
-          std::printf("%8.3f %8.3f %6.3f %7.3f | %7.3f %7.3f | %-7s %6s | %-7s %6s %7s   [%zu/%zu]\n", f, s, b, o, lg, lm,
-                      c[6].c_str(), c[7].c_str(), c[8].c_str(), c[9].c_str(), c[10].c_str(), count, total);
+          const double lg = std::atof(c[5].c_str()), lm = std::atof(c[6].c_str());
+          std::printf("%8.3f %8.3f %6.3f %7.3f %6.3f | %7.3f %7.3f | %-7s %6s | %-7s %6s %7s   [%zu/%zu]\n", f, s, b, o, g,
+                      lg, lm, c[7].c_str(), c[8].c_str(), c[9].c_str(), c[10].c_str(), c[11].c_str(), count, total);
           std::fflush(stdout);
           if (lg + lm < best) best = lg + lm, best_p = p;
         }
-  ClothParams cp;
+  ClothParams cp = base;
   cp.friction = best_p.friction;
   cp.stretch = best_p.stretch;
   cp.bend = best_p.bend;
+  const Scene& scene = scene_for(best_p.grip);
   const TrialResult rg = simulate_trial(scene, cp, spec_for(ArmHeight::High, good, best_p.offset));
   const TrialResult rm = simulate_trial(scene, cp, spec_for(ArmHeight::Low, miss, best_p.offset));
   write_file_atomic(out / "best_good.csv", format_trial_csv(rg.seq.samples));
   write_file_atomic(out / "best_miss.csv", format_trial_csv(rm.seq.samples));
   write_file_atomic(out / "best_params.txt", format_params(cp));
-  std::printf("best: friction %.3f stretch %.3f bend %.3f offset %.3f: L_good %.3f (%s, travel %.3f vs measured %.3f), "
+  std::printf("best: friction %.3f stretch %.3f bend %.3f offset %.3f grip %.3f: L_good %.3f (%s, travel %.3f vs measured %.3f), "
               "L_miss %.3f (%s, final drag %.2f vs measured %.2f N)\n",
-              best_p.friction, best_p.stretch, best_p.bend, best_p.offset, calib::area_objective(rg.seq.samples, good),
+              best_p.friction, best_p.stretch, best_p.bend, best_p.offset, best_p.grip, calib::area_objective(rg.seq.samples, good),
               std::string(outcome_name(rg.outcome)).c_str(), rg.travel, good.back().travel,
               calib::area_objective(rm.seq.samples, miss), std::string(outcome_name(rm.outcome)).c_str(),
               rm.seq.samples.empty() ? 0.0 : rm.seq.samples.back().f_motion, miss.back().f_motion);

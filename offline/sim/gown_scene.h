@@ -15,6 +15,9 @@ namespace dressguard::sim {
 // `base` supplies the solver options (substeps, contact offset, self-collision distance).
 Scene make_scene(const gown::GownMesh& mesh, const gown::PaperScene& paper = {}, SceneOptions base = {});
 
+// make_default_scene (trial.h) with the jaws holding the sleeve as `grip` says (placement.h).
+Scene make_default_scene(GownResolution res, bool parametric, const gown::OpeningGrip& grip);
+
 // The gown's triangle count for each GownResolution: Full 0 (no reduction, ~20k), Reduced
 // 5000, Coarse 1500.
 int target_triangles(GownResolution res);

@@ -17,6 +17,7 @@ namespace {
 struct OpeningPose {
   Eigen::Vector3d centroid;
   double z_min, z_max;
+  double y_min = 1e9, y_max = -1e9;
 };
 
 OpeningPose opening(const GownMesh& m, const std::vector<Eigen::Vector3d>& x) {
@@ -26,6 +27,8 @@ OpeningPose opening(const GownMesh& m, const std::vector<Eigen::Vector3d>& x) {
     o.centroid += x[v] / static_cast<double>(loop.size());
     o.z_min = std::min(o.z_min, x[v].z());
     o.z_max = std::max(o.z_max, x[v].z());
+    o.y_min = std::min(o.y_min, x[v].y());
+    o.y_max = std::max(o.y_max, x[v].y());
   }
   return o;
 }
@@ -161,8 +164,8 @@ TEST(Placement, OpeningPlacementIsIndependentOfTheFilesPose) {
           .toRotationMatrix();
   for (auto& p : moved.x) p = R * p + Eigen::Vector3d(0.3, -2.0, 5.0);
   GownMesh a = moved, b = built;
-  place_at_opening(a, s, kOpeningGripDepth, built.sleeve_loop);
-  place_at_opening(b, s, kOpeningGripDepth, built.sleeve_loop);
+  place_at_opening(a, s, OpeningGrip{}, built.sleeve_loop);
+  place_at_opening(b, s, OpeningGrip{}, built.sleeve_loop);
   double worst = 0;
   for (size_t i = 0; i < a.x.size(); ++i) worst = std::max(worst, (a.x[i] - b.x[i]).norm());
   EXPECT_LT(worst, 1e-9);  // the same pose whatever the file's pose (rounding only)
@@ -178,4 +181,55 @@ TEST(Placement, OpeningPlacementIsIndependentOfTheFilesPose) {
   EXPECT_LT(centroid.x(), c.x());
   EXPECT_LT(centroid.z(), c.z() - 0.1);
   EXPECT_GE(grasp_vertices(b, s).size(), 10u);
+}
+
+// OpeningGrip: where the sleeve is placed (the rim's top at the asked depth and lead, exactly),
+// and that the jaws reaching deeper below the sleeve's top grasp more of it. On the measured
+// gown, whose sleeve is a round tube, the deeper grip holds more of the opening's perimeter flat
+// across the jaws, so the hung opening is wider (y) and hangs less deep (z) below them. (The
+// parametric sleeve is a flattened lens: a deeper grip pinches its two layers together instead.)
+void check_grip(bool parametric) {
+  const PaperScene s;
+  const OpeningGrip base = parametric ? kParametricGrip : OpeningGrip{};
+  GownOptions opt;
+  opt.parametric = parametric;
+  opt.target_triangles = 5000;
+  struct Held {
+    std::size_t grasped;
+    OpeningPose placed, hung;
+  };
+  auto hold = [&](OpeningGrip g) {
+    opt.grip = g;
+    const GownMesh r = load_gown(opt);
+    const Held h{grasp_vertices(r, s).size(), opening(r, r.x), opening(r, crude_hang(r, s))};
+    EXPECT_NEAR(h.placed.z_max, sleeve_top_z_W(s, g.depth), 1e-9);
+    std::printf("%s grip %.3f m, rim %.3f m ahead: %zu grasped; hung opening y %.3f..%.3f, z %.3f..%.3f\n",
+                parametric ? "parametric" : "measured", g.depth, g.rim_ahead, h.grasped, h.hung.y_min, h.hung.y_max,
+                h.hung.z_min, h.hung.z_max);
+    return h;
+  };
+  const Held a = hold(base);
+  const Held b = hold({base.depth + 0.035, base.rim_ahead});
+  EXPECT_GT(b.grasped, a.grasped);
+  const Held c = hold({base.depth, base.rim_ahead + 0.03});
+  EXPECT_NEAR(c.placed.centroid.x() - a.placed.centroid.x(), 0.03, 1e-9);  // a rigid shift along x
+  EXPECT_NEAR(c.placed.centroid.z() - a.placed.centroid.z(), 0.0, 1e-9);
+  if (!parametric) {
+    // 3.5 cm deeper holds about 6 cm more of the 47 cm perimeter flat: wider by at least 2 cm
+    // and the lowest point at least 2 cm higher (the crude hang resolves about half a reduced
+    // edge, 1.5 cm).
+    EXPECT_GT(b.hung.y_max - b.hung.y_min, a.hung.y_max - a.hung.y_min + 0.02);
+    EXPECT_GT(b.hung.z_min, a.hung.z_min + 0.02);
+  }
+  opt.grip = OpeningGrip{0.2, 0.04};  // the sleeve's top under the lower jaw: nothing to grasp
+  EXPECT_THROW(load_gown(opt), std::invalid_argument);
+  opt.grip = OpeningGrip{0.02, -0.01};
+  EXPECT_THROW(load_gown(opt), std::invalid_argument);
+}
+
+TEST(Placement, GripPlacesTheParametricSleeveWhereAsked) { check_grip(true); }
+
+TEST(Placement, DeeperGripHoldsTheMeasuredOpeningWiderAndShallower) {
+  if (measured_gown_path().empty()) GTEST_SKIP() << "shared/data/gown/fullgown.obj is not present; skipping";
+  check_grip(false);
 }

@@ -31,3 +31,9 @@ file(READ ${TMP}/short.scene.json scene)
 if(NOT scene MATCHES "\"contacts\": \\[")
   message(FATAL_ERROR "the scene file has no contacts list")
 endif()
+# A grip the jaws cannot make is named, and nothing is written.
+execute_process(COMMAND ${DG} simulate --height high --gown coarse --grip-depth -0.01 --out ${TMP}/dg_grip_never.csv
+                RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "--grip-depth" OR EXISTS ${TMP}/dg_grip_never.csv)
+  message(FATAL_ERROR "bad --grip-depth: expected exit 2 naming it and no file, got rc=${rc}: ${err}")
+endif()

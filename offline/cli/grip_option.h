@@ -1,0 +1,28 @@
+// --grip-depth and --rim-ahead, shared by `dressguard gown` and `dressguard simulate`.
+#pragma once
+
+#include <optional>
+
+#include "args.h"
+#include "gown.h"
+
+namespace dressguard::cli {
+
+inline constexpr const char* kGripHelp =
+    "  --grip-depth M    [m] how far below the sleeve's top the jaws reach (default 0.015 for the\n"
+    "                    measured gown, 0.03 for the parametric one): deeper holds the opening\n"
+    "                    wider and shallower (offline/gown/placement.h, OpeningGrip)\n"
+    "  --rim-ahead M     [m] the opening's rim ahead of the jaws (default 0.04; parametric 0.01)\n";
+
+// The grip the options ask for, starting from the gown's own; nullopt when neither is given.
+inline std::optional<gown::OpeningGrip> grip_option(const Args& args, bool parametric_gown) {
+  if (!args.has("grip-depth") && !args.has("rim-ahead")) return std::nullopt;
+  gown::OpeningGrip g = parametric_gown ? gown::kParametricGrip : gown::OpeningGrip{};
+  g.depth = args.number("grip-depth", g.depth);
+  g.rim_ahead = args.number("rim-ahead", g.rim_ahead);
+  if (!(g.depth > 0 && g.depth < 0.15)) throw UsageError("--grip-depth must be in (0, 0.15) m, the grasp box's depth");
+  if (!(g.rim_ahead >= 0 && g.rim_ahead <= 0.5)) throw UsageError("--rim-ahead must be in [0, 0.5] m");
+  return g;
+}
+
+}  // namespace dressguard::cli
