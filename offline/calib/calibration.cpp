@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -42,6 +43,7 @@ Bounds default_bounds() {
   b.cloth[3] = {0.0, 2.0, 0.5};  // friction
   b.cloth[4] = {0.0, 2.0, 0.2};  // self_friction
   b.arm_offset = {-0.06, 0.06, 0.0};
+  b.arm_compliance = {0.0, 0.01, 0.004};
   return b;
 }
 
@@ -69,10 +71,13 @@ Bounds read_bounds(const std::filesystem::path& path) {
     for (int i = 0; i < kClothParams; ++i)
       if (name == kClothParamNames[i]) target = &b.cloth[i];
     if (name == "arm_offset") target = &b.arm_offset;
+    if (name == "arm_compliance") target = &b.arm_compliance;
     if (!target)
       throw_input_error(path, n,
                         "unknown parameter '" + name +
-                            "' (expected stretch, shear, bend, friction, self_friction or arm_offset)");
+                            "' (expected stretch, shear, bend, friction, self_friction, arm_offset or arm_compliance)");
+    if (name == "arm_compliance" && pb.lower < 0)
+      throw_input_error(path, n, "arm_compliance cannot be negative (0 is a fixed arm)");
     *target = pb;
   }
   return b;
@@ -88,12 +93,14 @@ Eigen::VectorXd ParameterSpace::initial_unit() const {
   for (int i = 0; i < kClothParams; ++i) x[i] = to_unit(bounds.cloth[i], bounds.cloth[i].initial);
   for (std::size_t k = 0; k < offset_heights.size(); ++k)
     x[kClothParams + static_cast<long>(k)] = to_unit(bounds.arm_offset, bounds.arm_offset.initial);
+  if (fit_arm_compliance) x[dimension() - 1] = to_unit(bounds.arm_compliance, bounds.arm_compliance.initial);
   return x;
 }
 
 ClothValues ParameterSpace::cloth(const Eigen::VectorXd& unit) const {
   ClothValues c;
   for (int i = 0; i < kClothParams; ++i) set_cloth_value(c, i, from_unit(bounds.cloth[i], unit[i]));
+  c.arm_compliance = fit_arm_compliance ? from_unit(bounds.arm_compliance, unit[dimension() - 1]) : arm_compliance;
   return c;
 }
 
@@ -107,7 +114,24 @@ std::array<double, 3> ParameterSpace::offsets(const Eigen::VectorXd& unit) const
 std::vector<std::string> ParameterSpace::names() const {
   std::vector<std::string> n(kClothParamNames.begin(), kClothParamNames.end());
   for (ArmHeight h : offset_heights) n.push_back("arm_offset_" + std::string(arm_height_name(h)));
+  if (fit_arm_compliance) n.push_back("arm_compliance");
   return n;
+}
+
+bool set_arm_compliance(ParameterSpace& space, const std::string& word) {
+  if (word == "fit") {
+    space.fit_arm_compliance = true;
+    return true;
+  }
+  double v = 0.0;
+  if (word != "fixed") {
+    char* end = nullptr;
+    v = std::strtod(word.c_str(), &end);
+    if (word.empty() || *end != '\0' || !std::isfinite(v) || v < 0 || v > 1) return false;
+  }
+  space.fit_arm_compliance = false;
+  space.arm_compliance = v;
+  return true;
 }
 
 std::vector<HapticSequence> select_inputs(const Dataset& ds, const std::string& participant, std::uint64_t seed) {
@@ -168,7 +192,14 @@ std::string fingerprint(const std::vector<HapticSequence>& inputs, const Paramet
   f << ";bounds=";
   for (const auto& b : space.bounds.cloth) f << hexd(b.lower) << ',' << hexd(b.upper) << ',' << hexd(b.initial) << ',';
   f << hexd(space.bounds.arm_offset.lower) << ',' << hexd(space.bounds.arm_offset.upper) << ','
-    << hexd(space.bounds.arm_offset.initial) << ";inputs=";
+    << hexd(space.bounds.arm_offset.initial);
+  // The arm's compliance only when it is not the paper's fixed arm (older checkpoints resume).
+  if (space.fit_arm_compliance)
+    f << ",arm_compliance:" << hexd(space.bounds.arm_compliance.lower) << ',' << hexd(space.bounds.arm_compliance.upper)
+      << ',' << hexd(space.bounds.arm_compliance.initial);
+  else if (space.arm_compliance != 0)
+    f << ",arm_compliance=" << hexd(space.arm_compliance);
+  f << ";inputs=";
   for (const auto& s : inputs) f << s.id << '/' << s.samples.size() << ',';
   return f.str();
 }
@@ -367,6 +398,9 @@ Json calibration_to_json(const Calibration& c) {
   j.set("participant", c.participant);
   Json cloth = Json::object();
   for (int i = 0; i < kClothParams; ++i) cloth.set(kClothParamNames[i], cloth_value(c.cloth, i));
+  // Only a compliant arm is written: a file without it is the paper's fixed arm (and synthesis
+  // folders made from such a calibration keep their record, so they still resume).
+  if (c.cloth.arm_compliance != 0) cloth.set("arm_compliance", c.cloth.arm_compliance);
   j.set("cloth", cloth);
   Json off = Json::object();
   for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
@@ -410,6 +444,12 @@ Calibration calibration_from_json(const Json& j, const std::filesystem::path& so
       const double v = j.at("cloth").at(kClothParamNames[i]).number();
       if (!std::isfinite(v)) throw std::runtime_error(std::string("cloth.") + kClothParamNames[i] + " is not finite");
       set_cloth_value(c.cloth, i, v);
+    }
+    // Files from before the compliant arm have none: the fixed arm they were calibrated with.
+    if (j.at("cloth").has("arm_compliance")) {
+      c.cloth.arm_compliance = j.at("cloth").at("arm_compliance").number();
+      if (!(c.cloth.arm_compliance >= 0 && c.cloth.arm_compliance <= 1))
+        throw std::runtime_error("cloth.arm_compliance must be in [0, 1] m/N");
     }
     for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
       const Json& e = j.at("arm_offsets").at(std::string(arm_height_name(h)));

@@ -37,6 +37,9 @@ struct ClothValues {
   double bend = 0.7;
   double friction = 0.5;       // cloth-arm
   double self_friction = 0.2;  // cloth-cloth
+  // [m/N] how far the person's arm gives per newton of the cloth's pull (sim/arm_spring.h); not
+  // one of the paper's five (its arm is fixed, 0), fitted only when ParameterSpace asks for it.
+  double arm_compliance = 0.0;
 };
 inline constexpr int kClothParams = 5;
 inline constexpr std::array<const char*, kClothParams> kClothParamNames = {"stretch", "shear", "bend", "friction",
@@ -78,30 +81,45 @@ struct ParamBound {
 };
 struct Bounds {
   std::array<ParamBound, kClothParams> cloth;
-  ParamBound arm_offset;  // [m], shared by the offsets of every height
+  ParamBound arm_offset;      // [m], shared by the offsets of every height
+  ParamBound arm_compliance;  // [m/N], when ParameterSpace::fit_arm_compliance
 };
 // Defaults (the simulator's box, sim/trial.h ClothParams): stretch, shear, bend in [0, 1] (start
 // 0.8, 0.5, 0.5); friction and self_friction in [0, 2] (start 0.5, 0.2); arm offset in
 // [-0.06, 0.06] m (start 0): the study's middle noise spans 6 cm (paper V-A), and the paper's
-// calibrated offset for participant 4 was -0.02 m.
+// calibrated offset for participant 4 was -0.02 m; arm compliance in [0, 0.01] m/N (start
+// 0.004): a stiffness of 100 N/m and up, the hand's postural stiffness being about 300-800 N/m
+// (sim/arm_spring.h) and a held-out forearm softer.
 Bounds default_bounds();
 // Bounds file: one "name lower upper [initial]" per line, '#' starts a comment, names as in
-// kClothParamNames plus "arm_offset"; unnamed parameters keep their defaults. InputError names the
+// kClothParamNames plus "arm_offset" and "arm_compliance"; unnamed parameters keep their defaults. InputError names the
 // file and line of a malformed row (unknown name, lower >= upper, initial outside the box).
 Bounds read_bounds(const std::filesystem::path& path);
 
-// The search vector: the five cloth parameters then one offset per used height (high, middle,
-// low order), each normalised to [0, 1] over its box (CMA-ES works in the unit box, as the
-// paper's public code did, so sigma means the same for every coordinate).
+// The search vector: the five cloth parameters, one offset per used height (high, middle, low
+// order), then the arm's compliance when it is fitted, each normalised to [0, 1] over its box
+// (CMA-ES works in the unit box, as the paper's public code did, so sigma means the same for
+// every coordinate).
 struct ParameterSpace {
   Bounds bounds;
   std::vector<ArmHeight> offset_heights;  // heights with an optimised offset; empty: --no-arm-offset
-  int dimension() const { return kClothParams + static_cast<int>(offset_heights.size()); }
+  // The arm's compliance: fitted within bounds.arm_compliance, or held at `arm_compliance`
+  // (0: the paper's fixed arm).
+  bool fit_arm_compliance = false;
+  double arm_compliance = 0.0;
+  int dimension() const {
+    return kClothParams + static_cast<int>(offset_heights.size()) + (fit_arm_compliance ? 1 : 0);
+  }
   Eigen::VectorXd initial_unit() const;
   ClothValues cloth(const Eigen::VectorXd& unit) const;
   std::array<double, 3> offsets(const Eigen::VectorXd& unit) const;  // [m] by ArmHeight, 0 if not optimised
-  std::vector<std::string> names() const;  // "stretch", ..., "arm_offset_high", ...
+  std::vector<std::string> names() const;  // "stretch", ..., "arm_offset_high", ..., "arm_compliance"
 };
+
+// The arm of `space` from a command line's word: "fit" (search bounds.arm_compliance), "fixed"
+// or "0" (the paper's fixed arm), or a compliance in m/N held during the search. False when the
+// word is none of these (or a negative or non-finite number).
+bool set_arm_compliance(ParameterSpace& space, const std::string& word);
 
 // ---- input selection (paper IV-B.1) -------------------------------------------------------------
 

@@ -19,6 +19,7 @@ sim::ClothParams params_of(const ClothValues& c) {
   p.bend = c.bend;
   p.friction = c.friction;
   p.self_friction = c.self_friction;
+  p.arm_compliance = c.arm_compliance;
   return p;
 }
 

@@ -42,6 +42,9 @@ int run_calibrate(int argc, char** argv) {
         "  --seed S            input selection and CMA-ES (default 1); same seed, same result\n"
         "  --objective area|position-weighted   (default area: paper eq. 3-5)\n"
         "  --no-arm-offset     do not optimise the arm offsets (paper Fig. 9 comparison)\n"
+        "  --arm-compliance fit|fixed|C   the person's arm: fit its compliance [m/N] too (one more\n"
+        "                      parameter; offline/sim/arm_spring.h), hold it fixed (the paper's, the\n"
+        "                      default) or give way by C m per N\n"
         "  --gown full|reduced|coarse   simulator gown (default reduced)\n"
         "  --threads N         threads per process (default: all cores)\n"
         "  --checkpoint FILE   default CAL.json.ckpt; an existing one is resumed\n"
@@ -53,7 +56,7 @@ int run_calibrate(int argc, char** argv) {
   }
   args.allow_only({"help", "json", "no-arm-offset", "data", "participant", "profile", "bounds", "seed", "out",
                    "checkpoint", "objective", "gown", "threads", "generations", "population",
-                   "stop-after-generations"});
+                   "stop-after-generations", "arm-compliance"});
   const std::string data = args.require("data");
   const std::string participant = args.require("participant");
   const std::string out = args.require("out");
@@ -83,6 +86,8 @@ int run_calibrate(int argc, char** argv) {
   space.bounds = args.get("bounds") ? read_bounds(*args.get("bounds")) : default_bounds();
   if (!args.has("no-arm-offset"))
     for (const auto& s : inputs) space.offset_heights.push_back(s.height);
+  if (const auto arm = args.get("arm-compliance"); arm && !set_arm_compliance(space, *arm))
+    throw UsageError("--arm-compliance must be fit, fixed or a compliance in [0, 1] m/N, not '" + *arm + "'");
 
 #ifndef DRESSGUARD_HAVE_SIM
   throw UsageError("this dressguard was built without the cloth simulator (offline/sim); calibrate needs it");

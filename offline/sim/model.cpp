@@ -265,6 +265,7 @@ GownModel make_model(const SceneData& s, const ClothParams& p, FrictionScheme sc
   m.alpha_bend = compliance_of(p.bend, 1e7, 1e1);
   m.friction = std::max(0.0, p.friction);
   m.self_friction = std::max(0.0, p.self_friction);
+  m.arm_compliance = std::max(0.0, p.arm_compliance);
   m.damping_factor = std::exp(-std::max(0.0, p.damping) * m.h);
   m.scheme = scheme;
   m.self_collision = self_collision;

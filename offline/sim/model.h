@@ -145,6 +145,7 @@ struct GownModel {
   double alpha_stretch = 0, alpha_shear = 0, alpha_bend = 0;  // XPBD compliances
   double alpha_compress = 0;          // stretch edges under compression (SceneOptions::compression_softening)
   double friction = 0, self_friction = 0;
+  double arm_compliance = 0;          // [m/N] ClothParams::arm_compliance (0: fixed arm)
   double damping_factor = 1;          // per substep
   FrictionScheme scheme = FrictionScheme::Improved;
   bool self_collision = true;
@@ -200,6 +201,12 @@ struct GownState {
   size_t pair_count = 0;
   long pairs_dropped = 0;
   V3 grip_offset;                     // gripper displacement from its start
+  // The arm's displacement from where m.arm has it (a compliant arm, arm_spring.h): step()
+  // moves it linearly from arm_shift_from to arm_shift_to over its substeps, as it moves the
+  // gripper; arm_shift is the current substep's, arm_move its change over that substep (the
+  // arm's surface motion, which friction acts against). All zero for a fixed arm.
+  V3 arm_shift_from{0, 0, 0}, arm_shift_to{0, 0, 0};
+  V3 arm_shift{0, 0, 0}, arm_move{0, 0, 0};
   double jaw_closed = 1;              // 0: grasped vertices at rest positions, 1: at grasp_target
   V3 grip_accel;                      // gripper acceleration (inertia of the grasped vertices)
   V3 force_acc;                       // sum over substeps of the force of the gown on the gripper

@@ -54,8 +54,12 @@ void detect_arm(const GownModel& m, GownState& s) {
   const int n = static_cast<int>(s.x.size());
   const bool planes = !sc.planes.empty();
   s.contact_count = 0;
+  // A moving arm: its cones where the step starts, the margin wider by the step's arm travel.
+  const V3 shift = s.arm_shift_from;
+  const double arm_travel = norm(s.arm_shift_to - s.arm_shift_from);
   for (int i = 0; i < n; ++i) {
-    const ArmCandidates c = sc.grasped[i] || m.arm.empty() ? ArmCandidates{} : arm_candidates(m, s.x[i], s.v[i], 0.0);
+    const ArmCandidates c =
+        sc.grasped[i] || m.arm.empty() ? ArmCandidates{} : arm_candidates(m, s.x[i] - shift, s.v[i], arm_travel);
     s.cand[i] = c;
     if (c.c[0] < 0) s.anchored[i] = 0;
     if (!sc.grasped[i] && (c.c[0] >= 0 || planes)) s.contact_list[s.contact_count++] = i;
@@ -279,19 +283,22 @@ void solve_kind(const GownModel& m, GownState& s, const std::vector<Block>& bloc
   }
 }
 
-// One contact against a static collider with the chosen friction scheme.
-inline void collide_static(const GownModel& m, GownState& s, int i, double phi, V3 nrm) {
+// One contact against a collider with the chosen friction scheme; `move` is the collider
+// surface's displacement over this substep (the arm's, zero for a fixed arm and the planes):
+// friction acts on the slip relative to it, so the vertex's start point is taken as p + move.
+inline void collide_static(const GownModel& m, GownState& s, int i, double phi, V3 nrm, V3 move) {
   const double dn = contact_constraint(s.x[i], phi, nrm, m.scene->opt.contact_offset);
   if (dn <= 0) return;
   s.contact_n[i] = nrm;
   s.contact_dn[i] += dn;
   if (m.scheme == FrictionScheme::Improved) {
-    friction_position(s.x[i], s.p[i], nrm, dn, m.friction);
+    friction_position(s.x[i], s.p[i] + move, nrm, dn, m.friction);
   } else if (m.scheme == FrictionScheme::Constraint) {
     if (!s.anchored[i]) {
       s.anchor[i] = s.p[i];
       s.anchored[i] = 1;
     }
+    s.anchor[i] += move;  // the stick point rides on the (moving) surface
     friction_anchor(s.x[i], s.anchor[i], nrm, dn, m.friction, m.friction * m.scene->opt.kinetic_ratio);
   }
 }
@@ -310,13 +317,13 @@ void solve_contacts(const GownModel& m, GownState& s, double inv_h2) {
       const int c = s.cand[i].c[k];
       if (c < 0) break;
       V3 nrm;
-      const double phi = round_cone_distance(m.arm[c], s.x[i], &nrm);
-      collide_static(m, s, i, phi, nrm);
+      const double phi = round_cone_distance(m.arm[c], s.x[i] - s.arm_shift, &nrm);
+      collide_static(m, s, i, phi, nrm, s.arm_move);
     }
     for (const HalfSpace& pl : sc.planes) {
       const double phi = dot(pl.n, s.x[i]) - pl.d;
       if (phi - off > 1e-3) s.anchored[i] = 0;
-      collide_static(m, s, i, phi, pl.n);
+      collide_static(m, s, i, phi, pl.n, V3{0, 0, 0});
     }
     if (s.contact_dn[i] > dn_before) s.contact_acc[i] += (m.mass[i] * inv_h2) * (s.x[i] - before);
   }
@@ -425,6 +432,9 @@ void step(const GownModel& m, GownState& s, V3 grip_from, V3 grip_to, V3 grip_ac
     const double f = static_cast<double>(k + 1) / m.substeps;
     const V3 grip = grip_from + f * (grip_to - grip_from);
     s.grip_offset = grip;
+    const V3 arm = s.arm_shift_from + f * (s.arm_shift_to - s.arm_shift_from);
+    s.arm_move = arm - s.arm_shift;
+    s.arm_shift = arm;
     substep(m, s, grip, grip_accel, k == 0);
   }
   update_velocities(m, s);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include "arm_spring.h"
 #include "model.h"
 
 namespace dressguard::sim {
@@ -218,18 +219,37 @@ void pull(const GownModel& m, GownState& s, const TrialSpec& spec, const Settled
   double t = 0;
   bool full = false;
   r.finite = all_finite(s);
+  // A compliant arm (arm_spring.h) moves once per sample toward where the last sample's contact
+  // force puts it, linearly over the sample's steps; its load is counted from the first sample.
+  ArmSpring arm{m.arm_compliance};
+  V3 arm_load0{0, 0, 0};
+  bool first_sample = true;
   const double max_time = spec.max_travel / spec.speed + spec.speed / spec.acceleration + 5.0;
   while (r.finite && t < max_time) {
     s.force_acc = zero;
     s.force_count = 0;
     for (int i = 0; i < n; ++i) s.contact_acc[i] = zero;
+    const V3 arm0 = s.arm_shift_to, arm1 = arm.d;
     for (int k = 0; k < 3; ++k) {
       const double t1 = t + m.dt;
       const V3 g0{prof.travel(t), 0, 0}, g1{prof.travel(t1), 0, 0};
+      if (!arm.rigid()) {
+        s.arm_shift_from = arm0 + (k / 3.0) * (arm1 - arm0);
+        s.arm_shift_to = arm0 + ((k + 1) / 3.0) * (arm1 - arm0);
+      }
       step(m, s, g0, g1, V3{prof.accel(t), 0, 0});
       t = t1;
       maybe_frame(t, g1.x);
     }
+    if (!arm.rigid()) {
+      V3 load{0, 0, 0};  // the cloth's force on the arm: minus the arm's on the cloth (eq. 2)
+      for (int i = 0; i < n; ++i) load -= s.contact_acc[i];
+      load = (1.0 / s.force_count) * load;
+      if (first_sample) arm_load0 = load;
+      arm.advance(load - arm_load0, 3 * m.dt);
+      r.arm_shift_max = std::max(r.arm_shift_max, norm(s.arm_shift));
+    }
+    first_sample = false;
     const V3 f = (1.0 / s.force_count) * s.force_acc - at_rest.bias;
     const double travel = prof.travel(t);
     r.seq.samples.push_back({t, travel, f.x, f.y, f.z});
@@ -255,11 +275,13 @@ void pull(const GownModel& m, GownState& s, const TrialSpec& spec, const Settled
   r.self_pairs_dropped = s.pairs_dropped;
   r.d_max = 0;
   if (!full) {
-    for (int v : at_rest.lower) r.d_max = std::max(r.d_max, std::abs(s.x[v].x - m.elbow.x));
+    // The elbow where the (compliant) arm has it now.
+    for (int v : at_rest.lower) r.d_max = std::max(r.d_max, std::abs(s.x[v].x - (m.elbow.x + s.arm_shift.x)));
   }
   r.outcome = label_outcome(full, r.d_max);
   r.seq.label = r.outcome;
   r.area_ratio = current_area(m, s) / m.scene->rest_area;
+  r.arm_shift = {s.arm_shift.x, s.arm_shift.y, s.arm_shift.z};
   // Contact force of the cloth on the arm per vertex, averaged over the last sample.
   if (s.force_count > 0)
     for (int i = 0; i < n; ++i) {

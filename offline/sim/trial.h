@@ -46,6 +46,10 @@ namespace dressguard::sim {
 // perturbation, fixed by default; 2/s costs the pulled gown only m * 2/s * 0.1 m/s = 0.05 N of
 // drag. Settling uses its own, heavier damping (TrialSpec::settle_damping).
 // areal_density [kg/m^2]: 0.145 as the paper's simulator, fixed by default.
+// arm_compliance [m/N]: how far the person's arm gives per newton of the cloth's pull during the
+// pull (arm_spring.h: a 2 kg arm on a critically damped spring of stiffness 1 / arm_compliance);
+// 0, the default and the paper's, holds the arm fixed. Not cloth, but a parameter of the scene
+// that a calibration may fit per person like the cloth's.
 struct ClothParams {
   double stretch = 0.8;
   double shear = 0.5;
@@ -54,6 +58,7 @@ struct ClothParams {
   double self_friction = 0.2;
   double damping = 2.0;
   double areal_density = 0.145;
+  double arm_compliance = 0.0;
 };
 
 // Friction of cloth against the arm and itself (paper IV-A.2, the point of the "improved" scheme):
@@ -133,6 +138,8 @@ struct TrialResult {
   double settle_speed = 0;          // [m/s] RMS speed of the free vertices over the last 0.1 s of it
   bool settled = true;              // settle_speed reached the spec's limit (false: gave up at the cap)
   double area_ratio = 1;            // final triangle area / rest area (explosion check)
+  std::array<double, 3> arm_shift{};  // [m] the compliant arm's displacement at the stop (0: fixed arm)
+  double arm_shift_max = 0;         // [m] its largest magnitude during the pull
   bool finite = true;               // every position stayed finite
   std::vector<ContactForce> contacts;
   std::vector<Frame> frames;

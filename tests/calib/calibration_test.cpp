@@ -95,6 +95,48 @@ TEST(Calibration, RecoversKnownParametersOfTheStandIn) {
   EXPECT_NEAR(r.fits[0].objective + r.fits[1].objective, r.objective, 1e-12);
 }
 
+// The arm's compliance as a seventh... ninth parameter (ParameterSpace::fit_arm_compliance):
+// inputs made with an arm that gives 5 mm per N are fitted to a small fraction of what the
+// paper's fixed arm can reach, and the compliance is found within 1 mm/N (the stand-in's drag
+// depends on it through the travel scale, which friction and stretch cannot mimic).
+TEST(Calibration, RecoversTheArmComplianceOfTheStandIn) {
+  Truth truth;
+  truth.cloth.arm_compliance = 0.005;
+  const auto inputs = fake_inputs(truth);
+  auto fixed = space_for(inputs);
+  auto fitted = fixed;
+  ASSERT_TRUE(set_arm_compliance(fitted, "fit"));
+  EXPECT_EQ(fitted.dimension(), fixed.dimension() + 1);
+  EXPECT_EQ(fitted.names().back(), "arm_compliance");
+  const auto rf = calibrate(inputs, fixed, testing::fake_simulate, quick(60, 2), Comm::world());
+  const auto rc = calibrate(inputs, fitted, testing::fake_simulate, quick(60, 2), Comm::world());
+  std::printf("  fixed arm L %.6f; fitted arm L %.6f with compliance %.5f m/N (truth 0.005)\n", rf.objective,
+              rc.objective, rc.cloth.arm_compliance);
+  EXPECT_EQ(rf.cloth.arm_compliance, 0.0);
+  EXPECT_NEAR(rc.cloth.arm_compliance, 0.005, 0.001);
+  EXPECT_LT(rc.objective, 0.25 * rf.objective);
+}
+
+TEST(Calibration, ArmComplianceWords) {
+  ParameterSpace s;
+  EXPECT_TRUE(set_arm_compliance(s, "fit"));
+  EXPECT_TRUE(s.fit_arm_compliance);
+  EXPECT_TRUE(set_arm_compliance(s, "0.003"));
+  EXPECT_FALSE(s.fit_arm_compliance);
+  EXPECT_EQ(s.arm_compliance, 0.003);
+  Eigen::VectorXd u = Eigen::VectorXd::Constant(s.dimension(), 0.5);
+  EXPECT_EQ(s.cloth(u).arm_compliance, 0.003);  // held, not searched
+  EXPECT_TRUE(set_arm_compliance(s, "fixed"));
+  EXPECT_EQ(s.arm_compliance, 0.0);
+  for (const char* bad : {"", "soft", "-0.001", "2", "0.003x", "nan"}) EXPECT_FALSE(set_arm_compliance(s, bad)) << bad;
+  // Fitted: the last coordinate spans the bounds' box.
+  s.bounds = default_bounds();
+  ASSERT_TRUE(set_arm_compliance(s, "fit"));
+  u = Eigen::VectorXd::Constant(s.dimension(), 0.25);
+  EXPECT_NEAR(s.cloth(u).arm_compliance, 0.25 * 0.01, 1e-15);
+  EXPECT_NEAR(s.initial_unit()[s.dimension() - 1], 0.4, 1e-12);  // 0.004 of [0, 0.01]
+}
+
 TEST(Calibration, ResultDoesNotDependOnThreadCount) {
   const auto inputs = fake_inputs(Truth{});
   const auto space = space_for(inputs);
@@ -152,8 +194,10 @@ TEST(Calibration, CheckpointOfAnotherRunIsRefused) {
 TEST(Calibration, BoundsFileParsesAndNamesBadLines) {
   const fs::path dir = temp_dir("bounds");
   const fs::path ok = dir / "ok.txt";
-  write_file_atomic(ok, "# cloth box\nfriction 0.1 1.5 0.6\n\narm_offset -0.03 0.03\n");
+  write_file_atomic(ok, "# cloth box\nfriction 0.1 1.5 0.6\n\narm_offset -0.03 0.03\narm_compliance 0 0.02 0.005\n");
   const Bounds b = read_bounds(ok);
+  EXPECT_EQ(b.arm_compliance.upper, 0.02);
+  EXPECT_EQ(b.arm_compliance.initial, 0.005);
   EXPECT_EQ(b.cloth[3].lower, 0.1);
   EXPECT_EQ(b.cloth[3].upper, 1.5);
   EXPECT_EQ(b.cloth[3].initial, 0.6);
@@ -172,6 +216,8 @@ TEST(Calibration, BoundsFileParsesAndNamesBadLines) {
   EXPECT_NE(error_of("bend 1 0\n").find("bad.txt:1:"), std::string::npos);
   EXPECT_NE(error_of("bend 0 1 2\n").find("outside"), std::string::npos);
   EXPECT_NE(error_of("bend 0\n").find("expected"), std::string::npos);
+  EXPECT_NE(error_of("arm_compliance -0.01 0.01\n").find("bad.txt:1: arm_compliance cannot be negative"),
+            std::string::npos);
   fs::remove_all(dir);
 }
 
@@ -206,6 +252,11 @@ TEST(Calibration, CalibrationFileRoundTripAndErrors) {
   const fs::path dir = temp_dir("calfile");
   write_calibration(dir / "cal.json", c);
   const Calibration d = read_calibration(dir / "cal.json");
+  EXPECT_EQ(d.cloth.arm_compliance, 0.0);  // the fixed arm: not written, read back as 0
+  EXPECT_EQ(read_file(dir / "cal.json").find("arm_compliance"), std::string::npos);
+  c.cloth.arm_compliance = 0.0045;
+  write_calibration(dir / "cal_arm.json", c);
+  EXPECT_EQ(read_calibration(dir / "cal_arm.json").cloth.arm_compliance, 0.0045);
   EXPECT_EQ(d.participant, "4");
   EXPECT_EQ(d.cloth.self_friction, 0.5);
   EXPECT_EQ(d.offsets[2], 0.011);

@@ -2,6 +2,7 @@
 //
 //   bench_calib_pipeline eval [--participants 0,1,...] [--generations G --population N]
 //                             [--per-height M] [--gown coarse|reduced|full] [--work DIR] [--threads T]
+//                             [--arm-compliance fit|fixed|C]
 //     Per participant P of the measured study: calibrate on P's 2-3 sequences, synthesize, train
 //     the STC; train the baseline classifier BC on the same measured sequences directly (paper
 //     VI-B.1; the study folder holds no caught trial, so BC has good and missed only); classify
@@ -12,7 +13,10 @@
 //     71%, 83%, 94%, 100% at the four cuts). Prints one row per participant and the means, and
 //     writes DIR/eval.json after each participant (plot: tools/plot/calib_eval.py); a rerun with
 //     the same DIR resumes from the calibration checkpoints and synthesized trials.
+//     --arm-compliance: the person's arm in the calibration (calibration.h, set_arm_compliance):
+//     fixed (the paper's, default), fit (one more parameter) or a compliance in m/N.
 //   bench_calib_pipeline timing [--gown ...] [--generations G --population N] [--threads T]
+//                               [--arm-compliance ...]
 //     Wall time per simulation and of a G x N calibration of participant 4, with the final
 //     objective, and the projection to the paper's 50 x 32 budget from the measured pace. Under
 //     mpirun (e.g. -n 1 and -n 2 with --threads 1) the calibration's wall time gives the MPI
@@ -137,10 +141,18 @@ int run_eval(const std::map<std::string, std::string>& a) {
   so.per_height = std::stoi(get(a, "per-height", "100"));
   so.threads = co.threads;
   const std::string gown = get(a, "gown", "reduced");
+  const std::string arm = get(a, "arm-compliance", "fixed");
+  {
+    ParameterSpace check;
+    if (!set_arm_compliance(check, arm)) {
+      std::fprintf(stderr, "--arm-compliance must be fit, fixed or a compliance in m/N, not '%s'\n", arm.c_str());
+      return 2;
+    }
+  }
   const fs::path work = get(a, "work", "calib-eval");
   const ClothSimulator sim = make_cloth_simulator(gown);
-  std::printf("evaluation: %zu participants, calibration %d x %d, %d trials per height, gown %s\n", chosen.size(),
-              co.generations, co.population, so.per_height, gown.c_str());
+  std::printf("evaluation: %zu participants, calibration %d x %d, %d trials per height, gown %s, arm %s\n",
+              chosen.size(), co.generations, co.population, so.per_height, gown.c_str(), arm.c_str());
 
   std::vector<const HapticSequence*> all;
   for (const auto& t : ds.trials) all.push_back(&t);
@@ -164,6 +176,7 @@ int run_eval(const std::map<std::string, std::string>& a) {
     out.set("population", co.population);
     out.set("per_height", so.per_height);
     out.set("gown", gown);
+    out.set("arm_compliance", arm);
     write_file_atomic(work / "eval.json", out.dump() + "\n");
   };
   double sum_stc[5] = {}, sum_stc2[5] = {}, sum_bc[5] = {};
@@ -174,6 +187,7 @@ int run_eval(const std::map<std::string, std::string>& a) {
     ParameterSpace space;
     space.bounds = default_bounds();
     for (const auto& s : inputs) space.offset_heights.push_back(s.height);
+    set_arm_compliance(space, arm);
     auto o = co;
     o.checkpoint = work / ("p" + p + ".ckpt");
     const CalibrationResult r = calibrate(inputs, space, sim.trials, o, Comm::world());
@@ -232,11 +246,11 @@ int run_eval(const std::map<std::string, std::string>& a) {
     std::snprintf(params, sizeof params, "%.2f %.2f %.2f %.2f %.2f", r.cloth.stretch, r.cloth.shear, r.cloth.bend,
                   r.cloth.friction, r.cloth.self_friction);
     std::printf("%-4s %-8.3f %-28s | %5.0f %5.0f %5.0f %5.0f %5.0f   | %5.0f %5.0f %5.0f %5.0f %5.0f   | %5.0f %5.0f %5.0f "
-                "%5.0f %5.0f  (%.0f s) STC classes %s, forces %s%s%s\n",
+                "%5.0f %5.0f  (%.0f s) arm compliance %.4f m/N; STC classes %s, forces %s%s%s\n",
                 p.c_str(), r.objective, params, 100 * stc[0], 100 * stc[1], 100 * stc[2], 100 * stc[3], 100 * stc[4],
                 100 * stc2[0], 100 * stc2[1], 100 * stc2[2], 100 * stc2[3], 100 * stc2[4],
                 100 * bc[0], 100 * bc[1], 100 * bc[2], 100 * bc[3], 100 * bc[4], seconds_since(t0),
-                stc_classes.c_str(), axes.reason.c_str(), stc_error.empty() ? "" : (" STC failed: " + stc_error).c_str(),
+                r.cloth.arm_compliance, stc_classes.c_str(), axes.reason.c_str(), stc_error.empty() ? "" : (" STC failed: " + stc_error).c_str(),
                 bc_error.empty() ? "" : (" BC failed: " + bc_error).c_str());
     std::fflush(stdout);
     Json row = calibration_to_json(cal);
@@ -291,6 +305,10 @@ int run_timing(const std::map<std::string, std::string>& a) {
   ParameterSpace space;
   space.bounds = default_bounds();
   for (const auto& s : inputs) space.offset_heights.push_back(s.height);
+  if (!set_arm_compliance(space, get(a, "arm-compliance", "fixed"))) {
+    std::fprintf(stderr, "--arm-compliance must be fit, fixed or a compliance in m/N\n");
+    return 2;
+  }
   t0 = std::chrono::steady_clock::now();
   const CalibrationResult r = calibrate(inputs, space, sim.trials, o, Comm::world());
   const double cal_s = seconds_since(t0);
