@@ -80,14 +80,14 @@ int run_calibrate(int argc, char** argv) {
   const std::string gown = args.get("gown").value_or("reduced");
   if (gown != "full" && gown != "reduced" && gown != "coarse") throw UsageError("--gown must be full, reduced or coarse");
 
-  const Dataset ds = load_dataset(data);
-  const std::vector<HapticSequence> inputs = select_inputs(ds, participant, o.seed);
   ParameterSpace space;
-  space.bounds = args.get("bounds") ? read_bounds(*args.get("bounds")) : default_bounds();
-  if (!args.has("no-arm-offset"))
-    for (const auto& s : inputs) space.offset_heights.push_back(s.height);
   if (const auto arm = args.get("arm-compliance"); arm && !set_arm_compliance(space, *arm))
     throw UsageError("--arm-compliance must be fit, fixed or a compliance in [0, 1] m/N, not '" + *arm + "'");
+  space.bounds = args.get("bounds") ? read_bounds(*args.get("bounds")) : default_bounds();
+  const Dataset ds = load_dataset(data);
+  const std::vector<HapticSequence> inputs = select_inputs(ds, participant, o.seed);
+  if (!args.has("no-arm-offset"))
+    for (const auto& s : inputs) space.offset_heights.push_back(s.height);
 
 #ifndef DRESSGUARD_HAVE_SIM
   throw UsageError("this dressguard was built without the cloth simulator (offline/sim); calibrate needs it");
