@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace dressguard::calib {
@@ -99,6 +100,21 @@ double position_weighted_objective(const std::vector<HapticSample>& sim, const s
     }
   }
   return score;
+}
+
+double vertical_sign_agreement(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured,
+                               double threshold) {
+  require_samples(sim, measured);
+  double asked = 0.0, agreed = 0.0;
+  for (std::size_t i = 1; i < measured.size(); ++i) {
+    const HapticSample& r = measured[i];
+    if (std::abs(r.f_vertical) <= threshold || r.travel > sim.back().travel) continue;
+    const double dx = step(measured, i);
+    const double s = force_at(sim, r.travel, ForceAxis::Vertical);
+    asked += dx;
+    if ((s > 0) == (r.f_vertical > 0) && s != 0) agreed += dx;
+  }
+  return asked > 0 ? agreed / asked : std::numeric_limits<double>::quiet_NaN();
 }
 
 double sequence_objective(ObjectiveKind kind, const std::vector<HapticSample>& sim,

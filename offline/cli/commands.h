@@ -24,5 +24,6 @@ int run_export_candump(int argc, char** argv);
 int run_calibrate(int argc, char** argv);
 int run_synthesize(int argc, char** argv);
 int run_build_model(int argc, char** argv);
+int run_predict(int argc, char** argv);
 
 }  // namespace dressguard::cli

@@ -23,6 +23,7 @@ constexpr Command kCommands[] = {
     {"calibrate", "fit the simulator to one participant's sequences (CMA-ES)", run_calibrate},
     {"synthesize", "simulate labelled trials with a calibrated simulator", run_synthesize},
     {"build-model", "train the simulation-trained classifier (STC) into a model file", run_build_model},
+    {"predict", "a calibrated simulator against the other participants' measured trials", run_predict},
 };
 
 void print_usage() {

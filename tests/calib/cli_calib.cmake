@@ -25,6 +25,15 @@ expect_fail("synthesize with a bad calibration file" "bad.json" synthesize --cal
 expect_fail("synthesize with --per-height 1" "--per-height" synthesize --calibration ${WORK}/bad.json --out ${WORK}/s --per-height 1)
 expect_fail("build-model with both inputs" "exactly one" build-model --calibration ${WORK}/bad.json --data ${WORK} --out ${WORK}/m.dgm)
 expect_fail("build-model with unknown forces" "--forces" build-model --data ${WORK} --forces lateral --out ${WORK}/m.dgm)
+expect_fail("predict without --calibration" "--calibration" predict --data ${WORK})
+expect_fail("predict with a bad calibration file" "bad.json" predict --calibration ${WORK}/bad.json --data ${WORK})
+# A calibration as `calibrate` writes it: participant 4, the plausibility grid's cloth, on the coarse gown.
+file(WRITE ${WORK}/cal4.json "{\"format\": \"dressguard-calibration 1\", \"participant\": \"4\",
+ \"cloth\": {\"stretch\": 0.2, \"shear\": 0.5, \"bend\": 0.7, \"friction\": 0.35, \"self_friction\": 0.2, \"arm_compliance\": 0.004},
+ \"arm_offsets\": {\"high\": {\"offset_m\": 0.0, \"calibrated\": true}, \"middle\": {\"offset_m\": 0.0, \"calibrated\": false},
+                   \"low\": {\"offset_m\": 0.0, \"calibrated\": true}},
+ \"objective_kind\": \"area\", \"objective\": 1.0, \"sequences\": [], \"gown\": \"coarse\", \"rig_travel_m\": 0.72}\n")
+expect_fail("predict with a bad --gown" "--gown" predict --calibration ${WORK}/cal4.json --data ${WORK} --gown fine)
 
 if(STUDY)
   execute_process(COMMAND ${DG} import --study ${STUDY} --out ${WORK}/study RESULT_VARIABLE rc)
@@ -32,6 +41,32 @@ if(STUDY)
   expect_fail("calibrate with a bad bounds file" "bounds.txt:2: unknown parameter 'stiffness'"
               calibrate --data ${WORK}/study --participant 4 --out ${WORK}/c.json --bounds ${WORK}/bounds.txt)
   expect_fail("calibrate an absent participant" "participant '42'" calibrate --data ${WORK}/study --participant 42 --out ${WORK}/c.json)
+  # predict: participant 4's calibration on the other six participants' 20 trials (coarse gown, ~40 s).
+  execute_process(COMMAND ${DG} predict --calibration ${WORK}/cal4.json --data ${WORK}/study --out ${WORK}/pred --json
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR NOT out MATCHES "\"participant\": \"4\", \"trials\": 20" OR NOT out MATCHES "\"height\": \"middle\""
+     OR NOT EXISTS ${WORK}/pred.csv OR NOT EXISTS ${WORK}/pred.curves.csv)
+    message(FATAL_ERROR "predict on the study (${rc}):\n${out}\n${err}")
+  endif()
+  file(STRINGS ${WORK}/pred.csv rows)
+  list(LENGTH rows n)
+  if(NOT n EQUAL 21)
+    message(FATAL_ERROR "predict: pred.csv has ${n} lines, not a header and 20 trials")
+  endif()
+  # A dataset of participant 4 alone has nobody else to predict.
+  file(MAKE_DIRECTORY ${WORK}/only4)
+  file(STRINGS ${WORK}/study/manifest.csv manifest)
+  list(GET manifest 0 header)
+  set(kept "${header}\n")
+  foreach(row IN LISTS manifest)
+    if(row MATCHES "^[^,]*,4,")
+      string(REGEX REPLACE ".*,([^,]*)$" "\\1" file "${row}")
+      file(COPY ${WORK}/study/${file} DESTINATION ${WORK}/only4)
+      string(APPEND kept "${row}\n")
+    endif()
+  endforeach()
+  file(WRITE ${WORK}/only4/manifest.csv "${kept}")
+  expect_fail("predict with nobody else" "other than '4'" predict --calibration ${WORK}/cal4.json --data ${WORK}/only4)
   if(HMM)
     execute_process(COMMAND ${DG} build-model --data ${WORK}/study --out ${WORK}/m.dgm --states 5 --json
                     RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)

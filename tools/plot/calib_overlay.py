@@ -9,6 +9,11 @@ Two modes:
   dataset:  calib_overlay.py dataset SYNTH_DIR --measured STUDY_DIR --participant P --out data.png
             All synthesized trials per outcome (thin) with the participant's measured trials (bold),
             as in Fig. 7 and 8.
+  predict:  calib_overlay.py predict PREFIX --out predict.png
+            `dressguard predict --out PREFIX`: per arm height, the other participants' measured
+            curves (solid, one colour per trial) with the calibrated simulator's curve of each
+            (dashed, same colour), and per trial the simulator's L against the median L of a real
+            third person (the yardstick; below the diagonal: no worse than a real person).
 Reads only the CSVs that dressguard writes (calibrate's curves file; dataset folders).
 """
 import argparse
@@ -94,6 +99,47 @@ def plot_dataset(args):
     fig.savefig(args.out, dpi=110)
 
 
+def plot_predict(args):
+    rows = list(csv.DictReader(open(args.prefix + ".csv", newline="")))
+    curves = collections.defaultdict(lambda: collections.defaultdict(list))
+    with open(args.prefix + ".curves.csv", newline="") as f:
+        for r in csv.DictReader(f):
+            curves[r["trial_id"]][r["source"]].append(
+                (float(r["travel"]), float(r["f_motion"]), float(r["f_vertical"])))
+    heights = [h for h in ("high", "middle", "low") if any(r["height"] == h for r in rows)]
+    fig, axes = plt.subplots(len(heights), 3, figsize=(15, 3.6 * len(heights)), squeeze=False)
+    for i, h in enumerate(heights):
+        mine = [r for r in rows if r["height"] == h]
+        for k, r in enumerate(mine):
+            color = plt.cm.tab10(k % 10)
+            for col, idx in enumerate((1, 2)):
+                for src, ls in (("measured", "-"), ("simulated", "--")):
+                    pts = curves[r["trial_id"]][src]
+                    axes[i][col].plot([p[0] for p in pts], [p[idx] for p in pts], color=color, ls=ls, lw=1.1,
+                                      label=r["trial_id"] if src == "measured" and col == 0 else None)
+        for col, name in enumerate(("F_motion [N]", "F_vertical [N]")):
+            axes[i][col].set_title(f"{h} arm: measured (solid), simulated (dashed)")
+            axes[i][col].set_xlabel("travel [m]")
+            axes[i][col].set_ylabel(name)
+            axes[i][col].grid(alpha=0.3)
+        axes[i][0].legend(fontsize=7, loc="lower left")
+        ax = axes[i][2]
+        real = [float(r["real_median"]) for r in mine]
+        sim = [float(r["objective"]) for r in mine]
+        for k, (x, y) in enumerate(zip(real, sim)):
+            ax.scatter([x], [y], color=plt.cm.tab10(k % 10), s=30)
+        top = max([v for v in real + sim if v == v and v < float("inf")] + [1.0]) * 1.1
+        ax.plot([0, top], [0, top], color="gray", lw=0.8)
+        ax.set_xlim(0, top)
+        ax.set_ylim(0, top)
+        ax.set_xlabel("L of a real third person (median)")
+        ax.set_ylabel("L of the calibrated simulator")
+        ax.set_title(f"{h} arm: eq. 3-5, w = 20")
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(args.out, dpi=100)
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="mode", required=True)
@@ -106,8 +152,11 @@ def main():
     d.add_argument("--measured", required=True)
     d.add_argument("--participant", required=True)
     d.add_argument("--out", required=True)
+    q = sub.add_parser("predict")
+    q.add_argument("prefix")
+    q.add_argument("--out", required=True)
     args = p.parse_args()
-    (plot_fit if args.mode == "fit" else plot_dataset)(args)
+    {"fit": plot_fit, "dataset": plot_dataset, "predict": plot_predict}[args.mode](args)
 
 
 if __name__ == "__main__":

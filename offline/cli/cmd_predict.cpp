@@ -1,0 +1,109 @@
+// dressguard predict: a calibrated simulator against the measured sequences of the other
+// participants, beside the real-person yardstick (offline/calib/prediction.h).
+#include <cmath>
+#include <cstdio>
+
+#include "args.h"
+#include "calibration.h"
+#include "commands.h"
+#include "dataset.h"
+#include "files.h"
+#include "prediction.h"
+#ifdef DRESSGUARD_HAVE_SIM
+#include "sim_bridge.h"
+#endif
+
+namespace dressguard::cli {
+
+using namespace dressguard::calib;
+
+namespace {
+
+// A JSON number, or null for NaN (no yardstick, no sign to agree on).
+std::string number(double v) {
+  if (!std::isfinite(v)) return "null";
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+}  // namespace
+
+int run_predict(int argc, char** argv) {
+  Args args(argc - 1, argv + 1, {"help", "json"});
+  if (args.has("help")) {
+    std::puts(
+        "usage: dressguard predict --calibration CAL.json --data DATASET [--out PREFIX] [options]\n"
+        "  Simulates, with the calibrated parameters, every labelled non-caught trial of the\n"
+        "  participants the calibration was not made on (their height, speed and end of travel) and\n"
+        "  scores each with the calibration's objective (eq. 3-5). Beside it, the median of the same\n"
+        "  objective from every real trial of a third participant at that height: the simulator\n"
+        "  predicts a trial no worse than another real person would when its L is at most that.\n"
+        "  Also the share of the travel where the simulated vertical force has the measured sign.\n"
+        "  --out PREFIX   write PREFIX.csv (per trial) and PREFIX.curves.csv (for\n"
+        "                 tools/plot/calib_overlay.py predict)\n"
+        "  --gown G       override the calibration's gown (full, reduced, coarse)\n"
+        "  --threads N    threads per process (default: all cores); under mpirun every rank runs a share\n"
+        "  --json         machine-readable summary");
+    return 0;
+  }
+  args.allow_only({"help", "json", "calibration", "data", "out", "gown", "threads"});
+  const std::string cal_path = args.require("calibration");
+  const std::string data = args.require("data");
+  const int threads = static_cast<int>(args.integer("threads", 0));
+  const Calibration cal = read_calibration(cal_path);
+  const std::string gown = args.get("gown").value_or(cal.gown);
+  if (gown != "full" && gown != "reduced" && gown != "coarse") throw UsageError("--gown must be full, reduced or coarse");
+  const Dataset ds = load_dataset(data);
+  if (prediction_targets(ds, cal.participant).empty())
+    throw InputError(data + ": no labelled, non-caught trial of a participant other than '" + cal.participant + "'");
+#ifndef DRESSGUARD_HAVE_SIM
+  (void)threads;
+  throw UsageError("this dressguard was built without the cloth simulator (offline/sim); predict needs it");
+#else
+  const Comm& comm = Comm::world();
+  if (comm.is_root())
+    std::fprintf(stderr, "predict: participant %s's calibration on %zu trials of the others, gown %s\n",
+                 cal.participant.c_str(), prediction_targets(ds, cal.participant).size(), gown.c_str());
+  const Prediction p = predict_others(cal, ds, make_cloth_simulator(gown).trial, threads, comm);
+  if (!comm.is_root()) return 0;
+  if (const auto prefix = args.get("out")) {
+    write_file_atomic(*prefix + ".csv", prediction_csv(p));
+    write_file_atomic(*prefix + ".curves.csv", prediction_curves_csv(p, ds));
+  }
+  const std::vector<PredictionSummary> sum = summarize(p);
+  if (args.has("json")) {
+    std::printf("{\"participant\": \"%s\", \"trials\": %zu, \"heights\": [", p.participant.c_str(), p.trials.size());
+    bool first = true;
+    for (const auto& s : sum) {
+      if (s.trials == 0) continue;
+      std::printf("%s{\"height\": \"%s\", \"trials\": %d, \"objective_median\": %s, \"real_median\": %s, "
+                  "\"no_worse\": %d, \"vertical_sign_median\": %s}",
+                  first ? "" : ", ", std::string(arm_height_name(s.height)).c_str(), s.trials,
+                  number(s.objective_median).c_str(), number(s.real_median).c_str(), s.no_worse,
+                  number(s.vertical_sign_median).c_str());
+      first = false;
+    }
+    std::printf("]}\n");
+    return 0;
+  }
+  std::printf("participant %s's calibrated simulator on %zu trials of the others (L: %s objective)\n",
+              p.participant.c_str(), p.trials.size(), cal.objective_kind.c_str());
+  std::printf("  %-18s %-6s %8s %12s %10s %9s %9s  %s\n", "trial", "height", "L sim", "L real (med)", "Fv sign",
+              "sim end", "meas end", "sim label");
+  for (const auto& t : p.trials)
+    std::printf("  %-18s %-6s %8.3f %8.3f (%2d) %9.0f%% %8.3f m %8.3f m  %s\n", t.trial_id.c_str(),
+                std::string(arm_height_name(t.height)).c_str(), t.objective, t.real_median, t.real_count,
+                100 * t.vertical_sign, t.simulated_end, t.measured_end,
+                std::string(outcome_name(t.simulated_outcome)).c_str());
+  for (const auto& s : sum)
+    if (s.trials > 0)
+      std::printf("%-6s median L %.3f against %.3f between real people; no worse on %d of %d; Fv sign %.0f%%\n",
+                  std::string(arm_height_name(s.height)).c_str(), s.objective_median, s.real_median, s.no_worse,
+                  s.trials, 100 * s.vertical_sign_median);
+  if (args.get("out")) std::printf("wrote %s.csv and %s.curves.csv\n", args.get("out")->c_str(), args.get("out")->c_str());
+  return 0;
+#endif
+}
+
+}  // namespace dressguard::cli

@@ -1,0 +1,170 @@
+// The prediction of other people's sequences (prediction.h) with the analytic stand-in simulator
+// (fake_sim.h): people are the stand-in at different parameters, so every figure has an exact
+// answer. Also the vertical-sign measure of objective.h in closed form, and the real-person
+// yardstick on the study's data.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+
+#include "dataset.h"
+#include "fake_sim.h"
+#include "files.h"
+#include "objective.h"
+#include "prediction.h"
+
+namespace dressguard::calib {
+namespace {
+
+// A person: the stand-in's cloth and arm offsets, with one trial per height (good high, missed
+// middle and low; the stand-in stops at 10 N or at 0.85 m).
+struct Person {
+  std::string id;
+  ClothValues cloth;
+  std::array<double, 3> offsets{};
+};
+
+HapticSequence trial_of(const Person& p, ArmHeight h) {
+  TrialRequest r;
+  r.height = h;
+  r.arm_offset = p.offsets[static_cast<int>(h)];
+  r.speed = 0.1;
+  HapticSequence s;
+  s.id = "p" + p.id + "-" + std::string(arm_height_name(h));
+  s.participant = p.id;
+  s.height = h;
+  s.speed = 0.1;
+  s.label = h == ArmHeight::High ? Outcome::Good : Outcome::Missed;
+  s.samples = testing::fake_simulate(p.cloth, r).samples;
+  return s;
+}
+
+const Person kA{"1", {0.6, 0.3, 0.7, 0.9, 0.4}, {0.02, 0.0, -0.03}};
+const Person kB{"2", {0.3, 0.6, 0.4, 0.5, 0.1}, {0.0, -0.02, 0.01}};
+const Person kC{"3", {0.8, 0.1, 0.6, 0.7, 0.3}, {-0.01, 0.01, 0.0}};
+const Person kTwinOfA{"4", kA.cloth, kA.offsets};  // another person, the same as A
+
+Dataset people(std::initializer_list<Person> ps) {
+  Dataset ds;
+  for (const Person& p : ps)
+    for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) ds.trials.push_back(trial_of(p, h));
+  return ds;
+}
+
+Calibration calibration_of(const Person& p) {
+  Calibration c;
+  c.participant = p.id;
+  c.cloth = p.cloth;
+  c.offsets = p.offsets;
+  c.offset_calibrated = {true, true, true};
+  return c;
+}
+
+const HapticSequence& find(const Dataset& ds, const std::string& id) {
+  for (const auto& t : ds.trials)
+    if (t.id == id) return t;
+  throw std::runtime_error("no trial " + id);
+}
+
+TEST(Prediction, TargetsAreTheOtherParticipantsLabelledTrialsWithoutCaught) {
+  Dataset ds = people({kA, kB});
+  ds.trials[3].label = Outcome::Caught;  // p2-high
+  ds.trials[4].label.reset();            // p2-middle: unlabelled
+  const auto t = prediction_targets(ds, "1");
+  ASSERT_EQ(t.size(), 1u);
+  EXPECT_EQ(t[0]->id, "p2-low");
+  EXPECT_TRUE(prediction_targets(people({kA}), "1").empty());
+  EXPECT_THROW(predict_others(calibration_of(kA), people({kA}), testing::fake_simulate, 1, Comm::world()), InputError);
+}
+
+// The calibrated simulator is person A; the targets are B's, C's and A's twin's trials. Each
+// simulated curve is A's own trial at that height, so its L is L(A's trial, target) to the bit;
+// the yardstick of a target is the one third person's trial (A is the calibrated one, excluded);
+// the twin's trials are predicted exactly (L = 0, the vertical force's sign everywhere).
+TEST(Prediction, ScoresEachTargetAgainstTheCalibratedPersonAndAThirdRealPerson) {
+  const Dataset ds = people({kA, kB, kC, kTwinOfA});
+  const Prediction p = predict_others(calibration_of(kA), ds, testing::fake_simulate, 2, Comm::world());
+  ASSERT_EQ(p.trials.size(), 9u);
+  for (const auto& t : p.trials) {
+    const HapticSequence& target = find(ds, t.trial_id);
+    const HapticSequence& own = find(ds, "p1-" + std::string(arm_height_name(t.height)));
+    EXPECT_EQ(t.objective, area_objective(own.samples, target.samples)) << t.trial_id;
+    EXPECT_EQ(t.simulated.size(), own.samples.size()) << t.trial_id;
+    EXPECT_EQ(t.simulated_end, own.samples.back().travel);
+    EXPECT_EQ(t.measured_end, target.samples.back().travel);
+    // Third persons: of B, C and the twin, the two that are not the target's.
+    std::vector<double> l;
+    for (const char* who : {"2", "3", "4"})
+      if (t.participant != who)
+        l.push_back(area_objective(find(ds, "p" + std::string(who) + "-" + std::string(arm_height_name(t.height))).samples,
+                                   target.samples));
+    EXPECT_EQ(t.real_count, 2);
+    EXPECT_DOUBLE_EQ(t.real_median, 0.5 * (l[0] + l[1])) << t.trial_id;
+    if (t.participant == "4") {
+      EXPECT_EQ(t.objective, 0.0) << t.trial_id;
+      if (!std::isnan(t.vertical_sign)) {
+        EXPECT_EQ(t.vertical_sign, 1.0) << t.trial_id;
+      }
+    }
+  }
+  // The twin is predicted exactly at every height, so the simulator is no worse than a real
+  // person on at least the twin's trial of each.
+  for (const auto& s : summarize(p)) {
+    EXPECT_EQ(s.trials, 3);
+    EXPECT_GE(s.no_worse, 1);
+  }
+}
+
+// run_batch's promise: the same results on one thread and on two.
+TEST(Prediction, SameResultsOnAnyThreadCount) {
+  const Dataset ds = people({kA, kB, kC});
+  const Prediction one = predict_others(calibration_of(kB), ds, testing::fake_simulate, 1, Comm::world());
+  const Prediction two = predict_others(calibration_of(kB), ds, testing::fake_simulate, 2, Comm::world());
+  EXPECT_EQ(prediction_csv(one), prediction_csv(two));
+  EXPECT_EQ(prediction_curves_csv(one, ds), prediction_curves_csv(two, ds));
+}
+
+// The measured vertical force is +1 N over its first 0.4 m and -1 N over the next 0.4 m; a
+// simulation of constant +0.5 N has its sign on half of that travel, one of -0.5 N on the other
+// half; a simulation that ends at 0.2 m is asked only about its own travel; a measurement that
+// never exceeds the threshold asks nothing.
+TEST(Objective, VerticalSignAgreementClosedForm) {
+  auto curve = [](double end, auto fv) {
+    std::vector<HapticSample> s;
+    for (int i = 0; i * 0.001 <= end + 1e-12; ++i) s.push_back({i * 0.01, i * 0.001, -1.0, 0.0, fv(i * 0.001)});
+    return s;
+  };
+  const auto measured = curve(0.8, [](double x) { return x < 0.4 ? 1.0 : -1.0; });
+  EXPECT_NEAR(vertical_sign_agreement(curve(0.8, [](double) { return 0.5; }), measured), 0.5, 2e-3);
+  EXPECT_NEAR(vertical_sign_agreement(curve(0.8, [](double) { return -0.5; }), measured), 0.5, 2e-3);
+  EXPECT_NEAR(vertical_sign_agreement(curve(0.8, [](double x) { return x < 0.4 ? 0.1 : -3.0; }), measured), 1.0, 1e-12);
+  EXPECT_NEAR(vertical_sign_agreement(curve(0.2, [](double) { return 0.5; }), measured), 1.0, 1e-12);
+  EXPECT_EQ(vertical_sign_agreement(curve(0.8, [](double) { return 0.0; }), measured), 0.0);
+  // The threshold: a measurement within +-0.2 N has no sign to agree with.
+  EXPECT_TRUE(std::isnan(vertical_sign_agreement(measured, curve(0.8, [](double) { return 0.15; }))));
+}
+
+// On the study's data the yardstick per target is the median over third persons' trials of the
+// same height; for participant 4 calibrated, each other participant's missed trial has 5 other
+// people's missed trials around it, and the pooled median is near the 0.55 for missed.
+TEST(Prediction, RealPersonYardstickOnTheStudy) {
+  const auto dir = study_dir();
+  if (dir.empty()) GTEST_SKIP() << "shared/data/kapusta2016-calibration-trials not present";
+  const Dataset ds = import_study(dir);
+  std::vector<double> medians;
+  for (const HapticSequence* t : prediction_targets(ds, "4")) {
+    if (t->height != ArmHeight::Low) continue;
+    const auto [median, count] = real_person_median(ds, *t, "4", ObjectiveKind::Area);
+    EXPECT_GE(count, 4) << t->id;
+    medians.push_back(median);
+  }
+  ASSERT_GE(medians.size(), 5u);
+  std::sort(medians.begin(), medians.end());
+  const double m = medians[medians.size() / 2];
+  std::printf("  missed: median of the per-trial real-person medians %.3f over %zu trials\n", m, medians.size());
+  EXPECT_GT(m, 0.3);
+  EXPECT_LT(m, 0.9);
+}
+
+}  // namespace
+}  // namespace dressguard::calib
