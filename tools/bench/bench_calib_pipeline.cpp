@@ -2,8 +2,11 @@
 //
 //   bench_calib_pipeline eval [--participants 0,1,...] [--generations G --population N]
 //                             [--per-height M] [--gown coarse|reduced|full] [--work DIR] [--threads T]
-//                             [--arm-compliance fit|fixed|C]
-//     Per participant P of the measured study: calibrate on P's 2-3 sequences, synthesize, train
+//                             [--arm-compliance fit|fixed|C] [--bounds FILE]
+//     Per participant P of the measured study: calibrate on P's 2-3 sequences (from the bounds
+//     file's initial values, default_bounds() without one); predict the other participants'
+//     measured trials with the calibrated simulator next to the real-person yardstick
+//     (prediction.h; DIR/predP.csv and .curves.csv); synthesize, train
 //     the STC; train the baseline classifier BC on the same measured sequences directly (paper
 //     VI-B.1; the study folder holds no caught trial, so BC has good and missed only); classify
 //     every measured trial of the other participants, whole and cut at 0.15/0.20/0.25/0.30 m of
@@ -39,6 +42,7 @@
 #include "calibration.h"
 #include "dataset.h"
 #include "files.h"
+#include "prediction.h"
 #include "sim_bridge.h"
 #include "stc.h"
 #include "synthesis.h"
@@ -150,6 +154,8 @@ int run_eval(const std::map<std::string, std::string>& a) {
     }
   }
   const fs::path work = get(a, "work", "calib-eval");
+  const std::string bounds_file = get(a, "bounds", "");
+  const Bounds bounds = bounds_file.empty() ? default_bounds() : read_bounds(bounds_file);
   const ClothSimulator sim = make_cloth_simulator(gown);
   std::printf("evaluation: %zu participants, calibration %d x %d, %d trials per height, gown %s, arm %s\n",
               chosen.size(), co.generations, co.population, so.per_height, gown.c_str(), arm.c_str());
@@ -177,6 +183,7 @@ int run_eval(const std::map<std::string, std::string>& a) {
     out.set("per_height", so.per_height);
     out.set("gown", gown);
     out.set("arm_compliance", arm);
+    out.set("bounds", bounds_file.empty() ? std::string("default") : bounds_file);
     write_file_atomic(work / "eval.json", out.dump() + "\n");
   };
   double sum_stc[5] = {}, sum_stc2[5] = {}, sum_bc[5] = {};
@@ -185,7 +192,7 @@ int run_eval(const std::map<std::string, std::string>& a) {
     const auto t0 = std::chrono::steady_clock::now();
     const auto inputs = select_inputs(ds, p, co.seed);
     ParameterSpace space;
-    space.bounds = default_bounds();
+    space.bounds = bounds;
     for (const auto& s : inputs) space.offset_heights.push_back(s.height);
     set_arm_compliance(space, arm);
     auto o = co;
@@ -206,6 +213,28 @@ int run_eval(const std::map<std::string, std::string>& a) {
     measure_axis_fits(cal.fits, inputs, curves);
     write_calibration(work / ("cal" + p + ".json"), cal);
     write_file_atomic(work / ("cal" + p + ".json.curves.csv"), overlay_csv(inputs, curves, "simulated"));
+    // The other participants' trials, predicted by this calibration (issue 4: L <= 0.6, no worse
+    // than another real person).
+    const Prediction pred = predict_others(cal, ds, sim.trial, co.threads, Comm::world());
+    write_file_atomic(work / ("pred" + p + ".csv"), prediction_csv(pred));
+    write_file_atomic(work / ("pred" + p + ".curves.csv"), prediction_curves_csv(pred, ds));
+    Json jpred = Json::array();
+    std::printf("     predicts the others:");
+    for (const auto& s : summarize(pred)) {
+      if (s.trials == 0) continue;
+      std::printf("  %s L %.2f (real %.2f, no worse %d/%d, Fv sign %.0f%%)", std::string(arm_height_name(s.height)).c_str(),
+                  s.objective_median, s.real_median, s.no_worse, s.trials, 100 * s.vertical_sign_median);
+      Json e = Json::object();
+      e.set("height", std::string(arm_height_name(s.height)));
+      e.set("trials", s.trials);
+      auto or_minus_one = [](double v) { return std::isfinite(v) ? v : -1.0; };  // JSON has no NaN
+      e.set("objective_median", or_minus_one(s.objective_median));
+      e.set("real_median", or_minus_one(s.real_median));
+      e.set("no_worse", s.no_worse);
+      e.set("vertical_sign_median", or_minus_one(s.vertical_sign_median));
+      jpred.push(e);
+    }
+    std::printf("\n");
     const fs::path synth = work / ("synth" + p);
     synthesize(cal, sim.trial, so, synth, Comm::world());
     const Dataset sd = load_dataset(synth);
@@ -262,6 +291,7 @@ int run_eval(const std::map<std::string, std::string>& a) {
     row.set("stc_both_forces_accuracy_whole_and_cuts", js2);
     row.set("bc_accuracy_whole_and_cuts", jb);
     row.set("seconds", seconds_since(t0));
+    row.set("prediction_of_others", jpred);
     row.set("stc_classes", stc_classes);
     int synth_labels[kOutcomeCount] = {};
     for (const auto* t : strain) synth_labels[static_cast<int>(*t->label)]++;
