@@ -39,6 +39,8 @@ int run_calibrate(int argc, char** argv) {
         "  --profile default|quick   default: 50 generations x 32 (the paper); quick: 6 x 8 (tests)\n"
         "  --generations N --population N   override the profile\n"
         "  --bounds FILE       'name lower upper [initial]' lines (offline/calib/README.md)\n"
+        "  --sigma0 S          CMA-ES's initial step in the unit box (default 0.3: a global search;\n"
+        "                      about 0.1 from initial values known to fit, e.g. another calibration's)\n"
         "  --seed S            input selection and CMA-ES (default 1); same seed, same result\n"
         "  --objective area|position-weighted   (default area: paper eq. 3-5)\n"
         "  --no-arm-offset     do not optimise the arm offsets (paper Fig. 9 comparison)\n"
@@ -56,7 +58,7 @@ int run_calibrate(int argc, char** argv) {
   }
   args.allow_only({"help", "json", "no-arm-offset", "data", "participant", "profile", "bounds", "seed", "out",
                    "checkpoint", "objective", "gown", "threads", "generations", "population",
-                   "stop-after-generations", "arm-compliance"});
+                   "stop-after-generations", "arm-compliance", "sigma0"});
   const std::string data = args.require("data");
   const std::string participant = args.require("participant");
   const std::string out = args.require("out");
@@ -68,6 +70,10 @@ int run_calibrate(int argc, char** argv) {
   o.generations = static_cast<int>(args.integer("generations", o.generations));
   o.population = static_cast<int>(args.integer("population", o.population));
   if (o.generations < 1 || o.population < 4) throw UsageError("need --generations >= 1 and --population >= 4");
+  if (const auto s0 = args.get("sigma0")) {
+    o.sigma0 = args.number("sigma0", o.sigma0);
+    if (!(o.sigma0 > 0 && o.sigma0 <= 1)) throw UsageError("--sigma0 must be in (0, 1], not '" + *s0 + "'");
+  }
   const long seed = args.integer("seed", 1);
   if (seed < 0) throw UsageError("--seed must be non-negative");
   o.seed = static_cast<std::uint64_t>(seed);

@@ -2,7 +2,7 @@
 //
 //   bench_calib_pipeline eval [--participants 0,1,...] [--generations G --population N]
 //                             [--per-height M] [--gown coarse|reduced|full] [--work DIR] [--threads T]
-//                             [--arm-compliance fit|fixed|C] [--bounds FILE]
+//                             [--arm-compliance fit|fixed|C] [--bounds FILE] [--sigma0 S]
 //     Per participant P of the measured study: calibrate on P's 2-3 sequences (from the bounds
 //     file's initial values, default_bounds() without one); predict the other participants'
 //     measured trials with the calibrated simulator next to the real-person yardstick
@@ -141,6 +141,7 @@ int run_eval(const std::map<std::string, std::string>& a) {
   co.generations = std::stoi(get(a, "generations", "50"));
   co.population = std::stoi(get(a, "population", "32"));
   co.threads = std::stoi(get(a, "threads", "0"));
+  co.sigma0 = std::stod(get(a, "sigma0", "0.3"));
   SynthesisOptions so;
   so.per_height = std::stoi(get(a, "per-height", "100"));
   so.threads = co.threads;
@@ -184,6 +185,7 @@ int run_eval(const std::map<std::string, std::string>& a) {
     out.set("gown", gown);
     out.set("arm_compliance", arm);
     out.set("bounds", bounds_file.empty() ? std::string("default") : bounds_file);
+    out.set("sigma0", co.sigma0);
     write_file_atomic(work / "eval.json", out.dump() + "\n");
   };
   double sum_stc[5] = {}, sum_stc2[5] = {}, sum_bc[5] = {};
