@@ -177,8 +177,9 @@ void measure_axis_fits(std::vector<SequenceFit>& fits, const std::vector<HapticS
 struct CalibrationResult {
   bool complete = false;          // false: stopped by stop_after_generations (resume later)
   int generations_done = 0;
-  long evaluations = 0;           // candidate evaluations (each = one simulation per sequence)
-  double objective = 0;           // L of the best candidate
+  long evaluations = 0;           // candidate evaluations (each = one simulation per sequence), the start's included
+  double objective = 0;           // L of the best candidate (the start, when no sample beat it)
+  double start_objective = 0;     // L of the start (the bounds' initial values)
   Eigen::VectorXd best_unit;      // in the unit box
   ClothValues cloth;
   std::array<double, 3> offsets{};  // [m] by ArmHeight
@@ -186,7 +187,8 @@ struct CalibrationResult {
   double elapsed_s = 0;
 };
 
-// Runs (or resumes from options.checkpoint) the calibration. Every rank of `comm` must call it
+// Runs (or resumes from options.checkpoint) the calibration. The start (the bounds' initial
+// values) is evaluated first, and is the result when no candidate of the search beats it. Every rank of `comm` must call it
 // with the same arguments; they evaluate shares of each generation and end with identical
 // results; only rank 0 writes the checkpoint and calls `progress`. A generation's tasks are its
 // candidates, each simulating all input sequences with one batch call; a one-trial simulator

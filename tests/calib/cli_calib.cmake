@@ -18,7 +18,7 @@ endfunction()
 expect_fail("calibrate without --data" "--data" calibrate --participant 1 --out ${WORK}/c.json)
 expect_fail("calibrate with an unknown objective" "--objective" calibrate --data ${WORK} --participant 1 --out ${WORK}/c.json --objective mse)
 expect_fail("calibrate with a typo option" "--sed" calibrate --data ${WORK} --participant 1 --out ${WORK}/c.json --sed 3)
-expect_fail("calibrate with a bad --sigma0" "--sigma0" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --sigma0 0
+expect_fail("calibrate with a bad --sigma0" "--sigma0" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --sigma0 0)
 expect_fail("calibrate with a bad --arm-compliance" "--arm-compliance" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --arm-compliance soft)
 expect_fail("calibrate on a missing dataset" "manifest.csv" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json)
 file(WRITE ${WORK}/bad.json "{\"format\": \"dressguard-calibration 1\",\n\"participant\": 4,\n}")
