@@ -53,6 +53,14 @@ if [ -f "$out/measured/manifest.csv" ]; then
       --sweep-out "$model/accuracy-vs-travel-$name" >/dev/null
   done
 fi
+if [ -f "$out/measured/manifest.csv" ]; then
+  # What the simulation gets wrong: the simulator of the default data on every measured trial
+  # (its height, speed and end of travel), scored with the paper's objective beside the median
+  # of the same objective between real people of that height, with the vertical force's sign.
+  "$dg" predict --calibration models/default-simulator.json --data "$out/measured" \
+    --out "$model/predict-default" | tail -3
+  /usr/bin/python3 tools/plot/calib_overlay.py predict "$model/predict-default" --out "$model/predict-default.png"
+fi
 echo "main-job: synthesized data, model and evaluation in $model"
 
 # Robot side (predictor/): the simulated trials as CAN traffic, and what the predictor would do

@@ -140,6 +140,8 @@ int run_calibrate(int argc, char** argv) {
   prov.set("generations", r.generations_done);
   prov.set("population", o.population);
   prov.set("evaluations", r.evaluations);
+  prov.set("start_objective", r.start_objective);
+  prov.set("sigma0", o.sigma0);
   prov.set("simulations", r.evaluations * static_cast<long>(inputs.size()));
   prov.set("ranks", comm.size());
   prov.set("threads_per_rank", thread_count(o.threads));
@@ -165,8 +167,9 @@ int run_calibrate(int argc, char** argv) {
     if (args.has("json")) {
       std::printf("%s\n", calibration_to_json(cal).dump(0).c_str());
     } else {
-      std::printf("participant %s: L = %.4f after %d generations (%ld evaluations, %s)\n", participant.c_str(),
-                  r.objective, r.generations_done, r.evaluations, minutes(r.elapsed_s).c_str());
+      std::printf("participant %s: L = %.4f after %d generations (%ld evaluations, %s; the start's L %.4f)\n",
+                  participant.c_str(), r.objective, r.generations_done, r.evaluations, minutes(r.elapsed_s).c_str(),
+                  r.start_objective);
       for (const auto& f : cal.fits)
         std::printf("  %-18s %-6s L = %.4f; over the common travel F_motion %.3f (zero force %.3f), F_vertical %.3f "
                     "(zero force %.3f) N m\n", f.trial_id.c_str(), std::string(arm_height_name(f.height)).c_str(),

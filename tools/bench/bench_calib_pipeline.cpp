@@ -294,6 +294,7 @@ int run_eval(const std::map<std::string, std::string>& a) {
     row.set("bc_accuracy_whole_and_cuts", jb);
     row.set("seconds", seconds_since(t0));
     row.set("prediction_of_others", jpred);
+    row.set("start_objective", r.start_objective);
     row.set("stc_classes", stc_classes);
     int synth_labels[kOutcomeCount] = {};
     for (const auto* t : strain) synth_labels[static_cast<int>(*t->label)]++;

@@ -11,8 +11,8 @@ Two modes:
             as in Fig. 7 and 8.
   predict:  calib_overlay.py predict PREFIX --out predict.png
             `dressguard predict --out PREFIX`: per arm height, the other participants' measured
-            curves (solid, one colour per trial) with the calibrated simulator's curve of each
-            (dashed, same colour), and per trial the simulator's L against the median L of a real
+            curves (one colour per trial) with the calibrated simulator's curve of each (black,
+            dashed), and per trial the simulator's L against the median L of a real
             third person (the yardstick; below the diagonal: no worse than a real person).
 Reads only the CSVs that dressguard writes (calibrate's curves file; dataset folders).
 """
@@ -112,13 +112,15 @@ def plot_predict(args):
         mine = [r for r in rows if r["height"] == h]
         for k, r in enumerate(mine):
             color = plt.cm.tab10(k % 10)
+            # The simulated curves of one height are one pull cut at each trial's end of travel
+            # (or at another speed): drawn in black, so the measured ones stay apart.
             for col, idx in enumerate((1, 2)):
-                for src, ls in (("measured", "-"), ("simulated", "--")):
+                for src, c, ls, lw in (("measured", color, "-", 1.1), ("simulated", "black", "--", 1.4)):
                     pts = curves[r["trial_id"]][src]
-                    axes[i][col].plot([p[0] for p in pts], [p[idx] for p in pts], color=color, ls=ls, lw=1.1,
+                    axes[i][col].plot([p[0] for p in pts], [p[idx] for p in pts], color=c, ls=ls, lw=lw,
                                       label=r["trial_id"] if src == "measured" and col == 0 else None)
         for col, name in enumerate(("F_motion [N]", "F_vertical [N]")):
-            axes[i][col].set_title(f"{h} arm: measured (solid), simulated (dashed)")
+            axes[i][col].set_title(f"{h} arm: measured (colours), simulated (black, dashed)")
             axes[i][col].set_xlabel("travel [m]")
             axes[i][col].set_ylabel(name)
             axes[i][col].grid(alpha=0.3)
