@@ -58,7 +58,7 @@ if [ -f "$out/measured/manifest.csv" ]; then
   # (its height, speed and end of travel), scored with the paper's objective beside the median
   # of the same objective between real people of that height, with the vertical force's sign.
   "$dg" predict --calibration models/default-simulator.json --data "$out/measured" \
-    --out "$model/predict-default" | tail -3
+    --out "$model/predict-default" | tail -4
   /usr/bin/python3 tools/plot/calib_overlay.py predict "$model/predict-default" --out "$model/predict-default.png"
 fi
 echo "main-job: synthesized data, model and evaluation in $model"

@@ -63,7 +63,7 @@ int run_predict(int argc, char** argv) {
 #else
   const Comm& comm = Comm::world();
   if (comm.is_root())
-    std::fprintf(stderr, "predict: participant %s's calibration on %zu trials of the others, gown %s\n",
+    std::fprintf(stderr, "predict: the calibration of participant '%s' on %zu trials of other participants, gown %s\n",
                  cal.participant.c_str(), prediction_targets(ds, cal.participant).size(), gown.c_str());
   const Prediction p = predict_others(cal, ds, make_cloth_simulator(gown).trial, threads, comm);
   if (!comm.is_root()) return 0;
@@ -87,7 +87,7 @@ int run_predict(int argc, char** argv) {
     std::printf("]}\n");
     return 0;
   }
-  std::printf("participant %s's calibrated simulator on %zu trials of the others (L: %s objective)\n",
+  std::printf("the simulator calibrated on participant '%s', on %zu trials of other participants (L: %s objective)\n",
               p.participant.c_str(), p.trials.size(), cal.objective_kind.c_str());
   std::printf("  %-18s %-6s %8s %12s %10s %9s %9s  %s\n", "trial", "height", "L sim", "L real (med)", "Fv sign",
               "sim end", "meas end", "sim label");
