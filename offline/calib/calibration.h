@@ -85,7 +85,8 @@ struct Bounds {
   ParamBound arm_compliance;  // [m/N], when ParameterSpace::fit_arm_compliance
 };
 // Defaults (the simulator's box, sim/trial.h ClothParams): stretch, shear, bend in [0, 1] (start
-// 0.8, 0.5, 0.5); friction and self_friction in [0, 2] (start 0.5, 0.2); arm offset in
+// 0.2, 0.5, 0.7); friction and self_friction in [0, 2] (start 0.35, 0.2): the plausibility grid's
+// best point against participant 4, see calibration.cpp; arm offset in
 // [-0.06, 0.06] m (start 0): the study's middle noise spans 6 cm (paper V-A), and the paper's
 // calibrated offset for participant 4 was -0.02 m; arm compliance in [0, 0.01] m/N (start
 // 0.004): a stiffness of 100 N/m and up, the hand's postural stiffness being about 300-800 N/m
