@@ -55,16 +55,17 @@ int run_predict(int argc, char** argv) {
   const std::string gown = args.get("gown").value_or(cal.gown);
   if (gown != "full" && gown != "reduced" && gown != "coarse") throw UsageError("--gown must be full, reduced or coarse");
   const Dataset ds = load_dataset(data);
-  if (prediction_targets(ds, cal.participant).empty())
+  const std::size_t targets = prediction_targets(ds, cal.participant).size();
+  if (targets == 0)
     throw InputError(data + ": no labelled, non-caught trial of a participant other than '" + cal.participant + "'");
 #ifndef DRESSGUARD_HAVE_SIM
-  (void)threads;
+  (void)threads, (void)targets;
   throw UsageError("this dressguard was built without the cloth simulator (offline/sim); predict needs it");
 #else
   const Comm& comm = Comm::world();
   if (comm.is_root())
     std::fprintf(stderr, "predict: the calibration of participant '%s' on %zu trials of other participants, gown %s\n",
-                 cal.participant.c_str(), prediction_targets(ds, cal.participant).size(), gown.c_str());
+                 cal.participant.c_str(), targets, gown.c_str());
   const Prediction p = predict_others(cal, ds, make_cloth_simulator(gown).trial, threads, comm);
   if (!comm.is_root()) return 0;
   if (const auto prefix = args.get("out")) {

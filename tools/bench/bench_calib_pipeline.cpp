@@ -221,6 +221,7 @@ int run_eval(const std::map<std::string, std::string>& a) {
     write_file_atomic(work / ("pred" + p + ".csv"), prediction_csv(pred));
     write_file_atomic(work / ("pred" + p + ".curves.csv"), prediction_curves_csv(pred, ds));
     Json jpred = Json::array();
+    auto or_minus_one = [](double v) { return std::isfinite(v) ? v : -1.0; };  // JSON has no NaN
     std::printf("     predicts the others:");
     for (const auto& s : summarize(pred)) {
       if (s.trials == 0) continue;
@@ -229,7 +230,6 @@ int run_eval(const std::map<std::string, std::string>& a) {
       Json e = Json::object();
       e.set("height", std::string(arm_height_name(s.height)));
       e.set("trials", s.trials);
-      auto or_minus_one = [](double v) { return std::isfinite(v) ? v : -1.0; };  // JSON has no NaN
       e.set("objective_median", or_minus_one(s.objective_median));
       e.set("real_median", or_minus_one(s.real_median));
       e.set("no_worse", s.no_worse);
