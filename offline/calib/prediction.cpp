@@ -54,36 +54,59 @@ std::pair<double, int> real_person_median(const Dataset& ds, const HapticSequenc
 
 Prediction predict_others(const Calibration& cal, const Dataset& ds, const TrialSimulator& sim, int threads,
                           const Comm& comm) {
+  return predict_others(cal, ds, one_by_one(sim), threads, comm);
+}
+
+Prediction predict_others(const Calibration& cal, const Dataset& ds, const TrialBatchSimulator& sim, int threads,
+                          const Comm& comm) {
   const std::vector<const HapticSequence*> targets = prediction_targets(ds, cal.participant);
   if (targets.empty())
     throw InputError("the dataset holds no labelled, non-caught trial of a participant other than '" +
                      cal.participant + "' to predict");
   const ObjectiveKind kind = parse_objective(cal.objective_kind).value_or(ObjectiveKind::Area);
   const int n = static_cast<int>(targets.size());
-  const std::vector<double> out = run_batch(n, kBlock, threads, comm, [&](int k, double* b) {
-    const HapticSequence& target = *targets[static_cast<std::size_t>(k)];
-    const SimulatedTrial st = sim(cal.cloth, request_for(target, cal.offsets));
-    if (st.samples.empty() || static_cast<int>(st.samples.size()) > kMaxSamples)
-      throw std::logic_error("predict_others: a simulated pull of " + std::to_string(st.samples.size()) + " samples");
-    b[kObjective] = st.finite ? sequence_objective(kind, st.samples, target.samples)
-                              : std::numeric_limits<double>::infinity();
-    b[kSign] = vertical_sign_agreement(st.samples, target.samples);
-    b[kSimEnd] = st.samples.back().travel;
-    b[kOutcome] = static_cast<double>(static_cast<int>(st.outcome));
-    b[kCount] = static_cast<double>(st.samples.size());
-    double* col = b + kColumns;
-    for (std::size_t i = 0; i < st.samples.size(); ++i) {
-      col[i] = st.samples[i].t;
-      col[kMaxSamples + i] = st.samples[i].travel;
-      col[2 * kMaxSamples + i] = st.samples[i].f_motion;
-      col[3 * kMaxSamples + i] = st.samples[i].f_vertical;
+  // Group g holds targets g, g + G, g + 2G, ...: a mix of heights and speeds in each, so that the
+  // groups cost about the same. Any G gives the same results (the batch simulator's contract).
+  const int groups = std::min(n, thread_count(threads) * comm.size());
+  const int per_group = (n + groups - 1) / groups;
+  const std::vector<double> out = run_batch(groups, per_group * kBlock, threads, comm, [&](int g, double* group_block) {
+    std::vector<int> members;
+    std::vector<TrialRequest> requests;
+    for (int k = g; k < n; k += groups) {
+      members.push_back(k);
+      requests.push_back(request_for(*targets[static_cast<std::size_t>(k)], cal.offsets));
+    }
+    const std::vector<SimulatedTrial> sims = sim(cal.cloth, requests);
+    if (sims.size() != requests.size())
+      throw std::logic_error("predict_others: the batch simulator returned " + std::to_string(sims.size()) +
+                             " trials for " + std::to_string(requests.size()));
+    for (std::size_t j = 0; j < members.size(); ++j) {
+      const HapticSequence& target = *targets[static_cast<std::size_t>(members[j])];
+      const SimulatedTrial& st = sims[j];
+      if (st.samples.empty() || static_cast<int>(st.samples.size()) > kMaxSamples)
+        throw std::logic_error("predict_others: a simulated pull of " + std::to_string(st.samples.size()) + " samples");
+      double* b = group_block + j * kBlock;
+      b[kObjective] = st.finite ? sequence_objective(kind, st.samples, target.samples)
+                                : std::numeric_limits<double>::infinity();
+      b[kSign] = vertical_sign_agreement(st.samples, target.samples);
+      b[kSimEnd] = st.samples.back().travel;
+      b[kOutcome] = static_cast<double>(static_cast<int>(st.outcome));
+      b[kCount] = static_cast<double>(st.samples.size());
+      double* col = b + kColumns;
+      for (std::size_t i = 0; i < st.samples.size(); ++i) {
+        col[i] = st.samples[i].t;
+        col[kMaxSamples + i] = st.samples[i].travel;
+        col[2 * kMaxSamples + i] = st.samples[i].f_motion;
+        col[3 * kMaxSamples + i] = st.samples[i].f_vertical;
+      }
     }
   });
   Prediction p;
   p.participant = cal.participant;
   for (int k = 0; k < n; ++k) {
     const HapticSequence& target = *targets[static_cast<std::size_t>(k)];
-    const double* b = out.data() + static_cast<std::size_t>(k) * kBlock;
+    // Target k is member k / groups of group k % groups.
+    const double* b = out.data() + (static_cast<std::size_t>(k % groups) * per_group + k / groups) * kBlock;
     PredictedTrial t;
     t.trial_id = target.id;
     t.participant = target.participant;

@@ -57,9 +57,15 @@ struct PredictionSummary {
 // `calibrated`. Empty when there is none.
 std::vector<const HapticSequence*> prediction_targets(const Dataset& ds, const std::string& calibrated);
 
-// Simulates every target with `cal`'s parameters (one simulation each, spread over threads and
-// ranks as run_batch does: the same bits on any count) and scores it. Throws InputError when the
-// dataset holds no trial of another participant to predict.
+// Simulates every target with `cal`'s parameters and scores it. The targets are dealt round-robin
+// into one group per thread and rank (run_batch spreads the groups), and each group goes to the
+// batch simulator at once, so that the cloth simulator settles the gown once per group instead of
+// once per target (sim::simulate_trials, the same bits as one at a time): the results do not
+// depend on the thread or rank count. Throws InputError when the dataset holds no trial of
+// another participant to predict.
+Prediction predict_others(const Calibration& cal, const Dataset& ds, const TrialBatchSimulator& sim, int threads,
+                          const Comm& comm);
+// The same with a one-trial simulator (one_by_one).
 Prediction predict_others(const Calibration& cal, const Dataset& ds, const TrialSimulator& sim, int threads,
                           const Comm& comm);
 

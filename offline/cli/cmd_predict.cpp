@@ -66,7 +66,7 @@ int run_predict(int argc, char** argv) {
   if (comm.is_root())
     std::fprintf(stderr, "predict: the calibration of participant '%s' on %zu trials of other participants, gown %s\n",
                  cal.participant.c_str(), targets, gown.c_str());
-  const Prediction p = predict_others(cal, ds, make_cloth_simulator(gown).trial, threads, comm);
+  const Prediction p = predict_others(cal, ds, make_cloth_simulator(gown).trials, threads, comm);
   if (!comm.is_root()) return 0;
   if (const auto prefix = args.get("out")) {
     write_file_atomic(*prefix + ".csv", prediction_csv(p));

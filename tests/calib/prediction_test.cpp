@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <algorithm>
 #include <map>
+#include <mutex>
 
 #include "dataset.h"
 #include "fake_sim.h"
@@ -122,6 +124,33 @@ TEST(Prediction, SameResultsOnAnyThreadCount) {
   const Prediction two = predict_others(calibration_of(kB), ds, testing::fake_simulate, 2, Comm::world());
   EXPECT_EQ(prediction_csv(one), prediction_csv(two));
   EXPECT_EQ(prediction_curves_csv(one, ds), prediction_curves_csv(two, ds));
+}
+
+// The batch form: the targets go to the batch simulator in one group per thread, dealt
+// round-robin, and every figure is the one-by-one simulator's, whatever the count (6 targets on
+// 4 threads: groups of 2, 2, 1, 1).
+TEST(Prediction, GroupsPerThreadGiveTheOneByOneResults) {
+  const Dataset ds = people({kA, kB, kC});
+  const Prediction ref = predict_others(calibration_of(kB), ds, testing::fake_simulate, 1, Comm::world());
+  for (int threads : {1, 2, 4}) {
+    std::mutex mu;
+    std::vector<std::size_t> sizes;
+    const TrialBatchSimulator batch = [&](const ClothValues& c, const std::vector<TrialRequest>& rs) {
+      {
+        std::lock_guard<std::mutex> lock(mu);
+        sizes.push_back(rs.size());
+      }
+      return one_by_one(testing::fake_simulate)(c, rs);
+    };
+    const Prediction p = predict_others(calibration_of(kB), ds, batch, threads, Comm::world());
+    EXPECT_EQ(prediction_csv(p), prediction_csv(ref)) << threads << " threads";
+    EXPECT_EQ(prediction_curves_csv(p, ds), prediction_curves_csv(ref, ds)) << threads << " threads";
+    std::sort(sizes.begin(), sizes.end());
+    const std::vector<std::size_t> expected = threads == 1   ? std::vector<std::size_t>{6}
+                                              : threads == 2 ? std::vector<std::size_t>{3, 3}
+                                                             : std::vector<std::size_t>{1, 1, 2, 2};
+    EXPECT_EQ(sizes, expected) << threads << " threads";
+  }
 }
 
 // The measured vertical force is +1 N over its first 0.4 m and -1 N over the next 0.4 m; a

@@ -2,9 +2,12 @@
 // dg_sim is. Kept small (coarse gown, one generation of 4): each simulation costs seconds.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <thread>
 
 #include "calibration.h"
+#include "fake_sim.h"
+#include "prediction.h"
 #include "sim_bridge.h"
 
 namespace dressguard::calib {
@@ -44,6 +47,40 @@ TEST(SimCalibration, BridgeIsDeterministicAcrossThreads) {
   for (std::size_t i = 0; i < a.samples.size(); ++i) EXPECT_EQ(ab[0].samples[i].f_motion, a.samples[i].f_motion);
   for (std::size_t i = 0; i < h.samples.size(); ++i) EXPECT_EQ(ab[1].samples[i].f_vertical, h.samples[i].f_vertical);
   EXPECT_EQ(ab[1].outcome, h.outcome);
+}
+
+// The prediction of other people through the batch form (one settling per group of targets)
+// gives the one-trial form's bits. The targets are three trials of another person, one per arm
+// height, cut at 0.15 m so that the pulls are short; their curves come from the stand-in
+// (only their heights, speeds and ends of travel reach the simulator).
+TEST(SimCalibration, PredictionWithSharedSettlingHasTheSameBits) {
+  const ClothSimulator both = make_cloth_simulator("coarse");
+  Dataset ds;
+  for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
+    TrialRequest r;
+    r.height = h;
+    r.max_travel = 0.15;
+    HapticSequence s;
+    s.id = "p2-" + std::string(arm_height_name(h));
+    s.participant = "2";
+    s.height = h;
+    s.speed = r.speed;
+    s.label = h == ArmHeight::High ? Outcome::Good : Outcome::Missed;
+    s.samples = testing::fake_simulate(ClothValues{}, r).samples;
+    ds.trials.push_back(std::move(s));
+  }
+  Calibration cal;
+  cal.participant = "1";
+  cal.offsets = {0.01, 0.0, -0.01};
+  const Prediction shared = predict_others(cal, ds, both.trials, 1, Comm::world());
+  const Prediction single = predict_others(cal, ds, both.trial, 1, Comm::world());
+  ASSERT_EQ(shared.trials.size(), 3u);
+  for (const PredictedTrial& t : shared.trials) {
+    EXPECT_NEAR(t.simulated_end, 0.15, 0.002) << t.trial_id;  // the targets' travel reached the simulator
+    EXPECT_TRUE(std::isfinite(t.objective)) << t.trial_id;
+  }
+  EXPECT_EQ(prediction_csv(shared), prediction_csv(single));
+  EXPECT_EQ(prediction_curves_csv(shared, ds), prediction_curves_csv(single, ds));
 }
 
 // One generation on participant 4's sequences (the paper's public code calibrated on the same

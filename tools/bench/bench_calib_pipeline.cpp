@@ -23,7 +23,9 @@
 //     Wall time per simulation and of a G x N calibration of participant 4, with the final
 //     objective, and the projection to the paper's 50 x 32 budget from the measured pace. Under
 //     mpirun (e.g. -n 1 and -n 2 with --threads 1) the calibration's wall time gives the MPI
-//     scaling efficiency T1 / (2 T2).
+//     scaling efficiency T1 / (2 T2). --baseline 1: the calibration once more with every trial
+//     settled on its own; --predict 1: the calibration's prediction of the other participants'
+//     trials with one settling per group of targets against one per target (same tables required).
 //
 // Everything runs through dg_calib's public API (the same code as the commands).
 #include <algorithm>
@@ -217,7 +219,7 @@ int run_eval(const std::map<std::string, std::string>& a) {
     write_file_atomic(work / ("cal" + p + ".json.curves.csv"), overlay_csv(inputs, curves, "simulated"));
     // The other participants' trials, predicted by this calibration (issue 4: L <= 0.6, no worse
     // than another real person).
-    const Prediction pred = predict_others(cal, ds, sim.trial, co.threads, Comm::world());
+    const Prediction pred = predict_others(cal, ds, sim.trials, co.threads, Comm::world());
     write_file_atomic(work / ("pred" + p + ".csv"), prediction_csv(pred));
     write_file_atomic(work / ("pred" + p + ".curves.csv"), prediction_curves_csv(pred, ds));
     Json jpred = Json::array();
@@ -369,6 +371,27 @@ int run_timing(const std::map<std::string, std::string>& a) {
                 "%.2fx faster; same result: %s\n", base_s, base_s / sims, base_s / cal_s, same ? "yes" : "NO");
   std::printf("projection to the paper's 50 x 32 (%.0f simulations) at this pace: %.1f h wall on this machine\n",
               full_sims, cal_s / sims * full_sims / 3600.0);
+  // --predict 1: the calibration just found predicts the other participants' trials (dressguard
+  // predict), with the targets in groups that settle once (the default) and, as the same run's
+  // baseline, every target settled on its own; the same tables, byte for byte, are required.
+  if (get(a, "predict", "0") == "1") {
+    Calibration cal;
+    cal.participant = "4";
+    cal.cloth = r.cloth;
+    cal.offsets = r.offsets;
+    t0 = std::chrono::steady_clock::now();
+    const Prediction grouped = predict_others(cal, ds, sim.trials, o.threads, Comm::world());
+    const double grouped_s = seconds_since(t0);
+    t0 = std::chrono::steady_clock::now();
+    const Prediction single = predict_others(cal, ds, sim.trial, o.threads, Comm::world());
+    const double single_s = seconds_since(t0);
+    const bool same_tables = prediction_csv(grouped) == prediction_csv(single) &&
+                             prediction_curves_csv(grouped, ds) == prediction_curves_csv(single, ds);
+    std::printf("predict, %zu trials of the other participants on %d thread(s): %.1f s wall with one settling per "
+                "group, %.1f s with one per trial (baseline): %.2fx faster; same tables: %s\n", grouped.trials.size(),
+                thread_count(o.threads), grouped_s, single_s, single_s / grouped_s, same_tables ? "yes" : "NO");
+    if (!same_tables) return 1;
+  }
   return 0;
 }
 
