@@ -56,10 +56,12 @@ fi
 if [ -f "$out/measured/manifest.csv" ]; then
   # What the simulation gets wrong: the simulator of the default data on every measured trial
   # (its height, speed and end of travel), scored with the paper's objective beside the median
-  # of the same objective between real people of that height, with the vertical force's sign.
+  # of the same objective between real people of that height, with the vertical force's sign,
+  # and the travel windows where it is further from the people's mean than they are from each other.
   "$dg" predict --calibration models/default-simulator.json --data "$out/measured" \
-    --out "$model/predict-default" | tail -4
+    --out "$model/predict-default" | sed -n '/median L/,$p'
   /usr/bin/python3 tools/plot/calib_overlay.py predict "$model/predict-default" --out "$model/predict-default.png"
+  /usr/bin/python3 tools/plot/calib_overlay.py residual "$model/predict-default" --out "$model/residual-default.png"
 fi
 echo "main-job: synthesized data, model and evaluation in $model"
 

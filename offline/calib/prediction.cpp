@@ -175,4 +175,154 @@ std::string prediction_curves_csv(const Prediction& p, const Dataset& ds) {
   return o.str();
 }
 
+// ---- the residual over travel ----------------------------------------------------------------------
+
+bool ResidualWindow::outside(int axis) const {
+  const double r = residual(axis);
+  return trials >= kResidualMinTrials && std::isfinite(r) && std::fabs(r) > std::max(spread[axis], kResidualFloor);
+}
+
+namespace {
+
+// Mean F_motion and F_vertical of the samples with from <= travel < to; false when there is none.
+bool window_mean(const std::vector<HapticSample>& s, double from, double to, double out[2]) {
+  double sum[2] = {0, 0};
+  int n = 0;
+  for (const auto& x : s)
+    if (x.travel >= from && x.travel < to) {
+      sum[0] += x.f_motion;
+      sum[1] += x.f_vertical;
+      ++n;
+    }
+  if (n == 0) return false;
+  out[0] = sum[0] / n;
+  out[1] = sum[1] / n;
+  return true;
+}
+
+const HapticSequence* find_trial(const Dataset& ds, const std::string& id) {
+  for (const auto& t : ds.trials)
+    if (t.id == id) return &t;
+  return nullptr;
+}
+
+}  // namespace
+
+std::vector<ResidualWindow> residual_windows(const Prediction& p, const Dataset& ds, double window) {
+  if (!(window > 0)) throw std::invalid_argument("residual_windows: the window must be positive");
+  struct Pair {
+    ArmHeight height;
+    const std::vector<HapticSample>* measured;
+    const std::vector<HapticSample>* simulated;
+  };
+  std::vector<Pair> pairs;
+  double longest = 0;
+  for (const auto& t : p.trials) {
+    const HapticSequence* m = find_trial(ds, t.trial_id);
+    if (m == nullptr || m->samples.empty() || t.simulated.empty()) continue;
+    pairs.push_back({t.height, &m->samples, &t.simulated});
+    longest = std::max(longest, m->samples.back().travel);
+  }
+  // Window k is [k w, (k + 1) w): computed from k, not accumulated, so the edges are exact
+  // multiples and every height's windows line up.
+  const int count = static_cast<int>(std::ceil(longest / window - 1e-9));
+  std::vector<ResidualWindow> out;
+  for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
+    if (std::none_of(pairs.begin(), pairs.end(), [&](const Pair& q) { return q.height == h; })) continue;
+    for (int k = 0; k < count; ++k) {
+      ResidualWindow w;
+      w.height = h;
+      w.from = k * window;
+      w.to = (k + 1) * window;
+      std::vector<double> meas[2];
+      double sim_sum[2] = {0, 0};
+      for (const Pair& q : pairs) {
+        if (q.height != h || q.measured->back().travel < w.to || q.simulated->back().travel < w.to) continue;
+        double a[2], b[2];
+        if (!window_mean(*q.measured, w.from, w.to, a) || !window_mean(*q.simulated, w.from, w.to, b)) continue;
+        for (int ax = 0; ax < 2; ++ax) {
+          meas[ax].push_back(a[ax]);
+          sim_sum[ax] += b[ax];
+        }
+      }
+      w.trials = static_cast<int>(meas[0].size());
+      for (int ax = 0; ax < 2; ++ax) {
+        if (w.trials == 0) {
+          w.measured[ax] = w.spread[ax] = w.simulated[ax] = kNaN;
+          continue;
+        }
+        double mean = 0;
+        for (double v : meas[ax]) mean += v;
+        mean /= w.trials;
+        double ss = 0;
+        for (double v : meas[ax]) ss += (v - mean) * (v - mean);
+        w.measured[ax] = mean;
+        w.spread[ax] = w.trials > 1 ? std::sqrt(ss / (w.trials - 1)) : kNaN;
+        w.simulated[ax] = sim_sum[ax] / w.trials;
+      }
+      out.push_back(w);
+    }
+  }
+  return out;
+}
+
+std::vector<ResidualFinding> residual_findings(const std::vector<ResidualWindow>& windows) {
+  std::vector<ResidualFinding> out;
+  for (int ax = 0; ax < 2; ++ax) {
+    std::size_t i = 0;
+    while (i < windows.size()) {
+      const ResidualWindow& a = windows[i];
+      if (!a.outside(ax)) {
+        ++i;
+        continue;
+      }
+      // Extend the run over the following windows of the same height, outside, same sign.
+      std::size_t j = i + 1;
+      while (j < windows.size() && windows[j].height == a.height && windows[j].outside(ax) &&
+             (windows[j].residual(ax) > 0) == (a.residual(ax) > 0) && std::fabs(windows[j].from - windows[j - 1].to) < 1e-9)
+        ++j;
+      ResidualFinding f;
+      f.height = a.height;
+      f.axis = ax;
+      f.from = a.from;
+      f.to = windows[j - 1].to;
+      f.trials = a.trials;
+      for (std::size_t k = i; k < j; ++k) {
+        f.residual += windows[k].residual(ax) / static_cast<double>(j - i);
+        f.measured += windows[k].measured[ax] / static_cast<double>(j - i);
+        f.spread += windows[k].spread[ax] / static_cast<double>(j - i);
+        f.trials = std::min(f.trials, windows[k].trials);
+      }
+      const char* what = ax == 0 ? (f.residual > 0 ? "too little drag" : "too much drag")
+                                 : (f.residual > 0 ? "pulls the gripper up too much" : "pulls the gripper down too much");
+      char buf[256];
+      std::snprintf(buf, sizeof buf, "%s arm, %s, %.2f-%.2f m: %s, simulated %+.2f N from the people's mean %.2f N "
+                    "(their spread %.2f N, %d trials)", std::string(arm_height_name(f.height)).c_str(),
+                    ax == 0 ? "F_motion" : "F_vertical", f.from, f.to, what, f.residual, f.measured, f.spread, f.trials);
+      f.text = buf;
+      out.push_back(f);
+      i = j;
+    }
+  }
+  std::stable_sort(out.begin(), out.end(), [](const ResidualFinding& x, const ResidualFinding& y) {
+    return std::fabs(x.residual) * (x.to - x.from) > std::fabs(y.residual) * (y.to - y.from);
+  });
+  return out;
+}
+
+std::string residual_csv(const std::vector<ResidualWindow>& windows) {
+  std::ostringstream o;
+  o.precision(7);
+  o << "height,from,to,trials,measured_motion,spread_motion,simulated_motion,residual_motion,outside_motion,"
+       "measured_vertical,spread_vertical,simulated_vertical,residual_vertical,outside_vertical\n";
+  for (const auto& w : windows) {
+    o << arm_height_name(w.height) << ',' << w.from << ',' << w.to << ',' << w.trials;
+    for (int ax = 0; ax < 2; ++ax)
+      o << ',' << w.measured[ax] << ',' << w.spread[ax] << ',' << w.simulated[ax] << ',' << w.residual(ax) << ','
+        << (w.outside(ax) ? 1 : 0);
+    o << '\n';
+  }
+  return o.str();
+}
+
 }  // namespace dressguard::calib

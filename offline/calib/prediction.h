@@ -84,4 +84,55 @@ std::vector<PredictionSummary> summarize(const Prediction& p);
 std::string prediction_csv(const Prediction& p);
 std::string prediction_curves_csv(const Prediction& p, const Dataset& ds);
 
+// ---- what the simulation gets wrong: the residual over travel ------------------------------------
+//
+// L says how far a prediction is off; the residual says where and which way. Per height and
+// travel window [from, to), over the predicted trials whose measured and simulated curves both
+// reach `to`: each trial's mean force over the window (samples with from <= travel < to), then
+// over those trials the measured mean, the people's spread (the sample standard deviation of
+// the measured window means: how much the real people differ from each other there) and the
+// simulated mean. residual = simulated - measured; F_motion is negative for drag, so a positive
+// F_motion residual is too little drag, and a positive F_vertical one too much upward force on
+// the gripper (or too little downward).
+//
+// A window is *outside* the people when at least kResidualMinTrials trials cover it and
+// |residual| exceeds both the people's spread and kResidualFloor: there the simulated mean is
+// further from the measured mean than a typical person is. (The floor keeps windows where every
+// person measures nearly the same, 0.02-0.05 N apart at the start of a pull, from flagging
+// differences of the size of the sensor's drift; it is six times the sensor's noise, 0.017 N.)
+inline constexpr int kResidualMinTrials = 3;
+inline constexpr double kResidualFloor = 0.1;  // [N]
+
+struct ResidualWindow {
+  ArmHeight height = ArmHeight::High;
+  double from = 0, to = 0;  // [m] travel
+  int trials = 0;
+  // [0] F_motion, [1] F_vertical; NaN when no trial covers the window
+  double measured[2] = {0, 0}, spread[2] = {0, 0}, simulated[2] = {0, 0};
+  double residual(int axis) const { return simulated[axis] - measured[axis]; }
+  bool outside(int axis) const;
+};
+
+// The windows of every height that has predicted trials, `window` metres wide from travel 0 to
+// the longest measured travel (windows no trial covers have trials = 0). Throws
+// std::invalid_argument for a window that is not positive.
+std::vector<ResidualWindow> residual_windows(const Prediction& p, const Dataset& ds, double window = 0.05);
+
+// Runs of consecutive outside windows of one height and axis whose residuals share a sign, as
+// findings: the run's travel, its mean residual, measured mean and spread (means over the run's
+// windows), the fewest trials of its windows, and one line of text. Sorted by |residual| times
+// the run's length (its share of eq. 3's area), largest first.
+struct ResidualFinding {
+  ArmHeight height = ArmHeight::High;
+  int axis = 0;  // 0 F_motion, 1 F_vertical
+  double from = 0, to = 0, residual = 0, measured = 0, spread = 0;
+  int trials = 0;
+  std::string text;
+};
+std::vector<ResidualFinding> residual_findings(const std::vector<ResidualWindow>& windows);
+
+// CSV: height,from,to,trials, then measured/spread/simulated/residual/outside for F_motion and for
+// F_vertical (tools/plot/calib_overlay.py residual).
+std::string residual_csv(const std::vector<ResidualWindow>& windows);
+
 }  // namespace dressguard::calib

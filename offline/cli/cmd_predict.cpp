@@ -39,18 +39,25 @@ int run_predict(int argc, char** argv) {
         "  scores each with the calibration's objective (eq. 3-5). Beside it, the median of the same\n"
         "  objective from every real trial of a third participant at that height: the simulator\n"
         "  predicts a trial no worse than another real person would when its L is at most that.\n"
-        "  Also the share of the travel where the simulated vertical force has the measured sign.\n"
-        "  --out PREFIX   write PREFIX.csv (per trial) and PREFIX.curves.csv (for\n"
-        "                 tools/plot/calib_overlay.py predict)\n"
+        "  Also the share of the travel where the simulated vertical force has the measured sign,\n"
+        "  and what the simulation gets wrong: per height and travel window, the simulated mean\n"
+        "  force against the measured mean and the people's spread; the runs of windows where the\n"
+        "  simulation is further from the people's mean than they are from each other are listed,\n"
+        "  largest first (offline/calib/prediction.h, residual_windows).\n"
+        "  --out PREFIX   write PREFIX.csv (per trial), PREFIX.curves.csv and PREFIX.residual.csv\n"
+        "                 (for tools/plot/calib_overlay.py predict and residual)\n"
+        "  --window M     [m] travel window of the residual (default 0.05)\n"
         "  --gown G       override the calibration's gown (full, reduced, coarse)\n"
         "  --threads N    threads per process (default: all cores); under mpirun every rank runs a share\n"
         "  --json         machine-readable summary");
     return 0;
   }
-  args.allow_only({"help", "json", "calibration", "data", "out", "gown", "threads"});
+  args.allow_only({"help", "json", "calibration", "data", "out", "gown", "threads", "window"});
   const std::string cal_path = args.require("calibration");
   const std::string data = args.require("data");
   const int threads = static_cast<int>(args.integer("threads", 0));
+  const double window = args.number("window", 0.05);
+  if (!(window >= 0.005 && window <= 0.85)) throw UsageError("--window must be between 0.005 and 0.85 m");
   const Calibration cal = read_calibration(cal_path);
   const std::string gown = args.get("gown").value_or(cal.gown);
   if (gown != "full" && gown != "reduced" && gown != "coarse") throw UsageError("--gown must be full, reduced or coarse");
@@ -72,6 +79,9 @@ int run_predict(int argc, char** argv) {
     write_file_atomic(*prefix + ".csv", prediction_csv(p));
     write_file_atomic(*prefix + ".curves.csv", prediction_curves_csv(p, ds));
   }
+  const std::vector<ResidualWindow> windows = residual_windows(p, ds, window);
+  const std::vector<ResidualFinding> findings = residual_findings(windows);
+  if (const auto prefix = args.get("out")) write_file_atomic(*prefix + ".residual.csv", residual_csv(windows));
   const std::vector<PredictionSummary> sum = summarize(p);
   if (args.has("json")) {
     std::printf("{\"participant\": \"%s\", \"trials\": %zu, \"heights\": [", p.participant.c_str(), p.trials.size());
@@ -83,6 +93,16 @@ int run_predict(int argc, char** argv) {
                   first ? "" : ", ", std::string(arm_height_name(s.height)).c_str(), s.trials,
                   number(s.objective_median).c_str(), number(s.real_median).c_str(), s.no_worse,
                   number(s.vertical_sign_median).c_str());
+      first = false;
+    }
+    std::printf("], \"residual_window_m\": %s, \"residual_findings\": [", number(window).c_str());
+    first = true;
+    for (const auto& f : findings) {
+      std::printf("%s{\"height\": \"%s\", \"force\": \"%s\", \"from_m\": %s, \"to_m\": %s, \"residual_n\": %s, "
+                  "\"measured_n\": %s, \"spread_n\": %s, \"trials\": %d}",
+                  first ? "" : ", ", std::string(arm_height_name(f.height)).c_str(), f.axis == 0 ? "motion" : "vertical",
+                  number(f.from).c_str(), number(f.to).c_str(), number(f.residual).c_str(), number(f.measured).c_str(),
+                  number(f.spread).c_str(), f.trials);
       first = false;
     }
     std::printf("]}\n");
@@ -102,7 +122,15 @@ int run_predict(int argc, char** argv) {
       std::printf("%-6s median L %.3f against %.3f between real people; no worse on %d of %d; Fv sign %.0f%%\n",
                   std::string(arm_height_name(s.height)).c_str(), s.objective_median, s.real_median, s.no_worse,
                   s.trials, 100 * s.vertical_sign_median);
-  if (args.get("out")) std::printf("wrote %s.csv and %s.curves.csv\n", args.get("out")->c_str(), args.get("out")->c_str());
+  if (findings.empty())
+    std::printf("what the simulation gets wrong: no %.2f m window where it is further from the people's mean than "
+                "they are from each other\n", window);
+  else
+    std::printf("what the simulation gets wrong (%.2f m windows where it is further from the people's mean than they are "
+                "from each other; largest first):\n", window);
+  for (const auto& f : findings) std::printf("  %s\n", f.text.c_str());
+  if (const auto prefix = args.get("out"))
+    std::printf("wrote %s.csv, %s.curves.csv and %s.residual.csv\n", prefix->c_str(), prefix->c_str(), prefix->c_str());
   return 0;
 #endif
 }

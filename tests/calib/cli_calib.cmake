@@ -35,6 +35,7 @@ file(WRITE ${WORK}/cal4.json "{\"format\": \"dressguard-calibration 1\", \"parti
                    \"low\": {\"offset_m\": 0.0, \"calibrated\": true}},
  \"objective_kind\": \"area\", \"objective\": 1.0, \"sequences\": [], \"gown\": \"coarse\", \"rig_travel_m\": 0.72}\n")
 expect_fail("predict with a bad --gown" "--gown" predict --calibration ${WORK}/cal4.json --data ${WORK} --gown fine)
+expect_fail("predict with a bad --window" "--window" predict --calibration ${WORK}/cal4.json --data ${WORK} --window 0)
 
 if(STUDY)
   execute_process(COMMAND ${DG} import --study ${STUDY} --out ${WORK}/study RESULT_VARIABLE rc)
@@ -46,8 +47,16 @@ if(STUDY)
   execute_process(COMMAND ${DG} predict --calibration ${WORK}/cal4.json --data ${WORK}/study --out ${WORK}/pred --json
                   RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT rc EQUAL 0 OR NOT out MATCHES "\"participant\": \"4\", \"trials\": 20" OR NOT out MATCHES "\"height\": \"middle\""
-     OR NOT EXISTS ${WORK}/pred.csv OR NOT EXISTS ${WORK}/pred.curves.csv)
+     OR NOT out MATCHES "\"residual_window_m\": 0.05, \"residual_findings\": \\["
+     OR NOT EXISTS ${WORK}/pred.csv OR NOT EXISTS ${WORK}/pred.curves.csv OR NOT EXISTS ${WORK}/pred.residual.csv)
     message(FATAL_ERROR "predict on the study (${rc}):\n${out}\n${err}")
+  endif()
+  # The residual table: a header and one row per 0.05 m window to the longest measured travel
+  # (0.85 m: 17 windows) for each of the three heights.
+  file(STRINGS ${WORK}/pred.residual.csv rows)
+  list(LENGTH rows n)
+  if(NOT n EQUAL 52)
+    message(FATAL_ERROR "predict: pred.residual.csv has ${n} lines, not a header and 3 x 17 windows")
   endif()
   file(STRINGS ${WORK}/pred.csv rows)
   list(LENGTH rows n)

@@ -153,6 +153,117 @@ TEST(Prediction, GroupsPerThreadGiveTheOneByOneResults) {
   }
 }
 
+// A curve to `end` in 1 mm steps, sampled mid-step (0.5 mm, 1.5 mm, ...: no sample on a window's
+// edge), with the forces f(travel).
+template <class F>
+std::vector<HapticSample> curve(double end, F f) {
+  std::vector<HapticSample> s;
+  for (int k = 0; k < static_cast<int>(std::lround(end * 1000)); ++k) {
+    const double x = (k + 0.5) / 1000.0;
+    const auto [fm, fv] = f(x);
+    s.push_back({x / 0.1, x, fm, 0.0, fv});
+  }
+  return s;
+}
+
+// The residual by hand: four people at the high arm pull F_motion -1, -2, -3, -2 N (mean -2, sample
+// spread sqrt(2/3) N) and F_vertical 0.1 N to 0.41 m; the simulation matches them to 0.2 m (F_motion)
+// and 0.1 m (F_vertical), then drags 2 N more, and its F_vertical is 0.4 N higher to 0.3 m and 0.4 N
+// lower after. One low trial to 0.21 m (too few to judge) is 4 N off. Expected: the windows' means and spreads,
+// the window beyond every trial empty, and three findings: F_motion 0.20-0.40 m (-2 N, area 0.4)
+// first, then F_vertical 0.10-0.30 (+0.4 N) and 0.30-0.40 m (-0.4 N), split where the sign turns.
+TEST(Prediction, ResidualWindowsAndFindingsByHand) {
+  Dataset ds;
+  Prediction p;
+  p.participant = "1";
+  const double drags[4] = {-1, -2, -3, -2};
+  for (int k = 0; k < 4; ++k) {
+    HapticSequence m;
+    m.id = "p" + std::to_string(k + 2) + "-high";
+    m.participant = std::to_string(k + 2);
+    m.height = ArmHeight::High;
+    m.label = Outcome::Good;
+    m.samples = curve(0.41, [&](double) { return std::pair{drags[k], 0.1}; });
+    ds.trials.push_back(m);
+    PredictedTrial t;
+    t.trial_id = m.id;
+    t.participant = m.participant;
+    t.height = ArmHeight::High;
+    t.simulated = curve(0.41, [](double x) { return std::pair{x < 0.2 ? -2.0 : -4.0, x < 0.1 ? 0.1 : (x < 0.3 ? 0.5 : -0.3)}; });
+    p.trials.push_back(t);
+  }
+  HapticSequence low;
+  low.id = "p6-low";
+  low.participant = "6";
+  low.height = ArmHeight::Low;
+  low.label = Outcome::Missed;
+  low.samples = curve(0.21, [](double) { return std::pair{-1.0, 0.0}; });
+  ds.trials.push_back(low);
+  PredictedTrial tl;
+  tl.trial_id = low.id;
+  tl.participant = "6";
+  tl.height = ArmHeight::Low;
+  tl.simulated = curve(0.21, [](double) { return std::pair{-5.0, 0.0}; });
+  p.trials.push_back(tl);
+
+  const std::vector<ResidualWindow> w = residual_windows(p, ds, 0.05);
+  ASSERT_EQ(w.size(), 18u);  // 9 windows to the longest travel, 0.41 m, for each of two heights
+  const double spread = std::sqrt(2.0 / 3.0);
+  for (int k = 0; k < 8; ++k) {
+    const ResidualWindow& a = w[static_cast<std::size_t>(k)];
+    EXPECT_EQ(a.height, ArmHeight::High);
+    EXPECT_NEAR(a.from, 0.05 * k, 1e-12);
+    EXPECT_EQ(a.trials, 4);
+    EXPECT_NEAR(a.measured[0], -2.0, 1e-12);
+    EXPECT_NEAR(a.spread[0], spread, 1e-12);
+    EXPECT_NEAR(a.residual(0), k < 4 ? 0.0 : -2.0, 1e-12) << k;
+    EXPECT_EQ(a.outside(0), k >= 4) << k;
+    EXPECT_NEAR(a.spread[1], 0.0, 1e-12);
+    EXPECT_NEAR(a.residual(1), k < 2 ? 0.0 : (k < 6 ? 0.4 : -0.4), 1e-12) << k;
+    EXPECT_EQ(a.outside(1), k >= 2) << k;
+  }
+  EXPECT_EQ(w[8].trials, 0);  // [0.40, 0.45): no trial reaches 0.45 m
+  EXPECT_FALSE(w[8].outside(0));
+  EXPECT_EQ(w[9].height, ArmHeight::Low);
+  EXPECT_EQ(w[9].trials, 1);
+  EXPECT_NEAR(w[9].residual(0), -4.0, 1e-12);
+  EXPECT_FALSE(w[9].outside(0));  // one trial: no spread to compare with
+  EXPECT_EQ(w[12].trials, 1);     // [0.15, 0.20): covered
+  EXPECT_EQ(w[13].trials, 0);     // [0.20, 0.25): the low trial ends at 0.21 m
+
+  const std::vector<ResidualFinding> f = residual_findings(w);
+  ASSERT_EQ(f.size(), 3u);
+  EXPECT_EQ(f[0].axis, 0);
+  EXPECT_NEAR(f[0].from, 0.2, 1e-12);
+  EXPECT_NEAR(f[0].to, 0.4, 1e-12);
+  EXPECT_NEAR(f[0].residual, -2.0, 1e-12);
+  EXPECT_NEAR(f[0].spread, spread, 1e-12);
+  EXPECT_EQ(f[0].trials, 4);
+  EXPECT_NE(f[0].text.find("too much drag"), std::string::npos) << f[0].text;
+  EXPECT_EQ(f[1].axis, 1);
+  EXPECT_NEAR(f[1].from, 0.1, 1e-12);
+  EXPECT_NEAR(f[1].to, 0.3, 1e-12);
+  EXPECT_NEAR(f[1].residual, 0.4, 1e-12);
+  EXPECT_NE(f[1].text.find("up too much"), std::string::npos) << f[1].text;
+  EXPECT_EQ(f[2].axis, 1);
+  EXPECT_NEAR(f[2].from, 0.3, 1e-12);
+  EXPECT_NEAR(f[2].residual, -0.4, 1e-12);
+
+  // The CSV has a header and one row per window; a window that is not positive is refused.
+  const std::string csv = residual_csv(w);
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 19);
+  EXPECT_EQ(csv.rfind("height,from,to,trials,measured_motion", 0), 0u);
+  EXPECT_THROW(residual_windows(p, ds, 0.0), std::invalid_argument);
+  // A simulation that matches every person's mean everywhere has nothing to report.
+  for (auto& t : p.trials) t.simulated = find(ds, t.trial_id).samples;
+  p.trials[0].simulated = curve(0.41, [](double) { return std::pair{-2.0, 0.1}; });  // the mean
+  p.trials[1].simulated = p.trials[0].simulated;
+  p.trials[2].simulated = p.trials[0].simulated;
+  p.trials[3].simulated = p.trials[0].simulated;
+  p.trials[4].simulated = low.samples;
+  EXPECT_TRUE(residual_findings(residual_windows(p, ds, 0.05)).empty());
+}
+
 // The measured vertical force is +1 N over its first 0.4 m and -1 N over the next 0.4 m; a
 // simulation of constant +0.5 N has its sign on half of that travel, one of -0.5 N on the other
 // half; a simulation that ends at 0.2 m is asked only about its own travel; a measurement that

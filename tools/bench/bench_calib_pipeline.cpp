@@ -6,7 +6,7 @@
 //     Per participant P of the measured study: calibrate on P's 2-3 sequences (from the bounds
 //     file's initial values, default_bounds() without one); predict the other participants'
 //     measured trials with the calibrated simulator next to the real-person yardstick
-//     (prediction.h; DIR/predP.csv and .curves.csv); synthesize, train
+//     (prediction.h; DIR/predP.csv, .curves.csv and .residual.csv); synthesize, train
 //     the STC; train the baseline classifier BC on the same measured sequences directly (paper
 //     VI-B.1; the study folder holds no caught trial, so BC has good and missed only); classify
 //     every measured trial of the other participants, whole and cut at 0.15/0.20/0.25/0.30 m of
@@ -222,6 +222,10 @@ int run_eval(const std::map<std::string, std::string>& a) {
     const Prediction pred = predict_others(cal, ds, sim.trials, co.threads, Comm::world());
     write_file_atomic(work / ("pred" + p + ".csv"), prediction_csv(pred));
     write_file_atomic(work / ("pred" + p + ".curves.csv"), prediction_curves_csv(pred, ds));
+    const std::vector<ResidualWindow> windows = residual_windows(pred, ds);
+    write_file_atomic(work / ("pred" + p + ".residual.csv"), residual_csv(windows));
+    Json jres = Json::array();
+    for (const ResidualFinding& f : residual_findings(windows)) jres.push(Json(f.text));
     Json jpred = Json::array();
     auto or_minus_one = [](double v) { return std::isfinite(v) ? v : -1.0; };  // JSON has no NaN
     std::printf("     predicts the others:");
@@ -296,6 +300,7 @@ int run_eval(const std::map<std::string, std::string>& a) {
     row.set("bc_accuracy_whole_and_cuts", jb);
     row.set("seconds", seconds_since(t0));
     row.set("prediction_of_others", jpred);
+    row.set("residual_findings", jres);  // largest first (prediction.h)
     row.set("start_objective", r.start_objective);
     row.set("stc_classes", stc_classes);
     int synth_labels[kOutcomeCount] = {};

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Overlay plots of measured and simulated force curves (paper Fig. 7-9).
 
-Two modes:
+Modes:
   fit:      calib_overlay.py fit CAL.json.curves.csv [--compare CAL0.json.curves.csv] --out fit.png
             One row per calibration input, F_motion and F_vertical over travel: measured (red,
             solid), simulated with the calibrated arm offsets (green, dashed) and, with --compare,
@@ -14,6 +14,12 @@ Two modes:
             curves (one colour per trial) with the calibrated simulator's curve of each (black,
             dashed), and per trial the simulator's L against the median L of a real
             third person (the yardstick; below the diagonal: no worse than a real person).
+  residual: calib_overlay.py residual PREFIX --out residual.png
+            `dressguard predict --out PREFIX`'s PREFIX.residual.csv: per arm height and force, the
+            people's mean force per travel window with their spread (grey band, +-1 standard
+            deviation) and the simulated mean (black); windows where the simulation is further from
+            the people's mean than they are from each other are shaded red (what the simulation
+            gets wrong, offline/calib/prediction.h).
 Reads only the CSVs that dressguard writes (calibrate's curves file; dataset folders).
 """
 import argparse
@@ -142,6 +148,35 @@ def plot_predict(args):
     fig.savefig(args.out, dpi=100)
 
 
+def plot_residual(args):
+    rows = list(csv.DictReader(open(args.prefix + ".residual.csv", newline="")))
+    heights = [h for h in ("high", "middle", "low") if any(r["height"] == h for r in rows)]
+    fig, axes = plt.subplots(len(heights), 2, figsize=(12, 3.4 * len(heights)), squeeze=False)
+    for i, h in enumerate(heights):
+        mine = [r for r in rows if r["height"] == h and int(r["trials"]) > 0]
+        for col, (axis, name) in enumerate((("motion", "F_motion [N]"), ("vertical", "F_vertical [N]"))):
+            ax = axes[i][col]
+            for r in mine:
+                a, b = float(r["from"]), float(r["to"])
+                m, sd, sim = (float(r[k + "_" + axis]) for k in ("measured", "spread", "simulated"))
+                if r["outside_" + axis] == "1":
+                    ax.axvspan(a, b, color="tab:red", alpha=0.15, lw=0)
+                if sd == sd:  # one trial has no spread
+                    ax.fill_between([a, b], [m - sd] * 2, [m + sd] * 2, color="gray", alpha=0.35, lw=0)
+                ax.plot([a, b], [m, m], color="tab:blue", lw=1.5)
+                ax.plot([a, b], [sim, sim], color="black", lw=1.5)
+            ax.plot([], [], color="tab:blue", label="people's mean (+-1 sd, grey)")
+            ax.plot([], [], color="black", label="simulated mean")
+            ax.fill_between([], [], [], color="tab:red", alpha=0.15, label="outside the people")
+            ax.set_title(f"{h} arm: residual per travel window")
+            ax.set_xlabel("travel [m]")
+            ax.set_ylabel(name)
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=7, loc="lower left")
+    fig.tight_layout()
+    fig.savefig(args.out, dpi=100)
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="mode", required=True)
@@ -157,8 +192,11 @@ def main():
     q = sub.add_parser("predict")
     q.add_argument("prefix")
     q.add_argument("--out", required=True)
+    r = sub.add_parser("residual")
+    r.add_argument("prefix")
+    r.add_argument("--out", required=True)
     args = p.parse_args()
-    {"fit": plot_fit, "dataset": plot_dataset, "predict": plot_predict}[args.mode](args)
+    {"fit": plot_fit, "dataset": plot_dataset, "predict": plot_predict, "residual": plot_residual}[args.mode](args)
 
 
 if __name__ == "__main__":
