@@ -2,7 +2,9 @@
 #include "prediction.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <mutex>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -53,12 +55,13 @@ std::pair<double, int> real_person_median(const Dataset& ds, const HapticSequenc
 }
 
 Prediction predict_others(const Calibration& cal, const Dataset& ds, const TrialSimulator& sim, int threads,
-                          const Comm& comm) {
-  return predict_others(cal, ds, one_by_one(sim), threads, comm);
+                          const Comm& comm, const std::function<void(const PredictionProgress&)>& progress) {
+  return predict_others(cal, ds, one_by_one(sim), threads, comm, progress);
 }
 
 Prediction predict_others(const Calibration& cal, const Dataset& ds, const TrialBatchSimulator& sim, int threads,
-                          const Comm& comm) {
+                          const Comm& comm, const std::function<void(const PredictionProgress&)>& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
   const std::vector<const HapticSequence*> targets = prediction_targets(ds, cal.participant);
   if (targets.empty())
     throw InputError("the dataset holds no labelled, non-caught trial of a participant other than '" +
@@ -67,8 +70,13 @@ Prediction predict_others(const Calibration& cal, const Dataset& ds, const Trial
   const int n = static_cast<int>(targets.size());
   // Group g holds targets g, g + G, g + 2G, ...: a mix of heights and speeds in each, so that the
   // groups cost about the same. Any G gives the same results (the batch simulator's contract).
-  const int groups = std::min(n, thread_count(threads) * comm.size());
+  const int groups = std::min(n, std::max(thread_count(threads) * comm.size(), (n + kPredictionGroup - 1) / kPredictionGroup));
   const int per_group = (n + groups - 1) / groups;
+  // This rank runs the groups g with g % size == rank (run_batch); its targets, for progress.
+  int mine = 0;
+  for (int g = comm.rank(); g < groups; g += comm.size()) mine += (n - g + groups - 1) / groups;
+  int done = 0;
+  std::mutex progress_mutex;
   const std::vector<double> out = run_batch(groups, per_group * kBlock, threads, comm, [&](int g, double* group_block) {
     std::vector<int> members;
     std::vector<TrialRequest> requests;
@@ -99,6 +107,18 @@ Prediction predict_others(const Calibration& cal, const Dataset& ds, const Trial
         col[2 * kMaxSamples + i] = st.samples[i].f_motion;
         col[3 * kMaxSamples + i] = st.samples[i].f_vertical;
       }
+    }
+    // Counted under the lock, so that the reports come in order.
+    std::lock_guard<std::mutex> lock(progress_mutex);
+    done += static_cast<int>(members.size());
+    if (progress && comm.is_root()) {
+      PredictionProgress pp;
+      const int d = done;
+      pp.done = d;
+      pp.total = mine;
+      pp.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      pp.eta_s = pp.elapsed_s / d * (mine - d);
+      progress(pp);
     }
   });
   Prediction p;

@@ -15,6 +15,7 @@
 // simulated at the nominal height, offset 0, as synthesis does.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -57,17 +58,29 @@ struct PredictionSummary {
 // `calibrated`. Empty when there is none.
 std::vector<const HapticSequence*> prediction_targets(const Dataset& ds, const std::string& calibrated);
 
+// Progress of predict_others on this rank: targets done of this rank's, elapsed and estimated
+// remaining seconds.
+struct PredictionProgress {
+  int done = 0, total = 0;
+  double elapsed_s = 0, eta_s = 0;
+};
+
+// At most this many targets share one settling, so that progress comes every few trials; the
+// settling is then done once per 4 targets instead of once per target.
+inline constexpr int kPredictionGroup = 4;
+
 // Simulates every target with `cal`'s parameters and scores it. The targets are dealt round-robin
-// into one group per thread and rank (run_batch spreads the groups), and each group goes to the
-// batch simulator at once, so that the cloth simulator settles the gown once per group instead of
-// once per target (sim::simulate_trials, the same bits as one at a time): the results do not
-// depend on the thread or rank count. Throws InputError when the dataset holds no trial of
-// another participant to predict.
+// into groups, one per thread and rank or more so that none holds more than kPredictionGroup
+// (run_batch spreads the groups), and each group goes to the batch simulator at once, so that the
+// cloth simulator settles the gown once per group instead of once per target
+// (sim::simulate_trials, the same bits as one at a time): the results do not depend on the
+// thread or rank count. `progress` (rank 0, may be empty) hears after every group. Throws
+// InputError when the dataset holds no trial of another participant to predict.
 Prediction predict_others(const Calibration& cal, const Dataset& ds, const TrialBatchSimulator& sim, int threads,
-                          const Comm& comm);
+                          const Comm& comm, const std::function<void(const PredictionProgress&)>& progress = {});
 // The same with a one-trial simulator (one_by_one).
 Prediction predict_others(const Calibration& cal, const Dataset& ds, const TrialSimulator& sim, int threads,
-                          const Comm& comm);
+                          const Comm& comm, const std::function<void(const PredictionProgress&)>& progress = {});
 
 // The real-person yardstick of one target: L(other, target) for every labelled, non-caught trial
 // of the same height whose participant is neither the target's nor `calibrated`, with the

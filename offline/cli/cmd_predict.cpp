@@ -73,7 +73,11 @@ int run_predict(int argc, char** argv) {
   if (comm.is_root())
     std::fprintf(stderr, "predict: the calibration of participant '%s' on %zu trials of other participants, gown %s\n",
                  cal.participant.c_str(), targets, gown.c_str());
-  const Prediction p = predict_others(cal, ds, make_cloth_simulator(gown).trials, threads, comm);
+  const Prediction p =
+      predict_others(cal, ds, make_cloth_simulator(gown).trials, threads, comm, [](const PredictionProgress& pp) {
+        std::fprintf(stderr, "predict: %d/%d trials on this rank, elapsed %.0f s, ETA %.0f s\n", pp.done, pp.total,
+                     pp.elapsed_s, pp.eta_s);
+      });
   if (!comm.is_root()) return 0;
   if (const auto prefix = args.get("out")) {
     write_file_atomic(*prefix + ".csv", prediction_csv(p));

@@ -126,9 +126,10 @@ TEST(Prediction, SameResultsOnAnyThreadCount) {
   EXPECT_EQ(prediction_curves_csv(one, ds), prediction_curves_csv(two, ds));
 }
 
-// The batch form: the targets go to the batch simulator in one group per thread, dealt
-// round-robin, and every figure is the one-by-one simulator's, whatever the count (6 targets on
-// 4 threads: groups of 2, 2, 1, 1).
+// The batch form: the targets go to the batch simulator in groups dealt round-robin, one per
+// thread or more so that none holds more than kPredictionGroup (4), and every figure is the
+// one-by-one simulator's, whatever the count: 6 targets on 1 or 2 threads in groups of 3 and 3,
+// on 4 threads 2, 2, 1, 1. Progress comes after each group and ends at all 6.
 TEST(Prediction, GroupsPerThreadGiveTheOneByOneResults) {
   const Dataset ds = people({kA, kB, kC});
   const Prediction ref = predict_others(calibration_of(kB), ds, testing::fake_simulate, 1, Comm::world());
@@ -142,13 +143,22 @@ TEST(Prediction, GroupsPerThreadGiveTheOneByOneResults) {
       }
       return one_by_one(testing::fake_simulate)(c, rs);
     };
-    const Prediction p = predict_others(calibration_of(kB), ds, batch, threads, Comm::world());
+    int last_done = 0, last_total = 0, reports = 0;
+    const Prediction p = predict_others(calibration_of(kB), ds, batch, threads, Comm::world(),
+                                        [&](const PredictionProgress& pp) {
+                                          EXPECT_GT(pp.done, last_done);
+                                          last_done = pp.done;
+                                          last_total = pp.total;
+                                          ++reports;
+                                        });
+    EXPECT_EQ(last_done, 6);
+    EXPECT_EQ(last_total, 6);
+    EXPECT_EQ(reports, static_cast<int>(sizes.size()));
     EXPECT_EQ(prediction_csv(p), prediction_csv(ref)) << threads << " threads";
     EXPECT_EQ(prediction_curves_csv(p, ds), prediction_curves_csv(ref, ds)) << threads << " threads";
     std::sort(sizes.begin(), sizes.end());
-    const std::vector<std::size_t> expected = threads == 1   ? std::vector<std::size_t>{6}
-                                              : threads == 2 ? std::vector<std::size_t>{3, 3}
-                                                             : std::vector<std::size_t>{1, 1, 2, 2};
+    const std::vector<std::size_t> expected =
+        threads < 4 ? std::vector<std::size_t>{3, 3} : std::vector<std::size_t>{1, 1, 2, 2};
     EXPECT_EQ(sizes, expected) << threads << " threads";
   }
 }
