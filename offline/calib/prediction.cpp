@@ -70,7 +70,8 @@ Prediction predict_others(const Calibration& cal, const Dataset& ds, const Trial
   const int n = static_cast<int>(targets.size());
   // Group g holds targets g, g + G, g + 2G, ...: a mix of heights and speeds in each, so that the
   // groups cost about the same. Any G gives the same results (the batch simulator's contract).
-  const int groups = std::min(n, std::max(thread_count(threads) * comm.size(), (n + kPredictionGroup - 1) / kPredictionGroup));
+  const int workers = thread_count(threads) * comm.size();
+  const int groups = std::min(n, std::max(workers, (n + kPredictionGroup - 1) / kPredictionGroup));
   const int per_group = (n + groups - 1) / groups;
   // This rank runs the groups g with g % size == rank (run_batch); its targets, for progress.
   int mine = 0;
@@ -113,11 +114,10 @@ Prediction predict_others(const Calibration& cal, const Dataset& ds, const Trial
     done += static_cast<int>(members.size());
     if (progress && comm.is_root()) {
       PredictionProgress pp;
-      const int d = done;
-      pp.done = d;
+      pp.done = done;
       pp.total = mine;
       pp.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      pp.eta_s = pp.elapsed_s / d * (mine - d);
+      pp.eta_s = pp.elapsed_s / done * (mine - done);
       progress(pp);
     }
   });
