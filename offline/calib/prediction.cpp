@@ -68,23 +68,45 @@ Prediction predict_others(const Calibration& cal, const Dataset& ds, const Trial
                      cal.participant + "' to predict");
   const ObjectiveKind kind = parse_objective(cal.objective_kind).value_or(ObjectiveKind::Area);
   const int n = static_cast<int>(targets.size());
-  // Group g holds targets g, g + G, g + 2G, ...: a mix of heights and speeds in each, so that the
-  // groups cost about the same. Any G gives the same results (the batch simulator's contract).
+  // Groups of targets of one height (one arm placement: the calibration's offset for it), so
+  // that each group settles the gown once whether or not the arm touches it while it settles
+  // (sim::simulate_trials); at most kPredictionGroup a group, and at least one group per
+  // worker where there are enough targets (the largest group split in two until then). Any
+  // grouping gives the same results (the batch simulator's contract).
   const int workers = thread_count(threads) * comm.size();
-  const int groups = std::min(n, std::max(workers, (n + kPredictionGroup - 1) / kPredictionGroup));
-  const int per_group = (n + groups - 1) / groups;
+  std::vector<std::vector<int>> groups;
+  for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
+    std::vector<int> of_h;
+    for (int k = 0; k < n; ++k)
+      if (targets[static_cast<std::size_t>(k)]->height == h) of_h.push_back(k);
+    const int parts = (static_cast<int>(of_h.size()) + kPredictionGroup - 1) / kPredictionGroup;
+    for (int q = 0; q < parts; ++q)  // consecutive, nearly equal parts
+      groups.emplace_back(of_h.begin() + of_h.size() * q / parts, of_h.begin() + of_h.size() * (q + 1) / parts);
+  }
+  while (static_cast<int>(groups.size()) < workers) {
+    auto largest = std::max_element(groups.begin(), groups.end(),
+                                    [](const auto& x, const auto& y) { return x.size() < y.size(); });
+    if (largest->size() < 2) break;
+    std::vector<int> back(largest->begin() + largest->size() / 2, largest->end());
+    largest->resize(largest->size() / 2);
+    groups.push_back(std::move(back));
+  }
+  std::size_t per_group = 0;
+  std::vector<std::size_t> slot_of(static_cast<std::size_t>(n));  // target -> its block in `out`
+  for (const auto& g : groups) per_group = std::max(per_group, g.size());
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    for (std::size_t j = 0; j < groups[g].size(); ++j) slot_of[static_cast<std::size_t>(groups[g][j])] = g * per_group + j;
   // This rank runs the groups g with g % size == rank (run_batch); its targets, for progress.
   int mine = 0;
-  for (int g = comm.rank(); g < groups; g += comm.size()) mine += (n - g + groups - 1) / groups;
+  for (std::size_t g = static_cast<std::size_t>(comm.rank()); g < groups.size(); g += static_cast<std::size_t>(comm.size()))
+    mine += static_cast<int>(groups[g].size());
   int done = 0;
   std::mutex progress_mutex;
-  const std::vector<double> out = run_batch(groups, per_group * kBlock, threads, comm, [&](int g, double* group_block) {
-    std::vector<int> members;
+  const int block = static_cast<int>(per_group) * kBlock;
+  const std::vector<double> out = run_batch(static_cast<int>(groups.size()), block, threads, comm, [&](int g, double* group_block) {
+    const std::vector<int>& members = groups[static_cast<std::size_t>(g)];
     std::vector<TrialRequest> requests;
-    for (int k = g; k < n; k += groups) {
-      members.push_back(k);
-      requests.push_back(request_for(*targets[static_cast<std::size_t>(k)], cal.offsets));
-    }
+    for (int k : members) requests.push_back(request_for(*targets[static_cast<std::size_t>(k)], cal.offsets));
     const std::vector<SimulatedTrial> sims = sim(cal.cloth, requests);
     if (sims.size() != requests.size())
       throw std::logic_error("predict_others: the batch simulator returned " + std::to_string(sims.size()) +
@@ -125,8 +147,7 @@ Prediction predict_others(const Calibration& cal, const Dataset& ds, const Trial
   p.participant = cal.participant;
   for (int k = 0; k < n; ++k) {
     const HapticSequence& target = *targets[static_cast<std::size_t>(k)];
-    // Target k is member k / groups of group k % groups.
-    const double* b = out.data() + (static_cast<std::size_t>(k % groups) * per_group + k / groups) * kBlock;
+    const double* b = out.data() + slot_of[static_cast<std::size_t>(k)] * kBlock;
     PredictedTrial t;
     t.trial_id = target.id;
     t.participant = target.participant;

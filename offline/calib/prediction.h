@@ -65,16 +65,16 @@ struct PredictionProgress {
   double elapsed_s = 0, eta_s = 0;
 };
 
-// At most this many targets share one settling, so that progress comes every few trials; the
-// settling is then done once per 4 targets instead of once per target.
+// At most this many targets (of one height) share one settling, so that progress comes every
+// few trials; the settling is then done once per 4 targets instead of once per target.
 inline constexpr int kPredictionGroup = 4;
 
-// Simulates every target with `cal`'s parameters and scores it. The targets are dealt round-robin
-// into groups, one per thread and rank or more so that none holds more than kPredictionGroup
-// (run_batch spreads the groups), and each group goes to the batch simulator at once, so that the
-// cloth simulator settles the gown once per group instead of once per target
-// (sim::simulate_trials, the same bits as one at a time): the results do not depend on the
-// thread or rank count. `progress` (rank 0, may be empty) hears after every group. Throws
+// Simulates every target with `cal`'s parameters and scores it. The targets go in groups of one
+// height (one arm placement), at most kPredictionGroup a group and at least one group per thread
+// and rank where there are enough (run_batch spreads the groups), and each group to the batch
+// simulator at once, so that the cloth simulator settles the gown once per group instead of once
+// per target (sim::simulate_trials: an arm placed alike settles alike, the same bits as one at a
+// time): the results do not depend on the thread or rank count. `progress` (rank 0, may be empty) hears after every group. Throws
 // InputError when the dataset holds no trial of another participant to predict.
 Prediction predict_others(const Calibration& cal, const Dataset& ds, const TrialBatchSimulator& sim, int threads,
                           const Comm& comm, const std::function<void(const PredictionProgress&)>& progress = {});

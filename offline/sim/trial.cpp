@@ -323,14 +323,17 @@ std::vector<TrialResult> simulate_trials(const Scene& scene, const ClothParams& 
   std::vector<uint8_t> done(specs.size(), 0);
   for (size_t a = 0; a < specs.size(); ++a) {
     if (done[a]) continue;
-    // The trials after `a` that settle the same way, and their arms relative to a's.
+    // The trials after `a` that settle the same way, and the other arms among them relative to
+    // a's (a trial whose arm is where a's is, to the bit, settles exactly as a does whether or
+    // not the arm touches the gown: it needs no probe).
     const double dz_a = arm_dz_of(sc, specs[a], draws[a].arm_offset);
     std::vector<size_t> group;
     std::vector<double> probe;
     for (size_t b = a + 1; b < specs.size(); ++b)
       if (!done[b] && same_settling(specs[a], draws[a], specs[b], draws[b])) {
         group.push_back(b);
-        probe.push_back(arm_dz_of(sc, specs[b], draws[b].arm_offset) - dz_a);
+        const double dz = arm_dz_of(sc, specs[b], draws[b].arm_offset) - dz_a;
+        if (dz != 0) probe.push_back(dz);
       }
     GownModel m = make_model(sc, params, specs[a].friction_scheme, specs[a].self_collision, dz_a);
     GownState s = make_state(m);
@@ -338,11 +341,14 @@ std::vector<TrialResult> simulate_trials(const Scene& scene, const ClothParams& 
     r.arm_offset = draws[a].arm_offset;
     const Settled at_rest = settle(m, s, specs[a], draws[a], probe, r);
     done[a] = 1;
-    if (!group.empty() && !at_rest.arm_reached) {
-      // No arm came near the gown while it settled, so every trial of the group would have
-      // settled to these same bits: start each pull from a copy.
+    if (!group.empty()) {
+      // A trial of the group starts its pull from a copy of this settling when its arm is a's
+      // (the same model, the same bits), or when no arm came near the gown while it settled
+      // (then no arm acted on it, and every arm height would have settled to these bits). The
+      // others settle on their own later, grouped among themselves.
       const GownState rest_state = s;
       for (size_t b : group) {
+        if (at_rest.arm_reached && arm_dz_of(sc, specs[b], draws[b].arm_offset) != dz_a) continue;
         // r holds only what the settling wrote (weight, bias, settle_*; no frames in a group).
         TrialResult& rb = out[b] = r;
         rb.arm_offset = draws[b].arm_offset;

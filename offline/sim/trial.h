@@ -231,12 +231,15 @@ TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const 
 
 // Several trials with one cloth, the same bits as simulate_trial() on each, in the order of
 // `specs`, but each settling done once where it can be: trials that settle alike (the same
-// perturbation, friction scheme, self-collision and settling settings; the arm height is free;
-// no frames kept) start their pulls from one settled gown when no arm of theirs came within
-// contact reach of the gown while it settled (arm_in_reach(), checked every step). The arm is
-// fixed, and without a candidate it acts on no vertex, so each of those trials would have
-// settled to those same bits on its own. In calibration, where one cloth is pulled over
-// 2-3 arm heights, that saves all settlings but one (TrialResult::settle_shared).
+// perturbation, friction scheme, self-collision and settling settings; no frames kept) start
+// their pulls from one settled gown when their arm is placed where the settling trial's is (to
+// the bit: the same model), or, for other arm heights, when no arm of theirs came within contact
+// reach of the gown while it settled (arm_in_reach(), checked every step): the arm is fixed, and
+// without a candidate it acts on no vertex, so each of those trials would have settled to those
+// same bits on its own. In calibration, where one cloth is pulled over 2-3 arm heights, that
+// saves all settlings but one while no arm touches the settling gown (on the measured gown the
+// low arm does); in `predict`, the trials of one height share theirs always
+// (TrialResult::settle_shared).
 std::vector<TrialResult> simulate_trials(const Scene& scene, const ClothParams& params,
                                          const std::vector<TrialSpec>& specs);
 

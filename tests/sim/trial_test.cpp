@@ -375,10 +375,12 @@ TEST(SimTrial, SharedSettlingGivesEachTrialItsOwnBits) {
   EXPECT_FALSE(together[5].settle_shared) << "another seed pushes another way";
 }
 
-// Where an arm touches the gown while it settles, no settling is shared, whether it is the
-// first trial's own arm or another trial's arm found by the probe (arm_in_reach()): a tube held
-// at one end falls onto a fist placed under the grasp at the high height; the low arm is far
-// below it. Each order gives every trial its own bits.
+// Where an arm touches the gown while it settles, no settling is shared between different arm
+// heights, whether it is the first trial's own arm or another trial's arm found by the probe
+// (arm_in_reach()): a tube held at one end falls onto a fist placed under the grasp at the high
+// height; the low arm is far below it. Each order gives every trial its own bits. Trials with
+// the same arm share the settling even so (it is the same simulation to the bit), before or
+// after a trial of the other height.
 TEST(SimTrial, NoSharedSettlingWhereAnArmTouchesTheGown) {
   ClothMesh mesh = tube(0.075, -0.4, 0.0, 16, 20);
   const int top = 19 * 16 + 4;
@@ -402,6 +404,16 @@ TEST(SimTrial, NoSharedSettlingWhereAnArmTouchesTheGown) {
     expect_same_trial(r[1], high_first ? l : h, "second");
     EXPECT_FALSE(r[0].settle_shared || r[1].settle_shared);
   }
+  TrialSpec high_on = high, low_on = low;
+  high_on.max_travel = low_on.max_travel = 0.08;  // a longer pull from the same settling
+  const std::vector<TrialResult> r = simulate_trials(scene, ClothParams{}, {high, low, high_on, low_on});
+  expect_same_trial(r[0], h, "high");
+  expect_same_trial(r[1], l, "low");
+  expect_same_trial(r[2], simulate_trial(scene, ClothParams{}, high_on), "high, longer");
+  expect_same_trial(r[3], simulate_trial(scene, ClothParams{}, low_on), "low, longer");
+  EXPECT_FALSE(r[0].settle_shared || r[1].settle_shared);
+  EXPECT_TRUE(r[2].settle_shared) << "the same high arm settles the same way, touching or not";
+  EXPECT_TRUE(r[3].settle_shared) << "the same low arm too";
 }
 
 namespace {

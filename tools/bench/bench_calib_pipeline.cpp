@@ -362,14 +362,16 @@ int run_timing(const std::map<std::string, std::string>& a) {
     base_s = seconds_since(t0);
     same = b.objective == r.objective && b.best_unit == r.best_unit;
   }
-  const double sims = static_cast<double>(o.generations) * o.population * inputs.size();
+  // The start is evaluated too (calibrate(): CalibrationResult::start_objective), one candidate more.
+  const double sims = (static_cast<double>(o.generations) * o.population + 1) * inputs.size();
   const double full_sims = 50.0 * 32 * inputs.size();
   if (!Comm::world().is_root()) return 0;
   std::printf("ranks %d x threads %d\n", Comm::world().size(), thread_count(o.threads));
   std::printf("gown %s: scene %.1f s; one simulation (%s, %zu samples) %.1f s on one thread\n", gown.c_str(), scene_s,
               inputs[0].id.c_str(), one.samples.size(), one_s);
-  std::printf("calibration of participant 4 (%zu sequences), %d x %d = %.0f simulations on %d thread(s): %.1f s "
-              "wall, %.2f s per simulation; final L = %.4f\n", inputs.size(), o.generations, o.population, sims,
+  std::printf("calibration of participant 4 (%zu sequences), (%d x %d + the start) x %zu = %.0f simulations on %d "
+              "thread(s): %.1f s wall, %.2f s per simulation; final L = %.4f\n", inputs.size(), o.generations,
+              o.population, inputs.size(), sims,
               thread_count(o.threads), cal_s, cal_s / sims, r.objective);
   if (base_s > 0)
     std::printf("baseline, each trial settled on its own: %.1f s wall, %.2f s per simulation; shared settling is "
