@@ -132,7 +132,11 @@ int run_predict(int argc, char** argv) {
   else
     std::printf("what the simulation gets wrong (%.2f m windows where it is further from the people's mean than they are "
                 "from each other; largest first):\n", window);
-  for (const auto& f : findings) std::printf("  %s\n", f.text.c_str());
+  // The largest few on the terminal; all of them in --json and, per window, in PREFIX.residual.csv.
+  constexpr std::size_t kShown = 8;
+  for (std::size_t i = 0; i < findings.size() && i < kShown; ++i) std::printf("  %s\n", findings[i].text.c_str());
+  if (findings.size() > kShown)
+    std::printf("  ... %zu smaller ones (--json lists all; --out writes every window)\n", findings.size() - kShown);
   if (const auto prefix = args.get("out"))
     std::printf("wrote %s.csv, %s.curves.csv and %s.residual.csv\n", prefix->c_str(), prefix->c_str(), prefix->c_str());
   return 0;
