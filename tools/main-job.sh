@@ -21,6 +21,7 @@ mkdir -p "$sim"
 for h in high middle low; do
   "$dg" simulate --height "$h" --gown reduced --out "$sim/trial-$h.csv"
   /usr/bin/python3 tools/plot/sim_scene.py "$sim/trial-$h.scene.json" "$sim/scene-$h.png"
+  /usr/bin/python3 tools/plot/arm_parts.py "$sim/trial-$h.arm.csv" "$sim/arm-$h.png" --trial "$sim/trial-$h.csv"
 done
 measured=()
 study="${DRESSGUARD_SHARED_DIR:-../shared}/data/kapusta2016-calibration-trials"

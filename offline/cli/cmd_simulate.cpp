@@ -29,6 +29,26 @@ std::vector<double> parse_times(const std::string& s) {
   return out;
 }
 
+// Per sample: t, travel, and the cloth's force on each arm part (sim::ArmPartLoads).
+std::string arm_parts_csv(const sim::Scene& scene, const sim::TrialResult& r) {
+  const std::vector<std::string> names = sim::arm_part_names(scene);
+  std::string o = "t,travel";
+  for (const auto& n : names) o += "," + n + "_fx," + n + "_fy," + n + "_fz";
+  o += "\n";
+  char buf[64];
+  for (std::size_t i = 0; i < r.arm_parts.size() && i < r.seq.samples.size(); ++i) {
+    std::snprintf(buf, sizeof buf, "%.2f,%.6f", r.seq.samples[i].t, r.seq.samples[i].travel);
+    o += buf;
+    for (std::size_t k = 0; k < names.size(); ++k)
+      for (double v : r.arm_parts[i].f[k]) {
+        std::snprintf(buf, sizeof buf, ",%.6g", v + 0.0);  // + 0.0: no "-0"
+        o += buf;
+      }
+    o += "\n";
+  }
+  return o;
+}
+
 }  // namespace
 
 int run_simulate(int argc, char** argv) {
@@ -40,7 +60,8 @@ int run_simulate(int argc, char** argv) {
         "  100 Hz haptic samples as a trial CSV (t,travel,f_motion,f_lateral,f_vertical; the rig's\n"
         "  signs), a summary FILE.json (label, travel, d_max, final forces, parameters) and, for\n"
         "  pictures, FILE.scene.json (mesh, arm, frames, contact forces on the arm at the end) read\n"
-        "  by tools/plot/sim_scene.py.\n"
+        "  by tools/plot/sim_scene.py, and FILE.arm.csv: per sample, the cloth's force on each part\n"
+        "  of the arm (elbow, fist, [hand,] forearm, upper arm; x y z, N) for tools/plot/arm_parts.py.\n"
         "  --arm-offset M    [m] added to the height's arm height (default 0)\n"
         "  --speed V         [m/s] pull speed, 0.1 or 0.15 (default 0.1)\n"
         "  --params FILE     cloth parameters ('name value' lines or flat JSON; see offline/sim/params.h)\n"
@@ -96,6 +117,7 @@ int run_simulate(int argc, char** argv) {
   if (auto pf = args.get("params")) params = sim::read_params(*pf);
   const std::filesystem::path out = args.require("out");
   spec.keep_frames = true;
+  spec.record_arm_parts = true;
   if (auto f = args.get("frames")) {
     spec.frame_times = parse_times(*f);
   } else {
@@ -131,6 +153,9 @@ int run_simulate(int argc, char** argv) {
   std::filesystem::path scene_file = out;
   scene_file.replace_extension(".scene.json");
   write_file_atomic(scene_file, sim::scene_json(scene, spec, r));
+  std::filesystem::path arm_file = out;
+  arm_file.replace_extension(".arm.csv");
+  write_file_atomic(arm_file, arm_parts_csv(scene, r));
   if (args.has("json")) {
     std::printf("%s\n", b);
   } else {

@@ -116,6 +116,7 @@ std::vector<RoundCone> build_arm(const SceneOptions& opt) {
   if (g.hand > 1e-9) arm.push_back(make_round_cone(fist, g.r_fist, wrist, g.r_wrist));
   arm.push_back(make_round_cone(wrist, g.r_wrist, elbow, g.r_elbow));
   arm.push_back(make_round_cone(elbow, g.r_elbow, shoulder, g.r_shoulder));
+  static_assert(kArmParts >= 5, "build_arm makes up to five colliders");
   return arm;
 }
 
@@ -134,6 +135,15 @@ int Scene::vertex_count() const { return static_cast<int>(d_->rest.size()); }
 int Scene::triangle_count() const { return static_cast<int>(d_->mesh.tris.size()); }
 double Scene::gown_mass() const { return d_->rest_area * ClothParams{}.areal_density; }
 const ClothMesh& Scene::mesh() const { return d_->mesh; }
+
+std::vector<std::string> arm_part_names(const Scene& scene) {
+  // build_arm's order; the hand's cone exists only for a hand of some length.
+  std::vector<std::string> names{"elbow", "fist"};
+  if (scene.data().opt.arm.hand > 1e-9) names.push_back("hand");
+  names.push_back("forearm");
+  names.push_back("upper_arm");
+  return names;
+}
 
 Scene make_scene(const ClothMesh& mesh, const SceneOptions& opt) {
   auto d = std::make_shared<SceneData>();

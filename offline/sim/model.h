@@ -12,6 +12,8 @@
 // and shear kernels transpose into x, y, z lanes of four vertices (solver_avx2.cpp).
 #pragma once
 
+#include <array>
+
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -190,6 +192,9 @@ struct GownState {
   std::vector<V3> contact_n;          // last contact normal of the output step (Stock friction)
   std::vector<double> contact_dn;     // sum of normal corrections over the output step [m]
   std::vector<V3> contact_acc;        // sum over substeps of the contact force on each vertex
+  // The same per arm collider (index of m.arm; m dx / h^2 of its corrections): which part of the
+  // arm carries the load (TrialResult::arm_parts).
+  std::array<V3, kArmParts> part_acc{};
   std::vector<V3> ext_force;          // per-vertex external force (the perturbation)
   bool ext_force_on = false;          // any non-zero ext_force this output step (set by step())
   // Self-collision: spatial hash and pair list, capacities fixed in make_state().

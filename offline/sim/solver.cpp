@@ -321,7 +321,9 @@ void solve_contacts(const GownModel& m, GownState& s, double inv_h2) {
       if (c < 0) break;
       V3 nrm;
       const double phi = round_cone_distance(m.arm[c], s.x[i] - s.arm_shift, &nrm);
+      const V3 pre = s.x[i];
       collide_static(m, s, i, phi, nrm, s.arm_move);
+      s.part_acc[static_cast<size_t>(c)] += (m.mass[i] * inv_h2) * (s.x[i] - pre);
     }
     for (const HalfSpace& pl : sc.planes) {
       const double phi = dot(pl.n, s.x[i]) - pl.d;

@@ -229,6 +229,7 @@ void pull(const GownModel& m, GownState& s, const TrialSpec& spec, const Settled
     s.force_acc = zero;
     s.force_count = 0;
     for (int i = 0; i < n; ++i) s.contact_acc[i] = zero;
+    s.part_acc.fill(zero);
     const V3 arm0 = s.arm_shift_to, arm1 = arm.d;
     for (int k = 0; k < 3; ++k) {
       const double t1 = t + m.dt;
@@ -253,6 +254,14 @@ void pull(const GownModel& m, GownState& s, const TrialSpec& spec, const Settled
     const V3 f = (1.0 / s.force_count) * s.force_acc - at_rest.bias;
     const double travel = prof.travel(t);
     r.seq.samples.push_back({t, travel, f.x, f.y, f.z});
+    if (spec.record_arm_parts) {
+      ArmPartLoads loads;
+      for (int k = 0; k < kArmParts; ++k) {
+        const V3 c = (-1.0 / s.force_count) * s.part_acc[static_cast<size_t>(k)];
+        loads.f[static_cast<size_t>(k)] = {c.x, c.y, c.z};
+      }
+      r.arm_parts.push_back(loads);
+    }
     r.finite = all_finite(s);
     if (r.contact_t < 0)
       for (int i = 0; i < n; ++i)

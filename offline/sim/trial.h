@@ -105,6 +105,7 @@ struct TrialSpec {
   double settle_speed = 0.005;
   double settle_damping = 5.0;
   bool keep_frames = false;     // keep gown positions at `frame_times` (for pictures)
+  bool record_arm_parts = false;  // fill TrialResult::arm_parts (one ArmPartLoads per sample)
   std::vector<double> frame_times;  // [s] since the start of the pull; negative = before the pull
 };
 
@@ -113,6 +114,18 @@ struct TrialSpec {
 struct ContactForce {
   int vertex = 0;
   std::array<double, 3> force{};  // [N] world frame, force of the cloth on the arm
+};
+
+// The arm's colliders, in the order of the scene's list (arm_part_names()): elbow sphere, fist
+// sphere, the hand's cone (only when ArmGeometry::hand > 0), forearm cone, upper-arm cone.
+inline constexpr int kArmParts = 5;
+
+// The cloth's force on each part of the arm over one haptic sample (paper eq. 2, f = m dx_col /
+// h^2, summed over the part's contacts and averaged over the sample's substeps, with the sign
+// flipped: the cloth's force on the arm, friction included): which part carries the drag.
+// Parts beyond arm_part_names(scene).size() stay zero.
+struct ArmPartLoads {
+  std::array<std::array<double, 3>, kArmParts> f{};  // [N] world frame
 };
 
 // Gown positions at one time, for pictures.
@@ -142,6 +155,7 @@ struct TrialResult {
   double arm_shift_max = 0;         // [m] its largest magnitude during the pull
   bool finite = true;               // every position stayed finite
   std::vector<ContactForce> contacts;
+  std::vector<ArmPartLoads> arm_parts;  // per sample of seq, with TrialSpec::record_arm_parts
   std::vector<Frame> frames;
   long self_pairs_dropped = 0;      // self-collision pairs beyond the preallocated capacity
   double wall_settle = 0, wall_pull = 0;  // [s] wall time of grasp+settling and of the pull
@@ -214,6 +228,10 @@ class Scene {
 // std::invalid_argument naming the problem (empty mesh, bad index, no grasped vertex...).
 // Masses are derived from ClothParams::areal_density at trial time.
 Scene make_scene(const ClothMesh& mesh, const SceneOptions& opt = {});
+
+// The names of the scene's arm colliders in ArmPartLoads order: "elbow", "fist", ["hand",]
+// "forearm", "upper_arm".
+std::vector<std::string> arm_part_names(const Scene& scene);
 
 // Which gown a default scene uses.
 enum class GownResolution { Full = 0, Reduced = 1, Coarse = 2 };

@@ -31,6 +31,14 @@ file(READ ${TMP}/short.scene.json scene)
 if(NOT scene MATCHES "\"contacts\": \\[")
   message(FATAL_ERROR "the scene file has no contacts list")
 endif()
+# ... and the arm's load per part, one row per sample (0.05 m at the rig's profile: 6 samples).
+file(STRINGS ${TMP}/short.arm.csv arm_rows)
+list(GET arm_rows 0 arm_header)
+list(LENGTH arm_rows arm_n)
+if(NOT arm_header STREQUAL "t,travel,elbow_fx,elbow_fy,elbow_fz,fist_fx,fist_fy,fist_fz,forearm_fx,forearm_fy,forearm_fz,upper_arm_fx,upper_arm_fy,upper_arm_fz"
+   OR arm_n LESS 3)
+  message(FATAL_ERROR "short.arm.csv: header '${arm_header}', ${arm_n} lines")
+endif()
 # A grip the jaws cannot make is named, and nothing is written.
 execute_process(COMMAND ${DG} simulate --height high --gown coarse --grip-depth -0.01 --out ${TMP}/dg_grip_never.csv
                 RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)

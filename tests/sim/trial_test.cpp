@@ -516,3 +516,51 @@ TEST(SimTrial, CompliantArmGivesWayByItsCompliance) {
   EXPECT_GT(r.travel, r0.travel + 0.5 * r.arm_shift[0]);
   EXPECT_NEAR(r.area_ratio, 1.0, 0.05);
 }
+
+// The arm's load per part (TrialSpec::record_arm_parts). (1) Bookkeeping: in the last sample the
+// parts' loads add up to the per-vertex contact forces of eq. 2 (TrialResult::contacts, the same
+// corrections summed by vertex instead of by collider). (2) Physics, the gown's momentum along
+// the pull: the gripper pulls it forward (-f_motion before the bias), the arm holds it back
+// (minus the parts' x loads), damping takes at most m * 2/s * v = 0.23 kg * 2/s * 0.1 m/s =
+// 0.05 N, and over 0.1 m of travel (1 s) the gown's own momentum changes by at most m * 0.1 m/s
+// = 0.023 N s; so per 0.1 m window the mean x load on the arm equals the mean drag within 0.1 N.
+// The missed trial at the low arm drags the gown over the arm for most of its travel.
+TEST(SimTrial, ArmPartLoadsAddUpAndBalanceTheDrag) {
+  TrialSpec spec;
+  spec.height = ArmHeight::Low;
+  spec.record_arm_parts = true;
+  const TrialResult r = simulate_trial(coarse_scene(), ClothParams{}, spec);
+  ASSERT_EQ(r.arm_parts.size(), r.seq.samples.size());
+  const std::vector<std::string> names = arm_part_names(coarse_scene());
+  ASSERT_EQ(names.size(), 4u);  // the default arm has no hand cone
+  V3 by_vertex{0, 0, 0}, by_part{0, 0, 0};
+  for (const ContactForce& c : r.contacts) by_vertex += V3{c.force[0], c.force[1], c.force[2]};
+  for (const auto& f : r.arm_parts.back().f) by_part += V3{f[0], f[1], f[2]};
+  EXPECT_NEAR(by_part.x, by_vertex.x, 1e-9);
+  EXPECT_NEAR(by_part.y, by_vertex.y, 1e-9);
+  EXPECT_NEAR(by_part.z, by_vertex.z, 1e-9);
+  for (std::size_t k = names.size(); k < static_cast<std::size_t>(kArmParts); ++k)
+    EXPECT_EQ(r.arm_parts.back().f[k][0], 0.0) << "no collider " << k;
+  int windows = 0;
+  double worst = 0, heaviest = 0;
+  for (double from = 0.1; from + 0.1 <= r.travel + 1e-9; from += 0.1) {
+    double drag = 0, held = 0;
+    int n = 0;
+    for (std::size_t i = 0; i < r.seq.samples.size(); ++i) {
+      const double x = r.seq.samples[i].travel;
+      if (x < from || x >= from + 0.1) continue;
+      drag += -(r.seq.samples[i].f_motion + r.bias[0]);
+      for (const auto& f : r.arm_parts[i].f) held += f[0];
+      ++n;
+    }
+    ASSERT_GT(n, 0);
+    worst = std::max(worst, std::abs(held - drag) / n);
+    heaviest = std::max(heaviest, held / n);
+    ++windows;
+  }
+  std::printf("low arm: %s at %.3f m, %d windows of 0.1 m, largest mean x load on the arm %.2f N, largest "
+              "imbalance %.3f N\n", r.stopped_by_force ? "10 N stop" : "end of travel", r.travel, windows, heaviest, worst);
+  EXPECT_GE(windows, 4);
+  EXPECT_GT(heaviest, 1.0) << "the arm should hold the dragged gown";
+  EXPECT_LT(worst, 0.1);
+}
