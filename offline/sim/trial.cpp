@@ -260,6 +260,10 @@ void pull(const GownModel& m, GownState& s, const TrialSpec& spec, const Settled
         const V3 c = (-1.0 / s.force_count) * s.part_acc[static_cast<size_t>(k)];
         loads.f[static_cast<size_t>(k)] = {c.x, c.y, c.z};
       }
+      V3 momentum{0, 0, 0};
+      for (int i = 0; i < n; ++i)
+        if (!m.scene->grasped[static_cast<size_t>(i)]) momentum += m.mass[static_cast<size_t>(i)] * s.v[static_cast<size_t>(i)];
+      loads.momentum = {momentum.x, momentum.y, momentum.z};
       r.arm_parts.push_back(loads);
     }
     r.finite = all_finite(s);

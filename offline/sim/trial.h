@@ -126,6 +126,9 @@ inline constexpr int kArmParts = 5;
 // Parts beyond arm_part_names(scene).size() stay zero.
 struct ArmPartLoads {
   std::array<std::array<double, 3>, kArmParts> f{};  // [N] world frame
+  // The free (not grasped) vertices' momentum, sum of m v, at the sample's end [kg m/s]: with the
+  // gripper's force, the arm's and damping, it closes the gown's momentum balance (tests).
+  std::array<double, 3> momentum{};
 };
 
 // Gown positions at one time, for pictures.

@@ -520,16 +520,20 @@ TEST(SimTrial, CompliantArmGivesWayByItsCompliance) {
 // The arm's load per part (TrialSpec::record_arm_parts). (1) Bookkeeping: in the last sample the
 // parts' loads add up to the per-vertex contact forces of eq. 2 (TrialResult::contacts, the same
 // corrections summed by vertex instead of by collider). (2) Physics, the gown's momentum along
-// the pull: the gripper pulls it forward (-f_motion before the bias), the arm holds it back
-// (minus the parts' x loads), damping takes at most m * 2/s * v = 0.23 kg * 2/s * 0.1 m/s =
-// 0.05 N, and over 0.1 m of travel (1 s) the gown's own momentum changes by at most m * 0.1 m/s
-// = 0.023 N s; so per 0.1 m window the mean x load on the arm equals the mean drag within 0.1 N.
-// The missed trial at the low arm drags the gown over the arm for most of its travel.
-TEST(SimTrial, ArmPartLoadsAddUpAndBalanceTheDrag) {
+// the pull (x; gravity has no x part): over every 0.05 m of travel at the pull's constant speed,
+// the change of the free vertices' momentum P equals the impulses of the gripper (-f_motion
+// before the bias: the grasped vertices do not accelerate, so f is the constraints' pull alone),
+// of the arm (minus the parts' x loads) and of damping (-c P, c = 2/s, taken with the samples'
+// mean momentum). Self-collision, stretch, shear and bending corrections are internal. What is
+// left is the damping's discretisation (P sampled every 0.01 s instead of every substep), well
+// under 1 mN here against an arm load of newtons; the bound, 5 mN, is 0.1 % of the 10 N stop.
+// The low arm's trial drags the gown over the arm from early on.
+TEST(SimTrial, ArmPartLoadsAddUpAndBalanceTheGownsMomentum) {
   TrialSpec spec;
   spec.height = ArmHeight::Low;
   spec.record_arm_parts = true;
-  const TrialResult r = simulate_trial(coarse_scene(), ClothParams{}, spec);
+  const ClothParams params;
+  const TrialResult r = simulate_trial(coarse_scene(), params, spec);
   ASSERT_EQ(r.arm_parts.size(), r.seq.samples.size());
   const std::vector<std::string> names = arm_part_names(coarse_scene());
   ASSERT_EQ(names.size(), 4u);  // the default arm has no hand cone
@@ -541,26 +545,33 @@ TEST(SimTrial, ArmPartLoadsAddUpAndBalanceTheDrag) {
   EXPECT_NEAR(by_part.z, by_vertex.z, 1e-9);
   for (std::size_t k = names.size(); k < static_cast<std::size_t>(kArmParts); ++k)
     EXPECT_EQ(r.arm_parts.back().f[k][0], 0.0) << "no collider " << k;
+  const double dt = 0.01;  // one haptic sample
   int windows = 0;
   double worst = 0, heaviest = 0;
-  for (double from = 0.1; from + 0.1 <= r.travel + 1e-9; from += 0.1) {
-    double drag = 0, held = 0;
+  for (int w = 1; 0.05 * (w + 1) <= r.travel + 1e-9; ++w) {
+    double impulse = 0, held = 0, p_first = 0, p_last = 0;
     int n = 0;
-    for (std::size_t i = 0; i < r.seq.samples.size(); ++i) {
+    for (std::size_t i = 1; i < r.seq.samples.size(); ++i) {
       const double x = r.seq.samples[i].travel;
-      if (x < from || x >= from + 0.1) continue;
-      drag += -(r.seq.samples[i].f_motion + r.bias[0]);
-      for (const auto& f : r.arm_parts[i].f) held += f[0];
+      if (x < 0.05 * w || x >= 0.05 * (w + 1)) continue;
+      const double p0 = r.arm_parts[i - 1].momentum[0], p1 = r.arm_parts[i].momentum[0];
+      if (n == 0) p_first = p0;
+      p_last = p1;
+      double arm = 0;
+      for (const auto& f : r.arm_parts[i].f) arm += f[0];
+      held += arm;
+      impulse += (-(r.seq.samples[i].f_motion + r.bias[0]) - arm - params.damping * 0.5 * (p0 + p1)) * dt;
       ++n;
     }
     ASSERT_GT(n, 0);
-    worst = std::max(worst, std::abs(held - drag) / n);
+    worst = std::max(worst, std::abs((p_last - p_first) - impulse) / (n * dt));
     heaviest = std::max(heaviest, held / n);
     ++windows;
   }
-  std::printf("low arm: %s at %.3f m, %d windows of 0.1 m, largest mean x load on the arm %.2f N, largest "
-              "imbalance %.3f N\n", r.stopped_by_force ? "10 N stop" : "end of travel", r.travel, windows, heaviest, worst);
+  std::printf("low arm: %s at %.3f m, %d windows of 0.05 m, largest mean x load on the arm %.2f N, largest "
+              "momentum imbalance %.5f N\n", r.stopped_by_force ? "10 N stop" : "end of travel", r.travel, windows,
+              heaviest, worst);
   EXPECT_GE(windows, 4);
   EXPECT_GT(heaviest, 1.0) << "the arm should hold the dragged gown";
-  EXPECT_LT(worst, 0.1);
+  EXPECT_LT(worst, 0.005);
 }
