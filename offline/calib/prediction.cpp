@@ -4,8 +4,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <mutex>
 #include <limits>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
 
@@ -34,6 +34,33 @@ double median_of(std::vector<double> v) {
 }
 
 bool predictable(const HapticSequence& t) { return t.label && *t.label != Outcome::Caught && !t.samples.empty(); }
+
+// The targets (indices) in groups of one height (one arm placement: the calibration's offset for
+// it), so that each group settles the gown once whether or not the arm touches it while it
+// settles (sim::simulate_trials); at most kPredictionGroup a group, and at least `workers` groups
+// where there are enough targets (the largest group split in two until then). Any grouping gives
+// the same results (the batch simulator's contract); this one keeps the workers busy.
+std::vector<std::vector<int>> groups_by_height(const std::vector<const HapticSequence*>& targets, int workers) {
+  const int n = static_cast<int>(targets.size());
+  std::vector<std::vector<int>> groups;
+  for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
+    std::vector<int> of_h;
+    for (int k = 0; k < n; ++k)
+      if (targets[static_cast<std::size_t>(k)]->height == h) of_h.push_back(k);
+    const int parts = (static_cast<int>(of_h.size()) + kPredictionGroup - 1) / kPredictionGroup;
+    for (int q = 0; q < parts; ++q)  // consecutive, nearly equal parts
+      groups.emplace_back(of_h.begin() + of_h.size() * q / parts, of_h.begin() + of_h.size() * (q + 1) / parts);
+  }
+  while (static_cast<int>(groups.size()) < workers) {
+    auto largest = std::max_element(groups.begin(), groups.end(),
+                                    [](const auto& x, const auto& y) { return x.size() < y.size(); });
+    if (largest->size() < 2) break;
+    std::vector<int> back(largest->begin() + largest->size() / 2, largest->end());
+    largest->resize(largest->size() / 2);
+    groups.push_back(std::move(back));
+  }
+  return groups;
+}
 
 }  // namespace
 
@@ -68,29 +95,7 @@ Prediction predict_others(const Calibration& cal, const Dataset& ds, const Trial
                      cal.participant + "' to predict");
   const ObjectiveKind kind = parse_objective(cal.objective_kind).value_or(ObjectiveKind::Area);
   const int n = static_cast<int>(targets.size());
-  // Groups of targets of one height (one arm placement: the calibration's offset for it), so
-  // that each group settles the gown once whether or not the arm touches it while it settles
-  // (sim::simulate_trials); at most kPredictionGroup a group, and at least one group per
-  // worker where there are enough targets (the largest group split in two until then). Any
-  // grouping gives the same results (the batch simulator's contract).
-  const int workers = thread_count(threads) * comm.size();
-  std::vector<std::vector<int>> groups;
-  for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
-    std::vector<int> of_h;
-    for (int k = 0; k < n; ++k)
-      if (targets[static_cast<std::size_t>(k)]->height == h) of_h.push_back(k);
-    const int parts = (static_cast<int>(of_h.size()) + kPredictionGroup - 1) / kPredictionGroup;
-    for (int q = 0; q < parts; ++q)  // consecutive, nearly equal parts
-      groups.emplace_back(of_h.begin() + of_h.size() * q / parts, of_h.begin() + of_h.size() * (q + 1) / parts);
-  }
-  while (static_cast<int>(groups.size()) < workers) {
-    auto largest = std::max_element(groups.begin(), groups.end(),
-                                    [](const auto& x, const auto& y) { return x.size() < y.size(); });
-    if (largest->size() < 2) break;
-    std::vector<int> back(largest->begin() + largest->size() / 2, largest->end());
-    largest->resize(largest->size() / 2);
-    groups.push_back(std::move(back));
-  }
+  const std::vector<std::vector<int>> groups = groups_by_height(targets, thread_count(threads) * comm.size());
   std::size_t per_group = 0;
   std::vector<std::size_t> slot_of(static_cast<std::size_t>(n));  // target -> its block in `out`
   for (const auto& g : groups) per_group = std::max(per_group, g.size());

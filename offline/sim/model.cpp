@@ -103,7 +103,8 @@ struct HalfEdge {
   int32_t a, b, tri, opp;
 };
 
-std::vector<RoundCone> build_arm(const SceneOptions& opt) {
+// The arm's colliders and their names (ArmPartLoads order), one list so that they cannot drift.
+std::vector<RoundCone> build_arm(const SceneOptions& opt, std::vector<std::string>* names) {
   const ArmGeometry& g = opt.arm;
   const V3 gp{opt.grasp_point[0], opt.grasp_point[1], opt.grasp_point[2]};
   const V3 fist = gp + V3{g.fist_x, 0, g.z_rel[0]};
@@ -111,11 +112,15 @@ std::vector<RoundCone> build_arm(const SceneOptions& opt) {
   const V3 elbow = wrist + V3{g.forearm, 0, 0};
   const V3 shoulder = elbow + V3{0, -g.upper_arm, 0};
   std::vector<RoundCone> arm;
-  arm.push_back(make_round_cone(elbow, g.r_elbow, elbow, g.r_elbow));  // [0] elbow (label reference)
-  arm.push_back(make_round_cone(fist, g.r_fist, fist, g.r_fist));
-  if (g.hand > 1e-9) arm.push_back(make_round_cone(fist, g.r_fist, wrist, g.r_wrist));
-  arm.push_back(make_round_cone(wrist, g.r_wrist, elbow, g.r_elbow));
-  arm.push_back(make_round_cone(elbow, g.r_elbow, shoulder, g.r_shoulder));
+  auto add = [&](const char* name, const RoundCone& c) {
+    arm.push_back(c);
+    names->push_back(name);
+  };
+  add("elbow", make_round_cone(elbow, g.r_elbow, elbow, g.r_elbow));  // [0] elbow (label reference)
+  add("fist", make_round_cone(fist, g.r_fist, fist, g.r_fist));
+  if (g.hand > 1e-9) add("hand", make_round_cone(fist, g.r_fist, wrist, g.r_wrist));
+  add("forearm", make_round_cone(wrist, g.r_wrist, elbow, g.r_elbow));
+  add("upper_arm", make_round_cone(elbow, g.r_elbow, shoulder, g.r_shoulder));
   static_assert(kArmParts >= 5, "build_arm makes up to five colliders");
   return arm;
 }
@@ -136,14 +141,7 @@ int Scene::triangle_count() const { return static_cast<int>(d_->mesh.tris.size()
 double Scene::gown_mass() const { return d_->rest_area * ClothParams{}.areal_density; }
 const ClothMesh& Scene::mesh() const { return d_->mesh; }
 
-std::vector<std::string> arm_part_names(const Scene& scene) {
-  // build_arm's order; the hand's cone exists only for a hand of some length.
-  std::vector<std::string> names{"elbow", "fist"};
-  if (scene.data().opt.arm.hand > 1e-9) names.push_back("hand");
-  names.push_back("forearm");
-  names.push_back("upper_arm");
-  return names;
-}
+std::vector<std::string> arm_part_names(const Scene& scene) { return scene.data().arm_names; }
 
 Scene make_scene(const ClothMesh& mesh, const SceneOptions& opt) {
   auto d = std::make_shared<SceneData>();
@@ -244,7 +242,7 @@ Scene make_scene(const ClothMesh& mesh, const SceneOptions& opt) {
     d->planes.push_back({(1.0 / l) * nn, pl[3] / l});
   }
   if (opt.with_arm) {
-    d->arm = build_arm(opt);
+    d->arm = build_arm(opt, &d->arm_names);
     d->elbow = d->arm[0].a;
   }
   return Scene(std::move(d));

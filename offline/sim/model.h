@@ -13,9 +13,9 @@
 #pragma once
 
 #include <array>
-
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "trial.h"
@@ -96,6 +96,7 @@ struct SceneData {
   // Colliders: the arm's round cones (index 0 is the elbow sphere, used for the label) and
   // planes for tests. The arm is placed at a trial's height by translating these along z.
   std::vector<RoundCone> arm;        // at arm height offset 0 relative to z_rel[High] (see arm_at())
+  std::vector<std::string> arm_names;  // one per collider of `arm` (arm_part_names())
   std::vector<HalfSpace> planes;
   V3 elbow;                          // elbow centre at the High height
 };

@@ -233,7 +233,7 @@ class Scene {
 Scene make_scene(const ClothMesh& mesh, const SceneOptions& opt = {});
 
 // The names of the scene's arm colliders in ArmPartLoads order: "elbow", "fist", ["hand",]
-// "forearm", "upper_arm".
+// "forearm", "upper_arm" (none for a scene without the arm).
 std::vector<std::string> arm_part_names(const Scene& scene);
 
 // Which gown a default scene uses.
