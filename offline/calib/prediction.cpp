@@ -33,6 +33,13 @@ double median_of(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+// The dataset's trial with this id (ids are unique in a dataset), or null.
+const HapticSequence* find_trial(const Dataset& ds, const std::string& id) {
+  for (const auto& t : ds.trials)
+    if (t.id == id) return &t;
+  return nullptr;
+}
+
 bool predictable(const HapticSequence& t) { return t.label && *t.label != Outcome::Caught && !t.samples.empty(); }
 
 // The targets (indices) in groups of one height (one arm placement: the calibration's offset for
@@ -214,8 +221,7 @@ std::string prediction_curves_csv(const Prediction& p, const Dataset& ds) {
     for (const auto& x : s) o << id << ',' << source << ',' << x.travel << ',' << x.f_motion << ',' << x.f_vertical << '\n';
   };
   for (const auto& t : p.trials) {
-    for (const auto& m : ds.trials)
-      if (m.id == t.trial_id) rows(t.trial_id, "measured", m.samples);
+    if (const HapticSequence* m = find_trial(ds, t.trial_id)) rows(t.trial_id, "measured", m->samples);
     rows(t.trial_id, "simulated", t.simulated);
   }
   return o.str();
@@ -244,12 +250,6 @@ bool window_mean(const std::vector<HapticSample>& s, double from, double to, dou
   out[0] = sum[0] / n;
   out[1] = sum[1] / n;
   return true;
-}
-
-const HapticSequence* find_trial(const Dataset& ds, const std::string& id) {
-  for (const auto& t : ds.trials)
-    if (t.id == id) return &t;
-  return nullptr;
 }
 
 }  // namespace
