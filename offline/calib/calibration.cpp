@@ -35,6 +35,13 @@ void set_cloth_value(ClothValues& c, int i, double v) {
   }
 }
 
+double person_value(const ClothValues& c, int i) { return i == kArmCompliance ? c.arm_compliance : c.fist_shift; }
+
+void set_person_value(ClothValues& c, int i, double v) {
+  if (i == kArmCompliance) c.arm_compliance = v;
+  else c.fist_shift = v;
+}
+
 Bounds default_bounds() {
   Bounds b;
   // The start is the plausibility grid's best point against participant 4 (offline/sim/README.md:
@@ -49,7 +56,8 @@ Bounds default_bounds() {
   b.cloth[3] = {0.0, 2.0, 0.35};  // friction
   b.cloth[4] = {0.0, 2.0, 0.2};  // self_friction
   b.arm_offset = {-0.06, 0.06, 0.0};
-  b.arm_compliance = {0.0, 0.01, 0.004};
+  b.person[kArmCompliance] = {0.0, 0.01, 0.004};
+  b.person[kFistShift] = {-0.05, 0.15, 0.0};
   return b;
 }
 
@@ -77,13 +85,16 @@ Bounds read_bounds(const std::filesystem::path& path) {
     for (int i = 0; i < kClothParams; ++i)
       if (name == kClothParamNames[i]) target = &b.cloth[i];
     if (name == "arm_offset") target = &b.arm_offset;
-    if (name == "arm_compliance") target = &b.arm_compliance;
+    for (int i = 0; i < kPersonParams; ++i)
+      if (name == kPersonParamInfo[i].name) {
+        if (pb.lower < kPersonParamInfo[i].lowest || pb.upper > kPersonParamInfo[i].highest)
+          throw_input_error(path, n, name + " " + kPersonParamInfo[i].range);
+        target = &b.person[i];
+      }
     if (!target)
       throw_input_error(path, n,
                         "unknown parameter '" + name +
-                            "' (expected stretch, shear, bend, friction, self_friction, arm_offset or arm_compliance)");
-    if (name == "arm_compliance" && pb.lower < 0)
-      throw_input_error(path, n, "arm_compliance cannot be negative (0 is a fixed arm)");
+                            "' (expected stretch, shear, bend, friction, self_friction, arm_offset, arm_compliance or fist_shift)");
     *target = pb;
   }
   return b;
@@ -99,14 +110,18 @@ Eigen::VectorXd ParameterSpace::initial_unit() const {
   for (int i = 0; i < kClothParams; ++i) x[i] = to_unit(bounds.cloth[i], bounds.cloth[i].initial);
   for (std::size_t k = 0; k < offset_heights.size(); ++k)
     x[kClothParams + static_cast<long>(k)] = to_unit(bounds.arm_offset, bounds.arm_offset.initial);
-  if (fit_arm_compliance) x[dimension() - 1] = to_unit(bounds.arm_compliance, bounds.arm_compliance.initial);
+  long k = kClothParams + static_cast<long>(offset_heights.size());
+  for (int i = 0; i < kPersonParams; ++i)
+    if (person[i].fit) x[k++] = to_unit(bounds.person[i], bounds.person[i].initial);
   return x;
 }
 
 ClothValues ParameterSpace::cloth(const Eigen::VectorXd& unit) const {
   ClothValues c;
   for (int i = 0; i < kClothParams; ++i) set_cloth_value(c, i, from_unit(bounds.cloth[i], unit[i]));
-  c.arm_compliance = fit_arm_compliance ? from_unit(bounds.arm_compliance, unit[dimension() - 1]) : arm_compliance;
+  long k = kClothParams + static_cast<long>(offset_heights.size());
+  for (int i = 0; i < kPersonParams; ++i)
+    set_person_value(c, i, person[i].fit ? from_unit(bounds.person[i], unit[k++]) : person[i].value);
   return c;
 }
 
@@ -120,23 +135,25 @@ std::array<double, 3> ParameterSpace::offsets(const Eigen::VectorXd& unit) const
 std::vector<std::string> ParameterSpace::names() const {
   std::vector<std::string> n(kClothParamNames.begin(), kClothParamNames.end());
   for (ArmHeight h : offset_heights) n.push_back("arm_offset_" + std::string(arm_height_name(h)));
-  if (fit_arm_compliance) n.push_back("arm_compliance");
+  for (int i = 0; i < kPersonParams; ++i)
+    if (person[i].fit) n.push_back(kPersonParamInfo[i].name);
   return n;
 }
 
-bool set_arm_compliance(ParameterSpace& space, const std::string& word) {
+bool set_person_param(ParameterSpace& space, int i, const std::string& word) {
   if (word == "fit") {
-    space.fit_arm_compliance = true;
+    space.person[i].fit = true;
     return true;
   }
   double v = 0.0;
   if (word != "fixed") {
     char* end = nullptr;
     v = std::strtod(word.c_str(), &end);
-    if (word.empty() || *end != '\0' || !std::isfinite(v) || v < 0 || v > 1) return false;
+    if (word.empty() || *end != '\0' || !std::isfinite(v) || v < kPersonParamInfo[i].lowest ||
+        v > kPersonParamInfo[i].highest)
+      return false;
   }
-  space.fit_arm_compliance = false;
-  space.arm_compliance = v;
+  space.person[i] = {false, v};
   return true;
 }
 
@@ -199,12 +216,14 @@ std::string fingerprint(const std::vector<HapticSequence>& inputs, const Paramet
   for (const auto& b : space.bounds.cloth) f << hexd(b.lower) << ',' << hexd(b.upper) << ',' << hexd(b.initial) << ',';
   f << hexd(space.bounds.arm_offset.lower) << ',' << hexd(space.bounds.arm_offset.upper) << ','
     << hexd(space.bounds.arm_offset.initial);
-  // The arm's compliance only when it is not the paper's fixed arm (older checkpoints resume).
-  if (space.fit_arm_compliance)
-    f << ",arm_compliance:" << hexd(space.bounds.arm_compliance.lower) << ',' << hexd(space.bounds.arm_compliance.upper)
-      << ',' << hexd(space.bounds.arm_compliance.initial);
-  else if (space.arm_compliance != 0)
-    f << ",arm_compliance=" << hexd(space.arm_compliance);
+  // A person parameter only when it is not the paper's arm (older checkpoints resume).
+  for (int i = 0; i < kPersonParams; ++i) {
+    const ParamBound& b = space.bounds.person[i];
+    if (space.person[i].fit)
+      f << ',' << kPersonParamInfo[i].name << ':' << hexd(b.lower) << ',' << hexd(b.upper) << ',' << hexd(b.initial);
+    else if (space.person[i].value != 0)
+      f << ',' << kPersonParamInfo[i].name << '=' << hexd(space.person[i].value);
+  }
   f << ";inputs=";
   for (const auto& s : inputs) f << s.id << '/' << s.samples.size() << ',';
   return f.str();
@@ -424,9 +443,10 @@ Json calibration_to_json(const Calibration& c) {
   j.set("participant", c.participant);
   Json cloth = Json::object();
   for (int i = 0; i < kClothParams; ++i) cloth.set(kClothParamNames[i], cloth_value(c.cloth, i));
-  // Only a compliant arm is written: a file without it is the paper's fixed arm (and synthesis
-  // folders made from such a calibration keep their record, so they still resume).
-  if (c.cloth.arm_compliance != 0) cloth.set("arm_compliance", c.cloth.arm_compliance);
+  // Only a person parameter other than the paper's is written: a file without one is the paper's
+  // arm (and synthesis folders made from such a calibration keep their record, so they resume).
+  for (int i = 0; i < kPersonParams; ++i)
+    if (person_value(c.cloth, i) != 0) cloth.set(kPersonParamInfo[i].name, person_value(c.cloth, i));
   j.set("cloth", cloth);
   Json off = Json::object();
   for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
@@ -471,11 +491,14 @@ Calibration calibration_from_json(const Json& j, const std::filesystem::path& so
       if (!std::isfinite(v)) throw std::runtime_error(std::string("cloth.") + kClothParamNames[i] + " is not finite");
       set_cloth_value(c.cloth, i, v);
     }
-    // Files from before the compliant arm have none: the fixed arm they were calibrated with.
-    if (j.at("cloth").has("arm_compliance")) {
-      c.cloth.arm_compliance = j.at("cloth").at("arm_compliance").number();
-      if (!(c.cloth.arm_compliance >= 0 && c.cloth.arm_compliance <= 1))
-        throw std::runtime_error("cloth.arm_compliance must be in [0, 1] m/N");
+    // Files without one have the paper's arm (0) they were calibrated with.
+    for (int i = 0; i < kPersonParams; ++i) {
+      const PersonParamInfo& info = kPersonParamInfo[i];
+      if (!j.at("cloth").has(info.name)) continue;
+      const double v = j.at("cloth").at(info.name).number();
+      if (!(v >= info.lowest && v <= info.highest))
+        throw std::runtime_error(std::string("cloth.") + info.name + " " + info.range);
+      set_person_value(c.cloth, i, v);
     }
     for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
       const Json& e = j.at("arm_offsets").at(std::string(arm_height_name(h)));

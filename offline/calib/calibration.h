@@ -37,15 +37,36 @@ struct ClothValues {
   double bend = 0.7;
   double friction = 0.5;       // cloth-arm
   double self_friction = 0.2;  // cloth-cloth
-  // [m/N] how far the person's arm gives per newton of the cloth's pull (sim/arm_spring.h); not
-  // one of the paper's five (its arm is fixed, 0), fitted only when ParameterSpace asks for it.
+  // The person's arm (kPersonParams below; 0 is the paper's), fitted only when ParameterSpace
+  // asks for it: [m/N] how far it gives per newton of the cloth's pull (sim/arm_spring.h), and
+  // [m] how far its fist sits beyond the paper's toward the elbow (sim/trial.h, ClothParams).
   double arm_compliance = 0.0;
+  double fist_shift = 0.0;
 };
 inline constexpr int kClothParams = 5;
 inline constexpr std::array<const char*, kClothParams> kClothParamNames = {"stretch", "shear", "bend", "friction",
                                                                            "self_friction"};
 double cloth_value(const ClothValues& c, int i);
 void set_cloth_value(ClothValues& c, int i, double v);
+
+// Parameters of the person's arm rather than the cloth's, each fitted within its bounds or held
+// at a value (ParameterSpace::person); none is among the paper's five, and 0 is the paper's arm.
+// `lowest`/`highest` bound every box and held value (the simulator's own limits); `range` says so
+// in an error message.
+struct PersonParamInfo {
+  const char* name;
+  double lowest, highest;
+  const char* range;
+};
+inline constexpr int kPersonParams = 2;
+inline constexpr int kArmCompliance = 0;  // [m/N] sim/arm_spring.h
+inline constexpr int kFistShift = 1;      // [m] sim/trial.h ClothParams::fist_shift
+inline constexpr std::array<PersonParamInfo, kPersonParams> kPersonParamInfo = {{
+    {"arm_compliance", 0.0, 1.0, "cannot be negative (0 is a fixed arm) nor above 1 m/N"},
+    {"fist_shift", -0.2, 0.2, "must be within +-0.2 m (the forearm is 0.31 m)"},
+}};
+double person_value(const ClothValues& c, int i);
+void set_person_value(ClothValues& c, int i, double v);
 
 // One simulated trial's conditions.
 struct TrialRequest {
@@ -81,8 +102,8 @@ struct ParamBound {
 };
 struct Bounds {
   std::array<ParamBound, kClothParams> cloth;
-  ParamBound arm_offset;      // [m], shared by the offsets of every height
-  ParamBound arm_compliance;  // [m/N], when ParameterSpace::fit_arm_compliance
+  ParamBound arm_offset;                           // [m], shared by the offsets of every height
+  std::array<ParamBound, kPersonParams> person;  // kPersonParamInfo order, when fitted
 };
 // Defaults (the simulator's box, sim/trial.h ClothParams): stretch, shear, bend in [0, 1] (start
 // 0.2, 0.5, 0.7); friction and self_friction in [0, 2] (start 0.35, 0.2): the plausibility grid's
@@ -90,37 +111,44 @@ struct Bounds {
 // [-0.06, 0.06] m (start 0): the study's middle noise spans 6 cm (paper V-A), and the paper's
 // calibrated offset for participant 4 was -0.02 m; arm compliance in [0, 0.01] m/N (start
 // 0.004): a stiffness of 100 N/m and up, the hand's postural stiffness being about 300-800 N/m
-// (sim/arm_spring.h) and a held-out forearm softer.
+// (sim/arm_spring.h) and a held-out forearm softer; fist shift in [-0.05, 0.15] m (start 0, the
+// paper's arm): a fist-to-elbow length of 0.16-0.36 m.
 Bounds default_bounds();
 // Bounds file: one "name lower upper [initial]" per line, '#' starts a comment, names as in
-// kClothParamNames plus "arm_offset" and "arm_compliance"; unnamed parameters keep their defaults. InputError names the
-// file and line of a malformed row (unknown name, lower >= upper, initial outside the box).
+// kClothParamNames plus "arm_offset" and kPersonParamInfo's; unnamed parameters keep their
+// defaults. InputError names the file and line of a malformed row (unknown name, lower >= upper,
+// initial outside the box, a person parameter's box outside its range).
 Bounds read_bounds(const std::filesystem::path& path);
 
 // The search vector: the five cloth parameters, one offset per used height (high, middle, low
-// order), then the arm's compliance when it is fitted, each normalised to [0, 1] over its box
+// order), then each fitted person parameter (kPersonParamInfo order), each normalised to [0, 1] over its box
 // (CMA-ES works in the unit box, as the paper's public code did, so sigma means the same for
 // every coordinate).
 struct ParameterSpace {
   Bounds bounds;
   std::vector<ArmHeight> offset_heights;  // heights with an optimised offset; empty: --no-arm-offset
-  // The arm's compliance: fitted within bounds.arm_compliance, or held at `arm_compliance`
-  // (0: the paper's fixed arm).
-  bool fit_arm_compliance = false;
-  double arm_compliance = 0.0;
-  int dimension() const {
-    return kClothParams + static_cast<int>(offset_heights.size()) + (fit_arm_compliance ? 1 : 0);
+  // Each person parameter: fitted within bounds.person[i], or held at `value` (0: the paper's arm).
+  struct Person {
+    bool fit = false;
+    double value = 0.0;
+  };
+  std::array<Person, kPersonParams> person{};
+  int fitted_person_params() const {
+    int n = 0;
+    for (const Person& p : person) n += p.fit ? 1 : 0;
+    return n;
   }
+  int dimension() const { return kClothParams + static_cast<int>(offset_heights.size()) + fitted_person_params(); }
   Eigen::VectorXd initial_unit() const;
   ClothValues cloth(const Eigen::VectorXd& unit) const;
   std::array<double, 3> offsets(const Eigen::VectorXd& unit) const;  // [m] by ArmHeight, 0 if not optimised
-  std::vector<std::string> names() const;  // "stretch", ..., "arm_offset_high", ..., "arm_compliance"
+  std::vector<std::string> names() const;  // "stretch", ..., "arm_offset_high", ..., "arm_compliance", ...
 };
 
-// The arm of `space` from a command line's word: "fit" (search bounds.arm_compliance), "fixed"
-// or "0" (the paper's fixed arm), or a compliance in m/N held during the search. False when the
-// word is none of these (or a negative or non-finite number).
-bool set_arm_compliance(ParameterSpace& space, const std::string& word);
+// Person parameter i of `space` from a command line's word: "fit" (search bounds.person[i]),
+// "fixed" or "0" (the paper's arm), or a value held during the search. False when the word is
+// none of these (or a non-finite number or one outside kPersonParamInfo[i]'s range).
+bool set_person_param(ParameterSpace& space, int i, const std::string& word);
 
 // ---- input selection (paper IV-B.1) -------------------------------------------------------------
 

@@ -20,6 +20,7 @@ sim::ClothParams params_of(const ClothValues& c) {
   p.friction = c.friction;
   p.self_friction = c.self_friction;
   p.arm_compliance = c.arm_compliance;
+  p.fist_shift = c.fist_shift;
   return p;
 }
 

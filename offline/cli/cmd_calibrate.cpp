@@ -47,6 +47,9 @@ int run_calibrate(int argc, char** argv) {
         "  --arm-compliance fit|fixed|C   the person's arm: fit its compliance [m/N] too (one more\n"
         "                      parameter; offline/sim/arm_spring.h), hold it fixed (the paper's, the\n"
         "                      default) or give way by C m per N\n"
+        "  --fist-shift fit|fixed|M   the person's fist: fit how far it sits beyond the paper's\n"
+        "                      toward the elbow (one more parameter; the elbow stays), hold it at the\n"
+        "                      paper's (the default) or at M metres\n"
         "  --gown full|reduced|coarse   simulator gown (default reduced)\n"
         "  --threads N         threads per process (default: all cores)\n"
         "  --checkpoint FILE   default CAL.json.ckpt; an existing one is resumed\n"
@@ -58,7 +61,7 @@ int run_calibrate(int argc, char** argv) {
   }
   args.allow_only({"help", "json", "no-arm-offset", "data", "participant", "profile", "bounds", "seed", "out",
                    "checkpoint", "objective", "gown", "threads", "generations", "population",
-                   "stop-after-generations", "arm-compliance", "sigma0"});
+                   "stop-after-generations", "arm-compliance", "fist-shift", "sigma0"});
   const std::string data = args.require("data");
   const std::string participant = args.require("participant");
   const std::string out = args.require("out");
@@ -87,8 +90,10 @@ int run_calibrate(int argc, char** argv) {
   if (gown != "full" && gown != "reduced" && gown != "coarse") throw UsageError("--gown must be full, reduced or coarse");
 
   ParameterSpace space;
-  if (const auto arm = args.get("arm-compliance"); arm && !set_arm_compliance(space, *arm))
+  if (const auto arm = args.get("arm-compliance"); arm && !set_person_param(space, kArmCompliance, *arm))
     throw UsageError("--arm-compliance must be fit, fixed or a compliance in [0, 1] m/N, not '" + *arm + "'");
+  if (const auto fist = args.get("fist-shift"); fist && !set_person_param(space, kFistShift, *fist))
+    throw UsageError("--fist-shift must be fit, fixed or a shift in [-0.2, 0.2] m, not '" + *fist + "'");
   space.bounds = args.get("bounds") ? read_bounds(*args.get("bounds")) : default_bounds();
   const Dataset ds = load_dataset(data);
   const std::vector<HapticSequence> inputs = select_inputs(ds, participant, o.seed);
@@ -175,6 +180,9 @@ int run_calibrate(int argc, char** argv) {
                     "(zero force %.3f) N m\n", f.trial_id.c_str(), std::string(arm_height_name(f.height)).c_str(),
                     f.objective, f.motion.error, f.motion.zero, f.vertical.error, f.vertical.zero);
       for (int i = 0; i < kClothParams; ++i) std::printf("  %-13s %.4f\n", kClothParamNames[i], cloth_value(r.cloth, i));
+      for (int i = 0; i < kPersonParams; ++i)
+        if (space.person[i].fit || person_value(r.cloth, i) != 0)
+          std::printf("  %-14s %.4f%s\n", kPersonParamInfo[i].name, person_value(r.cloth, i), space.person[i].fit ? "" : " (held)");
       for (ArmHeight h : space.offset_heights)
         std::printf("  arm offset %-6s %+.4f m\n", std::string(arm_height_name(h)).c_str(), r.offsets[static_cast<int>(h)]);
       std::printf("wrote %s and %s.curves.csv\n", out.c_str(), out.c_str());

@@ -103,29 +103,30 @@ struct HalfEdge {
   int32_t a, b, tri, opp;
 };
 
+}  // namespace
+
 // The arm's colliders and their names (ArmPartLoads order), one list so that they cannot drift.
-std::vector<RoundCone> build_arm(const SceneOptions& opt, std::vector<std::string>* names) {
+std::vector<RoundCone> arm_colliders(const SceneOptions& opt, double fist_shift, std::vector<std::string>* names) {
   const ArmGeometry& g = opt.arm;
   const V3 gp{opt.grasp_point[0], opt.grasp_point[1], opt.grasp_point[2]};
-  const V3 fist = gp + V3{g.fist_x, 0, g.z_rel[0]};
+  const V3 fist0 = gp + V3{g.fist_x, 0, g.z_rel[0]};
+  const V3 elbow = fist0 + V3{g.hand, 0, 0} + V3{g.forearm, 0, 0};
+  const V3 fist = fist0 + V3{fist_shift, 0, 0};  // fist0 itself when fist_shift is 0
   const V3 wrist = fist + V3{g.hand, 0, 0};
-  const V3 elbow = wrist + V3{g.forearm, 0, 0};
   const V3 shoulder = elbow + V3{0, -g.upper_arm, 0};
   std::vector<RoundCone> arm;
   auto add = [&](const char* name, const RoundCone& c) {
     arm.push_back(c);
-    names->push_back(name);
+    if (names) names->push_back(name);
   };
   add("elbow", make_round_cone(elbow, g.r_elbow, elbow, g.r_elbow));  // [0] elbow (label reference)
   add("fist", make_round_cone(fist, g.r_fist, fist, g.r_fist));
   if (g.hand > 1e-9) add("hand", make_round_cone(fist, g.r_fist, wrist, g.r_wrist));
   add("forearm", make_round_cone(wrist, g.r_wrist, elbow, g.r_elbow));
   add("upper_arm", make_round_cone(elbow, g.r_elbow, shoulder, g.r_shoulder));
-  static_assert(kArmParts >= 5, "build_arm makes up to five colliders");
+  static_assert(kArmParts >= 5, "arm_colliders makes up to five colliders");
   return arm;
 }
-
-}  // namespace
 
 const char* friction_scheme_name(FrictionScheme s) {
   switch (s) {
@@ -242,7 +243,7 @@ Scene make_scene(const ClothMesh& mesh, const SceneOptions& opt) {
     d->planes.push_back({(1.0 / l) * nn, pl[3] / l});
   }
   if (opt.with_arm) {
-    d->arm = build_arm(opt, &d->arm_names);
+    d->arm = arm_colliders(opt, 0.0, &d->arm_names);
     d->elbow = d->arm[0].a;
   }
   return Scene(std::move(d));
@@ -274,6 +275,7 @@ GownModel make_model(const SceneData& s, const ClothParams& p, FrictionScheme sc
   m.friction = std::max(0.0, p.friction);
   m.self_friction = std::max(0.0, p.self_friction);
   m.arm_compliance = std::max(0.0, p.arm_compliance);
+  m.fist_shift = p.fist_shift;
   m.damping_factor = std::exp(-std::max(0.0, p.damping) * m.h);
   m.scheme = scheme;
   m.self_collision = self_collision;

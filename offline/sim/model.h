@@ -149,6 +149,7 @@ struct GownModel {
   double alpha_compress = 0;          // stretch edges under compression (SceneOptions::compression_softening)
   double friction = 0, self_friction = 0;
   double arm_compliance = 0;          // [m/N] ClothParams::arm_compliance (0: fixed arm)
+  double fist_shift = 0;              // [m] ClothParams::fist_shift (place_arm)
   double damping_factor = 1;          // per substep
   FrictionScheme scheme = FrictionScheme::Improved;
   bool self_collision = true;
@@ -226,7 +227,13 @@ GownState make_state(const GownModel& m);
 // (linearly interpolated over the substeps), `grip_accel` its acceleration.
 void step(const GownModel& m, GownState& s, V3 grip_from, V3 grip_to, V3 grip_accel);
 
-// The arm of the scene moved by arm_dz along z (the trial's height): m.arm and m.elbow.
+// The arm's colliders (fist, hand when ArmGeometry::hand > 0, forearm, upper arm; the elbow's
+// sphere first, the label's reference), with the fist moved by fist_shift along the forearm and the
+// elbow where it was (ClothParams::fist_shift). `names` (may be null) gets each collider's name.
+std::vector<RoundCone> arm_colliders(const SceneOptions& opt, double fist_shift, std::vector<std::string>* names = nullptr);
+
+// The arm of the scene with its fist moved by m.fist_shift toward the elbow, then the whole arm
+// moved by arm_dz along z (the trial's height): m.arm and m.elbow.
 void place_arm(GownModel& m, double arm_dz);
 
 // Whether the arm, moved by dz along z from where m has it, would give any free vertex an arm

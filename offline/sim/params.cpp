@@ -20,6 +20,7 @@ double* field(ClothParams& p, const std::string& name) {
   if (name == "damping") return &p.damping;
   if (name == "areal_density") return &p.areal_density;
   if (name == "arm_compliance") return &p.arm_compliance;
+  if (name == "fist_shift") return &p.fist_shift;
   return nullptr;
 }
 
@@ -46,7 +47,7 @@ ClothParams parse_params(const std::string& text, const std::filesystem::path& f
       if (!(ws >> value)) throw_input_error(file, lineno, "parameter '" + name + "' has no value");
       if (ws >> extra) throw_input_error(file, lineno, "unexpected '" + extra + "' after " + name);
       double* f = field(p, name);
-      if (!f) throw_input_error(file, lineno, "unknown parameter '" + name + "' (stretch, shear, bend, friction, self_friction, damping, areal_density, arm_compliance)");
+      if (!f) throw_input_error(file, lineno, "unknown parameter '" + name + "' (stretch, shear, bend, friction, self_friction, damping, areal_density, arm_compliance, fist_shift)");
       double v = 0;
       auto [ptr, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
       if (ec != std::errc() || ptr != value.data() + value.size() || !std::isfinite(v))
@@ -56,26 +57,30 @@ ClothParams parse_params(const std::string& text, const std::filesystem::path& f
   }
   if (p.areal_density <= 0) throw_input_error(file, 0, "areal_density must be positive");
   if (p.arm_compliance < 0) throw_input_error(file, 0, "arm_compliance must be 0 (a fixed arm) or positive");
+  if (!(std::abs(p.fist_shift) <= kMaxFistShift))
+    throw_input_error(file, 0, "fist_shift must be within +-" + std::to_string(kMaxFistShift) + " m");
   return p;
 }
 
 ClothParams read_params(const std::filesystem::path& file) { return parse_params(read_file(file), file); }
 
 std::string format_params(const ClothParams& p) {
-  char b[512];
+  char b[768];
   std::snprintf(b, sizeof b,
                 "stretch %.17g\nshear %.17g\nbend %.17g\nfriction %.17g\nself_friction %.17g\ndamping %.17g\n"
-                "areal_density %.17g\narm_compliance %.17g\n",
-                p.stretch, p.shear, p.bend, p.friction, p.self_friction, p.damping, p.areal_density, p.arm_compliance);
+                "areal_density %.17g\narm_compliance %.17g\nfist_shift %.17g\n",
+                p.stretch, p.shear, p.bend, p.friction, p.self_friction, p.damping, p.areal_density, p.arm_compliance,
+                p.fist_shift);
   return b;
 }
 
 std::string params_json(const ClothParams& p) {
-  char b[512];
+  char b[768];
   std::snprintf(b, sizeof b,
                 "{\"stretch\": %.17g, \"shear\": %.17g, \"bend\": %.17g, \"friction\": %.17g, \"self_friction\": %.17g, "
-                "\"damping\": %.17g, \"areal_density\": %.17g, \"arm_compliance\": %.17g}",
-                p.stretch, p.shear, p.bend, p.friction, p.self_friction, p.damping, p.areal_density, p.arm_compliance);
+                "\"damping\": %.17g, \"areal_density\": %.17g, \"arm_compliance\": %.17g, \"fist_shift\": %.17g}",
+                p.stretch, p.shear, p.bend, p.friction, p.self_friction, p.damping, p.areal_density, p.arm_compliance,
+                p.fist_shift);
   return b;
 }
 

@@ -419,7 +419,7 @@ bool arm_in_reach(const GownModel& m, const GownState& s, double dz) {
 }
 
 void place_arm(GownModel& m, double arm_dz) {
-  m.arm = m.scene->arm;
+  m.arm = m.fist_shift == 0 || m.scene->arm.empty() ? m.scene->arm : arm_colliders(m.scene->opt, m.fist_shift);
   for (auto& c : m.arm) {
     c.a.z += arm_dz;
     c.b.z += arm_dz;

@@ -50,6 +50,12 @@ namespace dressguard::sim {
 // pull (arm_spring.h: a 2 kg arm on a critically damped spring of stiffness 1 / arm_compliance);
 // 0, the default and the paper's, holds the arm fixed. Not cloth, but a parameter of the scene
 // that a calibration may fit per person like the cloth's.
+// fist_shift [m]: the fist (and wrist) moved along the forearm toward the elbow, the elbow and
+// upper arm fixed, so the forearm is that much shorter (negative: longer). 0, the default, is the
+// paper's arm (data README: the elbow 0.53 m ahead of the gripper's start, the fist 0.31 m before
+// it). In the paper's simulator the gripper's start is placed from the elbow and the fist from
+// the forearm's length, so this is the person's fist-to-elbow length; the measured trials place
+// the elbow (the good trials' 10 N stop) but not the fist, and calibration may fit it per person.
 struct ClothParams {
   double stretch = 0.8;
   double shear = 0.5;
@@ -59,7 +65,10 @@ struct ClothParams {
   double damping = 2.0;
   double areal_density = 0.145;
   double arm_compliance = 0.0;
+  double fist_shift = 0.0;
 };
+// |fist_shift| beyond this leaves no forearm worth the name (the paper's is 0.31 m).
+inline constexpr double kMaxFistShift = 0.2;
 
 // Friction of cloth against the arm and itself (paper IV-A.2, the point of the "improved" scheme):
 //  Stock:      PBD as in stock PhysX: contacts push vertices out along the normal in every

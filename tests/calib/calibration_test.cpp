@@ -118,46 +118,63 @@ TEST(Calibration, RecoversKnownParametersOfTheStandIn) {
   EXPECT_NEAR(r.fits[0].objective + r.fits[1].objective, r.objective, 1e-12);
 }
 
-// The arm's compliance as a seventh... ninth parameter (ParameterSpace::fit_arm_compliance):
-// inputs made with an arm that gives 5 mm per N are fitted to a small fraction of what the
-// paper's fixed arm can reach, and the compliance is found within 1 mm/N (the stand-in's drag
-// depends on it through the travel scale, which friction and stretch cannot mimic).
-TEST(Calibration, RecoversTheArmComplianceOfTheStandIn) {
-  Truth truth;
-  truth.cloth.arm_compliance = 0.005;
-  const auto inputs = fake_inputs(truth);
+// A person parameter as one more dimension (ParameterSpace::person): inputs made with the
+// parameter at `truth` are fitted to a small fraction of what the paper's arm (0) reaches, and the
+// parameter is found within `tolerance`.
+void recovers_person_param(int i, double truth, double tolerance) {
+  Truth t;
+  set_person_value(t.cloth, i, truth);
+  const auto inputs = fake_inputs(t);
   auto fixed = space_for(inputs);
   auto fitted = fixed;
-  ASSERT_TRUE(set_arm_compliance(fitted, "fit"));
+  ASSERT_TRUE(set_person_param(fitted, i, "fit"));
   EXPECT_EQ(fitted.dimension(), fixed.dimension() + 1);
-  EXPECT_EQ(fitted.names().back(), "arm_compliance");
+  EXPECT_EQ(fitted.names().back(), kPersonParamInfo[i].name);
   const auto rf = calibrate(inputs, fixed, testing::fake_simulate, quick(60, 2), Comm::world());
   const auto rc = calibrate(inputs, fitted, testing::fake_simulate, quick(60, 2), Comm::world());
-  std::printf("  fixed arm L %.6f; fitted arm L %.6f with compliance %.5f m/N (truth 0.005)\n", rf.objective,
-              rc.objective, rc.cloth.arm_compliance);
-  EXPECT_EQ(rf.cloth.arm_compliance, 0.0);
-  EXPECT_NEAR(rc.cloth.arm_compliance, 0.005, 0.001);
+  std::printf("  %s: the paper's arm L %.6f; fitted L %.6f at %.5f (truth %g)\n", kPersonParamInfo[i].name,
+              rf.objective, rc.objective, person_value(rc.cloth, i), truth);
+  EXPECT_EQ(person_value(rf.cloth, i), 0.0);
+  EXPECT_NEAR(person_value(rc.cloth, i), truth, tolerance);
   EXPECT_LT(rc.objective, 0.25 * rf.objective);
 }
 
-TEST(Calibration, ArmComplianceWords) {
+// An arm that gives 5 mm per N, found within 1 mm/N: the stand-in's drag depends on it through
+// the travel scale, which friction and stretch cannot mimic.
+TEST(Calibration, RecoversTheArmComplianceOfTheStandIn) { recovers_person_param(kArmCompliance, 0.005, 0.001); }
+
+// The fist 6 cm further along the arm, found within 5 mm: the stand-in's drag starts where the
+// fist is, which no cloth parameter can move.
+TEST(Calibration, RecoversTheFistShiftOfTheStandIn) { recovers_person_param(kFistShift, 0.06, 0.005); }
+
+TEST(Calibration, PersonParameterWords) {
   ParameterSpace s;
-  EXPECT_TRUE(set_arm_compliance(s, "fit"));
-  EXPECT_TRUE(s.fit_arm_compliance);
-  EXPECT_TRUE(set_arm_compliance(s, "0.003"));
-  EXPECT_FALSE(s.fit_arm_compliance);
-  EXPECT_EQ(s.arm_compliance, 0.003);
+  EXPECT_TRUE(set_person_param(s, kArmCompliance, "fit"));
+  EXPECT_TRUE(s.person[kArmCompliance].fit);
+  EXPECT_TRUE(set_person_param(s, kArmCompliance, "0.003"));
+  EXPECT_FALSE(s.person[kArmCompliance].fit);
+  EXPECT_EQ(s.person[kArmCompliance].value, 0.003);
+  EXPECT_TRUE(set_person_param(s, kFistShift, "-0.04"));
   Eigen::VectorXd u = Eigen::VectorXd::Constant(s.dimension(), 0.5);
   EXPECT_EQ(s.cloth(u).arm_compliance, 0.003);  // held, not searched
-  EXPECT_TRUE(set_arm_compliance(s, "fixed"));
-  EXPECT_EQ(s.arm_compliance, 0.0);
-  for (const char* bad : {"", "soft", "-0.001", "2", "0.003x", "nan"}) EXPECT_FALSE(set_arm_compliance(s, bad)) << bad;
-  // Fitted: the last coordinate spans the bounds' box.
+  EXPECT_EQ(s.cloth(u).fist_shift, -0.04);
+  EXPECT_TRUE(set_person_param(s, kArmCompliance, "fixed"));
+  EXPECT_EQ(s.person[kArmCompliance].value, 0.0);
+  for (const char* bad : {"", "soft", "-0.001", "2", "0.003x", "nan"})
+    EXPECT_FALSE(set_person_param(s, kArmCompliance, bad)) << bad;
+  for (const char* bad : {"0.21", "-0.3", "inf", "4cm"}) EXPECT_FALSE(set_person_param(s, kFistShift, bad)) << bad;
+  // Fitted: after the cloth and offsets, in kPersonParamInfo order, each spanning its box.
   s.bounds = default_bounds();
-  ASSERT_TRUE(set_arm_compliance(s, "fit"));
+  ASSERT_TRUE(set_person_param(s, kArmCompliance, "fit"));
+  ASSERT_TRUE(set_person_param(s, kFistShift, "fit"));
+  EXPECT_EQ(s.dimension(), kClothParams + 2);
+  EXPECT_EQ(s.names()[kClothParams], "arm_compliance");
+  EXPECT_EQ(s.names()[kClothParams + 1], "fist_shift");
   u = Eigen::VectorXd::Constant(s.dimension(), 0.25);
   EXPECT_NEAR(s.cloth(u).arm_compliance, 0.25 * 0.01, 1e-15);
-  EXPECT_NEAR(s.initial_unit()[s.dimension() - 1], 0.4, 1e-12);  // 0.004 of [0, 0.01]
+  EXPECT_NEAR(s.cloth(u).fist_shift, -0.05 + 0.25 * 0.2, 1e-15);
+  EXPECT_NEAR(s.initial_unit()[kClothParams], 0.4, 1e-12);      // 0.004 of [0, 0.01]
+  EXPECT_NEAR(s.initial_unit()[kClothParams + 1], 0.25, 1e-12);  // 0 of [-0.05, 0.15]
 }
 
 TEST(Calibration, ResultDoesNotDependOnThreadCount) {
@@ -217,10 +234,13 @@ TEST(Calibration, CheckpointOfAnotherRunIsRefused) {
 TEST(Calibration, BoundsFileParsesAndNamesBadLines) {
   const fs::path dir = temp_dir("bounds");
   const fs::path ok = dir / "ok.txt";
-  write_file_atomic(ok, "# cloth box\nfriction 0.1 1.5 0.6\n\narm_offset -0.03 0.03\narm_compliance 0 0.02 0.005\n");
+  write_file_atomic(ok, "# cloth box\nfriction 0.1 1.5 0.6\n\narm_offset -0.03 0.03\narm_compliance 0 0.02 0.005\n"
+                        "fist_shift 0 0.12 0.04\n");
   const Bounds b = read_bounds(ok);
-  EXPECT_EQ(b.arm_compliance.upper, 0.02);
-  EXPECT_EQ(b.arm_compliance.initial, 0.005);
+  EXPECT_EQ(b.person[kArmCompliance].upper, 0.02);
+  EXPECT_EQ(b.person[kArmCompliance].initial, 0.005);
+  EXPECT_EQ(b.person[kFistShift].upper, 0.12);
+  EXPECT_EQ(b.person[kFistShift].initial, 0.04);
   EXPECT_EQ(b.cloth[3].lower, 0.1);
   EXPECT_EQ(b.cloth[3].upper, 1.5);
   EXPECT_EQ(b.cloth[3].initial, 0.6);
@@ -241,6 +261,7 @@ TEST(Calibration, BoundsFileParsesAndNamesBadLines) {
   EXPECT_NE(error_of("bend 0\n").find("expected"), std::string::npos);
   EXPECT_NE(error_of("arm_compliance -0.01 0.01\n").find("bad.txt:1: arm_compliance cannot be negative"),
             std::string::npos);
+  EXPECT_NE(error_of("stretch 0 1\nfist_shift 0 0.3\n").find("bad.txt:2: fist_shift must be within"), std::string::npos);
   fs::remove_all(dir);
 }
 
@@ -280,6 +301,10 @@ TEST(Calibration, CalibrationFileRoundTripAndErrors) {
   c.cloth.arm_compliance = 0.0045;
   write_calibration(dir / "cal_arm.json", c);
   EXPECT_EQ(read_calibration(dir / "cal_arm.json").cloth.arm_compliance, 0.0045);
+  EXPECT_EQ(read_file(dir / "cal_arm.json").find("fist_shift"), std::string::npos);
+  c.cloth.fist_shift = 0.075;
+  write_calibration(dir / "cal_fist.json", c);
+  EXPECT_EQ(read_calibration(dir / "cal_fist.json").cloth.fist_shift, 0.075);
   EXPECT_EQ(d.participant, "4");
   EXPECT_EQ(d.cloth.self_friction, 0.5);
   EXPECT_EQ(d.offsets[2], 0.011);

@@ -4,7 +4,8 @@
 // It has the shape of a sleeve pull: the drag grows with travel at a rate set by friction and
 // stretch, with a bump set by shear; the vertical force's slope depends on the arm height and its
 // offset (bend and self-friction shift it); a compliant arm (arm_compliance) gives way, so the
-// drag grows over a longer travel; the pull stops at 10 N or 0.85 m like the rig. Every
+// drag grows over a longer travel; a fist further along the arm (fist_shift) starts the drag that
+// much later; the pull stops at 10 N or 0.85 m like the rig. Every
 // parameter changes the curves, so a calibration against curves made at known parameters must
 // find a near-zero objective. The gown noise adds a seeded, smooth disturbance. Deterministic
 // and thread-safe (no state).
@@ -25,7 +26,7 @@ inline SimulatedTrial fake_simulate(const ClothValues& c, const TrialRequest& r)
   for (int i = 0;; ++i) {
     const double t = i * 0.01;
     const double x = std::min(r.speed * t, r.max_travel);
-    const double xa = x / (1.0 + 40.0 * c.arm_compliance);  // the travel the cloth feels
+    const double xa = std::max(0.0, x - c.fist_shift) / (1.0 + 40.0 * c.arm_compliance);  // the travel the cloth feels
     const double drag = (1.5 * c.friction + 2.0 * c.stretch) * xa * (1.0 + 12.0 * catchiness * xa * xa) +
                         0.6 * c.shear * std::sin(6.0 * x) + noise_amp * std::sin(20.0 * x + r.seed % 7);
     const double vert = (0.5 + 10.0 * arm) * x * (0.5 + c.bend) - 0.8 * c.self_friction * x * x;

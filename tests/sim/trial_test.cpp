@@ -2,6 +2,7 @@
 // gown module's parametric gown), coarse resolution to keep the suite fast.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <thread>
@@ -142,6 +143,8 @@ TEST(SimParams, ParseFormats) {
   const ClothParams c = parse_params(format_params(a), "x");
   EXPECT_EQ(std::memcmp(&a, &c, sizeof a), 0);
   EXPECT_THROW(parse_params("frction 0.3\n", "p.txt"), InputError);
+  EXPECT_EQ(parse_params("fist_shift 0.08\n", "x").fist_shift, 0.08);
+  EXPECT_THROW(parse_params("fist_shift 0.25\n", "p.txt"), InputError);  // beyond kMaxFistShift
   try {
     parse_params("friction 0.3\nbend x\n", "p.txt");
     FAIL();
@@ -527,6 +530,40 @@ TEST(SimTrial, CompliantArmGivesWayByItsCompliance) {
 // mean momentum). Self-collision, stretch, shear and bending corrections are internal. What is
 // left is the damping's discretisation (P sampled every 0.01 s instead of every substep), well
 // under 1 mN here against an arm load of newtons; the bound, 5 mN, is 0.1 % of the 10 N stop.
+// ClothParams::fist_shift moves the fist (and the forearm's distal end) along the forearm toward
+// the elbow; the elbow, the upper arm and the label's reference stay where they were, to the bit,
+// and a shift of 0 is the scene's arm itself.
+TEST(SimTrial, FistShiftMovesTheFistAndKeepsTheElbow) {
+  const Scene& scene = coarse_scene();
+  const std::vector<std::string> names = arm_part_names(scene);
+  auto index = [&](const char* name) {
+    return static_cast<std::size_t>(std::find(names.begin(), names.end(), name) - names.begin());
+  };
+  const std::size_t fist = index("fist"), forearm = index("forearm"), elbow = index("elbow"), upper = index("upper_arm");
+  ASSERT_LT(std::max({fist, forearm, elbow, upper}), names.size());
+  const auto& arm0 = scene.data().arm;
+  ClothParams p;
+  const GownModel same = make_model(scene.data(), p, FrictionScheme::Improved, true, 0.01);
+  p.fist_shift = 0.05;
+  const GownModel m = make_model(scene.data(), p, FrictionScheme::Improved, true, 0.01);
+  ASSERT_EQ(m.arm.size(), arm0.size());
+  for (std::size_t k = 0; k < arm0.size(); ++k) {
+    EXPECT_EQ(same.arm[k].a.x, arm0[k].a.x) << names[k];
+    EXPECT_EQ(same.arm[k].b.z, arm0[k].b.z + 0.01) << names[k];
+  }
+  EXPECT_NEAR(m.arm[fist].a.x, arm0[fist].a.x + 0.05, 1e-15);
+  EXPECT_EQ(m.arm[fist].ra, arm0[fist].ra);
+  EXPECT_NEAR(m.arm[forearm].a.x, arm0[forearm].a.x + 0.05, 1e-15);  // the wrist
+  EXPECT_EQ(m.arm[forearm].b.x, arm0[forearm].b.x);                   // the elbow's end
+  EXPECT_NEAR(m.arm[forearm].len, arm0[forearm].len - 0.05, 1e-12);
+  for (std::size_t k : {elbow, upper}) {
+    EXPECT_EQ(m.arm[k].a.x, arm0[k].a.x) << names[k];
+    EXPECT_EQ(m.arm[k].b.y, arm0[k].b.y) << names[k];
+  }
+  EXPECT_EQ(m.elbow.x, same.elbow.x);
+  EXPECT_EQ(m.elbow.z, same.elbow.z);
+}
+
 // The low arm's trial drags the gown over the arm from early on.
 TEST(SimTrial, ArmPartLoadsAddUpAndBalanceTheGownsMomentum) {
   TrialSpec spec;

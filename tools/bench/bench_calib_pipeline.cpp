@@ -2,7 +2,8 @@
 //
 //   bench_calib_pipeline eval [--participants 0,1,...] [--generations G --population N]
 //                             [--per-height M] [--gown coarse|reduced|full] [--work DIR] [--threads T]
-//                             [--arm-compliance fit|fixed|C] [--bounds FILE] [--sigma0 S]
+//                             [--arm-compliance fit|fixed|C] [--fist-shift fit|fixed|M]
+//                             [--bounds FILE] [--sigma0 S]
 //     Per participant P of the measured study: calibrate on P's 2-3 sequences (from the bounds
 //     file's initial values, default_bounds() without one); predict the other participants'
 //     measured trials with the calibrated simulator next to the real-person yardstick
@@ -16,8 +17,8 @@
 //     71%, 83%, 94%, 100% at the four cuts). Prints one row per participant and the means, and
 //     writes DIR/eval.json after each participant (plot: tools/plot/calib_eval.py); a rerun with
 //     the same DIR resumes from the calibration checkpoints and synthesized trials.
-//     --arm-compliance: the person's arm in the calibration (calibration.h, set_arm_compliance):
-//     fixed (the paper's, default), fit (one more parameter) or a compliance in m/N.
+//     --arm-compliance, --fist-shift: the person's arm in the calibration (calibration.h, set_person_param):
+//     fixed (the paper's, default), fit (one more parameter each) or a compliance in m/N, a shift in m.
 //   bench_calib_pipeline timing [--gown ...] [--generations G --population N] [--threads T]
 //                               [--arm-compliance ...]
 //     Wall time per simulation and of a G x N calibration of participant 4, with the final
@@ -149,10 +150,15 @@ int run_eval(const std::map<std::string, std::string>& a) {
   so.threads = co.threads;
   const std::string gown = get(a, "gown", "reduced");
   const std::string arm = get(a, "arm-compliance", "fixed");
+  const std::string fist = get(a, "fist-shift", "fixed");
   {
     ParameterSpace check;
-    if (!set_arm_compliance(check, arm)) {
+    if (!set_person_param(check, kArmCompliance, arm)) {
       std::fprintf(stderr, "--arm-compliance must be fit, fixed or a compliance in m/N, not '%s'\n", arm.c_str());
+      return 2;
+    }
+    if (!set_person_param(check, kFistShift, fist)) {
+      std::fprintf(stderr, "--fist-shift must be fit, fixed or a shift in [-0.2, 0.2] m, not '%s'\n", fist.c_str());
       return 2;
     }
   }
@@ -160,8 +166,8 @@ int run_eval(const std::map<std::string, std::string>& a) {
   const std::string bounds_file = get(a, "bounds", "");
   const Bounds bounds = bounds_file.empty() ? default_bounds() : read_bounds(bounds_file);
   const ClothSimulator sim = make_cloth_simulator(gown);
-  std::printf("evaluation: %zu participants, calibration %d x %d, %d trials per height, gown %s, arm %s\n",
-              chosen.size(), co.generations, co.population, so.per_height, gown.c_str(), arm.c_str());
+  std::printf("evaluation: %zu participants, calibration %d x %d, %d trials per height, gown %s, arm %s, fist %s\n",
+              chosen.size(), co.generations, co.population, so.per_height, gown.c_str(), arm.c_str(), fist.c_str());
 
   std::vector<const HapticSequence*> all;
   for (const auto& t : ds.trials) all.push_back(&t);
@@ -186,6 +192,7 @@ int run_eval(const std::map<std::string, std::string>& a) {
     out.set("per_height", so.per_height);
     out.set("gown", gown);
     out.set("arm_compliance", arm);
+    out.set("fist_shift", fist);
     out.set("bounds", bounds_file.empty() ? std::string("default") : bounds_file);
     out.set("sigma0", co.sigma0);
     write_file_atomic(work / "eval.json", out.dump() + "\n");
@@ -198,7 +205,8 @@ int run_eval(const std::map<std::string, std::string>& a) {
     ParameterSpace space;
     space.bounds = bounds;
     for (const auto& s : inputs) space.offset_heights.push_back(s.height);
-    set_arm_compliance(space, arm);
+    set_person_param(space, kArmCompliance, arm);
+    set_person_param(space, kFistShift, fist);
     auto o = co;
     o.checkpoint = work / ("p" + p + ".ckpt");
     const CalibrationResult r = calibrate(inputs, space, sim.trials, o, Comm::world());
@@ -283,11 +291,11 @@ int run_eval(const std::map<std::string, std::string>& a) {
     std::snprintf(params, sizeof params, "%.2f %.2f %.2f %.2f %.2f", r.cloth.stretch, r.cloth.shear, r.cloth.bend,
                   r.cloth.friction, r.cloth.self_friction);
     std::printf("%-4s %-8.3f %-28s | %5.0f %5.0f %5.0f %5.0f %5.0f   | %5.0f %5.0f %5.0f %5.0f %5.0f   | %5.0f %5.0f %5.0f "
-                "%5.0f %5.0f  (%.0f s) arm compliance %.4f m/N; STC classes %s, forces %s%s%s\n",
+                "%5.0f %5.0f  (%.0f s) arm compliance %.4f m/N, fist shift %+.3f m; STC classes %s, forces %s%s%s\n",
                 p.c_str(), r.objective, params, 100 * stc[0], 100 * stc[1], 100 * stc[2], 100 * stc[3], 100 * stc[4],
                 100 * stc2[0], 100 * stc2[1], 100 * stc2[2], 100 * stc2[3], 100 * stc2[4],
                 100 * bc[0], 100 * bc[1], 100 * bc[2], 100 * bc[3], 100 * bc[4], seconds_since(t0),
-                r.cloth.arm_compliance, stc_classes.c_str(), axes.reason.c_str(), stc_error.empty() ? "" : (" STC failed: " + stc_error).c_str(),
+                r.cloth.arm_compliance, r.cloth.fist_shift, stc_classes.c_str(), axes.reason.c_str(), stc_error.empty() ? "" : (" STC failed: " + stc_error).c_str(),
                 bc_error.empty() ? "" : (" BC failed: " + bc_error).c_str());
     std::fflush(stdout);
     Json row = calibration_to_json(cal);
@@ -345,7 +353,7 @@ int run_timing(const std::map<std::string, std::string>& a) {
   ParameterSpace space;
   space.bounds = default_bounds();
   for (const auto& s : inputs) space.offset_heights.push_back(s.height);
-  if (!set_arm_compliance(space, get(a, "arm-compliance", "fixed"))) {
+  if (!set_person_param(space, kArmCompliance, get(a, "arm-compliance", "fixed"))) {
     std::fprintf(stderr, "--arm-compliance must be fit, fixed or a compliance in m/N\n");
     return 2;
   }
