@@ -12,6 +12,12 @@ bool cloth_simulator_available() { return true; }
 
 namespace {
 
+// The calibration's range for the fist (calibration.h, which cannot include the simulator) is the
+// simulator's own limit.
+static_assert(kPersonParamInfo[kFistShift].highest == sim::kMaxFistShift &&
+                  kPersonParamInfo[kFistShift].lowest == -sim::kMaxFistShift,
+              "fist_shift's range differs between calibration.h and sim/trial.h");
+
 sim::ClothParams params_of(const ClothValues& c) {
   sim::ClothParams p;  // damping and density keep the simulator's defaults (not calibrated, paper IV-B.2)
   p.stretch = c.stretch;
