@@ -152,7 +152,7 @@ int run_simulate(int argc, char** argv) {
   write_file_atomic(meta, std::string(b) + "\n");
   std::filesystem::path scene_file = out;
   scene_file.replace_extension(".scene.json");
-  write_file_atomic(scene_file, sim::scene_json(scene, spec, r));
+  write_file_atomic(scene_file, sim::scene_json(scene, params, spec, r));
   std::filesystem::path arm_file = out;
   arm_file.replace_extension(".arm.csv");
   write_file_atomic(arm_file, arm_parts_csv(scene, r));

@@ -84,8 +84,10 @@ std::string params_json(const ClothParams& p) {
   return b;
 }
 
-std::string scene_json(const Scene& scene, const TrialSpec& spec, const TrialResult& r) {
+std::string scene_json(const Scene& scene, const ClothParams& params, const TrialSpec& spec, const TrialResult& r) {
   const SceneData& sc = scene.data();
+  // The trial's own arm: the fist where params.fist_shift puts it (the scene's arm has it at 0).
+  const std::vector<RoundCone> arm = arm_colliders(sc.opt, params.fist_shift);
   const double dz = sc.opt.arm.z_rel[static_cast<int>(spec.height)] - sc.opt.arm.z_rel[0] + r.arm_offset;
   std::ostringstream o;
   o.precision(6);
@@ -93,8 +95,8 @@ std::string scene_json(const Scene& scene, const TrialSpec& spec, const TrialRes
   for (size_t t = 0; t < sc.mesh.tris.size(); ++t)
     o << (t ? "," : "") << '[' << sc.mesh.tris[t][0] << ',' << sc.mesh.tris[t][1] << ',' << sc.mesh.tris[t][2] << ']';
   o << "],\n\"arm\": [";
-  for (size_t k = 0; k < sc.arm.size(); ++k) {
-    const RoundCone& c = sc.arm[k];
+  for (size_t k = 0; k < arm.size(); ++k) {
+    const RoundCone& c = arm[k];
     o << (k ? "," : "") << "{\"a\": [" << c.a.x << ',' << c.a.y << ',' << c.a.z + dz << "], \"ra\": " << c.ra
       << ", \"b\": [" << c.b.x << ',' << c.b.y << ',' << c.b.z + dz << "], \"rb\": " << c.rb << '}';
   }

@@ -18,8 +18,8 @@ std::string format_params(const ClothParams& p);  // "name value" lines, readabl
 std::string params_json(const ClothParams& p);    // a flat JSON object
 
 // The trial's scene for the picture script (tools/plot/sim_scene.py), as JSON: triangles,
-// arm round cones at the trial's height, gripper start, grasped and sleeve-opening vertices,
+// arm round cones at the trial's height (with the params' fist_shift), gripper start, grasped and sleeve-opening vertices,
 // the frames' positions, gripper travel per frame, and the haptic samples.
-std::string scene_json(const Scene& scene, const TrialSpec& spec, const TrialResult& r);
+std::string scene_json(const Scene& scene, const ClothParams& params, const TrialSpec& spec, const TrialResult& r);
 
 }  // namespace dressguard::sim

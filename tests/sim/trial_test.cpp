@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <thread>
 #include <vector>
@@ -562,6 +563,15 @@ TEST(SimTrial, FistShiftMovesTheFistAndKeepsTheElbow) {
   }
   EXPECT_EQ(m.elbow.x, same.elbow.x);
   EXPECT_EQ(m.elbow.z, same.elbow.z);
+  // The scene picture (tools/plot/sim_scene.py) draws the trial's arm, not the scene's: the
+  // fist's sphere is the first entry with the fist's radius and sits at the shifted x.
+  TrialSpec spec;
+  const std::string json = scene_json(scene, p, spec, TrialResult{});
+  char fist_at[64];
+  std::snprintf(fist_at, sizeof fist_at, "{\"a\": [%g,", arm0[fist].a.x + 0.05);
+  EXPECT_NE(json.find(fist_at), std::string::npos) << "no arm part at the shifted fist in: " << json.substr(0, 400);
+  std::snprintf(fist_at, sizeof fist_at, "{\"a\": [%g,", arm0[fist].a.x);
+  EXPECT_EQ(json.find(fist_at), std::string::npos) << "the scene's unshifted fist is drawn";
 }
 
 // The low arm's trial drags the gown over the arm from early on.
