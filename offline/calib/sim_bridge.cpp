@@ -4,6 +4,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "synthesis.h"
 #include "trial.h"
 
 namespace dressguard::calib {
@@ -17,6 +18,10 @@ namespace {
 static_assert(kPersonParamInfo[kFistShift].highest == sim::kMaxFistShift &&
                   kPersonParamInfo[kFistShift].lowest == -sim::kMaxFistShift,
               "fist_shift's range differs between calibration.h and sim/trial.h");
+// The middle arm's nominal height below the high one (synthesis.h) is the simulator's.
+constexpr double kSimMiddleBelowHigh = sim::ArmGeometry{}.z_rel[0] - sim::ArmGeometry{}.z_rel[1];
+static_assert(kSimMiddleBelowHigh - kMiddleBelowHigh < 1e-12 && kMiddleBelowHigh - kSimMiddleBelowHigh < 1e-12,
+              "the middle arm's nominal height differs between synthesis.h and sim/trial.h");
 
 sim::ClothParams params_of(const ClothValues& c) {
   sim::ClothParams p;  // damping and density keep the simulator's defaults (not calibrated, paper IV-B.2)

@@ -18,7 +18,10 @@ std::string synthesis_trial_id(ArmHeight height, int index) {
   return buf;
 }
 
-TrialRequest synthesis_request(const Calibration& cal, ArmHeight height, int index, const SynthesisOptions& o) {
+const char* middle_arm_name(MiddleArm m) { return m == MiddleArm::CaughtEdge ? "caught-edge" : "nominal"; }
+
+TrialRequest synthesis_request(const Calibration& cal, ArmHeight height, int index, const SynthesisOptions& o,
+                               double middle_base) {
   const std::uint64_t key = static_cast<std::uint64_t>(height) * 1000003ull + static_cast<std::uint64_t>(index);
   const std::uint64_t stream = mix_seed(o.seed, key);
   const double u = static_cast<double>(stream >> 11) * 0x1.0p-53;  // U[0, 1)
@@ -30,13 +33,63 @@ TrialRequest synthesis_request(const Calibration& cal, ArmHeight height, int ind
   r.seed = mix_seed(stream, 1);
   r.max_travel = cal.rig_travel;  // the calibrated participant's rig (calibration.h, rig_travel_of)
   if (height == ArmHeight::Middle) {
-    // Middle: noise on the nominal height, U[-6, 0] cm (the paper's gravity compensation).
-    r.arm_offset = o.arm_noise ? kArmNoiseMiddleLow * u : 0.0;
+    // Middle: noise on the nominal height (or the simulator's edge), U[-6, 0] cm (the paper's
+    // gravity compensation).
+    r.arm_offset = middle_base + (o.arm_noise ? kArmNoiseMiddleLow * u : 0.0);
   } else {
     // High and low: calibrated offset + U[-1.5, 1.5] cm.
     r.arm_offset = cal.offsets[static_cast<int>(height)] + (o.arm_noise ? kArmNoiseHighLow * (2.0 * u - 1.0) : 0.0);
   }
   return r;
+}
+
+MiddleEdge locate_middle_edge(const Calibration& cal, const TrialSimulator& sim, int threads, const Comm& comm,
+                              double tolerance) {
+  if (!(tolerance > 0)) throw std::invalid_argument("locate_middle_edge: tolerance must be positive");
+  MiddleEdge e;
+  // Two arm offsets (from the nominal middle) per round; result block: outcome code.
+  auto outcomes = [&](double a, double b) {
+    const double at[2] = {a, b};
+    const std::vector<double> res = run_batch(2, 1, thread_count(threads), comm, [&](int t, double* r) {
+      TrialRequest q;
+      q.height = ArmHeight::Middle;
+      q.arm_offset = at[t];
+      q.speed = 0.1;
+      q.max_travel = cal.rig_travel;
+      const SimulatedTrial st = sim(cal.cloth, q);
+      if (!st.finite) throw std::runtime_error("locate_middle_edge: the simulation did not stay finite");
+      r[0] = static_cast<double>(st.outcome);
+    });
+    e.trials += 2;
+    return std::array<Outcome, 2>{static_cast<Outcome>(static_cast<int>(res[0])),
+                                  static_cast<Outcome>(static_cast<int>(res[1]))};
+  };
+  double hi = kMiddleBelowHigh + cal.offsets[static_cast<int>(ArmHeight::High)], lo = 0.0;
+  const auto ends = outcomes(hi, lo);
+  if (ends[0] != Outcome::Good || ends[1] == Outcome::Good)
+    throw std::runtime_error(std::string("locate_middle_edge: no good/not-good edge between the high arm (") +
+                             std::string(outcome_name(ends[0])) + ") and the nominal middle (" +
+                             std::string(outcome_name(ends[1])) + "); use the nominal middle");
+  Outcome below = ends[1];
+  // Invariant: hi is good, lo is not.
+  while (hi - lo > tolerance) {
+    const double a = hi - (hi - lo) / 3.0, b = hi - 2.0 * (hi - lo) / 3.0;
+    const auto o = outcomes(a, b);
+    if (o[0] != Outcome::Good) {
+      lo = a;
+      below = o[0];
+    } else if (o[1] != Outcome::Good) {
+      hi = a;
+      lo = b;
+      below = o[1];
+    } else {
+      hi = b;
+    }
+  }
+  e.offset = lo;
+  e.good_at = hi;
+  e.below = below;
+  return e;
 }
 
 namespace {
@@ -45,7 +98,7 @@ namespace {
 // diagnostics (axis fits, provenance) still resumes its synthesis. Version 2 of the record
 // (2026-11-23); version 1 held the whole calibration file and is read through the same fields.
 std::string settings_record_of(const Json& calibration, const Json& per_height, const Json& gown_noise,
-                               const Json& arm_noise, const Json& seed) {
+                               const Json& arm_noise, const Json& seed, MiddleArm middle = MiddleArm::Nominal) {
   Json c = Json::object();
   for (const char* key : {"participant", "cloth", "arm_offsets", "gown", "rig_travel_m"})
     c.set(key, calibration.at(key));
@@ -56,12 +109,14 @@ std::string settings_record_of(const Json& calibration, const Json& per_height, 
   j.set("gown_noise", gown_noise);
   j.set("arm_noise", arm_noise);
   j.set("seed", seed);
+  // Only when not the paper's: records written before the option existed still match.
+  if (middle != MiddleArm::Nominal) j.set("middle", middle_arm_name(middle));
   return j.dump() + "\n";
 }
 
 std::string settings_record(const Calibration& cal, const SynthesisOptions& o) {
   return settings_record_of(calibration_to_json(cal), Json(o.per_height), Json(o.gown_noise), Json(o.arm_noise),
-                            Json(std::to_string(o.seed)));
+                            Json(std::to_string(o.seed)), o.middle);
 }
 
 // A folder's record in version 2, whichever version it was written in ("" when unreadable).
@@ -98,6 +153,13 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
   if (comm.is_root()) write_file_atomic(record_path, record);
   comm.barrier();
 
+  MiddleEdge edge;
+  double middle_base = 0.0;
+  if (options.middle == MiddleArm::CaughtEdge) {
+    edge = locate_middle_edge(cal, sim, options.threads, comm);
+    middle_base = edge.offset;
+  }
+
   const ArmHeight heights[3] = {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low};
   const int total = 3 * options.per_height;
   std::atomic<int> done{0}, skipped{0};
@@ -121,7 +183,7 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
           }
         }
         if (!resumed) {
-          const SimulatedTrial st = sim(cal.cloth, synthesis_request(cal, h, index, options));
+          const SimulatedTrial st = sim(cal.cloth, synthesis_request(cal, h, index, options, middle_base));
           if (!st.finite || st.samples.empty())
             throw std::runtime_error("simulation of " + id + " did not stay finite; check the calibration");
           write_file_atomic(csv, format_trial_csv(st.samples));
@@ -146,6 +208,8 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
 
   SynthesisSummary s;
   s.trials = total;
+  s.middle_base = middle_base;
+  s.edge = edge;
   for (int t = 0; t < total; ++t) {
     s.per_label[static_cast<int>(res[2 * t])]++;
     s.resumed += res[2 * t + 1] > 0.5;
@@ -159,7 +223,7 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
       seq.id = synthesis_trial_id(h, index);
       seq.participant = "";
       seq.height = h;
-      seq.speed = synthesis_request(cal, h, index, options).speed;
+      seq.speed = synthesis_request(cal, h, index, options, middle_base).speed;
       seq.label = static_cast<Outcome>(static_cast<int>(res[2 * t]));
       seq.samples = read_trial_csv(out / (seq.id + ".csv"));
       ds.trials.push_back(std::move(seq));

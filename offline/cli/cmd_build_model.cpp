@@ -35,12 +35,14 @@ int run_build_model(int argc, char** argv) {
         "  --forces F   auto | both | motion: which forces the HMMs model (default auto: with\n"
         "               --calibration, F_vertical only where the calibrated simulator predicts it\n"
         "               better than a zero force on the calibration's sequences; with --data, both)\n"
-        "  --per-height N --no-gown-noise --no-arm-noise --seed S --threads N --gown G  (synthesis)\n"
+        "  --per-height N --no-gown-noise --no-arm-noise --middle M --seed S --threads N --gown G\n"
+        "               (synthesis; see dressguard synthesize --help)\n"
+        "  --created T  creation time to record (default now, UTC); fixes the model's bytes\n"
         "  --json       machine-readable summary");
     return 0;
   }
   args.allow_only({"help", "json", "no-gown-noise", "no-arm-noise", "calibration", "data", "out", "synth-dir",
-                   "states", "per-height", "seed", "gown", "threads", "forces"});
+                   "states", "per-height", "seed", "gown", "threads", "forces", "middle", "created"});
   const std::string out = args.require("out");
   if (args.has("calibration") == args.has("data")) throw UsageError("give exactly one of --calibration and --data");
   const int states = static_cast<int>(args.integer("states", 10));
@@ -74,7 +76,7 @@ int run_build_model(int argc, char** argv) {
   so.use_vertical = axes.use_vertical;
   model::OutcomeModel m = build_outcome_model(trials, so);
   m.tool_version = "dressguard 0.1.0 build-model";
-  m.created = utc_now();
+  m.created = args.get("created").value_or(utc_now());
   model::write_model(out, m);
   const double acc = accuracy(m, trials, std::numeric_limits<double>::infinity());
   if (args.has("json")) {

@@ -25,6 +25,10 @@ SynthesisOptions synthesis_options_from(const Args& args) {
   if (seed < 0) throw UsageError("--seed must be non-negative");
   o.seed = static_cast<std::uint64_t>(seed);
   o.threads = static_cast<int>(args.integer("threads", 0));
+  const std::string middle = args.get("middle").value_or("nominal");
+  if (middle == "nominal") o.middle = MiddleArm::Nominal;
+  else if (middle == "caught-edge") o.middle = MiddleArm::CaughtEdge;
+  else throw UsageError("--middle must be nominal or caught-edge");
   return o;
 }
 
@@ -38,13 +42,21 @@ SynthesisSummary run_synthesis(const Calibration& cal, const std::string& gown, 
   const Comm& comm = Comm::world();
   const TrialSimulator sim = make_cloth_simulator(gown).trial;
   int last = -1;
-  return synthesize(cal, sim, o, out, comm, [&](const SynthesisProgress& p) {
+  if (o.middle == MiddleArm::CaughtEdge && comm.is_root())
+    std::fprintf(stderr, "synthesize: locating the simulator's good/caught edge for the middle arm (about 10 trials)\n");
+  const SynthesisSummary s = synthesize(cal, sim, o, out, comm, [&](const SynthesisProgress& p) {
     const int pct = 100 * p.done / std::max(1, p.total);
     if (pct / 5 == last / 5 && p.done != p.total) return;
     last = pct;
     std::fprintf(stderr, "synthesize: %d/%d trials on this rank (%d from an earlier run), elapsed %.0f s, ETA %.0f s\n",
                  p.done, p.total, p.skipped, p.elapsed_s, p.eta_s);
   });
+  if (o.middle == MiddleArm::CaughtEdge && comm.is_root())
+    std::fprintf(stderr,
+                 "synthesize: the middle arm's noise sat below %+.4f m from its nominal height (good at %+.4f m, "
+                 "%s below; %d trials)\n",
+                 s.edge.offset, s.edge.good_at, std::string(outcome_name(s.edge.below)).c_str(), s.edge.trials);
+  return s;
 #endif
 }
 
@@ -58,6 +70,9 @@ int run_synthesize(int argc, char** argv) {
         "  --per-height N    default 100 (the paper)\n"
         "  --no-gown-noise   no initial gown perturbation (6 N, 0.5 s)\n"
         "  --no-arm-noise    no arm-height noise (+-1.5 cm high/low, [-6, 0] cm middle)\n"
+        "  --middle M        nominal | caught-edge: where the middle arm's [-6, 0] cm noise sits: the\n"
+        "                    nominal middle height (default, the paper) or the simulator's own edge\n"
+        "                    between good and caught, found first by trisection (offline/calib/README.md)\n"
         "  --seed S          default 1; the dataset depends on the seed only, not on threads/ranks\n"
         "  --gown G          override the calibration's gown (full, reduced, coarse)\n"
         "  --threads N       threads per process (default: all cores)\n"
@@ -66,7 +81,7 @@ int run_synthesize(int argc, char** argv) {
     return 0;
   }
   args.allow_only({"help", "json", "no-gown-noise", "no-arm-noise", "calibration", "out", "per-height", "seed",
-                   "gown", "threads"});
+                   "gown", "threads", "middle"});
   const std::string out = args.require("out");
   const SynthesisOptions o = synthesis_options_from(args);  // options first: a usage error needs no file
   const Calibration cal = read_calibration(args.require("calibration"));
@@ -74,8 +89,10 @@ int run_synthesize(int argc, char** argv) {
   const SynthesisSummary s = run_synthesis(cal, gown, o, out);
   if (Comm::world().is_root()) {
     if (args.has("json"))
-      std::printf("{\"trials\": %d, \"resumed\": %d, \"good\": %d, \"missed\": %d, \"caught\": %d, \"out\": \"%s\"}\n",
-                  s.trials, s.resumed, s.per_label[0], s.per_label[1], s.per_label[2], out.c_str());
+      std::printf("{\"trials\": %d, \"resumed\": %d, \"good\": %d, \"missed\": %d, \"caught\": %d, "
+                  "\"middle\": \"%s\", \"middle_base_m\": %.6f, \"out\": \"%s\"}\n",
+                  s.trials, s.resumed, s.per_label[0], s.per_label[1], s.per_label[2], middle_arm_name(o.middle),
+                  s.middle_base, out.c_str());
     else
       std::printf("synthesized %d trials (%d kept from an earlier run): %d good, %d missed, %d caught -> %s\n",
                   s.trials, s.resumed, s.per_label[0], s.per_label[1], s.per_label[2], out.c_str());

@@ -413,6 +413,66 @@ TEST(Synthesis, CountsSpeedsNoiseRangesAndLabels) {
   EXPECT_FALSE(synthesis_request(cal, ArmHeight::Low, 3, off).gown_noise);
 }
 
+// The middle arm at the simulator's own edge: the stand-in stops by force above -0.05 m from the
+// high arm (good) and catches below it down to where it no longer reaches 10 N, so the edge is
+// 0.123 - 0.05 = 0.073 m above the nominal middle. The trisection brackets it within its
+// tolerance whatever the thread count, and the middle trials' noise then sits below it.
+TEST(Synthesis, MiddleArmAtTheSimulatorsCaughtEdge) {
+  Calibration cal;
+  cal.offsets = {0.01, 0.0, -0.02};
+  const double edge = kMiddleBelowHigh - 0.05;
+  const MiddleEdge e1 = locate_middle_edge(cal, testing::fake_simulate, 1, Comm::world());
+  const MiddleEdge e3 = locate_middle_edge(cal, testing::fake_simulate, 3, Comm::world());
+  EXPECT_LE(e1.offset, edge);
+  EXPECT_GE(e1.good_at, edge);
+  EXPECT_LE(e1.good_at - e1.offset, 0.002);
+  EXPECT_EQ(e1.below, Outcome::Caught);
+  EXPECT_EQ(e1.offset, e3.offset);  // the rounds do not depend on the threads
+  EXPECT_EQ(e1.trials, e3.trials);
+  // 2 ends + 2 per round, rounds until (0.133 m) / 3^n <= 2 mm: n = 4.
+  EXPECT_EQ(e1.trials, 2 + 2 * 4);
+  // The middle's noise sits below the edge; high and low are unchanged.
+  SynthesisOptions o;
+  o.middle = MiddleArm::CaughtEdge;
+  double lo = 1, hi = -1;
+  for (int i = 0; i < 100; ++i) {
+    const double a = synthesis_request(cal, ArmHeight::Middle, i, o, e1.offset).arm_offset;
+    lo = std::min(lo, a);
+    hi = std::max(hi, a);
+    EXPECT_EQ(synthesis_request(cal, ArmHeight::Low, i, o, e1.offset).arm_offset,
+              synthesis_request(cal, ArmHeight::Low, i, SynthesisOptions{}).arm_offset);
+  }
+  EXPECT_LE(hi, e1.offset);
+  EXPECT_GE(lo, e1.offset - 0.06);
+  EXPECT_LT(lo, e1.offset - 0.05);
+  // The synthesis locates the edge itself, labels both caught and missed at the middle (the
+  // stand-in catches down to about -0.09 m from the high arm), and a folder made with the nominal
+  // middle refuses the other placement.
+  o.per_height = 10;
+  o.gown_noise = false;
+  const fs::path a = temp_dir("synth_edge");
+  const SynthesisSummary s = synthesize(cal, testing::fake_simulate, o, a, Comm::world());
+  EXPECT_EQ(s.middle_base, e1.offset);
+  const Dataset ds = load_dataset(a);
+  int middle_caught = 0, middle_missed = 0;
+  for (const auto& t : ds.trials)
+    if (t.height == ArmHeight::Middle) (t.label == Outcome::Caught ? middle_caught : middle_missed) += 1;
+  EXPECT_GT(middle_caught, 0);
+  EXPECT_GT(middle_missed, 0);
+  o.middle = MiddleArm::Nominal;
+  EXPECT_THROW(synthesize(cal, testing::fake_simulate, o, a, Comm::world()), InputError);
+  fs::remove_all(a);
+  // No edge to find: a high arm that does not go in is refused with both ends' outcomes.
+  Calibration low_high = cal;
+  low_high.offsets[0] = -0.2;
+  try {
+    locate_middle_edge(low_high, testing::fake_simulate, 1, Comm::world());
+    ADD_FAILURE() << "no error without an edge";
+  } catch (const std::runtime_error& err) {
+    EXPECT_NE(std::string(err.what()).find("high arm (missed)"), std::string::npos) << err.what();
+  }
+}
+
 TEST(Synthesis, DatasetIsIndependentOfThreadsAndResumes) {
   Calibration cal;
   SynthesisOptions o;

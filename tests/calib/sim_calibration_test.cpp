@@ -8,7 +8,9 @@
 #include "calibration.h"
 #include "fake_sim.h"
 #include "prediction.h"
+#include "gown.h"
 #include "sim_bridge.h"
+#include "synthesis.h"
 
 namespace dressguard::calib {
 namespace {
@@ -81,6 +83,23 @@ TEST(SimCalibration, PredictionWithSharedSettlingHasTheSameBits) {
   }
   EXPECT_EQ(prediction_csv(shared), prediction_csv(single));
   EXPECT_EQ(prediction_curves_csv(shared, ds), prediction_curves_csv(single, ds));
+}
+
+// The middle arm's edge on the real simulator (synthesis.h, MiddleArm::CaughtEdge): participant
+// 4's calibration on the reduced measured gown goes in at its high arm and misses at the nominal
+// middle; between them it catches (session 10's sweep: good down to 0 cm from the high arm,
+// caught from -1 to -4 cm, missed below). A coarse trisection (2 cm) must land in that band.
+TEST(SimCalibration, MiddleEdgeOfParticipant4sSimulator) {
+  if (gown::measured_gown_path().empty()) GTEST_SKIP() << "shared/data/gown not present (the band is the measured gown's)";
+  const Calibration cal = read_calibration(std::filesystem::path(DRESSGUARD_SOURCE_DIR) / "models/participant4-simulator.json");
+  const MiddleEdge e = locate_middle_edge(cal, make_cloth_simulator("reduced").trial, 2, Comm::world(), 0.02);
+  std::printf("  participant 4's simulator: good at %+.4f m, %s at %+.4f m from the nominal middle (%d trials)\n",
+              e.good_at, std::string(outcome_name(e.below)).c_str(), e.offset, e.trials);
+  EXPECT_EQ(e.below, Outcome::Caught);
+  EXPECT_LE(e.good_at - e.offset, 0.02);
+  const double high = kMiddleBelowHigh + cal.offsets[0];
+  EXPECT_LE(e.good_at, high);
+  EXPECT_GE(e.offset, high - 0.05);  // within the 1-5 cm caught band below the high arm
 }
 
 // One generation on participant 4's sequences (the paper's public code calibrated on the same
