@@ -45,7 +45,7 @@ mkdir -p "$model"
 "$dg" model show "$model/stc.dgm" | head -8
 if [ -f "$out/measured/manifest.csv" ]; then
   # The measured trials against the model just trained and against the shipped default model
-  # (models/default.dgm: the same pipeline with 20 reduced-gown trials per height).
+  # (models/default.dgm: participant 4's calibrated simulator, 100 reduced-gown trials per height).
   for m in "$model/stc.dgm" models/default.dgm; do
     name=$(basename "$m" .dgm)
     echo "main-job: the measured trials classified by $m"
