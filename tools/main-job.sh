@@ -67,15 +67,33 @@ if [ -f "$out/measured/manifest.csv" ]; then
 fi
 echo "main-job: synthesized data, model and evaluation in $model"
 
-# Robot side (predictor/): the simulated trials as CAN traffic, and what the predictor would do
-# on each with the default model (models/default.dgm, or the model just trained).
+# Robot side (predictor/): simulated trials as CAN traffic, and what the predictor would do on
+# each. The shipped model (models/default.dgm) was trained on participant 4's calibrated
+# simulator, so its trials come from that simulator (`simulate --calibration`): the high arm
+# (good), the low arm (missed), and the high arm 2 cm lower, inside that simulator's caught band
+# (1-4 cm below its high arm on the measured gown; offline/sim/README.md). The default-parameter
+# trials above go to the model just trained on the same simulator (stc.dgm), when it has a
+# caught class.
 robot="$out/robot"
 mkdir -p "$robot"
-predictor_model=models/default.dgm
-[ -f "$predictor_model" ] || predictor_model="$model/stc.dgm"
-for h in high middle low; do
-  "$dg" export-candump --trial "$sim/trial-$h.csv" --out "$robot/trial-$h.log" >/dev/null
-  printf 'replay of the simulated %-6s trial:' "$h"
-  "$dg" replay --model "$predictor_model" --log "$robot/trial-$h.log" | sed -n 2p
-done
+replay() {  # replay MODEL CSV NAME
+  "$dg" export-candump --trial "$2" --out "$robot/$3.log" >/dev/null
+  printf 'replay of %-44s' "$3:"
+  "$dg" replay --model "$1" --log "$robot/$3.log" | sed -n 2p
+}
+if "$dg" model show "$model/stc.dgm" | grep -q "class 'caught'"; then
+  for h in high middle low; do
+    replay "$model/stc.dgm" "$sim/trial-$h.csv" "default-parameters-$h ($(sed -n 's/.*"label": "\([a-z]*\)".*/\1/p' "$sim/trial-$h.json"))"
+  done
+else
+  echo "main-job: $model/stc.dgm has no caught class (its few trials held none), so the predictor could not stop on it: no replay"
+fi
+if [ -f models/default.dgm ]; then
+  cal=models/participant4-simulator.json
+  for spec in "high 0 high" "low 0 low" "high -0.02 high-2cm"; do
+    set -- $spec
+    "$dg" simulate --calibration "$cal" --height "$1" --arm-offset "$2" --frames 0 --out "$robot/p4-$3.csv" >/dev/null
+    replay models/default.dgm "$robot/p4-$3.csv" "participant4-$3 ($(sed -n 's/.*"label": "\([a-z]*\)".*/\1/p' "$robot/p4-$3.json"))"
+  done
+fi
 echo "main-job: candump logs and replays in $robot"

@@ -11,6 +11,18 @@ namespace dressguard::calib {
 
 bool cloth_simulator_available() { return true; }
 
+sim::ClothParams cloth_params_of(const ClothValues& c) {
+  sim::ClothParams p;  // damping and density keep the simulator's defaults (not calibrated, paper IV-B.2)
+  p.stretch = c.stretch;
+  p.shear = c.shear;
+  p.bend = c.bend;
+  p.friction = c.friction;
+  p.self_friction = c.self_friction;
+  p.arm_compliance = c.arm_compliance;
+  p.fist_shift = c.fist_shift;
+  return p;
+}
+
 namespace {
 
 // The calibration's range for the fist (calibration.h, which cannot include the simulator) is the
@@ -23,17 +35,6 @@ constexpr double kSimMiddleBelowHigh = sim::ArmGeometry{}.z_rel[0] - sim::ArmGeo
 static_assert(kSimMiddleBelowHigh - kMiddleBelowHigh < 1e-12 && kMiddleBelowHigh - kSimMiddleBelowHigh < 1e-12,
               "the middle arm's nominal height differs between synthesis.h and sim/trial.h");
 
-sim::ClothParams params_of(const ClothValues& c) {
-  sim::ClothParams p;  // damping and density keep the simulator's defaults (not calibrated, paper IV-B.2)
-  p.stretch = c.stretch;
-  p.shear = c.shear;
-  p.bend = c.bend;
-  p.friction = c.friction;
-  p.self_friction = c.self_friction;
-  p.arm_compliance = c.arm_compliance;
-  p.fist_shift = c.fist_shift;
-  return p;
-}
 
 sim::TrialSpec spec_of(const TrialRequest& r) {
   sim::TrialSpec spec;
@@ -65,12 +66,12 @@ ClothSimulator make_cloth_simulator(const std::string& gown) {
   auto scene = std::make_shared<const sim::Scene>(sim::make_default_scene(res));
   ClothSimulator cs;
   cs.trial = [scene](const ClothValues& c, const TrialRequest& r) {
-    return simulated(sim::simulate_trial(*scene, params_of(c), spec_of(r)));
+    return simulated(sim::simulate_trial(*scene, cloth_params_of(c), spec_of(r)));
   };
   cs.trials = [scene](const ClothValues& c, const std::vector<TrialRequest>& rs) {
     std::vector<sim::TrialSpec> specs;
     for (const TrialRequest& r : rs) specs.push_back(spec_of(r));
-    std::vector<sim::TrialResult> res = sim::simulate_trials(*scene, params_of(c), specs);
+    std::vector<sim::TrialResult> res = sim::simulate_trials(*scene, cloth_params_of(c), specs);
     std::vector<SimulatedTrial> out;
     for (sim::TrialResult& r : res) out.push_back(simulated(std::move(r)));
     return out;

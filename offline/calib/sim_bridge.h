@@ -5,6 +5,7 @@
 #include <string>
 
 #include "calibration.h"
+#include "trial.h"
 
 namespace dressguard::calib {
 
@@ -20,6 +21,10 @@ struct ClothSimulator {
 // "full" (the measured 20k-triangle gown), "reduced" (the default for calibration and synthesis)
 // or "coarse" (small, for tests). Throws std::invalid_argument for another name.
 ClothSimulator make_cloth_simulator(const std::string& gown);
+
+// The simulator's parameters for a calibration's cloth and person values (damping and areal
+// density keep the simulator's defaults: not calibrated, paper IV-B.2).
+sim::ClothParams cloth_params_of(const ClothValues& c);
 
 // True (this file is only compiled with dg_sim); lets tests ask without the macro.
 bool cloth_simulator_available();

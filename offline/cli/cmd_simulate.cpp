@@ -1,9 +1,11 @@
 // dressguard simulate: one simulated sleeve-pulling trial (offline/sim) -> trial CSV + summary.
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <sstream>
 
 #include "args.h"
+#include "calibration.h"
 #include "commands.h"
 #include "dataset.h"
 #include "files.h"
@@ -11,6 +13,7 @@
 #include "gown_scene.h"
 #include "grip_option.h"
 #include "params.h"
+#include "sim_bridge.h"
 #include "trial.h"
 
 namespace dressguard::cli {
@@ -65,6 +68,9 @@ int run_simulate(int argc, char** argv) {
         "  --arm-offset M    [m] added to the height's arm height (default 0)\n"
         "  --speed V         [m/s] pull speed, 0.1 or 0.15 (default 0.1)\n"
         "  --params FILE     cloth parameters ('name value' lines or flat JSON; see offline/sim/params.h)\n"
+        "  --calibration CAL a calibration file instead (dressguard calibrate): its cloth and person\n"
+        "                    parameters, its offset for this height added to --arm-offset, its gown\n"
+        "                    and its end of travel as the defaults of --gown and --max-travel\n"
         "  --seed S          seed of the noise models (default 0)\n"
         "  --max-travel M    [m] where the rig stops if the force limit does not stop it first\n"
         "                    (default 0.85; a measured trial's own end: rig_end_of_travel)\n"
@@ -82,7 +88,7 @@ int run_simulate(int argc, char** argv) {
         kGripHelp);
     return 0;
   }
-  args.allow_only({"help", "json", "noise", "arm-noise", "no-self-collision", "height", "arm-offset", "max-travel", "speed", "params", "seed",
+  args.allow_only({"help", "json", "noise", "arm-noise", "no-self-collision", "height", "arm-offset", "max-travel", "speed", "params", "calibration", "seed",
                    "gown", "friction", "out", "frames", "parametric", "grip-depth", "rim-ahead"});
   sim::TrialSpec spec;
   const std::string hs = args.require("height");
@@ -96,7 +102,13 @@ int run_simulate(int argc, char** argv) {
   const long seed = args.integer("seed", 0);
   if (seed < 0) throw UsageError("--seed must be non-negative");
   spec.seed = static_cast<uint64_t>(seed);
-  spec.max_travel = args.number("max-travel", 0.85);
+  if (args.has("params") && args.has("calibration")) throw UsageError("give at most one of --params and --calibration");
+  std::optional<calib::Calibration> cal;
+  if (auto cf = args.get("calibration")) {
+    cal = calib::read_calibration(*cf);
+    spec.arm_offset += cal->offsets[static_cast<int>(spec.height)];
+  }
+  spec.max_travel = args.number("max-travel", cal ? cal->rig_travel : 0.85);
   if (!(spec.max_travel > 0.0 && spec.max_travel <= 0.85))
     throw UsageError("--max-travel must be in (0, 0.85] m (the rig's travel)");
   spec.gown_noise = args.has("noise");
@@ -107,7 +119,7 @@ int run_simulate(int argc, char** argv) {
   else if (fr == "improved") spec.friction_scheme = sim::FrictionScheme::Improved;
   else if (fr == "constraint") spec.friction_scheme = sim::FrictionScheme::Constraint;
   else throw UsageError("--friction must be stock, improved or constraint, not '" + fr + "'");
-  const std::string gs = args.get("gown").value_or("reduced");
+  const std::string gs = args.get("gown").value_or(cal ? cal->gown : "reduced");
   sim::GownResolution res;
   if (gs == "full") res = sim::GownResolution::Full;
   else if (gs == "reduced") res = sim::GownResolution::Reduced;
@@ -115,6 +127,7 @@ int run_simulate(int argc, char** argv) {
   else throw UsageError("--gown must be full, reduced or coarse, not '" + gs + "'");
   sim::ClothParams params;
   if (auto pf = args.get("params")) params = sim::read_params(*pf);
+  if (cal) params = calib::cloth_params_of(cal->cloth);
   const std::filesystem::path out = args.require("out");
   spec.keep_frames = true;
   spec.record_arm_parts = true;

@@ -16,6 +16,11 @@ execute_process(COMMAND ${DG} simulate --height high --max-travel 2 --out /tmp/d
 if(NOT rc EQUAL 2 OR NOT err MATCHES "--max-travel")
   message(FATAL_ERROR "bad --max-travel not named: rc=${rc} ${err}")
 endif()
+execute_process(COMMAND ${DG} simulate --height high --params ${TMP}/bad_params.txt --calibration ${SRC}/models/participant4-simulator.json
+                --out /tmp/dg_sim_never.csv RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "at most one of --params and --calibration")
+  message(FATAL_ERROR "--params with --calibration not refused: rc=${rc} ${err}")
+endif()
 if(EXISTS /tmp/dg_sim_never.csv)
   message(FATAL_ERROR "a failed simulate wrote its output")
 endif()
@@ -44,4 +49,14 @@ execute_process(COMMAND ${DG} simulate --height high --gown coarse --grip-depth 
                 RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
 if(NOT rc EQUAL 2 OR NOT err MATCHES "--grip-depth" OR EXISTS ${TMP}/dg_grip_never.csv)
   message(FATAL_ERROR "bad --grip-depth: expected exit 2 naming it and no file, got rc=${rc}: ${err}")
+endif()
+
+# --calibration: participant 4's cloth and person parameters, and its low arm's offset (+1.105 cm)
+# added to --arm-offset.
+execute_process(COMMAND ${DG} simulate --gown coarse --height low --arm-offset 0.01 --max-travel 0.05 --frames 0
+                        --calibration ${SRC}/models/participant4-simulator.json --out ${TMP}/cal.csv --json
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "\"arm_offset\": 0.02105" OR NOT out MATCHES "\"fist_shift\": 0.0544853"
+   OR NOT out MATCHES "\"stretch\": 0.34440")
+  message(FATAL_ERROR "--calibration did not reach the simulation: rc=${rc} ${out} ${err}")
 endif()
