@@ -35,7 +35,6 @@ constexpr double kSimMiddleBelowHigh = sim::ArmGeometry{}.z_rel[0] - sim::ArmGeo
 static_assert(kSimMiddleBelowHigh - kMiddleBelowHigh < 1e-12 && kMiddleBelowHigh - kSimMiddleBelowHigh < 1e-12,
               "the middle arm's nominal height differs between synthesis.h and sim/trial.h");
 
-
 sim::TrialSpec spec_of(const TrialRequest& r) {
   sim::TrialSpec spec;
   spec.height = r.height;
