@@ -208,7 +208,6 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
 
   SynthesisSummary s;
   s.trials = total;
-  s.middle_base = middle_base;
   s.edge = edge;
   for (int t = 0; t < total; ++t) {
     s.per_label[static_cast<int>(res[2 * t])]++;

@@ -88,8 +88,7 @@ struct SynthesisProgress {
 
 struct SynthesisSummary {
   int trials = 0, resumed = 0;
-  double middle_base = 0;      // [m] where the middle arm's noise sat (0: nominal)
-  MiddleEdge edge;             // with MiddleArm::CaughtEdge
+  MiddleEdge edge;             // with MiddleArm::CaughtEdge: where the middle arm's noise sat
   int per_label[kOutcomeCount] = {};
   double elapsed_s = 0;
 };

@@ -92,7 +92,7 @@ int run_synthesize(int argc, char** argv) {
       std::printf("{\"trials\": %d, \"resumed\": %d, \"good\": %d, \"missed\": %d, \"caught\": %d, "
                   "\"middle\": \"%s\", \"middle_base_m\": %.6f, \"out\": \"%s\"}\n",
                   s.trials, s.resumed, s.per_label[0], s.per_label[1], s.per_label[2], middle_arm_name(o.middle),
-                  s.middle_base, out.c_str());
+                  o.middle == MiddleArm::CaughtEdge ? s.edge.offset : 0.0, out.c_str());
     else
       std::printf("synthesized %d trials (%d kept from an earlier run): %d good, %d missed, %d caught -> %s\n",
                   s.trials, s.resumed, s.per_label[0], s.per_label[1], s.per_label[2], out.c_str());

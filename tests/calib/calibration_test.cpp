@@ -452,7 +452,7 @@ TEST(Synthesis, MiddleArmAtTheSimulatorsCaughtEdge) {
   o.gown_noise = false;
   const fs::path a = temp_dir("synth_edge");
   const SynthesisSummary s = synthesize(cal, testing::fake_simulate, o, a, Comm::world());
-  EXPECT_EQ(s.middle_base, e1.offset);
+  EXPECT_EQ(s.edge.offset, e1.offset);
   const Dataset ds = load_dataset(a);
   int middle_caught = 0, middle_missed = 0;
   for (const auto& t : ds.trials)
