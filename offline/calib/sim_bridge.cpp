@@ -4,6 +4,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "model.h"
 #include "synthesis.h"
 #include "trial.h"
 
@@ -74,6 +75,11 @@ ClothSimulator make_cloth_simulator(const std::string& gown) {
     std::vector<SimulatedTrial> out;
     for (sim::TrialResult& r : res) out.push_back(simulated(std::move(r)));
     return out;
+  };
+  const double factor = sim::bend_mesh_factor(scene->data());
+  const double density = sim::ClothParams{}.areal_density;
+  cs.bending_length = [factor, density](double bend) {
+    return sim::bending_length(sim::bending_rigidity(bend, factor), density);
   };
   return cs;
 }

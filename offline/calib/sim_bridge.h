@@ -2,6 +2,7 @@
 // (DRESSGUARD_HAVE_SIM); the commands check that macro and say so otherwise.
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "calibration.h"
@@ -16,6 +17,9 @@ namespace dressguard::calib {
 struct ClothSimulator {
   TrialSimulator trial;
   TrialBatchSimulator trials;
+  // Peirce's bending length [m] that a bend value gives on this simulator's gown mesh
+  // (sim::bending_length in offline/sim/model.h): what the calibrated `bend` means as a fabric.
+  std::function<double(double bend)> bending_length;
 };
 
 // "full" (the measured 20k-triangle gown), "reduced" (the default for calibration and synthesis)

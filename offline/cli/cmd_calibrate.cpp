@@ -179,7 +179,13 @@ int run_calibrate(int argc, char** argv) {
         std::printf("  %-18s %-6s L = %.4f; over the common travel F_motion %.3f (zero force %.3f), F_vertical %.3f "
                     "(zero force %.3f) N m\n", f.trial_id.c_str(), std::string(arm_height_name(f.height)).c_str(),
                     f.objective, f.motion.error, f.motion.zero, f.vertical.error, f.vertical.zero);
-      for (int i = 0; i < kClothParams; ++i) std::printf("  %-13s %.4f\n", kClothParamNames[i], cloth_value(r.cloth, i));
+      for (int i = 0; i < kClothParams; ++i) {
+        std::printf("  %-13s %.4f", kClothParamNames[i], cloth_value(r.cloth, i));
+        // What bend means as a fabric (light woven fabrics: 1.5-3 cm; offline/sim/README.md).
+        if (std::string(kClothParamNames[i]) == "bend" && sim.bending_length)
+          std::printf("  (bending length %.1f cm on this gown)", 100 * sim.bending_length(cloth_value(r.cloth, i)));
+        std::printf("\n");
+      }
       for (int i = 0; i < kPersonParams; ++i)
         if (space.person[i].fit || person_value(r.cloth, i) != 0)
           std::printf("  %-14s %.4f%s\n", kPersonParamInfo[i].name, person_value(r.cloth, i), space.person[i].fit ? "" : " (held)");

@@ -12,6 +12,7 @@
 #include "gown.h"
 #include "gown_scene.h"
 #include "grip_option.h"
+#include "model.h"
 #include "params.h"
 #include "sim_bridge.h"
 #include "trial.h"
@@ -146,6 +147,8 @@ int run_simulate(int argc, char** argv) {
 
   write_file_atomic(out, format_trial_csv(r.seq.samples));
   const HapticSample last = r.seq.samples.empty() ? HapticSample{} : r.seq.samples.back();
+  // What `bend` means as a material on this mesh (model.h): B [N m] and Peirce's bending length.
+  const double rigidity = sim::bending_rigidity(params.bend, sim::bend_mesh_factor(scene.data()));
   char b[2048];
   std::snprintf(b, sizeof b,
                 "{\"label\": \"%s\", \"height\": \"%s\", \"arm_offset\": %.6g, \"speed\": %.6g, \"seed\": %llu, "
@@ -153,12 +156,14 @@ int run_simulate(int argc, char** argv) {
                 "\"stopped_by_force\": %s, \"contact_travel\": %.6f, \"samples\": %zu, \"f_motion\": %.6f, "
                 "\"f_lateral\": %.6f, \"f_vertical\": %.6f, \"weight\": %.6f, \"area_ratio\": %.6f, "
                 "\"settle_s\": %.4f, \"settle_speed\": %.6f, \"settled\": %s, "
+                "\"bending_rigidity\": %.6g, \"bending_length\": %.6g, "
                 "\"out\": \"%s\", \"params\": %s}",
                 std::string(outcome_name(r.outcome)).c_str(), hs.c_str(), r.arm_offset, spec.speed,
                 static_cast<unsigned long long>(spec.seed), spec.gown_noise ? "true" : "false", gs.c_str(), fr.c_str(),
                 r.travel, r.d_max, r.stopped_by_force ? "true" : "false", r.contact_travel, r.seq.samples.size(),
                 last.f_motion, last.f_lateral, last.f_vertical, r.weight, r.area_ratio, r.settle_time,
-                r.settle_speed, r.settled ? "true" : "false", out.c_str(),
+                r.settle_speed, r.settled ? "true" : "false", rigidity, sim::bending_length(rigidity, params.areal_density),
+                out.c_str(),
                 sim::params_json(params).c_str());
   std::filesystem::path meta = out;
   meta.replace_extension(".json");

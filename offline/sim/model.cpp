@@ -254,6 +254,29 @@ double compliance_of(double k, double alpha_soft, double alpha_stiff) {
   return std::exp(std::log(alpha_soft) + k * (std::log(alpha_stiff) - std::log(alpha_soft)));
 }
 
+double bend_mesh_factor(const SceneData& s) {
+  double sum = 0;
+  for (const BendStencil& b : s.bend) {
+    // Unfold the stencil about its hinge x0-x1: u along the hinge, v across it, x2 and x3 on
+    // opposite sides at their rest distances (the dihedral opened flat).
+    const V3 e = s.rest[b.v[1]] - s.rest[b.v[0]];
+    const double le = norm(e);
+    if (le < 1e-12) continue;
+    const V3 t = (1.0 / le) * e;
+    double u[4] = {0, le, 0, 0}, v[4] = {0, 0, 0, 0};
+    for (int k = 2; k < 4; ++k) {
+      const V3 d = s.rest[b.v[k]] - s.rest[b.v[0]];
+      u[k] = dot(d, t);
+      v[k] = std::sqrt(std::max(0.0, dot(d, d) - u[k] * u[k])) * (k == 2 ? 1.0 : -1.0);
+    }
+    double sa = 0, sb = 0, sc = 0;
+    for (int k = 0; k < 4; ++k) sa += b.k[k] * u[k] * u[k], sb += b.k[k] * u[k] * v[k], sc += b.k[k] * v[k] * v[k];
+    const double mean = 0.5 * (sa + sc), dev = 0.5 * (sa - sc);
+    sum += 0.25 * (mean * mean + 0.5 * dev * dev + 0.5 * sb * sb);  // |K X|^2 / kappa^2, direction-averaged
+  }
+  return s.rest_area > 0 ? sum / s.rest_area : 0.0;
+}
+
 GownModel make_model(const SceneData& s, const ClothParams& p, FrictionScheme scheme, bool self_collision, double arm_dz) {
   GownModel m;
   m.scene = &s;
@@ -268,10 +291,10 @@ GownModel make_model(const SceneData& s, const ClothParams& p, FrictionScheme sc
     m.w[i] = s.grasped[i] ? 0.0 : 1.0 / m.mass[i];
   }
   // Ranges documented in trial.h (ClothParams).
-  m.alpha_stretch = compliance_of(p.stretch, 1e-2, 1e-7);
+  m.alpha_stretch = compliance_of(p.stretch, kStretchComplianceSoft, kStretchComplianceStiff);
   m.alpha_compress = m.alpha_stretch * s.opt.compression_softening;
-  m.alpha_shear = compliance_of(p.shear, 1e0, 1e-5);
-  m.alpha_bend = compliance_of(p.bend, 1e7, 1e1);
+  m.alpha_shear = compliance_of(p.shear, kShearComplianceSoft, kShearComplianceStiff);
+  m.alpha_bend = compliance_of(p.bend, kBendComplianceSoft, kBendComplianceStiff);
   m.friction = std::max(0.0, p.friction);
   m.self_friction = std::max(0.0, p.self_friction);
   m.arm_compliance = std::max(0.0, p.arm_compliance);

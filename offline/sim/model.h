@@ -166,6 +166,35 @@ struct GownModel {
 
 // Compliance from a stiffness in [0, 1]: log-linear between alpha_soft (k = 0) and alpha_stiff.
 double compliance_of(double k, double alpha_soft, double alpha_stiff);
+
+// The calibrated parameters' compliance ranges (ClothParams in trial.h: k = 0 soft ... k = 1 stiff).
+inline constexpr double kStretchComplianceSoft = 1e-2, kStretchComplianceStiff = 1e-7;
+inline constexpr double kShearComplianceSoft = 1e0, kShearComplianceStiff = 1e-5;
+inline constexpr double kBendComplianceSoft = 1e7, kBendComplianceStiff = 1e1;  // [1/(N m)]
+
+// What the bending parameter means as a material. The isometric bending energy (constraints.h)
+// of a mesh bent to a constant curvature kappa is  1/2 (1/alpha) sum_e |K_e X|^2, and a plate's
+// is 1/2 B kappa^2 A: so the mesh represents a bending rigidity
+//   B = f / alpha,   f = sum_e |K_e X|^2 / (kappa^2 A)   (dimensionless, about 3-9),
+// where f depends on the triangulation and on the direction of bending. For a flat stencil
+// (x_i in its unfolded plane) the curvature field X = x + kappa/2 (x.d)^2 n gives
+// K_e X = kappa/2 sum_i k_i (x_i.d)^2 n, since K annihilates linear fields; averaged over the
+// directions d in the plane:
+//   <(sum_i k_i (x_i.d)^2)^2> = ((Sa + Sc)/2)^2 + ((Sa - Sc)/2)^2 / 2 + Sb^2 / 2,
+//   Sa = sum k_i u_i^2, Sb = sum k_i u_i v_i, Sc = sum k_i v_i^2   (u, v: the unfolded coordinates).
+// bend_mesh_factor() returns that direction-averaged f over all stencils of the rest mesh, each
+// unfolded about its hinge (the rest shape's own curvature plays no part: the rest state is flat).
+// The cantilever test (tests/sim/physics_test.cpp) checks B against the simulated droop.
+double bend_mesh_factor(const SceneData& s);
+// B [N m] of bend parameter k on a mesh of factor f.
+inline double bending_rigidity(double bend, double mesh_factor) {
+  return mesh_factor / compliance_of(bend, kBendComplianceSoft, kBendComplianceStiff);
+}
+// Peirce's bending length c = (B / (rho g))^(1/3) [m]: a strip of length 2c, held flat at one end,
+// droops 41.5 degrees (the cantilever test of fabrics, ASTM D1388). Light woven fabrics 1.5-3 cm.
+inline double bending_length(double rigidity, double areal_density) {
+  return std::cbrt(rigidity / (areal_density * 9.81));
+}
 GownModel make_model(const SceneData& s, const ClothParams& p, FrictionScheme scheme, bool self_collision,
                      double arm_dz);
 // Rebuilds the solver's blocks from the model's masses, inverse masses and compliances (make_model

@@ -32,6 +32,11 @@ execute_process(COMMAND ${DG} simulate --gown coarse --height low --max-travel 0
 if(NOT rc EQUAL 0 OR NOT out MATCHES "\"travel\": 0.050000" OR NOT out MATCHES "\"label\": \"missed\"")
   message(FATAL_ERROR "--max-travel 0.05 did not end the trial at 0.05 m: rc=${rc} ${out} ${err}")
 endif()
+# The summary says what bend means as a fabric: the default bend 0.7 is B of 1-99 mN m, a
+# bending length of centimetres to decimetres (offline/sim/model.h, bending_length()).
+if(NOT out MATCHES "\"bending_rigidity\": 0\\.0[0-9]" OR NOT out MATCHES "\"bending_length\": 0\\.[0-2]")
+  message(FATAL_ERROR "the summary lacks a plausible bending rigidity and length: ${out}")
+endif()
 file(READ ${TMP}/short.scene.json scene)
 if(NOT scene MATCHES "\"contacts\": \\[")
   message(FATAL_ERROR "the scene file has no contacts list")
