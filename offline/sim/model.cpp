@@ -1,6 +1,7 @@
 // Building the constant model (SceneData, GownModel) and the preallocated state.
 #include "model.h"
 
+#include <limits>
 #include <array>
 #include <algorithm>
 #include <stdexcept>
@@ -236,6 +237,9 @@ Scene make_scene(const ClothMesh& mesh, const SceneOptions& opt) {
   for (int v : mesh.sleeve_opening)
     if (v < 0 || v >= n) throw std::invalid_argument("make_scene: sleeve opening vertex " + std::to_string(v) + " out of range");
   d->opening = std::vector<int32_t>(mesh.sleeve_opening.begin(), mesh.sleeve_opening.end());
+  d->rim_distance.assign(n, std::numeric_limits<double>::infinity());
+  for (int i = 0; i < n; ++i)
+    for (int32_t o : d->opening) d->rim_distance[i] = std::min(d->rim_distance[i], norm(d->rest[i] - d->rest[o]));
   for (const auto& pl : opt.planes) {
     const V3 nn{pl[0], pl[1], pl[2]};
     const double l = norm(nn);
@@ -299,6 +303,8 @@ GownModel make_model(const SceneData& s, const ClothParams& p, FrictionScheme sc
   m.self_friction = std::max(0.0, p.self_friction);
   m.arm_compliance = std::max(0.0, p.arm_compliance);
   m.fist_shift = p.fist_shift;
+  m.hem_width = std::max(0.0, p.hem_width);
+  m.hem_bend_ratio = p.hem_bend_ratio > 0 ? p.hem_bend_ratio : 1.0;
   m.damping_factor = std::exp(-std::max(0.0, p.damping) * m.h);
   m.scheme = scheme;
   m.self_collision = self_collision;
@@ -427,11 +433,15 @@ void refresh_constraints(GownModel& m) {
       },
       [](ShearBlock& b, int k) { b.v[0][k] = b.v[1][k] = b.v[2][k] = -1; }, m.shear_blocks, m.shear_spans);
   const double ab = m.alpha_bend * inv_h2;
+  // The cuff (ClothParams::hem_width): a stencil whose hinge lies within it is hem_bend_ratio x stiffer.
+  auto in_hem = [&](const BendStencil& st) {
+    return m.hem_width > 0 && s.rim_distance[st.v[0]] <= m.hem_width && s.rim_distance[st.v[1]] <= m.hem_width;
+  };
   pack_blocks<BendBlock>(
       s.bend, s.bend_colours, s.grasped,
       [](const BendStencil& b) { return std::array<int, 4>{b.v[0], b.v[1], b.v[2], b.v[3]}; },
       [&](BendBlock& b, int k, const BendStencil& st) {
-        double denom = ab;
+        double denom = in_hem(st) ? ab / m.hem_bend_ratio : ab;
         for (int a = 0; a < 4; ++a) {
           b.v[a][k] = st.v[a];
           b.k[a][k] = st.k[a];

@@ -93,6 +93,7 @@ struct SceneData {
   std::vector<int32_t> grasp_list;
   std::vector<V3> grasp_target;      // where the closed jaws hold each vertex (rest elsewhere)
   std::vector<int32_t> opening;      // sleeve opening loop
+  std::vector<double> rim_distance;  // [m] rest distance of each vertex to the nearest opening vertex (inf: none)
   // Colliders: the arm's round cones (index 0 is the elbow sphere, used for the label) and
   // planes for tests. The arm is placed at a trial's height by translating these along z.
   std::vector<RoundCone> arm;        // at arm height offset 0 relative to z_rel[High] (see arm_at())
@@ -150,6 +151,8 @@ struct GownModel {
   double friction = 0, self_friction = 0;
   double arm_compliance = 0;          // [m/N] ClothParams::arm_compliance (0: fixed arm)
   double fist_shift = 0;              // [m] ClothParams::fist_shift (place_arm)
+  double hem_width = 0;               // [m] ClothParams::hem_width (refresh_constraints)
+  double hem_bend_ratio = 1;          // ClothParams::hem_bend_ratio
   double damping_factor = 1;          // per substep
   FrictionScheme scheme = FrictionScheme::Improved;
   bool self_collision = true;

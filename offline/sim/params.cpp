@@ -21,6 +21,8 @@ double* field(ClothParams& p, const std::string& name) {
   if (name == "areal_density") return &p.areal_density;
   if (name == "arm_compliance") return &p.arm_compliance;
   if (name == "fist_shift") return &p.fist_shift;
+  if (name == "hem_width") return &p.hem_width;
+  if (name == "hem_bend_ratio") return &p.hem_bend_ratio;
   return nullptr;
 }
 
@@ -47,7 +49,7 @@ ClothParams parse_params(const std::string& text, const std::filesystem::path& f
       if (!(ws >> value)) throw_input_error(file, lineno, "parameter '" + name + "' has no value");
       if (ws >> extra) throw_input_error(file, lineno, "unexpected '" + extra + "' after " + name);
       double* f = field(p, name);
-      if (!f) throw_input_error(file, lineno, "unknown parameter '" + name + "' (stretch, shear, bend, friction, self_friction, damping, areal_density, arm_compliance, fist_shift)");
+      if (!f) throw_input_error(file, lineno, "unknown parameter '" + name + "' (stretch, shear, bend, friction, self_friction, damping, areal_density, arm_compliance, fist_shift, hem_width, hem_bend_ratio)");
       double v = 0;
       auto [ptr, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
       if (ec != std::errc() || ptr != value.data() + value.size() || !std::isfinite(v))
@@ -59,6 +61,9 @@ ClothParams parse_params(const std::string& text, const std::filesystem::path& f
   if (p.arm_compliance < 0) throw_input_error(file, 0, "arm_compliance must be 0 (a fixed arm) or positive");
   if (!(std::abs(p.fist_shift) <= kMaxFistShift))
     throw_input_error(file, 0, "fist_shift must be within +-" + std::to_string(kMaxFistShift) + " m");
+  if (!(p.hem_width >= 0 && p.hem_width <= 0.2)) throw_input_error(file, 0, "hem_width must be within [0, 0.2] m");
+  if (!(p.hem_bend_ratio >= 1 && p.hem_bend_ratio <= 1e4))
+    throw_input_error(file, 0, "hem_bend_ratio must be within [1, 10000] (a hem is stiffer than the fabric)");
   return p;
 }
 
@@ -68,9 +73,9 @@ std::string format_params(const ClothParams& p) {
   char b[768];
   std::snprintf(b, sizeof b,
                 "stretch %.17g\nshear %.17g\nbend %.17g\nfriction %.17g\nself_friction %.17g\ndamping %.17g\n"
-                "areal_density %.17g\narm_compliance %.17g\nfist_shift %.17g\n",
+                "areal_density %.17g\narm_compliance %.17g\nfist_shift %.17g\nhem_width %.17g\nhem_bend_ratio %.17g\n",
                 p.stretch, p.shear, p.bend, p.friction, p.self_friction, p.damping, p.areal_density, p.arm_compliance,
-                p.fist_shift);
+                p.fist_shift, p.hem_width, p.hem_bend_ratio);
   return b;
 }
 
@@ -78,9 +83,10 @@ std::string params_json(const ClothParams& p) {
   char b[768];
   std::snprintf(b, sizeof b,
                 "{\"stretch\": %.17g, \"shear\": %.17g, \"bend\": %.17g, \"friction\": %.17g, \"self_friction\": %.17g, "
-                "\"damping\": %.17g, \"areal_density\": %.17g, \"arm_compliance\": %.17g, \"fist_shift\": %.17g}",
+                "\"damping\": %.17g, \"areal_density\": %.17g, \"arm_compliance\": %.17g, \"fist_shift\": %.17g, "
+                "\"hem_width\": %.17g, \"hem_bend_ratio\": %.17g}",
                 p.stretch, p.shear, p.bend, p.friction, p.self_friction, p.damping, p.areal_density, p.arm_compliance,
-                p.fist_shift);
+                p.fist_shift, p.hem_width, p.hem_bend_ratio);
   return b;
 }
 

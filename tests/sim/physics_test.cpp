@@ -315,6 +315,7 @@ Cantilever make_cantilever(int elements, double h) {
     mesh.grasp.push_back(iv * nu + 1);
     c.tip.push_back(iv * nu + nu - 1);
   }
+  mesh.sleeve_opening = c.tip;  // the free end stands for an opening (the hem test)
   SceneOptions opt;
   opt.with_arm = false;
   opt.require_grasp = false;
@@ -342,8 +343,7 @@ double directional_factor(const SceneData& s, double phi) {
 }
 
 // Peirce's bending length [m] from the strip's droop after 10 s of overdamped settling.
-double peirce_length(const Cantilever& c, double bend) {
-  ClothParams p;
+double peirce_length(const Cantilever& c, double bend, ClothParams p = {}) {
   p.stretch = 1;
   p.shear = 1;
   p.bend = bend;
@@ -376,6 +376,23 @@ TEST(SimPhysics, CantileverDroopGivesTheBendingLength) {
   const double measured = peirce_length(fine, 0.8);
   std::printf("bend 0.8, 5 mm edges: bending length %.2f cm, declared %.2f cm\n", 100 * measured, 100 * declared);
   EXPECT_LT(measured, 0.5 * declared);
+}
+
+// The hem (ClothParams::hem_width, hem_bend_ratio) multiplies the rigidity of the stencils near
+// the opening: over the whole strip, a ratio of 8 doubles the bending length (c ~ B^(1/3)); a hem
+// of width 0 leaves the strip's droop bit for bit as it was.
+TEST(SimPhysics, HemMultipliesTheBendingRigidity) {
+  const Cantilever reduced = make_cantilever(10, 0.028);
+  const double plain = peirce_length(reduced, 0.3);
+  ClothParams hem;
+  hem.hem_width = 1.0;  // every vertex is within 1 m of the strip's free end
+  hem.hem_bend_ratio = 8;
+  const double whole = peirce_length(reduced, 0.3, hem);
+  std::printf("bend 0.3: bending length %.2f cm, with the whole strip a hem of ratio 8 %.2f cm\n", 100 * plain,
+              100 * whole);
+  EXPECT_NEAR(whole / plain, 2.0, 0.1);
+  hem.hem_width = 0;
+  EXPECT_EQ(peirce_length(reduced, 0.3, hem), plain);
 }
 
 // bend_mesh_factor()'s closed-form average over directions equals the mean of the directional
