@@ -122,6 +122,8 @@ ClothValues ParameterSpace::cloth(const Eigen::VectorXd& unit) const {
   long k = kClothParams + static_cast<long>(offset_heights.size());
   for (int i = 0; i < kPersonParams; ++i)
     set_person_value(c, i, person[i].fit ? from_unit(bounds.person[i], unit[k++]) : person[i].value);
+  c.hem_width = hem_width;
+  c.hem_bend_ratio = hem_bend_ratio;
   return c;
 }
 
@@ -224,6 +226,8 @@ std::string fingerprint(const std::vector<HapticSequence>& inputs, const Paramet
     else if (space.person[i].value != 0)
       f << ',' << kPersonParamInfo[i].name << '=' << hexd(space.person[i].value);
   }
+  // The cuff only when there is one (older checkpoints resume).
+  if (space.hem_width > 0) f << ";hem=" << hexd(space.hem_width) << ',' << hexd(space.hem_bend_ratio);
   f << ";inputs=";
   for (const auto& s : inputs) f << s.id << '/' << s.samples.size() << ',';
   return f.str();
@@ -447,6 +451,10 @@ Json calibration_to_json(const Calibration& c) {
   // arm (and synthesis folders made from such a calibration keep their record, so they resume).
   for (int i = 0; i < kPersonParams; ++i)
     if (person_value(c.cloth, i) != 0) cloth.set(kPersonParamInfo[i].name, person_value(c.cloth, i));
+  if (c.cloth.hem_width > 0) {  // likewise the cuff: none is the paper's uniform cloth
+    cloth.set("hem_width", c.cloth.hem_width);
+    cloth.set("hem_bend_ratio", c.cloth.hem_bend_ratio);
+  }
   j.set("cloth", cloth);
   Json off = Json::object();
   for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
@@ -499,6 +507,14 @@ Calibration calibration_from_json(const Json& j, const std::filesystem::path& so
       if (!(v >= info.lowest && v <= info.highest))
         throw std::runtime_error(std::string("cloth.") + info.name + " " + info.range);
       set_person_value(c.cloth, i, v);
+    }
+    if (j.at("cloth").has("hem_width")) {
+      c.cloth.hem_width = j.at("cloth").at("hem_width").number();
+      c.cloth.hem_bend_ratio = j.at("cloth").at("hem_bend_ratio").number();
+      if (!(c.cloth.hem_width >= 0 && c.cloth.hem_width <= kMaxHemWidth))
+        throw std::runtime_error("cloth.hem_width must be within [0, 0.2] m");
+      if (!(c.cloth.hem_bend_ratio >= 1 && c.cloth.hem_bend_ratio <= kMaxHemBendRatio))
+        throw std::runtime_error("cloth.hem_bend_ratio must be within [1, 10000]");
     }
     for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
       const Json& e = j.at("arm_offsets").at(std::string(arm_height_name(h)));

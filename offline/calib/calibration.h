@@ -42,8 +42,15 @@ struct ClothValues {
   // [m] how far its fist sits beyond the paper's toward the elbow (sim/trial.h, ClothParams).
   double arm_compliance = 0.0;
   double fist_shift = 0.0;
+  // The gown's cuff (sim/trial.h ClothParams::hem_width, hem_bend_ratio): bending hem_bend_ratio x
+  // stiffer within hem_width [m] of the sleeve opening. Held, never fitted (ParameterSpace::hem);
+  // 0 and 1 are the paper's uniform cloth.
+  double hem_width = 0.0;
+  double hem_bend_ratio = 1.0;
 };
 inline constexpr int kClothParams = 5;
+// A cuff's limits (sim/params.cpp checks the same): width in [0, 0.2] m, ratio in [1, 1e4].
+inline constexpr double kMaxHemWidth = 0.2, kMaxHemBendRatio = 1e4;
 inline constexpr std::array<const char*, kClothParams> kClothParamNames = {"stretch", "shear", "bend", "friction",
                                                                            "self_friction"};
 double cloth_value(const ClothValues& c, int i);
@@ -133,6 +140,8 @@ struct ParameterSpace {
     double value = 0.0;
   };
   std::array<Person, kPersonParams> person{};
+  // The gown's cuff every candidate is simulated with (ClothValues::hem_width, hem_bend_ratio).
+  double hem_width = 0.0, hem_bend_ratio = 1.0;
   int fitted_person_params() const {
     int n = 0;
     for (const Person& p : person) n += p.fit ? 1 : 0;

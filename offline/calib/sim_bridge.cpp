@@ -21,6 +21,8 @@ sim::ClothParams cloth_params_of(const ClothValues& c) {
   p.self_friction = c.self_friction;
   p.arm_compliance = c.arm_compliance;
   p.fist_shift = c.fist_shift;
+  p.hem_width = c.hem_width;
+  p.hem_bend_ratio = c.hem_bend_ratio;
   return p;
 }
 
@@ -33,6 +35,8 @@ static_assert(kPersonParamInfo[kFistShift].highest == sim::kMaxFistShift &&
               "fist_shift's range differs between calibration.h and sim/trial.h");
 // The middle arm's nominal height below the high one (synthesis.h) is the simulator's.
 constexpr double kSimMiddleBelowHigh = sim::ArmGeometry{}.z_rel[0] - sim::ArmGeometry{}.z_rel[1];
+static_assert(kMaxHemWidth == sim::kMaxHemWidth && kMaxHemBendRatio == sim::kMaxHemBendRatio,
+              "the cuff's limits differ between calibration.h and sim/trial.h");
 static_assert(kSimMiddleBelowHigh - kMiddleBelowHigh < 1e-12 && kMiddleBelowHigh - kSimMiddleBelowHigh < 1e-12,
               "the middle arm's nominal height differs between synthesis.h and sim/trial.h");
 

@@ -50,6 +50,9 @@ int run_calibrate(int argc, char** argv) {
         "  --fist-shift fit|fixed|M   the person's fist: fit how far it sits beyond the paper's\n"
         "                      toward the elbow (one more parameter; the elbow stays), hold it at the\n"
         "                      paper's (the default) or at M metres\n"
+        "  --hem W,R           the gown's cuff: bending R x stiffer within W metres of the sleeve\n"
+        "                      opening (held, not fitted; recorded in CAL.json, so synthesis uses\n"
+        "                      it too; offline/sim/README.md, \"How stiff the gown is\"). Default none\n"
         "  --gown full|reduced|coarse   simulator gown (default reduced)\n"
         "  --threads N         threads per process (default: all cores)\n"
         "  --checkpoint FILE   default CAL.json.ckpt; an existing one is resumed\n"
@@ -61,7 +64,7 @@ int run_calibrate(int argc, char** argv) {
   }
   args.allow_only({"help", "json", "no-arm-offset", "data", "participant", "profile", "bounds", "seed", "out",
                    "checkpoint", "objective", "gown", "threads", "generations", "population",
-                   "stop-after-generations", "arm-compliance", "fist-shift", "sigma0"});
+                   "stop-after-generations", "arm-compliance", "fist-shift", "sigma0", "hem"});
   const std::string data = args.require("data");
   const std::string participant = args.require("participant");
   const std::string out = args.require("out");
@@ -94,6 +97,16 @@ int run_calibrate(int argc, char** argv) {
     throw UsageError("--arm-compliance must be fit, fixed or a compliance in [0, 1] m/N, not '" + *arm + "'");
   if (const auto fist = args.get("fist-shift"); fist && !set_person_param(space, kFistShift, *fist))
     throw UsageError("--fist-shift must be fit, fixed or a shift in [-0.2, 0.2] m, not '" + *fist + "'");
+  if (const auto hem = args.get("hem")) {
+    double w = 0, r = 0;
+    char tail = 0;
+    if (std::sscanf(hem->c_str(), "%lf,%lf%c", &w, &r, &tail) != 2 || !(w > 0 && w <= kMaxHemWidth) ||
+        !(r >= 1 && r <= kMaxHemBendRatio))
+      throw UsageError("--hem must be WIDTH,RATIO with a width in (0, 0.2] m and a ratio in [1, 10000], not '" +
+                       *hem + "'");
+    space.hem_width = w;
+    space.hem_bend_ratio = r;
+  }
   space.bounds = args.get("bounds") ? read_bounds(*args.get("bounds")) : default_bounds();
   const Dataset ds = load_dataset(data);
   const std::vector<HapticSequence> inputs = select_inputs(ds, participant, o.seed);
@@ -189,6 +202,8 @@ int run_calibrate(int argc, char** argv) {
       for (int i = 0; i < kPersonParams; ++i)
         if (space.person[i].fit || person_value(r.cloth, i) != 0)
           std::printf("  %-14s %.4f%s\n", kPersonParamInfo[i].name, person_value(r.cloth, i), space.person[i].fit ? "" : " (held)");
+      if (r.cloth.hem_width > 0)
+        std::printf("  hem           %.3f m, bending x %g (held)\n", r.cloth.hem_width, r.cloth.hem_bend_ratio);
       for (ArmHeight h : space.offset_heights)
         std::printf("  arm offset %-6s %+.4f m\n", std::string(arm_height_name(h)).c_str(), r.offsets[static_cast<int>(h)]);
       std::printf("wrote %s and %s.curves.csv\n", out.c_str(), out.c_str());

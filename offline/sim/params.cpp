@@ -61,8 +61,8 @@ ClothParams parse_params(const std::string& text, const std::filesystem::path& f
   if (p.arm_compliance < 0) throw_input_error(file, 0, "arm_compliance must be 0 (a fixed arm) or positive");
   if (!(std::abs(p.fist_shift) <= kMaxFistShift))
     throw_input_error(file, 0, "fist_shift must be within +-" + std::to_string(kMaxFistShift) + " m");
-  if (!(p.hem_width >= 0 && p.hem_width <= 0.2)) throw_input_error(file, 0, "hem_width must be within [0, 0.2] m");
-  if (!(p.hem_bend_ratio >= 1 && p.hem_bend_ratio <= 1e4))
+  if (!(p.hem_width >= 0 && p.hem_width <= kMaxHemWidth)) throw_input_error(file, 0, "hem_width must be within [0, 0.2] m");
+  if (!(p.hem_bend_ratio >= 1 && p.hem_bend_ratio <= kMaxHemBendRatio))
     throw_input_error(file, 0, "hem_bend_ratio must be within [1, 10000] (a hem is stiffer than the fabric)");
   return p;
 }

@@ -80,6 +80,8 @@ struct ClothParams {
 };
 // |fist_shift| beyond this leaves no forearm worth the name (the paper's is 0.31 m).
 inline constexpr double kMaxFistShift = 0.2;
+// A cuff's limits: width [m] and how much stiffer than the fabric it may be.
+inline constexpr double kMaxHemWidth = 0.2, kMaxHemBendRatio = 1e4;
 
 // Friction of cloth against the arm and itself (paper IV-A.2, the point of the "improved" scheme):
 //  Stock:      PBD as in stock PhysX: contacts push vertices out along the normal in every

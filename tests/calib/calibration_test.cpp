@@ -226,6 +226,18 @@ TEST(Calibration, CheckpointOfAnotherRunIsRefused) {
   calibrate(inputs, space, testing::fake_simulate, o, Comm::world());
   o.seed = 12;  // another run
   EXPECT_THROW(calibrate(inputs, space, testing::fake_simulate, o, Comm::world()), InputError);
+  o.seed = 11;  // back to the first run's
+  auto hemmed = space;  // the same run on a gown with a cuff is another run too
+  hemmed.hem_width = 0.03;
+  hemmed.hem_bend_ratio = 30;
+  EXPECT_EQ(hemmed.cloth(hemmed.initial_unit()).hem_bend_ratio, 30.0);
+  try {
+    calibrate(inputs, hemmed, testing::fake_simulate, o, Comm::world());
+    FAIL() << "a checkpoint without the cuff resumed a run with one";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("different calibration"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW(calibrate(inputs, space, testing::fake_simulate, o, Comm::world()));  // its own run resumes
   write_file_atomic(o.checkpoint, "garbage\n");
   EXPECT_THROW(calibrate(inputs, space, testing::fake_simulate, o, Comm::world()), InputError);
   fs::remove_all(dir);
@@ -305,6 +317,28 @@ TEST(Calibration, CalibrationFileRoundTripAndErrors) {
   c.cloth.fist_shift = 0.075;
   write_calibration(dir / "cal_fist.json", c);
   EXPECT_EQ(read_calibration(dir / "cal_fist.json").cloth.fist_shift, 0.075);
+  // The cuff: absent is none (the paper's uniform cloth); present, it reads back; out of range names the file.
+  EXPECT_EQ(read_file(dir / "cal_fist.json").find("hem_"), std::string::npos);
+  EXPECT_EQ(d.cloth.hem_width, 0.0);
+  EXPECT_EQ(d.cloth.hem_bend_ratio, 1.0);
+  c.cloth.hem_width = 0.03;
+  c.cloth.hem_bend_ratio = 30;
+  write_calibration(dir / "cal_hem.json", c);
+  const Calibration h = read_calibration(dir / "cal_hem.json");
+  EXPECT_EQ(h.cloth.hem_width, 0.03);
+  EXPECT_EQ(h.cloth.hem_bend_ratio, 30.0);
+  std::string text = read_file(dir / "cal_hem.json");
+  text.replace(text.find("\"hem_bend_ratio\": 30"), 22, "\"hem_bend_ratio\": 0.5");
+  write_file_atomic(dir / "cal_hem_bad.json", text);
+  try {
+    read_calibration(dir / "cal_hem_bad.json");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cal_hem_bad.json"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("hem_bend_ratio"), std::string::npos) << e.what();
+  }
+  c.cloth.hem_width = 0;
+  c.cloth.hem_bend_ratio = 1;
   EXPECT_EQ(d.participant, "4");
   EXPECT_EQ(d.cloth.self_friction, 0.5);
   EXPECT_EQ(d.offsets[2], 0.011);

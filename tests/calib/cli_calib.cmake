@@ -20,6 +20,8 @@ expect_fail("calibrate with an unknown objective" "--objective" calibrate --data
 expect_fail("calibrate with a typo option" "--sed" calibrate --data ${WORK} --participant 1 --out ${WORK}/c.json --sed 3)
 expect_fail("calibrate with a bad --sigma0" "--sigma0" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --sigma0 0)
 expect_fail("calibrate with a bad --arm-compliance" "--arm-compliance" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --arm-compliance soft)
+expect_fail("calibrate with a bad --hem" "--hem" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --hem 0.03)
+expect_fail("calibrate with a softening --hem" "--hem" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --hem 0.03,0.5)
 expect_fail("calibrate on a missing dataset" "manifest.csv" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json)
 file(WRITE ${WORK}/bad.json "{\"format\": \"dressguard-calibration 1\",\n\"participant\": 4,\n}")
 expect_fail("synthesize with a bad calibration file" "bad.json" synthesize --calibration ${WORK}/bad.json --out ${WORK}/s)

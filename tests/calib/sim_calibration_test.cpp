@@ -15,6 +15,20 @@
 namespace dressguard::calib {
 namespace {
 
+// A calibration's values reach the simulator whole: the five cloth values, the person's arm and
+// the gown's cuff (calibrate --hem records it in the file, synthesis simulates with it).
+TEST(SimCalibration, ClothParamsCarryEveryCalibratedValue) {
+  ClothValues c{0.1, 0.2, 0.3, 0.4, 0.5, 0.006, 0.05, 0.03, 30};
+  const sim::ClothParams p = cloth_params_of(c);
+  EXPECT_EQ(p.stretch, 0.1);
+  EXPECT_EQ(p.self_friction, 0.5);
+  EXPECT_EQ(p.arm_compliance, 0.006);
+  EXPECT_EQ(p.fist_shift, 0.05);
+  EXPECT_EQ(p.hem_width, 0.03);
+  EXPECT_EQ(p.hem_bend_ratio, 30.0);
+  EXPECT_EQ(p.damping, sim::ClothParams{}.damping);  // not calibrated (paper IV-B.2)
+}
+
 // The bridge is deterministic and thread-safe: the same trial simulated on two threads at once
 // and once more on this thread gives the same samples, bit for bit (calibration's independence
 // of the thread count rests on this).
