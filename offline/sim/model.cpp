@@ -1,9 +1,9 @@
 // Building the constant model (SceneData, GownModel) and the preallocated state.
 #include "model.h"
 
-#include <limits>
-#include <array>
 #include <algorithm>
+#include <array>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
