@@ -178,7 +178,7 @@ inline constexpr double kBendComplianceSoft = 1e7, kBendComplianceStiff = 1e1;  
 // What the bending parameter means as a material. The isometric bending energy (constraints.h)
 // of a mesh bent to a constant curvature kappa is  1/2 (1/alpha) sum_e |K_e X|^2, and a plate's
 // is 1/2 B kappa^2 A: so the mesh represents a bending rigidity
-//   B = f / alpha,   f = sum_e |K_e X|^2 / (kappa^2 A)   (dimensionless: 2.9-4.5 on the meshes here),
+//   B = f / alpha,   f = sum_e |K_e X|^2 / (kappa^2 A)   (dimensionless; 4.5 on the reduced gown, 3.6 full, 7.7 coarse),
 // where f depends on the triangulation and on the direction of bending. For a flat stencil
 // (x_i in its unfolded plane) the curvature field X = x + kappa/2 (x.d)^2 n gives
 // K_e X = kappa/2 sum_i k_i (x_i.d)^2 n, since K annihilates linear fields; averaged over the
