@@ -511,10 +511,8 @@ Calibration calibration_from_json(const Json& j, const std::filesystem::path& so
     if (j.at("cloth").has("hem_width")) {
       c.cloth.hem_width = j.at("cloth").at("hem_width").number();
       c.cloth.hem_bend_ratio = j.at("cloth").at("hem_bend_ratio").number();
-      if (!(c.cloth.hem_width >= 0 && c.cloth.hem_width <= kMaxHemWidth))
-        throw std::runtime_error("cloth.hem_width must be within [0, 0.2] m");
-      if (!(c.cloth.hem_bend_ratio >= 1 && c.cloth.hem_bend_ratio <= kMaxHemBendRatio))
-        throw std::runtime_error("cloth.hem_bend_ratio must be within [1, 10000]");
+      if (!hem_in_range(c.cloth.hem_width, c.cloth.hem_bend_ratio))
+        throw std::runtime_error("cloth.hem_width / hem_bend_ratio must be within [0, 0.2] m / [1, 10000]");
     }
     for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
       const Json& e = j.at("arm_offsets").at(std::string(arm_height_name(h)));

@@ -51,6 +51,9 @@ struct ClothValues {
 inline constexpr int kClothParams = 5;
 // A cuff's limits (sim/params.cpp checks the same): width in [0, 0.2] m, ratio in [1, 1e4].
 inline constexpr double kMaxHemWidth = 0.2, kMaxHemBendRatio = 1e4;
+inline bool hem_in_range(double width, double ratio) {
+  return width >= 0 && width <= kMaxHemWidth && ratio >= 1 && ratio <= kMaxHemBendRatio;
+}
 inline constexpr std::array<const char*, kClothParams> kClothParamNames = {"stretch", "shear", "bend", "friction",
                                                                            "self_friction"};
 double cloth_value(const ClothValues& c, int i);

@@ -100,8 +100,7 @@ int run_calibrate(int argc, char** argv) {
   if (const auto hem = args.get("hem")) {
     double w = 0, r = 0;
     char tail = 0;
-    if (std::sscanf(hem->c_str(), "%lf,%lf%c", &w, &r, &tail) != 2 || !(w > 0 && w <= kMaxHemWidth) ||
-        !(r >= 1 && r <= kMaxHemBendRatio))
+    if (std::sscanf(hem->c_str(), "%lf,%lf%c", &w, &r, &tail) != 2 || !(w > 0) || !hem_in_range(w, r))
       throw UsageError("--hem must be WIDTH,RATIO with a width in (0, 0.2] m and a ratio in [1, 10000], not '" +
                        *hem + "'");
     space.hem_width = w;
