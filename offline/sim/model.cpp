@@ -404,6 +404,10 @@ void refresh_constraints(GownModel& m) {
   m.path = simd ? KernelPath::Avx2 : KernelPath::Scalar;
   const double at = m.alpha_stretch * inv_h2, ac = m.alpha_compress * inv_h2;
   auto inv_pos = [](double d) { return d > 0 ? 1.0 / d : 0.0; };
+  // The cuff (ClothParams::hem_width): a vertex within it, and an edge or hinge with both ends
+  // within it. Compression softening stands for single fabric buckling below the mesh's scale; a
+  // hem's stitched layers do not, so its edges keep the tension compliance in compression too.
+  auto in_hem = [&](int32_t v) { return m.hem_width > 0 && s.rim_distance[v] <= m.hem_width; };
   pack_blocks<StretchBlock>(
       s.stretch, s.stretch_colours, s.grasped, [](const DistanceLink& l) { return std::array<int, 2>{l.i, l.j}; },
       [&](StretchBlock& b, int k, const DistanceLink& l) {
@@ -413,7 +417,7 @@ void refresh_constraints(GownModel& m) {
         b.wi[k] = w[l.i];
         b.wj[k] = w[l.j];
         b.inv_t[k] = inv_pos(w[l.i] + w[l.j] + at);
-        b.inv_c[k] = inv_pos(w[l.i] + w[l.j] + ac);
+        b.inv_c[k] = inv_pos(w[l.i] + w[l.j] + (in_hem(l.i) && in_hem(l.j) ? at : ac));
       },
       [](StretchBlock& b, int k) { b.i[k] = b.j[k] = -1; }, m.stretch_blocks, m.stretch_spans);
   const double as = m.alpha_shear * inv_h2;
@@ -433,15 +437,12 @@ void refresh_constraints(GownModel& m) {
       },
       [](ShearBlock& b, int k) { b.v[0][k] = b.v[1][k] = b.v[2][k] = -1; }, m.shear_blocks, m.shear_spans);
   const double ab = m.alpha_bend * inv_h2;
-  // The cuff (ClothParams::hem_width): a stencil whose hinge lies within it is hem_bend_ratio x stiffer.
-  auto in_hem = [&](const BendStencil& st) {
-    return m.hem_width > 0 && s.rim_distance[st.v[0]] <= m.hem_width && s.rim_distance[st.v[1]] <= m.hem_width;
-  };
+  // A stencil whose hinge lies within the cuff is hem_bend_ratio x stiffer.
   pack_blocks<BendBlock>(
       s.bend, s.bend_colours, s.grasped,
       [](const BendStencil& b) { return std::array<int, 4>{b.v[0], b.v[1], b.v[2], b.v[3]}; },
       [&](BendBlock& b, int k, const BendStencil& st) {
-        double denom = in_hem(st) ? ab / m.hem_bend_ratio : ab;
+        double denom = in_hem(st.v[0]) && in_hem(st.v[1]) ? ab / m.hem_bend_ratio : ab;
         for (int a = 0; a < 4; ++a) {
           b.v[a][k] = st.v[a];
           b.k[a][k] = st.k[a];

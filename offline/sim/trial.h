@@ -62,9 +62,11 @@ namespace dressguard::sim {
 // hem_width [m], hem_bend_ratio: the sleeve's cuff. A garment's opening is hemmed (the fabric
 // folded over twice and stitched: three layers, 3x to 27x the fabric's bending rigidity between
 // loose and bonded layers), so bending stencils whose hinge lies within hem_width of the sleeve
-// opening (rest distance) have hem_bend_ratio times the rigidity of `bend`. 0 and 1, the
-// defaults, are the paper's uniform cloth. A hem holds an opening of soft fabric open the way a
-// stiff `bend` holds the whole gown (offline/sim/README.md, "How stiff the gown is").
+// opening (rest distance) have hem_bend_ratio times the rigidity of `bend`, and its edges are not
+// softened in compression (SceneOptions::compression_softening stands for single fabric buckling
+// below the mesh's scale; stitched layers do not, and a softened cuff shrank its rim by 12-20 %).
+// 0 and 1, the defaults, are the paper's uniform cloth. A hem holds an opening of soft fabric
+// open the way a stiff `bend` holds the whole gown (offline/sim/README.md, "How stiff the gown is").
 struct ClothParams {
   double stretch = 0.8;
   double shear = 0.5;
