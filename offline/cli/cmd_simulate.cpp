@@ -157,13 +157,16 @@ int run_simulate(int argc, char** argv) {
                 "\"f_lateral\": %.6f, \"f_vertical\": %.6f, \"weight\": %.6f, \"area_ratio\": %.6f, "
                 "\"settle_s\": %.4f, \"settle_speed\": %.6f, \"settled\": %s, "
                 "\"bending_rigidity\": %.6g, \"bending_length\": %.6g, "
+                "\"opening\": {\"depth\": %.4f, \"height\": %.4f, \"width\": %.4f, \"centre_y\": %.4f, "
+                "\"perimeter_ratio\": %.4f, \"rim_low_above_fist\": %.4f}, "
                 "\"out\": \"%s\", \"params\": %s}",
                 std::string(outcome_name(r.outcome)).c_str(), hs.c_str(), r.arm_offset, spec.speed,
                 static_cast<unsigned long long>(spec.seed), spec.gown_noise ? "true" : "false", gs.c_str(), fr.c_str(),
                 r.travel, r.d_max, r.stopped_by_force ? "true" : "false", r.contact_travel, r.seq.samples.size(),
                 last.f_motion, last.f_lateral, last.f_vertical, r.weight, r.area_ratio, r.settle_time,
                 r.settle_speed, r.settled ? "true" : "false", rigidity, sim::bending_length(rigidity, params.areal_density),
-                out.c_str(),
+                r.opening.depth, r.opening.height, r.opening.width, r.opening.centre_y, r.opening.perimeter_ratio,
+                r.opening.rim_low_above_fist, out.c_str(),
                 sim::params_json(params).c_str());
   std::filesystem::path meta = out;
   meta.replace_extension(".json");
@@ -180,6 +183,10 @@ int run_simulate(int argc, char** argv) {
     std::printf("%s at %s arm (offset %+.3f m): travel %.3f m, d_max %.3f m, final F motion %.2f N vertical %.2f N -> %s\n",
                 std::string(outcome_name(r.outcome)).c_str(), hs.c_str(), r.arm_offset, r.travel, r.d_max,
                 last.f_motion, last.f_vertical, out.c_str());
+    std::printf("  opening at the start of the pull: %.1f cm below the jaws, %.1f cm tall, %.1f cm wide, centre y %+.1f cm,"
+                " rim %.0f %% of its rest length; its lowest point %+.1f cm from the fist's centre\n",
+                100 * r.opening.depth, 100 * r.opening.height, 100 * r.opening.width, 100 * r.opening.centre_y,
+                100 * r.opening.perimeter_ratio, 100 * r.opening.rim_low_above_fist);
   }
   return 0;
 }

@@ -106,6 +106,9 @@ std::string scene_json(const Scene& scene, const ClothParams& params, const Tria
     o << (k ? "," : "") << "{\"a\": [" << c.a.x << ',' << c.a.y << ',' << c.a.z + dz << "], \"ra\": " << c.ra
       << ", \"b\": [" << c.b.x << ',' << c.b.y << ',' << c.b.z + dz << "], \"rb\": " << c.rb << '}';
   }
+  // Each height's nominal arm axis (the scene's arm is at the high one), for the view from the fist.
+  o << "],\n\"arm_axis_z\": [";
+  for (int k = 0; k < 3; ++k) o << (k ? "," : "") << arm[0].a.z + sc.opt.arm.z_rel[k] - sc.opt.arm.z_rel[0];
   o << "],\n\"grip\": [" << sc.opt.grasp_point[0] << ',' << sc.opt.grasp_point[1] << ',' << sc.opt.grasp_point[2] << "],";
   o << "\"jaw_half\": [" << sc.opt.jaw_half[0] << ',' << sc.opt.jaw_half[1] << ',' << sc.opt.jaw_half[2] << "],";
   o << "\"grasped\": [";

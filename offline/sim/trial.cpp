@@ -80,6 +80,29 @@ double arm_dz_of(const SceneData& sc, const TrialSpec& spec, double arm_offset) 
   return sc.opt.arm.z_rel[hi] - sc.opt.arm.z_rel[0] + arm_offset;
 }
 
+OpeningShape opening_shape(const GownModel& m, const GownState& s) {
+  const SceneData& sc = *m.scene;
+  const size_t k = sc.opening.size();
+  const double grasp_z = sc.opt.grasp_point[2];
+  double zlo = s.x[sc.opening[0]].z, zhi = zlo, ylo = s.x[sc.opening[0]].y, yhi = ylo, ysum = 0, now = 0, rest = 0;
+  for (size_t a = 0; a < k; ++a) {
+    const int32_t v = sc.opening[a], u = sc.opening[(a + 1) % k];
+    zlo = std::min(zlo, s.x[v].z), zhi = std::max(zhi, s.x[v].z);
+    ylo = std::min(ylo, s.x[v].y), yhi = std::max(yhi, s.x[v].y);
+    ysum += s.x[v].y;
+    now += norm(s.x[u] - s.x[v]);
+    rest += norm(sc.rest[u] - sc.rest[v]);
+  }
+  OpeningShape o;
+  o.depth = grasp_z - zlo;
+  o.height = zhi - zlo;
+  o.width = yhi - ylo;
+  o.centre_y = ysum / k;
+  o.perimeter_ratio = rest > 0 ? now / rest : 0;
+  o.rim_low_above_fist = zlo - m.elbow.z;  // every arm sphere's centre lies at the elbow's height
+  return o;
+}
+
 // What the settling leaves for the pull besides the state and r's settle_* fields.
 struct Settled {
   V3 bias{0, 0, 0};             // the raw gripper force at rest (the sensor's bias)
@@ -189,6 +212,7 @@ Settled settle(GownModel& m, GownState& s, const TrialSpec& spec, const TrialDra
     zmean /= sc.opening.size();
     for (int v : sc.opening)
       if (s.x[v].z <= zmean) out.lower.push_back(v);
+    r.opening = opening_shape(m, s);
   }
   r.wall_settle = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count();
   return out;

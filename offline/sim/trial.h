@@ -162,6 +162,21 @@ struct Frame {
   std::vector<float> xyz;           // 3 per vertex, world frame
 };
 
+// The sleeve opening as it hangs at the start of the pull, after settling: what decides the
+// outcome before any force does. Heights are world z relative to the grasp point (the jaws);
+// the arm's axis lies at y = 0. The fist passes under a rim whose lowest point is above its top
+// (rim_low_above_fist > r_fist), meets the rim with its face when that point lies between its top
+// and its underside, and can enter when it is lower (offline/sim/README.md, "Where the simulator
+// catches"). Zero when the mesh has no opening.
+struct OpeningShape {
+  double depth = 0;               // [m] the lowest rim vertex below the grasp point
+  double height = 0;              // [m] the loop's vertical extent
+  double width = 0;               // [m] its lateral (y) extent
+  double centre_y = 0;            // [m] the mean y of its vertices
+  double perimeter_ratio = 0;     // its length now / at rest (the loop in order, ClothMesh::sleeve_opening)
+  double rim_low_above_fist = 0;  // [m] the lowest rim vertex above this trial's fist centre
+};
+
 struct TrialResult {
   double arm_offset = 0;            // [m] the arm offset used (spec.arm_offset plus the arm noise)
   HapticSequence seq;               // samples from the start of the pull; label set
@@ -177,6 +192,7 @@ struct TrialResult {
   double settle_time = 0;           // [s] their duration
   double settle_speed = 0;          // [m/s] RMS speed of the free vertices over the last 0.1 s of it
   bool settled = true;              // settle_speed reached the spec's limit (false: gave up at the cap)
+  OpeningShape opening;             // at the start of the pull
   double area_ratio = 1;            // final triangle area / rest area (explosion check)
   std::array<double, 3> arm_shift{};  // [m] the compliant arm's displacement at the stop (0: fixed arm)
   double arm_shift_max = 0;         // [m] its largest magnitude during the pull
@@ -208,7 +224,7 @@ struct ClothMesh {
   std::vector<std::array<double, 3>> x;       // [m] vertex positions
   std::vector<std::array<int, 3>> tris;
   std::vector<int> grasp;                     // vertices held by the gripper (may be empty: use the jaw box)
-  std::vector<int> sleeve_opening;            // the sleeve opening's boundary loop (labels, paper V-A)
+  std::vector<int> sleeve_opening;            // the sleeve opening's boundary loop, in order (labels, paper V-A)
   std::string name;
 };
 

@@ -37,6 +37,13 @@ endif()
 if(NOT out MATCHES "\"bending_rigidity\": 0\\.0[0-9]" OR NOT out MATCHES "\"bending_length\": 0\\.[0-2]")
   message(FATAL_ERROR "the summary lacks a plausible bending rigidity and length: ${out}")
 endif()
+# ... and where the sleeve opening hangs at the start of the pull (sim::OpeningShape): some
+# centimetres below the jaws, its rim within 50-110 % of its rest length, and its lowest point
+# above the low arm's fist centre (0.29 m below the jaws), which passes under it.
+if(NOT out MATCHES "\"opening\": {\"depth\": 0\.[0-2]" OR NOT out MATCHES "\"perimeter_ratio\": (0\.[5-9]|1\.0)"
+   OR NOT out MATCHES "\"rim_low_above_fist\": 0\.[0-9]")
+  message(FATAL_ERROR "the summary lacks a plausible opening: ${out}")
+endif()
 file(READ ${TMP}/short.scene.json scene)
 if(NOT scene MATCHES "\"contacts\": \\[")
   message(FATAL_ERROR "the scene file has no contacts list")

@@ -1,7 +1,9 @@
 #!/usr/bin/python3
 """Pictures of a simulated trial (dressguard simulate's FILE.scene.json): the gown, the arm and
 the gripper at the start of the pull, at first contact with the arm, and at the end; three 3-D
-panels and a side view. Usage: sim_scene.py SCENE.json OUT.png"""
+panels and a side view; and the sleeve opening seen from the fist at the start and at contact,
+with the fist at each of the three arm heights (where the rim hangs decides the outcome before
+any force does). Usage: sim_scene.py SCENE.json OUT.png"""
 import json
 import sys
 
@@ -93,6 +95,31 @@ def side(ax, sc, frame):
     ax.set_ylabel("z [m]")
 
 
+def from_fist(ax, sc, frame, title):
+    """The gown near the opening seen from the fist (y-z, looking along -x): the cloth within
+    0.25 m behind the opening's front, the opening in red, this trial's fist solid and the three
+    heights' nominal fists dashed."""
+    X = np.array(frame["x"]).reshape(-1, 3)
+    op = np.array(sc["opening"], dtype=int)
+    front = X[op, 0].max() if len(op) else X[:, 0].max()
+    near = (X[:, 0] > front - 0.25) & (X[:, 0] <= front + 0.01)
+    ax.scatter(X[near, 1], X[near, 2], s=1, c=X[near, 0], cmap="Blues", vmin=front - 0.3, vmax=front)
+    if len(op):
+        loop = np.r_[op, op[:1]]
+        ax.plot(X[loop, 1], X[loop, 2], ".-", color="red", markersize=3, linewidth=0.8)
+    fist = sc["arm"][1]  # the fist's sphere (offline/sim: elbow, fist, ...)
+    ax.add_patch(plt.Circle((fist["a"][1], fist["a"][2]), fist["ra"], fill=False, color="peru", linewidth=2))
+    for z, name in zip(sc.get("arm_axis_z", []), ("high", "middle", "low")):
+        ax.add_patch(plt.Circle((0, z), fist["ra"], fill=False, color="gray", linestyle="--", linewidth=0.8))
+        ax.text(fist["ra"] + 0.01, z, name, fontsize=7, color="gray", va="center")
+    ax.set_aspect("equal")
+    ax.set_xlim(-0.3, 0.3)
+    ax.set_ylim(-0.4, 0.3)
+    ax.set_xlabel("y (lateral) [m]")
+    ax.set_ylabel("z [m]")
+    ax.set_title(title, fontsize=9)
+
+
 def main():
     if len(sys.argv) != 3:
         sys.exit(__doc__)
@@ -111,11 +138,13 @@ def main():
     else:
         contact = later[len(later) // 2] if later else start
     end = frames[-1]
-    fig = plt.figure(figsize=(16, 10))
+    fig = plt.figure(figsize=(21, 10))
     for k, (f, name) in enumerate([(start, "start of the pull"), (contact, "contact"), (end, "end")]):
-        ax = fig.add_subplot(2, 3, k + 1, projection="3d")
+        ax = fig.add_subplot(2, 4, k + 1, projection="3d")
         draw(ax, sc, f, f"{name}: t = {f['t']:.2f} s, travel = {f['travel']:.3f} m")
-        side(fig.add_subplot(2, 3, k + 4), sc, f)
+        side(fig.add_subplot(2, 4, k + 5), sc, f)
+    from_fist(fig.add_subplot(2, 4, 4), sc, start, "from the fist: start of the pull")
+    from_fist(fig.add_subplot(2, 4, 8), sc, contact, f"from the fist: travel {contact['travel']:.3f} m")
     fig.suptitle(f"simulated trial, {sc['height']} arm (offset {sc['arm_offset']:+.3f} m): "
                  f"{sc['label']}, travel {sc['travel']:.3f} m, d_max {sc['d_max']:.3f} m")
     fig.tight_layout()
