@@ -64,7 +64,7 @@ namespace dressguard::sim {
 // loose and bonded layers), so bending stencils whose hinge lies within hem_width of the sleeve
 // opening (rest distance) have hem_bend_ratio times the rigidity of `bend`, and its edges are not
 // softened in compression (SceneOptions::compression_softening stands for single fabric buckling
-// below the mesh's scale; stitched layers do not, and a softened cuff shrank its rim by 12-20 %).
+// below the mesh's scale; stitched layers do not, and a softened cuff shrank its rim by 9-22 %).
 // 0 and 1, the defaults, are the paper's uniform cloth. A hem holds an opening of soft fabric
 // open the way a stiff `bend` holds the whole gown (offline/sim/README.md, "How stiff the gown is").
 struct ClothParams {
@@ -166,8 +166,8 @@ struct Frame {
 // outcome before any force does. Heights are world z relative to the grasp point (the jaws);
 // the arm's axis lies at y = 0. The fist passes under a rim whose lowest point is above its top
 // (rim_low_above_fist > r_fist), meets the rim with its face when that point lies between its top
-// and its underside, and can enter when it is lower (offline/sim/README.md, "Where the simulator
-// catches"). Zero when the mesh has no opening.
+// and its underside, and can enter when it is lower (offline/sim/README.md, "Where the opening
+// must hang"). Zero when the mesh has no opening.
 struct OpeningShape {
   double depth = 0;               // [m] the lowest rim vertex below the grasp point
   double height = 0;              // [m] the loop's vertical extent
