@@ -296,6 +296,37 @@ TEST(SimTrial, HangingGownWeightOnTheGripper) {
   EXPECT_NEAR(std::hypot(r.bias[0], r.bias[1]), 0.0, 0.01 * r.weight);
 }
 
+// Where the opening hangs (TrialResult::opening) is measured once the gown has settled, from this
+// trial's own fist: with the arm far below the gown (it settles alike at both heights) the
+// opening is the same, its rim keeps its length within 10 % (the default cloth), and its lowest
+// point's height above the fist centre differs between the high and low arm by exactly their
+// heights' difference: depth + rim_low_above_fist = -(z_rel + arm offset), the fist's depth below
+// the jaws.
+TEST(SimTrial, OpeningIsMeasuredFromTheTrialsFist) {
+  const SceneOptions& opt = coarse_scene().data().opt;
+  TrialResult r[2];
+  const ArmHeight heights[2] = {ArmHeight::High, ArmHeight::Low};
+  for (int k = 0; k < 2; ++k) {
+    TrialSpec spec;
+    spec.height = heights[k];
+    spec.max_travel = 1e-4;
+    spec.arm_offset = -2.0;
+    r[k] = simulate_trial(coarse_scene(), ClothParams{}, spec);
+    const double fist_below_jaws = -(opt.arm.z_rel[static_cast<int>(heights[k])] + spec.arm_offset);
+    EXPECT_NEAR(r[k].opening.depth + r[k].opening.rim_low_above_fist, fist_below_jaws, 1e-9);
+    EXPECT_GT(r[k].opening.depth, 0.05);
+    EXPECT_LT(r[k].opening.depth, 0.3);
+    EXPECT_NEAR(r[k].opening.perimeter_ratio, 1.0, 0.1);
+    EXPECT_GT(r[k].opening.width, 0.05);
+  }
+  std::printf("coarse gown, default cloth: opening %.1f cm below the jaws, %.1f x %.1f cm, rim %.0f %%\n",
+              100 * r[0].opening.depth, 100 * r[0].opening.height, 100 * r[0].opening.width,
+              100 * r[0].opening.perimeter_ratio);
+  EXPECT_EQ(r[0].opening.depth, r[1].opening.depth);
+  EXPECT_NEAR(r[0].opening.rim_low_above_fist - r[1].opening.rim_low_above_fist, opt.arm.z_rel[2] - opt.arm.z_rel[0],
+              1e-9);
+}
+
 // Paper V-A: after the perturbation the robot waits for the gown to settle before it pulls. With
 // the push (two seeds) the gown is at rest when the pull starts (RMS vertex speed <= 5 mm/s, the
 // settling's criterion) and, on the low arm that it does not touch in the first 3 cm, the first
