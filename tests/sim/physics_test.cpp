@@ -307,6 +307,16 @@ struct Cantilever {
   double h, free_length;
 };
 
+// A scene without an arm whose grasped vertices are held where the mesh places them (no jaws
+// closing): the cantilever's clamp and the cuff's hanging point.
+Scene held_as_placed(const ClothMesh& mesh) {
+  SceneOptions opt;
+  opt.with_arm = false;
+  opt.require_grasp = false;
+  opt.jaw_close_steps = 0;
+  return make_scene(mesh, opt);
+}
+
 Cantilever make_cantilever(int elements, double h) {
   const int nu = elements + 1, nv = 3;
   ClothMesh mesh = grid_patch({0, 0, 0}, {elements * h, 0, 0}, {0, 2 * h, 0}, nu, nv);
@@ -317,11 +327,7 @@ Cantilever make_cantilever(int elements, double h) {
     c.tip.push_back(iv * nu + nu - 1);
   }
   mesh.sleeve_opening = c.tip;  // the free end stands for an opening (the hem test)
-  SceneOptions opt;
-  opt.with_arm = false;
-  opt.require_grasp = false;
-  opt.jaw_close_steps = 0;
-  c.scene = make_scene(mesh, opt);
+  c.scene = held_as_placed(mesh);
   c.h = h;
   c.free_length = (elements - 1) * h;  // from the second clamped column
   return c;
@@ -412,11 +418,7 @@ Cuff hang_cuff(const ClothParams& cuff) {
   const int top = kAround / 4;  // angle pi/2 from +y toward +z: the ring's highest vertex
   mesh.grasp = {top, kAround + top};
   for (int iu = 0; iu < kAround; ++iu) mesh.sleeve_opening.push_back(kAround + iu);  // the ring at x = 0
-  SceneOptions opt;
-  opt.with_arm = false;
-  opt.require_grasp = false;
-  opt.jaw_close_steps = 0;
-  const Scene scene = make_scene(mesh, opt);
+  const Scene scene = held_as_placed(mesh);
   ClothParams p = cuff;
   p.stretch = 0.34;
   p.shear = 0.42;
