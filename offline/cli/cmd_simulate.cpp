@@ -33,6 +33,20 @@ std::vector<double> parse_times(const std::string& s) {
   return out;
 }
 
+// The default scene, with the jaws where --grip-depth / --rim-ahead put them. A grip that leaves
+// the jaws off the sleeve's top (the rim too far ahead of them, say) grasps nothing; that is the
+// options' fault, so it is reported as a usage error that names them.
+sim::Scene scene_with_grip(sim::GownResolution res, bool parametric, const std::optional<gown::OpeningGrip>& grip) {
+  if (!grip) return sim::make_default_scene(res, parametric);
+  try {
+    return sim::make_default_scene(res, parametric, *grip);
+  } catch (const std::invalid_argument& e) {
+    char b[160];
+    std::snprintf(b, sizeof b, "--grip-depth %g --rim-ahead %g: ", grip->depth, grip->rim_ahead);
+    throw UsageError(b + std::string(e.what()));
+  }
+}
+
 // Per sample: t, travel, and the cloth's force on each arm part (sim::ArmPartLoads).
 std::string arm_parts_csv(const sim::Scene& scene, const sim::TrialResult& r) {
   const std::vector<std::string> names = sim::arm_part_names(scene);
@@ -140,8 +154,7 @@ int run_simulate(int argc, char** argv) {
 
   const bool parametric = args.has("parametric") || gown::measured_gown_path().empty();
   const auto grip = grip_option(args, parametric);
-  const sim::Scene scene =
-      grip ? sim::make_default_scene(res, parametric, *grip) : sim::make_default_scene(res, parametric);
+  const sim::Scene scene = scene_with_grip(res, parametric, grip);
   const sim::TrialResult r = sim::simulate_trial(scene, params, spec);
   if (!r.finite) throw std::runtime_error("the simulation diverged (non-finite positions)");
 

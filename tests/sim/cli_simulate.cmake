@@ -62,6 +62,14 @@ execute_process(COMMAND ${DG} simulate --height high --gown coarse --grip-depth 
 if(NOT rc EQUAL 2 OR NOT err MATCHES "--grip-depth" OR EXISTS ${TMP}/dg_grip_never.csv)
   message(FATAL_ERROR "bad --grip-depth: expected exit 2 naming it and no file, got rc=${rc}: ${err}")
 endif()
+# A grip within the options' ranges that leaves the jaws off the sleeve's top (the rim 0.5 m ahead
+# of them: past the sleeve's end on every gown) grasps nothing: a usage error naming both options.
+execute_process(COMMAND ${DG} simulate --height high --gown coarse --rim-ahead 0.5 --out ${TMP}/dg_grip_off.csv
+                RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "--rim-ahead 0.5" OR NOT err MATCHES "--grip-depth" OR NOT err MATCHES "jaws"
+   OR EXISTS ${TMP}/dg_grip_off.csv)
+  message(FATAL_ERROR "jaws off the sleeve: expected exit 2 naming the grip options and no file, got rc=${rc}: ${err}")
+endif()
 
 # --calibration: participant 4's cloth and person parameters, and its low arm's offset (+1.105 cm)
 # added to --arm-offset.
