@@ -35,11 +35,20 @@ void set_cloth_value(ClothValues& c, int i, double v) {
   }
 }
 
-double person_value(const ClothValues& c, int i) { return i == kArmCompliance ? c.arm_compliance : c.fist_shift; }
+double person_value(const ClothValues& c, int i) {
+  switch (i) {
+    case kArmCompliance: return c.arm_compliance;
+    case kFistShift: return c.fist_shift;
+    default: return c.rim_shift;
+  }
+}
 
 void set_person_value(ClothValues& c, int i, double v) {
-  if (i == kArmCompliance) c.arm_compliance = v;
-  else c.fist_shift = v;
+  switch (i) {
+    case kArmCompliance: c.arm_compliance = v; break;
+    case kFistShift: c.fist_shift = v; break;
+    default: c.rim_shift = v; break;
+  }
 }
 
 Bounds default_bounds() {
@@ -58,6 +67,7 @@ Bounds default_bounds() {
   b.arm_offset = {-0.06, 0.06, 0.0};
   b.person[kArmCompliance] = {0.0, 0.01, 0.004};
   b.person[kFistShift] = {-0.05, 0.15, 0.0};
+  b.person[kRimShift] = {-0.04, 0.04, 0.0};
   return b;
 }
 
@@ -94,7 +104,7 @@ Bounds read_bounds(const std::filesystem::path& path) {
     if (!target)
       throw_input_error(path, n,
                         "unknown parameter '" + name +
-                            "' (expected stretch, shear, bend, friction, self_friction, arm_offset, arm_compliance or fist_shift)");
+                            "' (expected stretch, shear, bend, friction, self_friction, arm_offset, arm_compliance, fist_shift or rim_shift)");
     *target = pb;
   }
   return b;

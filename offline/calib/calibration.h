@@ -47,6 +47,10 @@ struct ClothValues {
   // 0 and 1 are the paper's uniform cloth.
   double hem_width = 0.0;
   double hem_bend_ratio = 1.0;
+  // How the robot holds the gown (kRimShift below; 0 is the gown's placement): [m] how much
+  // further ahead of the jaws the sleeve opening's rim is than offline/gown/placement.h puts it
+  // (kOpeningRimAhead, 4 cm on the measured gown). The study did not measure it.
+  double rim_shift = 0.0;
 };
 inline constexpr int kClothParams = 5;
 // A cuff's limits (sim/params.cpp checks the same): width in [0, 0.2] m, ratio in [1, 1e4].
@@ -59,8 +63,9 @@ inline constexpr std::array<const char*, kClothParams> kClothParamNames = {"stre
 double cloth_value(const ClothValues& c, int i);
 void set_cloth_value(ClothValues& c, int i, double v);
 
-// Parameters of the person's arm rather than the cloth's, each fitted within its bounds or held
-// at a value (ParameterSpace::person); none is among the paper's five, and 0 is the paper's arm.
+// Parameters of the person's arm and of the robot's grasp rather than the cloth's, each fitted
+// within its bounds or held at a value (ParameterSpace::person); none is among the paper's five,
+// and 0 is the paper's arm and the gown's own placement.
 // `lowest`/`highest` bound every box and held value (the simulator's own limits); `range` says so
 // in an error message.
 struct PersonParamInfo {
@@ -68,12 +73,14 @@ struct PersonParamInfo {
   double lowest, highest;
   const char* range;
 };
-inline constexpr int kPersonParams = 2;
+inline constexpr int kPersonParams = 3;
 inline constexpr int kArmCompliance = 0;  // [m/N] sim/arm_spring.h
 inline constexpr int kFistShift = 1;      // [m] sim/trial.h ClothParams::fist_shift
+inline constexpr int kRimShift = 2;       // [m] ClothValues::rim_shift (the grasp, sim_bridge.h)
 inline constexpr std::array<PersonParamInfo, kPersonParams> kPersonParamInfo = {{
     {"arm_compliance", 0.0, 1.0, "cannot be negative (0 is a fixed arm) nor above 1 m/N"},
     {"fist_shift", -0.2, 0.2, "must be within +-0.2 m (the forearm is 0.31 m)"},
+    {"rim_shift", -0.04, 0.06, "must be within -0.04 and +0.06 m (the rim 0 to 10 cm ahead of the jaws)"},
 }};
 double person_value(const ClothValues& c, int i);
 void set_person_value(ClothValues& c, int i, double v);
@@ -122,7 +129,9 @@ struct Bounds {
 // calibrated offset for participant 4 was -0.02 m; arm compliance in [0, 0.01] m/N (start
 // 0.004): a stiffness of 100 N/m and up, the hand's postural stiffness being about 300-800 N/m
 // (sim/arm_spring.h) and a held-out forearm softer; fist shift in [-0.05, 0.15] m (start 0, the
-// paper's arm): a fist-to-elbow length of 0.16-0.36 m.
+// paper's arm): a fist-to-elbow length of 0.16-0.36 m; rim shift in [-0.04, 0.04] m (start 0):
+// the measured gown's rim held 0 to 8 cm ahead of the jaws (beyond 8 cm the jaws' 8 cm run off
+// the reduced gown's sleeve top).
 Bounds default_bounds();
 // Bounds file: one "name lower upper [initial]" per line, '#' starts a comment, names as in
 // kClothParamNames plus "arm_offset" and kPersonParamInfo's; unnamed parameters keep their

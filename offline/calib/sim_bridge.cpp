@@ -1,9 +1,15 @@
 // dg_sim behind the calibration's TrialSimulator, see sim_bridge.h.
 #include "sim_bridge.h"
 
+#include <cstdio>
 #include <memory>
+#include <mutex>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
+#include "gown.h"
+#include "gown_scene.h"
 #include "model.h"
 #include "synthesis.h"
 #include "trial.h"
@@ -59,7 +65,54 @@ SimulatedTrial simulated(sim::TrialResult&& res) {
   return out;
 }
 
+// The scenes of one gown resolution by rim_shift: the gown's own placement (0) always, and the
+// last kKept others. A calibration asks for a new rim_shift with every candidate, synthesis for
+// one over and over; keeping a few serves both without holding a scene per candidate.
+class SceneCache {
+ public:
+  explicit SceneCache(sim::GownResolution res)
+      : res_(res), parametric_(gown::measured_gown_path().empty()),
+        own_(std::make_shared<const sim::Scene>(sim::make_default_scene(res))) {}
+
+  std::shared_ptr<const sim::Scene> own() const { return own_; }
+
+  std::shared_ptr<const sim::Scene> get(double rim_shift) {
+    if (rim_shift == 0.0) return own_;
+    const std::optional<gown::OpeningGrip> grip = grasp_of(rim_shift, parametric_);
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& [shift, scene] : kept_)
+      if (shift == rim_shift) return scene;
+    // Built under the lock: a thread that wants another grasp waits about 0.3 s, once per
+    // candidate, against the candidate's seconds of simulation.
+    auto scene = std::make_shared<const sim::Scene>(sim::make_default_scene(res_, parametric_, *grip));
+    if (kept_.size() == kKept) kept_.erase(kept_.begin());
+    kept_.emplace_back(rim_shift, scene);
+    return scene;
+  }
+
+ private:
+  static constexpr std::size_t kKept = 4;
+  sim::GownResolution res_;
+  bool parametric_;
+  std::shared_ptr<const sim::Scene> own_;
+  std::mutex mutex_;
+  std::vector<std::pair<double, std::shared_ptr<const sim::Scene>>> kept_;
+};
+
 }  // namespace
+
+std::optional<gown::OpeningGrip> grasp_of(double rim_shift, bool parametric) {
+  if (rim_shift == 0.0) return std::nullopt;
+  gown::OpeningGrip g = parametric ? gown::kParametricGrip : gown::OpeningGrip{};
+  g.rim_ahead += rim_shift;
+  if (!(g.rim_ahead >= 0.0)) {
+    char b[200];
+    std::snprintf(b, sizeof b, "rim_shift %g m puts the sleeve opening's rim %g m behind the jaws (this gown's is held %g m ahead)",
+                  rim_shift, -g.rim_ahead, g.rim_ahead - rim_shift);
+    throw std::invalid_argument(b);
+  }
+  return g;
+}
 
 ClothSimulator make_cloth_simulator(const std::string& gown) {
   sim::GownResolution res;
@@ -67,20 +120,21 @@ ClothSimulator make_cloth_simulator(const std::string& gown) {
   else if (gown == "reduced") res = sim::GownResolution::Reduced;
   else if (gown == "coarse") res = sim::GownResolution::Coarse;
   else throw std::invalid_argument("unknown gown '" + gown + "' (expected full, reduced or coarse)");
-  auto scene = std::make_shared<const sim::Scene>(sim::make_default_scene(res));
+  auto scenes = std::make_shared<SceneCache>(res);
   ClothSimulator cs;
-  cs.trial = [scene](const ClothValues& c, const TrialRequest& r) {
-    return simulated(sim::simulate_trial(*scene, cloth_params_of(c), spec_of(r)));
+  cs.trial = [scenes](const ClothValues& c, const TrialRequest& r) {
+    return simulated(sim::simulate_trial(*scenes->get(c.rim_shift), cloth_params_of(c), spec_of(r)));
   };
-  cs.trials = [scene](const ClothValues& c, const std::vector<TrialRequest>& rs) {
+  cs.trials = [scenes](const ClothValues& c, const std::vector<TrialRequest>& rs) {
     std::vector<sim::TrialSpec> specs;
     for (const TrialRequest& r : rs) specs.push_back(spec_of(r));
-    std::vector<sim::TrialResult> res = sim::simulate_trials(*scene, cloth_params_of(c), specs);
+    std::vector<sim::TrialResult> res = sim::simulate_trials(*scenes->get(c.rim_shift), cloth_params_of(c), specs);
     std::vector<SimulatedTrial> out;
     for (sim::TrialResult& r : res) out.push_back(simulated(std::move(r)));
     return out;
   };
-  const double factor = sim::bend_mesh_factor(scene->data());
+  // The bending length is the mesh's: a grasp moves the gown, it does not change its triangles.
+  const double factor = sim::bend_mesh_factor(scenes->own()->data());
   const double density = sim::ClothParams{}.areal_density;
   cs.bending_length = [factor, density](double bend) {
     return sim::bending_length(sim::bending_rigidity(bend, factor), density);

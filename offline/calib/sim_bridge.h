@@ -3,15 +3,19 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "calibration.h"
+#include "placement.h"
 #include "trial.h"
 
 namespace dressguard::calib {
 
-// The cloth simulator in both forms, over one Scene (constant model) built once and shared by
-// every call; sim::simulate_trial() and simulate_trials() keep their mutable state per call, so
+// The cloth simulator in both forms, over one Scene (constant model) per grasp: the gown's own
+// placement built once, and a cloth whose rim_shift moves the rim (ClothValues) on a scene of
+// that grasp, built when first asked for (about 0.3 s for the reduced gown) and kept among the
+// last few; sim::simulate_trial() and simulate_trials() keep their mutable state per call, so
 // both functions may run on any number of threads. `trials` settles a cloth once for all its
 // arm heights where that is exact (sim::simulate_trials) and gives the same bits as `trial`.
 struct ClothSimulator {
@@ -27,8 +31,15 @@ struct ClothSimulator {
 ClothSimulator make_cloth_simulator(const std::string& gown);
 
 // The simulator's parameters for a calibration's cloth and person values (damping and areal
-// density keep the simulator's defaults: not calibrated, paper IV-B.2).
+// density keep the simulator's defaults: not calibrated, paper IV-B.2). rim_shift is the scene's
+// (grasp_of), not a ClothParams field.
 sim::ClothParams cloth_params_of(const ClothValues& c);
+
+// How the jaws hold the gown for a rim_shift: nullopt for 0 (the gown's own placement, the
+// scene make_default_scene(res) builds), else the default grasp of the gown in use (measured:
+// gown::OpeningGrip{}; parametric: gown::kParametricGrip) with its rim `rim_shift` further ahead.
+// Throws std::invalid_argument when that puts the rim behind the jaws.
+std::optional<gown::OpeningGrip> grasp_of(double rim_shift, bool parametric);
 
 // True (this file is only compiled with dg_sim); lets tests ask without the macro.
 bool cloth_simulator_available();

@@ -50,6 +50,10 @@ int run_calibrate(int argc, char** argv) {
         "  --fist-shift fit|fixed|M   the person's fist: fit how far it sits beyond the paper's\n"
         "                      toward the elbow (one more parameter; the elbow stays), hold it at the\n"
         "                      paper's (the default) or at M metres\n"
+        "  --rim-shift fit|fixed|M   the robot's grasp: fit how much further ahead of the jaws\n"
+        "                      the sleeve opening's rim hangs than the gown's placement puts it\n"
+        "                      (4 cm on the measured gown; one more parameter, in [-0.04, 0.04] m by\n"
+        "                      default), hold it there (the default) or shift it by M metres\n"
         "  --hem W,R           the gown's cuff: bending R x stiffer within W metres of the sleeve\n"
         "                      opening (held, not fitted; recorded in CAL.json, so synthesis uses\n"
         "                      it too; offline/sim/README.md, \"How stiff the gown is\"). Default none\n"
@@ -64,7 +68,7 @@ int run_calibrate(int argc, char** argv) {
   }
   args.allow_only({"help", "json", "no-arm-offset", "data", "participant", "profile", "bounds", "seed", "out",
                    "checkpoint", "objective", "gown", "threads", "generations", "population",
-                   "stop-after-generations", "arm-compliance", "fist-shift", "sigma0", "hem"});
+                   "stop-after-generations", "arm-compliance", "fist-shift", "rim-shift", "sigma0", "hem"});
   const std::string data = args.require("data");
   const std::string participant = args.require("participant");
   const std::string out = args.require("out");
@@ -97,6 +101,8 @@ int run_calibrate(int argc, char** argv) {
     throw UsageError("--arm-compliance must be fit, fixed or a compliance in [0, 1] m/N, not '" + *arm + "'");
   if (const auto fist = args.get("fist-shift"); fist && !set_person_param(space, kFistShift, *fist))
     throw UsageError("--fist-shift must be fit, fixed or a shift in [-0.2, 0.2] m, not '" + *fist + "'");
+  if (const auto rim = args.get("rim-shift"); rim && !set_person_param(space, kRimShift, *rim))
+    throw UsageError("--rim-shift must be fit, fixed or a shift in [-0.04, 0.06] m, not '" + *rim + "'");
   if (const auto hem = args.get("hem")) {
     double w = 0, r = 0;
     char tail = 0;

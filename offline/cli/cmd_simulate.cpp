@@ -153,7 +153,9 @@ int run_simulate(int argc, char** argv) {
   }
 
   const bool parametric = args.has("parametric") || gown::measured_gown_path().empty();
-  const auto grip = grip_option(args, parametric);
+  // A calibration's grasp (its rim_shift) is the default that --grip-depth / --rim-ahead change.
+  const auto grip = grip_option(args, parametric, cal ? calib::grasp_of(cal->cloth.rim_shift, parametric) : std::nullopt);
+  const gown::OpeningGrip held = grip ? *grip : parametric ? gown::kParametricGrip : gown::OpeningGrip{};
   const sim::Scene scene = scene_with_grip(res, parametric, grip);
   const sim::TrialResult r = sim::simulate_trial(scene, params, spec);
   if (!r.finite) throw std::runtime_error("the simulation diverged (non-finite positions)");
@@ -172,6 +174,7 @@ int run_simulate(int argc, char** argv) {
                 "\"bending_rigidity\": %.6g, \"bending_length\": %.6g, "
                 "\"opening\": {\"depth\": %.4f, \"height\": %.4f, \"width\": %.4f, \"centre_y\": %.4f, "
                 "\"perimeter_ratio\": %.4f, \"rim_low_above_fist\": %.4f}, "
+                "\"grip\": {\"depth\": %.6g, \"rim_ahead\": %.6g}, "
                 "\"out\": \"%s\", \"params\": %s}",
                 std::string(outcome_name(r.outcome)).c_str(), hs.c_str(), r.arm_offset, spec.speed,
                 static_cast<unsigned long long>(spec.seed), spec.gown_noise ? "true" : "false", gs.c_str(), fr.c_str(),
@@ -179,7 +182,7 @@ int run_simulate(int argc, char** argv) {
                 last.f_motion, last.f_lateral, last.f_vertical, r.weight, r.area_ratio, r.settle_time,
                 r.settle_speed, r.settled ? "true" : "false", rigidity, sim::bending_length(rigidity, params.areal_density),
                 r.opening.depth, r.opening.height, r.opening.width, r.opening.centre_y, r.opening.perimeter_ratio,
-                r.opening.rim_low_above_fist, out.c_str(),
+                r.opening.rim_low_above_fist, held.depth, held.rim_ahead, out.c_str(),
                 sim::params_json(params).c_str());
   std::filesystem::path meta = out;
   meta.replace_extension(".json");

@@ -14,10 +14,12 @@ inline constexpr const char* kGripHelp =
     "                    wider and shallower (offline/gown/placement.h, OpeningGrip)\n"
     "  --rim-ahead M     [m] the opening's rim ahead of the jaws (default 0.04; parametric 0.01)\n";
 
-// The grip the options ask for, starting from the gown's own; nullopt when neither is given.
-inline std::optional<gown::OpeningGrip> grip_option(const Args& args, bool parametric_gown) {
-  if (!args.has("grip-depth") && !args.has("rim-ahead")) return std::nullopt;
-  gown::OpeningGrip g = parametric_gown ? gown::kParametricGrip : gown::OpeningGrip{};
+// The grip the options ask for, starting from `base` (a calibration's grasp) or else the gown's
+// own; nullopt when neither option is given and there is no base.
+inline std::optional<gown::OpeningGrip> grip_option(const Args& args, bool parametric_gown,
+                                                    std::optional<gown::OpeningGrip> base = std::nullopt) {
+  if (!args.has("grip-depth") && !args.has("rim-ahead")) return base;
+  gown::OpeningGrip g = base ? *base : parametric_gown ? gown::kParametricGrip : gown::OpeningGrip{};
   g.depth = args.number("grip-depth", g.depth);
   g.rim_ahead = args.number("rim-ahead", g.rim_ahead);
   if (!(g.depth > 0 && g.depth < 0.15)) throw UsageError("--grip-depth must be in (0, 0.15) m, the grasp box's depth");

@@ -147,6 +147,10 @@ TEST(Calibration, RecoversTheArmComplianceOfTheStandIn) { recovers_person_param(
 // fist is, which no cloth parameter can move.
 TEST(Calibration, RecoversTheFistShiftOfTheStandIn) { recovers_person_param(kFistShift, 0.06, 0.005); }
 
+// The rim held 3.5 cm further ahead of the jaws, found within 5 mm: in the stand-in the rim meets
+// the fist that much earlier (a bump of drag), which no cloth parameter can move.
+TEST(Calibration, RecoversTheRimShiftOfTheStandIn) { recovers_person_param(kRimShift, 0.035, 0.005); }
+
 TEST(Calibration, PersonParameterWords) {
   ParameterSpace s;
   EXPECT_TRUE(set_person_param(s, kArmCompliance, "fit"));
@@ -163,6 +167,11 @@ TEST(Calibration, PersonParameterWords) {
   for (const char* bad : {"", "soft", "-0.001", "2", "0.003x", "nan"})
     EXPECT_FALSE(set_person_param(s, kArmCompliance, bad)) << bad;
   for (const char* bad : {"0.21", "-0.3", "inf", "4cm"}) EXPECT_FALSE(set_person_param(s, kFistShift, bad)) << bad;
+  // The rim: held at a shift, or refused beyond the gown's sleeve (-0.04 puts it at the jaws).
+  EXPECT_TRUE(set_person_param(s, kRimShift, "0.02"));
+  EXPECT_EQ(s.cloth(u).rim_shift, 0.02);
+  for (const char* bad : {"-0.05", "0.07", "nan"}) EXPECT_FALSE(set_person_param(s, kRimShift, bad)) << bad;
+  EXPECT_TRUE(set_person_param(s, kRimShift, "fixed"));
   // Fitted: after the cloth and offsets, in kPersonParamInfo order, each spanning its box.
   s.bounds = default_bounds();
   ASSERT_TRUE(set_person_param(s, kArmCompliance, "fit"));
@@ -247,12 +256,14 @@ TEST(Calibration, BoundsFileParsesAndNamesBadLines) {
   const fs::path dir = temp_dir("bounds");
   const fs::path ok = dir / "ok.txt";
   write_file_atomic(ok, "# cloth box\nfriction 0.1 1.5 0.6\n\narm_offset -0.03 0.03\narm_compliance 0 0.02 0.005\n"
-                        "fist_shift 0 0.12 0.04\n");
+                        "fist_shift 0 0.12 0.04\nrim_shift -0.02 0.03 0.01\n");
   const Bounds b = read_bounds(ok);
   EXPECT_EQ(b.person[kArmCompliance].upper, 0.02);
   EXPECT_EQ(b.person[kArmCompliance].initial, 0.005);
   EXPECT_EQ(b.person[kFistShift].upper, 0.12);
   EXPECT_EQ(b.person[kFistShift].initial, 0.04);
+  EXPECT_EQ(b.person[kRimShift].lower, -0.02);
+  EXPECT_EQ(b.person[kRimShift].initial, 0.01);
   EXPECT_EQ(b.cloth[3].lower, 0.1);
   EXPECT_EQ(b.cloth[3].upper, 1.5);
   EXPECT_EQ(b.cloth[3].initial, 0.6);
@@ -274,6 +285,7 @@ TEST(Calibration, BoundsFileParsesAndNamesBadLines) {
   EXPECT_NE(error_of("arm_compliance -0.01 0.01\n").find("bad.txt:1: arm_compliance cannot be negative"),
             std::string::npos);
   EXPECT_NE(error_of("stretch 0 1\nfist_shift 0 0.3\n").find("bad.txt:2: fist_shift must be within"), std::string::npos);
+  EXPECT_NE(error_of("rim_shift -0.05 0.03\n").find("bad.txt:1: rim_shift must be within"), std::string::npos);
   fs::remove_all(dir);
 }
 
@@ -317,6 +329,11 @@ TEST(Calibration, CalibrationFileRoundTripAndErrors) {
   c.cloth.fist_shift = 0.075;
   write_calibration(dir / "cal_fist.json", c);
   EXPECT_EQ(read_calibration(dir / "cal_fist.json").cloth.fist_shift, 0.075);
+  EXPECT_EQ(read_file(dir / "cal_fist.json").find("rim_shift"), std::string::npos);  // the gown's own grasp
+  c.cloth.rim_shift = -0.015;
+  write_calibration(dir / "cal_rim.json", c);
+  EXPECT_EQ(read_calibration(dir / "cal_rim.json").cloth.rim_shift, -0.015);
+  c.cloth.rim_shift = 0.0;
   // The cuff: absent is none (the paper's uniform cloth); present, it reads back; out of range names the file.
   EXPECT_EQ(read_file(dir / "cal_fist.json").find("hem_"), std::string::npos);
   EXPECT_EQ(d.cloth.hem_width, 0.0);

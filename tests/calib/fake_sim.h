@@ -5,7 +5,9 @@
 // stretch, with a bump set by shear; the vertical force's slope depends on the arm height and its
 // offset (bend and self-friction shift it); a compliant arm (arm_compliance) gives way, so the
 // drag grows over a longer travel; a fist further along the arm (fist_shift) starts the drag that
-// much later; the pull stops at 10 N or 0.85 m like the rig. Every
+// much later; the rim meets the fist at 0.15 m of travel plus fist_shift minus rim_shift (the
+// rim held further ahead of the jaws meets it earlier), a 0.5 N bump of drag there; the pull
+// stops at 10 N or 0.85 m like the rig. Every
 // parameter changes the curves, so a calibration against curves made at known parameters must
 // find a near-zero objective. The gown noise adds a seeded, smooth disturbance. Deterministic
 // and thread-safe (no state).
@@ -28,7 +30,8 @@ inline SimulatedTrial fake_simulate(const ClothValues& c, const TrialRequest& r)
     const double x = std::min(r.speed * t, r.max_travel);
     const double xa = std::max(0.0, x - c.fist_shift) / (1.0 + 40.0 * c.arm_compliance);  // the travel the cloth feels
     const double drag = (1.5 * c.friction + 2.0 * c.stretch) * xa * (1.0 + 12.0 * catchiness * xa * xa) +
-                        0.6 * c.shear * std::sin(6.0 * x) + noise_amp * std::sin(20.0 * x + r.seed % 7);
+                        0.6 * c.shear * std::sin(6.0 * x) + noise_amp * std::sin(20.0 * x + r.seed % 7) +
+                        0.5 * std::exp(-std::pow((x - (0.15 + c.fist_shift - c.rim_shift)) / 0.03, 2));
     const double vert = (0.5 + 10.0 * arm) * x * (0.5 + c.bend) - 0.8 * c.self_friction * x * x;
     out.samples.push_back({t, x, -drag, 0.0, vert});
     if (drag >= 10.0 || std::abs(vert) >= 10.0) {

@@ -9,6 +9,7 @@
 #include "fake_sim.h"
 #include "prediction.h"
 #include "gown.h"
+#include "gown_scene.h"
 #include "sim_bridge.h"
 #include "synthesis.h"
 
@@ -63,6 +64,48 @@ TEST(SimCalibration, BridgeIsDeterministicAcrossThreads) {
   for (std::size_t i = 0; i < a.samples.size(); ++i) EXPECT_EQ(ab[0].samples[i].f_motion, a.samples[i].f_motion);
   for (std::size_t i = 0; i < h.samples.size(); ++i) EXPECT_EQ(ab[1].samples[i].f_vertical, h.samples[i].f_vertical);
   EXPECT_EQ(ab[1].outcome, h.outcome);
+}
+
+// A calibration's rim_shift reaches the simulator as the scene's grasp: a cloth with the rim
+// 2 cm further ahead of the jaws gives, bit for bit, the trial of the scene that `simulate
+// --rim-ahead` builds (make_default_scene with grasp_of's grip), and another trial than the
+// gown's own grasp. A shift that puts the rim behind the jaws is refused with its numbers.
+TEST(SimCalibration, RimShiftIsTheScenesGrasp) {
+  const ClothSimulator both = make_cloth_simulator("coarse");
+  TrialRequest r;
+  r.height = ArmHeight::High;
+  r.max_travel = 0.2;  // short: identity, not physics
+  ClothValues shifted;
+  shifted.rim_shift = 0.02;
+  const bool parametric = gown::measured_gown_path().empty();
+  const auto grip = grasp_of(0.02, parametric);
+  ASSERT_TRUE(grip.has_value());
+  EXPECT_DOUBLE_EQ(grip->rim_ahead, (parametric ? gown::kParametricGrip.rim_ahead : gown::kOpeningRimAhead) + 0.02);
+  EXPECT_FALSE(grasp_of(0.0, parametric).has_value());  // the gown's own: make_default_scene(res)
+  const sim::Scene scene = sim::make_default_scene(sim::GownResolution::Coarse, parametric, *grip);
+  sim::TrialSpec spec;
+  spec.height = r.height;
+  spec.max_travel = r.max_travel;
+  const sim::TrialResult direct = sim::simulate_trial(scene, cloth_params_of(shifted), spec);
+  const SimulatedTrial a = both.trial(shifted, r);
+  const SimulatedTrial own = both.trial(ClothValues{}, r);
+  const std::vector<SimulatedTrial> batch = both.trials(shifted, {r});
+  ASSERT_EQ(a.samples.size(), direct.seq.samples.size());
+  ASSERT_EQ(batch.at(0).samples.size(), a.samples.size());
+  bool differs = a.samples.size() != own.samples.size();
+  for (std::size_t i = 0; i < a.samples.size(); ++i) {
+    EXPECT_EQ(a.samples[i].f_motion, direct.seq.samples[i].f_motion);
+    EXPECT_EQ(a.samples[i].f_vertical, direct.seq.samples[i].f_vertical);
+    EXPECT_EQ(batch[0].samples[i].f_motion, a.samples[i].f_motion);
+    if (i < own.samples.size()) differs |= a.samples[i].f_vertical != own.samples[i].f_vertical;
+  }
+  EXPECT_TRUE(differs) << "the rim shift did not reach the simulation";
+  try {
+    grasp_of(-0.05, parametric);
+    ADD_FAILURE() << "a rim behind the jaws was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("behind the jaws"), std::string::npos) << e.what();
+  }
 }
 
 // The prediction of other people through the batch form (one settling per group of targets)

@@ -80,3 +80,23 @@ if(NOT rc EQUAL 0 OR NOT out MATCHES "\"arm_offset\": 0.02105" OR NOT out MATCHE
    OR NOT out MATCHES "\"stretch\": 0.34440")
   message(FATAL_ERROR "--calibration did not reach the simulation: rc=${rc} ${out} ${err}")
 endif()
+# A calibration's grasp (cloth.rim_shift) moves the rim: 2 cm further ahead of the jaws than the
+# gown's own (measured 0.04 m, parametric 0.01 m); --rim-ahead still overrides it.
+file(READ ${SRC}/models/participant4-simulator.json p4)
+string(REPLACE "\"fist_shift\":" "\"rim_shift\": 0.02, \"fist_shift\":" p4rim "${p4}")
+if(p4rim STREQUAL p4)
+  message(FATAL_ERROR "participant4-simulator.json has no cloth.fist_shift to place rim_shift beside")
+endif()
+file(WRITE ${TMP}/p4rim-calibration.json "${p4rim}")
+execute_process(COMMAND ${DG} simulate --gown coarse --height high --max-travel 0.01 --frames 0
+                        --calibration ${TMP}/p4rim-calibration.json --out ${TMP}/cal_rim.csv --json
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "\"grip\": {\"depth\": 0.0[13]5?, \"rim_ahead\": 0.0[63]}")
+  message(FATAL_ERROR "the calibration's rim_shift did not move the rim: rc=${rc} ${out} ${err}")
+endif()
+execute_process(COMMAND ${DG} simulate --gown coarse --height high --max-travel 0.01 --frames 0 --rim-ahead 0.025
+                        --calibration ${TMP}/p4rim-calibration.json --out ${TMP}/cal_rim2.csv --json
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "\"rim_ahead\": 0.025}")
+  message(FATAL_ERROR "--rim-ahead did not override the calibration's grasp: rc=${rc} ${out} ${err}")
+endif()
