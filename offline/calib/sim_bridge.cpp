@@ -103,7 +103,7 @@ class SceneCache {
 
 std::optional<gown::OpeningGrip> grasp_of(double rim_shift, bool parametric) {
   if (rim_shift == 0.0) return std::nullopt;
-  gown::OpeningGrip g = parametric ? gown::kParametricGrip : gown::OpeningGrip{};
+  gown::OpeningGrip g = gown::own_grip(parametric);
   g.rim_ahead += rim_shift;
   if (!(g.rim_ahead >= 0.0)) {
     char b[200];

@@ -155,7 +155,7 @@ int run_simulate(int argc, char** argv) {
   const bool parametric = args.has("parametric") || gown::measured_gown_path().empty();
   // A calibration's grasp (its rim_shift) is the default that --grip-depth / --rim-ahead change.
   const auto grip = grip_option(args, parametric, cal ? calib::grasp_of(cal->cloth.rim_shift, parametric) : std::nullopt);
-  const gown::OpeningGrip held = grip ? *grip : parametric ? gown::kParametricGrip : gown::OpeningGrip{};
+  const gown::OpeningGrip held = grip ? *grip : gown::own_grip(parametric);
   const sim::Scene scene = scene_with_grip(res, parametric, grip);
   const sim::TrialResult r = sim::simulate_trial(scene, params, spec);
   if (!r.finite) throw std::runtime_error("the simulation diverged (non-finite positions)");

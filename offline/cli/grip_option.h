@@ -19,7 +19,7 @@ inline constexpr const char* kGripHelp =
 inline std::optional<gown::OpeningGrip> grip_option(const Args& args, bool parametric_gown,
                                                     std::optional<gown::OpeningGrip> base = std::nullopt) {
   if (!args.has("grip-depth") && !args.has("rim-ahead")) return base;
-  gown::OpeningGrip g = base ? *base : parametric_gown ? gown::kParametricGrip : gown::OpeningGrip{};
+  gown::OpeningGrip g = base ? *base : gown::own_grip(parametric_gown);
   g.depth = args.number("grip-depth", g.depth);
   g.rim_ahead = args.number("rim-ahead", g.rim_ahead);
   if (!(g.depth > 0 && g.depth < 0.15)) throw UsageError("--grip-depth must be in (0, 0.15) m, the grasp box's depth");

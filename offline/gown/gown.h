@@ -83,6 +83,9 @@ GownMesh read_obj(const std::filesystem::path& path, double scale);
 // Its sleeve is a flattened tube, so the jaws reach both layers (3 cm) with the cuff 1 cm ahead.
 inline constexpr OpeningGrip kParametricGrip{0.03, 0.01};
 GownMesh make_parametric_gown(const OpeningGrip& grip = kParametricGrip);
+// How the jaws hold a gown unless told otherwise: the parametric gown's kParametricGrip, a mesh
+// file's OpeningGrip{} (kOpeningGripDepth, kOpeningRimAhead).
+inline OpeningGrip own_grip(bool parametric) { return parametric ? kParametricGrip : OpeningGrip{}; }
 
 // Quadric-error-metric edge collapse (Garland & Heckbert 1997) down to about `target_triangles`.
 // Boundary loops keep their shape (boundary vertices move only along the boundary, with a

@@ -99,7 +99,7 @@ int main(int argc, char** argv) {
       if (grip < 0) {
         it = scenes.emplace(grip, make_default_scene(res, parametric)).first;
       } else {
-        gown::OpeningGrip g = parametric ? gown::kParametricGrip : gown::OpeningGrip{};
+        gown::OpeningGrip g = gown::own_grip(parametric);
         g.depth = grip;
         it = scenes.emplace(grip, make_default_scene(res, parametric, g)).first;
       }

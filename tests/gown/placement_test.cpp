@@ -190,7 +190,7 @@ TEST(Placement, OpeningPlacementIsIndependentOfTheFilesPose) {
 // parametric sleeve is a flattened lens: a deeper grip pinches its two layers together instead.)
 void check_grip(bool parametric) {
   const PaperScene s;
-  const OpeningGrip base = parametric ? kParametricGrip : OpeningGrip{};
+  const OpeningGrip base = own_grip(parametric);
   GownOptions opt;
   opt.parametric = parametric;
   opt.target_triangles = 5000;
