@@ -119,7 +119,8 @@ Eigen::VectorXd ParameterSpace::initial_unit() const {
   Eigen::VectorXd x(dimension());
   for (int i = 0; i < kClothParams; ++i) x[i] = to_unit(bounds.cloth[i], bounds.cloth[i].initial);
   for (std::size_t k = 0; k < offset_heights.size(); ++k)
-    x[kClothParams + static_cast<long>(k)] = to_unit(bounds.arm_offset, bounds.arm_offset.initial);
+    x[kClothParams + static_cast<long>(k)] =
+        to_unit(bounds.arm_offset, bounds.offset_initial[static_cast<int>(offset_heights[k])].value_or(bounds.arm_offset.initial));
   long k = kClothParams + static_cast<long>(offset_heights.size());
   for (int i = 0; i < kPersonParams; ++i)
     if (person[i].fit) x[k++] = to_unit(bounds.person[i], bounds.person[i].initial);
@@ -228,6 +229,10 @@ std::string fingerprint(const std::vector<HapticSequence>& inputs, const Paramet
   for (const auto& b : space.bounds.cloth) f << hexd(b.lower) << ',' << hexd(b.upper) << ',' << hexd(b.initial) << ',';
   f << hexd(space.bounds.arm_offset.lower) << ',' << hexd(space.bounds.arm_offset.upper) << ','
     << hexd(space.bounds.arm_offset.initial);
+  // Per-height starts only when there are any (older checkpoints resume).
+  for (int h = 0; h < 3; ++h)
+    if (space.bounds.offset_initial[h])
+      f << ",offset" << h << '=' << hexd(*space.bounds.offset_initial[h]);
   // A person parameter only when it is not the paper's arm (older checkpoints resume).
   for (int i = 0; i < kPersonParams; ++i) {
     const ParamBound& b = space.bounds.person[i];
@@ -446,6 +451,26 @@ void measure_axis_fits(std::vector<SequenceFit>& fits, const std::vector<HapticS
     fits[k].motion = {area_error(sim, measured, ForceAxis::Motion, 0.0), area_error(zero, measured, ForceAxis::Motion, 0.0)};
     fits[k].vertical = {area_error(sim, measured, ForceAxis::Vertical, 0.0),
                         area_error(zero, measured, ForceAxis::Vertical, 0.0)};
+  }
+}
+
+void start_from(Bounds& b, const Calibration& c) {
+  auto take = [](ParamBound& pb, double v, const std::string& name) {
+    if (!(v >= pb.lower && v <= pb.upper)) {
+      char buf[200];
+      std::snprintf(buf, sizeof buf, "%s %g is outside its bounds [%g, %g]", name.c_str(), v, pb.lower, pb.upper);
+      throw std::invalid_argument(buf);
+    }
+    pb.initial = v;
+  };
+  for (int i = 0; i < kClothParams; ++i) take(b.cloth[i], cloth_value(c.cloth, i), kClothParamNames[i]);
+  for (int i = 0; i < kPersonParams; ++i) take(b.person[i], person_value(c.cloth, i), kPersonParamInfo[i].name);
+  for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
+    const int k = static_cast<int>(h);
+    if (!c.offset_calibrated[k]) continue;
+    ParamBound one = b.arm_offset;
+    take(one, c.offsets[k], "arm_offset_" + std::string(arm_height_name(h)));
+    b.offset_initial[k] = c.offsets[k];
   }
 }
 

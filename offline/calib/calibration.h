@@ -121,6 +121,9 @@ struct Bounds {
   std::array<ParamBound, kClothParams> cloth;
   ParamBound arm_offset;                           // [m], shared by the offsets of every height
   std::array<ParamBound, kPersonParams> person;  // kPersonParamInfo order, when fitted
+  // Per height (ArmHeight order), a start for that height's offset instead of arm_offset.initial:
+  // another calibration's own offsets (start_from, below).
+  std::array<std::optional<double>, 3> offset_initial{};
 };
 // Defaults (the simulator's box, sim/trial.h ClothParams): stretch, shear, bend in [0, 1] (start
 // 0.2, 0.5, 0.7); friction and self_friction in [0, 2] (start 0.35, 0.2): the plausibility grid's
@@ -280,6 +283,12 @@ struct Calibration {
   double rig_travel = 0.85;                   // [m] end of travel for synthesis (rig_travel_of)
   Json provenance = Json::object();           // dataset, seed, budget, evaluations, timing, tool
 };
+// Starts a search where calibration `c` ended (`calibrate --start`): every initial value of `b`
+// becomes c's (the five cloth values, the person parameters, each calibrated height's own
+// offset), so that a longer or wider search continues from a fit instead of from a bounds file
+// written by hand. Throws std::invalid_argument naming the first value outside its box in `b`.
+void start_from(Bounds& b, const Calibration& c);
+
 Json calibration_to_json(const Calibration& c);
 Calibration calibration_from_json(const Json& j, const std::filesystem::path& source);
 void write_calibration(const std::filesystem::path& path, const Calibration& c);

@@ -39,6 +39,8 @@ int run_calibrate(int argc, char** argv) {
         "  --profile default|quick   default: 50 generations x 32 (the paper); quick: 6 x 8 (tests)\n"
         "  --generations N --population N   override the profile\n"
         "  --bounds FILE       'name lower upper [initial]' lines (offline/calib/README.md)\n"
+        "  --start CAL.json    start where that calibration ended: its values (and each height's\n"
+        "                      own offset) become the initial values within the bounds\n"
         "  --sigma0 S          CMA-ES's initial step in the unit box (default 0.3: a global search;\n"
         "                      about 0.1 from initial values known to fit, e.g. another calibration's)\n"
         "  --seed S            input selection and CMA-ES (default 1); same seed, same result\n"
@@ -66,7 +68,7 @@ int run_calibrate(int argc, char** argv) {
         "  tools/plot/calib_overlay.py). Under mpirun every rank runs a share of each generation.");
     return 0;
   }
-  args.allow_only({"help", "json", "no-arm-offset", "data", "participant", "profile", "bounds", "seed", "out",
+  args.allow_only({"help", "json", "no-arm-offset", "data", "participant", "profile", "bounds", "start", "seed", "out",
                    "checkpoint", "objective", "gown", "threads", "generations", "population",
                    "stop-after-generations", "arm-compliance", "fist-shift", "rim-shift", "sigma0", "hem"});
   const std::string data = args.require("data");
@@ -113,6 +115,13 @@ int run_calibrate(int argc, char** argv) {
     space.hem_bend_ratio = r;
   }
   space.bounds = args.get("bounds") ? read_bounds(*args.get("bounds")) : default_bounds();
+  if (const auto start = args.get("start")) {
+    try {
+      start_from(space.bounds, read_calibration(*start));
+    } catch (const std::invalid_argument& e) {
+      throw UsageError("--start " + *start + ": " + e.what());
+    }
+  }
   const Dataset ds = load_dataset(data);
   const std::vector<HapticSequence> inputs = select_inputs(ds, participant, o.seed);
   if (!args.has("no-arm-offset"))

@@ -289,6 +289,50 @@ TEST(Calibration, BoundsFileParsesAndNamesBadLines) {
   fs::remove_all(dir);
 }
 
+// calibrate --start: a calibration's values become the next search's start, each calibrated
+// height's offset its own (a bounds file holds one for all), inside the bounds or refused by name.
+TEST(Calibration, StartFromACalibration) {
+  Calibration c;
+  c.cloth = {0.1, 0.2, 0.3, 0.4, 0.5};
+  c.cloth.fist_shift = 0.05;
+  c.cloth.rim_shift = -0.01;
+  c.offsets = {0.01, 0.0, -0.02};
+  c.offset_calibrated = {true, false, true};
+  ParameterSpace s;
+  s.bounds = default_bounds();
+  start_from(s.bounds, c);
+  s.offset_heights = {ArmHeight::High, ArmHeight::Low};
+  ASSERT_TRUE(set_person_param(s, kFistShift, "fit"));
+  ASSERT_TRUE(set_person_param(s, kRimShift, "fit"));
+  const Eigen::VectorXd u = s.initial_unit();
+  const ClothValues v = s.cloth(u);
+  EXPECT_NEAR(v.stretch, 0.1, 1e-15);
+  EXPECT_NEAR(v.bend, 0.3, 1e-15);
+  EXPECT_NEAR(v.self_friction, 0.5, 1e-15);
+  EXPECT_NEAR(v.fist_shift, 0.05, 1e-15);
+  EXPECT_NEAR(v.rim_shift, -0.01, 1e-15);
+  EXPECT_EQ(v.arm_compliance, 0.0);  // not searched: held at the paper's arm
+  const auto off = s.offsets(u);
+  EXPECT_NEAR(off[static_cast<int>(ArmHeight::High)], 0.01, 1e-15);
+  EXPECT_NEAR(off[static_cast<int>(ArmHeight::Low)], -0.02, 1e-15);
+  EXPECT_FALSE(s.bounds.offset_initial[static_cast<int>(ArmHeight::Middle)].has_value());
+  auto refused = [](Calibration bad) {
+    Bounds b = default_bounds();
+    try {
+      start_from(b, bad);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  Calibration stiff = c;
+  stiff.cloth.bend = 1.2;
+  EXPECT_NE(refused(stiff).find("bend 1.2 is outside its bounds [0, 1]"), std::string::npos) << refused(stiff);
+  Calibration high = c;
+  high.offsets[0] = 0.1;
+  EXPECT_NE(refused(high).find("arm_offset_high 0.1"), std::string::npos) << refused(high);
+}
+
 // Paper IV-B.1 on the measured data: one sequence per height, caught never chosen (the study
 // folder holds none), two sequences when a participant has no middle-height miss.
 TEST(Calibration, InputSelectionOnMeasuredData) {

@@ -20,6 +20,7 @@ expect_fail("calibrate with an unknown objective" "--objective" calibrate --data
 expect_fail("calibrate with a typo option" "--sed" calibrate --data ${WORK} --participant 1 --out ${WORK}/c.json --sed 3)
 expect_fail("calibrate with a bad --sigma0" "--sigma0" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --sigma0 0)
 expect_fail("calibrate with a bad --arm-compliance" "--arm-compliance" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --arm-compliance soft)
+expect_fail("calibrate from a missing --start" "nostart.json" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --start ${WORK}/nostart.json)
 expect_fail("calibrate with a rim behind the jaws" "--rim-shift" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --rim-shift -0.05)
 expect_fail("calibrate with a bad --hem" "--hem" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --hem 0.03)
 expect_fail("calibrate with a softening --hem" "--hem" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --hem 0.03,0.5)
