@@ -455,21 +455,26 @@ void measure_axis_fits(std::vector<SequenceFit>& fits, const std::vector<HapticS
 }
 
 void start_from(Bounds& b, const Calibration& c) {
-  auto take = [](ParamBound& pb, double v, const std::string& name) {
+  auto check = [](const ParamBound& pb, double v, const std::string& name) {
     if (!(v >= pb.lower && v <= pb.upper)) {
       char buf[200];
       std::snprintf(buf, sizeof buf, "%s %g is outside its bounds [%g, %g]", name.c_str(), v, pb.lower, pb.upper);
       throw std::invalid_argument(buf);
     }
-    pb.initial = v;
   };
-  for (int i = 0; i < kClothParams; ++i) take(b.cloth[i], cloth_value(c.cloth, i), kClothParamNames[i]);
-  for (int i = 0; i < kPersonParams; ++i) take(b.person[i], person_value(c.cloth, i), kPersonParamInfo[i].name);
+  for (int i = 0; i < kClothParams; ++i) {
+    check(b.cloth[i], cloth_value(c.cloth, i), kClothParamNames[i]);
+    b.cloth[i].initial = cloth_value(c.cloth, i);
+  }
+  for (int i = 0; i < kPersonParams; ++i) {
+    check(b.person[i], person_value(c.cloth, i), kPersonParamInfo[i].name);
+    b.person[i].initial = person_value(c.cloth, i);
+  }
+  // The offsets share one box; each calibrated height starts from its own value.
   for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
     const int k = static_cast<int>(h);
     if (!c.offset_calibrated[k]) continue;
-    ParamBound one = b.arm_offset;
-    take(one, c.offsets[k], "arm_offset_" + std::string(arm_height_name(h)));
+    check(b.arm_offset, c.offsets[k], "arm_offset_" + std::string(arm_height_name(h)));
     b.offset_initial[k] = c.offsets[k];
   }
 }

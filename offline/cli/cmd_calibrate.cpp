@@ -1,5 +1,6 @@
 // dressguard calibrate: fit the simulator's cloth parameters and arm offsets to one participant's
 // measured sequences with CMA-ES (paper section IV-B). See offline/calib/README.md.
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <ctime>
@@ -99,12 +100,12 @@ int run_calibrate(int argc, char** argv) {
   if (gown != "full" && gown != "reduced" && gown != "coarse") throw UsageError("--gown must be full, reduced or coarse");
 
   ParameterSpace space;
-  if (const auto arm = args.get("arm-compliance"); arm && !set_person_param(space, kArmCompliance, *arm))
-    throw UsageError("--arm-compliance must be fit, fixed or a compliance in [0, 1] m/N, not '" + *arm + "'");
-  if (const auto fist = args.get("fist-shift"); fist && !set_person_param(space, kFistShift, *fist))
-    throw UsageError("--fist-shift must be fit, fixed or a shift in [-0.2, 0.2] m, not '" + *fist + "'");
-  if (const auto rim = args.get("rim-shift"); rim && !set_person_param(space, kRimShift, *rim))
-    throw UsageError("--rim-shift must be fit, fixed or a shift in [-0.04, 0.06] m, not '" + *rim + "'");
+  // --arm-compliance, --fist-shift, --rim-shift, in kPersonParamInfo order.
+  static constexpr std::array<const char*, kPersonParams> kPersonFlags = {"arm-compliance", "fist-shift", "rim-shift"};
+  for (int i = 0; i < kPersonParams; ++i)
+    if (const auto v = args.get(kPersonFlags[i]); v && !set_person_param(space, i, *v))
+      throw UsageError(std::string("--") + kPersonFlags[i] + " must be fit, fixed or a value (" +
+                       kPersonParamInfo[i].name + " " + kPersonParamInfo[i].range + "), not '" + *v + "'");
   if (const auto hem = args.get("hem")) {
     double w = 0, r = 0;
     char tail = 0;
