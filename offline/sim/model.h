@@ -216,6 +216,12 @@ struct SelfPair {
   int32_t i, j;
 };
 
+// A free vertex within contact reach of a watched arm (watch_arms()) this output step.
+struct ArmWatch {
+  int32_t vertex;
+  double dz;  // [m] the watched arm's placement, along z from the model's arm
+};
+
 struct GownState {
   std::vector<V3> x, p, v;            // positions, positions at the substep's start, velocities
   std::vector<V3> anchor;             // Constraint friction: stick point of each arm contact
@@ -252,6 +258,9 @@ struct GownState {
   V3 grip_accel;                      // gripper acceleration (inertia of the grasped vertices)
   V3 force_acc;                       // sum over substeps of the force of the gown on the gripper
   long force_count = 0;
+  // Other placements of the arm, watched while the gown settles (watch_arms()).
+  std::vector<ArmWatch> watch;        // this step's vertices within their contact reach
+  bool watch_touched = false;         // one came within the contact offset of its watched arm
 };
 
 GownState make_state(const GownModel& m);
@@ -270,11 +279,20 @@ std::vector<RoundCone> arm_colliders(const SceneOptions& opt, double fist_shift,
 // moved by arm_dz along z (the trial's height): m.arm and m.elbow.
 void place_arm(GownModel& m, double arm_dz);
 
-// Whether the arm, moved by dz along z from where m has it, would give any free vertex an arm
-// candidate in the next step() (the same margin as step()'s own detection, 1 um wider). While it
-// is false at every step, the arm cannot have changed the gown: simulate_trials() shares a
-// settling between arm heights only then.
-bool arm_in_reach(const GownModel& m, const GownState& s, double dz);
+// Watching other placements of the arm while the gown settles: may trials with other arm heights
+// start their pulls from this settling (simulate_trials())? A watched arm is m's arm moved by
+// `dz` along z; it acts on nothing. Had an arm been there, it would have changed the gown only
+// through contact corrections, and solve_contacts() corrects only a vertex that detect_arm() made
+// its candidate and that then lies within the contact offset of it in a substep (a candidate that
+// stays outside moves no bit). So, before each step():
+// - watch_arms() lists in s.watch the free vertices within contact reach of each watched arm
+//   (detect_arm()'s margin, 1 um wider for the rounding of the move) and returns whether it
+//   listed any;
+// - then every substep checks the listed vertices against all of that arm's cones and sets
+//   s.watch_touched when one lies within the contact offset (plus 1 um).
+// While watch_touched stays false, an arm at any watched placement would have left the gown
+// with the same bits. Clear s.watch to stop watching.
+bool watch_arms(const GownModel& m, GownState& s, const std::vector<double>& dz);
 
 // Total triangle area of the current positions.
 double current_area(const GownModel& m, const GownState& s);

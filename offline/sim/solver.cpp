@@ -18,7 +18,7 @@ namespace {
 // The arm candidates of a vertex at `x` moving at `v`: up to two round cones whose surface is
 // within the margin (contact offset + 1 cm + twice this step's travel); the exact distance is
 // re-evaluated every substep against these (two are enough at the elbow where the forearm and
-// upper arm meet). `extra` widens the margin (arm_in_reach()).
+// upper arm meet). `extra` widens the margin (watch_arms()).
 ArmCandidates arm_candidates(const GownModel& m, V3 x, V3 v, double extra) {
   ArmCandidates c;
   const double margin = m.scene->opt.contact_offset + 0.01 + 2.0 * norm(v) * m.dt + extra;
@@ -384,6 +384,20 @@ void stock_friction(const GownModel& m, GownState& s) {
     if (s.contact_dn[i] > 0) friction_velocity(s.v[i], s.contact_n[i], s.contact_dn[i], m.friction, m.h);
 }
 
+// Where solve_contacts() would have moved a listed vertex, had a watched arm been placed there
+// (watch_arms()): within the contact offset of any of its cones (1 um wider, as the listing).
+void check_watched_arms(const GownModel& m, GownState& s) {
+  const double reach = m.scene->opt.contact_offset + 1e-6;
+  for (const ArmWatch& w : s.watch)
+    for (const RoundCone& cone : m.arm) {
+      V3 nrm;
+      if (round_cone_distance(cone, s.x[w.vertex] - s.arm_shift - V3{0, 0, w.dz}, &nrm) < reach) {
+        s.watch_touched = true;
+        return;
+      }
+    }
+}
+
 // One substep; `first`: the step's first substep (the velocities are current), else the
 // previous substep's velocity update is fused into the integration.
 void substep(const GownModel& m, GownState& s, V3 grip, V3 grip_accel, bool first) {
@@ -400,6 +414,7 @@ void substep(const GownModel& m, GownState& s, V3 grip, V3 grip_accel, bool firs
   solve_kind(m, s, m.shear_blocks, m.shear_spans, shear_scalar, shear_free_avx2, shear_careful_avx2, inv_h2, force);
   solve_kind(m, s, m.bend_blocks, m.bend_spans, bend_scalar, bend_free_avx2, bend_careful_avx2, inv_h2, force);
   solve_contacts(m, s, inv_h2);
+  if (!s.watch.empty() && !s.watch_touched) check_watched_arms(m, s);
   if (m.self_collision) solve_self(m, s, inv_h2, force);
   // The grasped vertices' own weight and inertia also load the gripper.
   for (int g : sc.grasp_list) force += m.mass[g] * (m.gravity - grip_accel);
@@ -409,13 +424,17 @@ void substep(const GownModel& m, GownState& s, V3 grip, V3 grip_accel, bool firs
 
 }  // namespace
 
-bool arm_in_reach(const GownModel& m, const GownState& s, double dz) {
+bool watch_arms(const GownModel& m, GownState& s, const std::vector<double>& dz) {
   const SceneData& sc = *m.scene;
+  s.watch.clear();
+  if (m.arm.empty()) return false;
   // The arm moved by dz is the vertex moved by -dz; 1 um more margin covers the rounding of
-  // that move, so that "not in reach" here is never "a candidate" in detect_arm().
-  for (size_t i = 0; i < s.x.size(); ++i)
-    if (!sc.grasped[i] && arm_candidates(m, s.x[i] - V3{0, 0, dz}, s.v[i], 1e-6).c[0] >= 0) return true;
-  return false;
+  // that move, so that a vertex not listed here is never a candidate of an arm placed there.
+  for (double d : dz)
+    for (size_t i = 0; i < s.x.size(); ++i)
+      if (!sc.grasped[i] && arm_candidates(m, s.x[i] - s.arm_shift_from - V3{0, 0, d}, s.v[i], 1e-6).c[0] >= 0)
+        s.watch.push_back({static_cast<int32_t>(i), d});
+  return !s.watch.empty();
 }
 
 void place_arm(GownModel& m, double arm_dz) {

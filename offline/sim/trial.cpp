@@ -107,13 +107,14 @@ OpeningShape opening_shape(const GownModel& m, const GownState& s) {
 struct Settled {
   V3 bias{0, 0, 0};             // the raw gripper force at rest (the sensor's bias)
   std::vector<int32_t> lower;   // the lower half of the sleeve opening as it hangs
-  bool arm_reached = false;     // the arm (or one of the probed arms) came within contact reach
+  bool arm_touched = false;     // the arm, or one of the watched arms, touched the gown
 };
 
 // Grasp, gravity, the optional perturbation and settling until the gown is at rest (see
 // TrialSpec). Fills r's settle_* fields, weight, bias, wall_settle and the frames before the
-// pull. `probe_dz`: other arm placements (relative to m's) checked with arm_in_reach() before
-// every step; Settled::arm_reached is set if any of them, or m's own arm, could touch the gown.
+// pull. `probe_dz`: other arm placements (relative to m's) watched with watch_arms() while no
+// arm has touched the gown; Settled::arm_touched is set when m's own arm corrected a vertex or
+// a watched arm would have (TrialResult::settle_arm_near when one came within contact reach).
 Settled settle(GownModel& m, GownState& s, const TrialSpec& spec, const TrialDraws& d,
                const std::vector<double>& probe_dz, TrialResult& r) {
   const SceneData& sc = *m.scene;
@@ -158,14 +159,19 @@ Settled settle(GownModel& m, GownState& s, const TrialSpec& spec, const TrialDra
     }
     const int close = sc.opt.jaw_close_steps;
     s.jaw_closed = close > 0 ? std::min(1.0, (k + 1.0) / close) : 1.0;
-    if (!out.arm_reached)
-      for (double dz : probe_dz)
-        if (arm_in_reach(m, s, dz)) {
-          out.arm_reached = true;
-          break;
-        }
+    if (!out.arm_touched && watch_arms(m, s, probe_dz)) r.settle_arm_near = true;
     step(m, s, zero, zero, zero);
-    if (!own_arm_probe || s.contact_count > 0) out.arm_reached = true;
+    if (!out.arm_touched) {
+      // The own arm corrected a vertex when a normal correction was made this step (a
+      // candidate that stayed outside the contact offset moved nothing).
+      bool own_touched = !own_arm_probe;
+      for (size_t q = 0; q < s.contact_count && !own_touched; ++q) own_touched = s.contact_dn[s.contact_list[q]] > 0;
+      if (s.contact_count > 0) r.settle_arm_near = true;
+      if (own_touched || s.watch_touched) {
+        out.arm_touched = true;
+        s.watch.clear();
+      }
+    }
     ++k;
     if (keep_snaps > 0 && k % 15 == 0) {
       if (snaps.size() == keep_snaps) snaps.erase(snaps.begin());
@@ -186,6 +192,8 @@ Settled settle(GownModel& m, GownState& s, const TrialSpec& spec, const TrialDra
     if (!adaptive) break;
     if (k % kWindow == 0 && (r.settle_speed <= spec.settle_speed || k >= max_steps)) break;
   }
+  s.watch.clear();
+  s.watch_touched = false;
   r.settle_steps = k;
   r.settle_time = k * m.dt;
   r.settled = !adaptive || r.settle_speed <= spec.settle_speed;
@@ -380,12 +388,12 @@ std::vector<TrialResult> simulate_trials(const Scene& scene, const ClothParams& 
     done[a] = 1;
     if (!group.empty()) {
       // A trial of the group starts its pull from a copy of this settling when its arm is a's
-      // (the same model, the same bits), or when no arm came near the gown while it settled
-      // (then no arm acted on it, and every arm height would have settled to these bits). The
-      // others settle on their own later, grouped among themselves.
+      // (the same model, the same bits), or when no arm touched the gown while it settled (then
+      // no arm acted on it, and every watched arm height would have settled to these bits;
+      // watch_arms()). The others settle on their own later, grouped among themselves.
       const GownState rest_state = s;
       for (size_t b : group) {
-        if (at_rest.arm_reached && arm_dz_of(sc, specs[b], draws[b].arm_offset) != dz_a) continue;
+        if (at_rest.arm_touched && arm_dz_of(sc, specs[b], draws[b].arm_offset) != dz_a) continue;
         // r holds only what the settling wrote (weight, bias, settle_*; no frames in a group).
         TrialResult& rb = out[b] = r;
         rb.arm_offset = draws[b].arm_offset;

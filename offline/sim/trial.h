@@ -203,6 +203,10 @@ struct TrialResult {
   long self_pairs_dropped = 0;      // self-collision pairs beyond the preallocated capacity
   double wall_settle = 0, wall_pull = 0;  // [s] wall time of grasp+settling and of the pull
   bool settle_shared = false;       // simulate_trials(): began from another trial's settling (wall_settle 0)
+  // An arm came within contact reach of the settling gown: this trial's, or in simulate_trials()
+  // another trial's arm that this settling watched (watch_arms()). Reach is not touch: settlings
+  // are shared unless an arm touched the gown.
+  bool settle_arm_near = false;
 };
 
 // The arm (data README; paper IV: capsules, fixed, uniform friction). Spheres fist, wrist,
@@ -294,13 +298,14 @@ TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const 
 // `specs`, but each settling done once where it can be: trials that settle alike (the same
 // perturbation, friction scheme, self-collision and settling settings; no frames kept) start
 // their pulls from one settled gown when their arm is placed where the settling trial's is (to
-// the bit: the same model), or, for other arm heights, when no arm of theirs came within contact
-// reach of the gown while it settled (arm_in_reach(), checked every step): the arm is fixed, and
-// without a candidate it acts on no vertex, so each of those trials would have settled to those
-// same bits on its own. In calibration, where one cloth is pulled over 2-3 arm heights, that
-// saves all settlings but one while no arm touches the settling gown (on the measured gown the
-// low arm does); in `predict`, the trials of one height share theirs always
-// (TrialResult::settle_shared).
+// the bit: the same model), or, for other arm heights, when no arm of theirs touched the gown
+// while it settled (watch_arms(), model.h: the arm is fixed, and it corrects only a vertex that
+// comes within the contact offset of it; one that merely comes within contact reach, as in the
+// first steps after the grasp, when the stiff gown springs from its measured shape, moves no
+// bit), so each of those trials would have settled to those same bits on its own. In
+// calibration, where one cloth is pulled over 2-3 arm heights, that saves all settlings but one
+// while no arm touches the settling gown; in `predict`, the trials of one height share theirs
+// always (TrialResult::settle_shared, settle_arm_near).
 std::vector<TrialResult> simulate_trials(const Scene& scene, const ClothParams& params,
                                          const std::vector<TrialSpec>& specs);
 

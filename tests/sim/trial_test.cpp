@@ -451,6 +451,42 @@ TEST(SimTrial, NoSharedSettlingWhereAnArmTouchesTheGown) {
   EXPECT_TRUE(r[3].settle_shared) << "the same low arm too";
 }
 
+// Coming within contact reach is not touching: an arm whose candidates stay outside the contact
+// offset corrects no vertex, so trials of that arm height still share the settling, with their
+// own bits. The tube held at one end swings down past a second arm placed at a sweep of heights
+// under the grasp (the first trial's own arm is 2 m below, out of reach). Some heights are
+// touched (not shared), some only neared (shared, which the reach-only rule refused), and every
+// trial has the bits of its own simulate_trial().
+TEST(SimTrial, SharedSettlingWhereAnArmCameNearButDidNotTouch) {
+  ClothMesh mesh = tube(0.075, -0.4, 0.0, 16, 20);
+  const int top = 19 * 16 + 4;
+  mesh.grasp = {top - 1, top, top + 1};
+  int near_shared = 0, touched = 0;
+  for (int mm = 310; mm <= 350; mm += 5) {
+    SceneOptions opt;
+    opt.jaw_close_steps = 0;
+    opt.arm.fist_x = 0.0;
+    opt.arm.z_rel = {-2.0, -0.001 * mm, -3.0};
+    const Scene scene = make_scene(mesh, opt);
+    TrialSpec far, swept;
+    far.height = ArmHeight::High;
+    swept.height = ArmHeight::Middle;
+    far.max_travel = swept.max_travel = 0.02;
+    const std::vector<TrialResult> r = simulate_trials(scene, ClothParams{}, {far, swept});
+    const std::string at = "second arm " + std::to_string(mm) + " mm below the grasp";
+    expect_same_trial(r[0], simulate_trial(scene, ClothParams{}, far), (at + ", first").c_str());
+    expect_same_trial(r[1], simulate_trial(scene, ClothParams{}, swept), (at + ", second").c_str());
+    if (r[1].settle_shared) {
+      near_shared += r[0].settle_arm_near;
+    } else {
+      ++touched;
+      EXPECT_TRUE(r[0].settle_arm_near) << at << ": not shared, so the arm should have come near";
+    }
+  }
+  EXPECT_GT(near_shared, 0) << "no height where the arm came within reach without touching";
+  EXPECT_GT(touched, 0) << "no height where the swinging tube touched the arm";
+}
+
 namespace {
 
 // The self-collision pairs that step() must find from positions x, by brute force over all
