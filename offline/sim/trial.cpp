@@ -226,104 +226,141 @@ Settled settle(GownModel& m, GownState& s, const TrialSpec& spec, const TrialDra
   return out;
 }
 
-// The pull from the settled state until max_travel or the force limit, and the label.
-void pull(const GownModel& m, GownState& s, const TrialSpec& spec, const Settled& at_rest, TrialResult& r) {
+// A pull under way: everything its sample loop carries from one sample to the next, so that
+// trials whose pulls agree so far can go on from a copy of it (simulate_trials()).
+struct Pulling {
+  GownState s;
+  TrialResult r;
+  ArmSpring arm;                 // a compliant arm (arm_spring.h) moves once per sample
+  V3 arm_load0{0, 0, 0};         // its load at the first sample, counted from
+  bool first_sample = true;
+  double t = 0;                  // [s] since the start of the pull
+  size_t next_frame = 0;         // into the sorted non-negative frame times
+  bool ended = false, full = false;
+};
+
+std::vector<double> pull_frame_times(const TrialSpec& spec) {
+  std::vector<double> times;
+  for (double t : spec.frame_times)
+    if (t >= -1e-9) times.push_back(t);
+  std::sort(times.begin(), times.end());
+  return times;
+}
+
+void maybe_frame(Pulling& p, const TrialSpec& spec, const std::vector<double>& times, double travel) {
+  while (spec.keep_frames && p.next_frame < times.size() && times[p.next_frame] <= p.t + 1e-9) {
+    p.r.frames.push_back(make_frame(p.s, p.t, travel));
+    ++p.next_frame;
+  }
+}
+
+// The pull's start from the settled state `s`; r holds what the settling wrote.
+Pulling start_pull(const GownModel& m, GownState s, const TrialSpec& spec, TrialResult r) {
+  Pulling p{std::move(s), std::move(r), ArmSpring{m.arm_compliance}};
+  p.r.seq.height = spec.height;
+  p.r.seq.speed = spec.speed;
+  p.r.seq.id = std::string("sim-") + std::string(arm_height_name(spec.height)) + "-" + std::to_string(spec.seed);
+  p.r.finite = all_finite(p.s);
+  maybe_frame(p, spec, pull_frame_times(spec), 0.0);
+  p.ended = !p.r.finite;
+  return p;
+}
+
+// One sample of the pull (3 output steps), until max_travel or the force limit (Pulling::ended).
+// `touched` (may be null): set when the model's arm corrected a vertex in these steps, or when a
+// watched arm (`watch_dz`, watch_arms()) would have.
+void pull_sample(const GownModel& m, Pulling& p, const TrialSpec& spec, const Settled& at_rest,
+                 const std::vector<double>& watch_dz = {}, bool* touched = nullptr) {
+  GownState& s = p.s;
+  TrialResult& r = p.r;
   const int n = static_cast<int>(s.x.size());
   const V3 zero{0, 0, 0};
-  std::vector<double> frame_times;
-  for (double t : spec.frame_times)
-    if (t >= -1e-9) frame_times.push_back(t);
-  std::sort(frame_times.begin(), frame_times.end());
-  size_t next_frame = 0;
-  auto maybe_frame = [&](double t, double travel) {
-    while (spec.keep_frames && next_frame < frame_times.size() && frame_times[next_frame] <= t + 1e-9) {
-      r.frames.push_back(make_frame(s, t, travel));
-      ++next_frame;
-    }
-  };
-  maybe_frame(0.0, 0.0);
-
-  const auto clock1 = std::chrono::steady_clock::now();
+  const auto clock = std::chrono::steady_clock::now();
   const Profile prof{spec.acceleration, spec.speed, spec.max_travel};
-  r.seq.height = spec.height;
-  r.seq.speed = spec.speed;
-  r.seq.id = std::string("sim-") + std::string(arm_height_name(spec.height)) + "-" + std::to_string(spec.seed);
-  double t = 0;
-  bool full = false;
-  r.finite = all_finite(s);
-  // A compliant arm (arm_spring.h) moves once per sample toward where the last sample's contact
-  // force puts it, linearly over the sample's steps; its load is counted from the first sample.
-  ArmSpring arm{m.arm_compliance};
-  V3 arm_load0{0, 0, 0};
-  bool first_sample = true;
-  const double max_time = spec.max_travel / spec.speed + spec.speed / spec.acceleration + 5.0;
-  while (r.finite && t < max_time) {
-    s.force_acc = zero;
-    s.force_count = 0;
-    for (int i = 0; i < n; ++i) s.contact_acc[i] = zero;
-    s.part_acc.fill(zero);
-    const V3 arm0 = s.arm_shift_to, arm1 = arm.d;
-    for (int k = 0; k < 3; ++k) {
-      const double t1 = t + m.dt;
-      const V3 g0{prof.travel(t), 0, 0}, g1{prof.travel(t1), 0, 0};
-      if (!arm.rigid()) {
-        s.arm_shift_from = arm0 + (k / 3.0) * (arm1 - arm0);
-        s.arm_shift_to = arm0 + ((k + 1) / 3.0) * (arm1 - arm0);
-      }
-      step(m, s, g0, g1, V3{prof.accel(t), 0, 0});
-      t = t1;
-      maybe_frame(t, g1.x);
+  const std::vector<double> frame_times = spec.keep_frames ? pull_frame_times(spec) : std::vector<double>{};
+  s.force_acc = zero;
+  s.force_count = 0;
+  for (int i = 0; i < n; ++i) s.contact_acc[i] = zero;
+  s.part_acc.fill(zero);
+  // A compliant arm moves toward where the last sample's contact force puts it, linearly over
+  // this sample's steps; its load is counted from the first sample.
+  const V3 arm0 = s.arm_shift_to, arm1 = p.arm.d;
+  for (int k = 0; k < 3; ++k) {
+    const double t1 = p.t + m.dt;
+    const V3 g0{prof.travel(p.t), 0, 0}, g1{prof.travel(t1), 0, 0};
+    if (!p.arm.rigid()) {
+      s.arm_shift_from = arm0 + (k / 3.0) * (arm1 - arm0);
+      s.arm_shift_to = arm0 + ((k + 1) / 3.0) * (arm1 - arm0);
     }
-    if (!arm.rigid()) {
-      V3 load{0, 0, 0};  // the cloth's force on the arm: minus the arm's on the cloth (eq. 2)
-      for (int i = 0; i < n; ++i) load -= s.contact_acc[i];
-      load = (1.0 / s.force_count) * load;
-      if (first_sample) arm_load0 = load;
-      arm.advance(load - arm_load0, 3 * m.dt);
-      r.arm_shift_max = std::max(r.arm_shift_max, norm(s.arm_shift));
+    if (touched && !*touched) watch_arms(m, s, watch_dz);
+    step(m, s, g0, g1, V3{prof.accel(p.t), 0, 0});
+    if (touched && !*touched) {
+      for (size_t q = 0; q < s.contact_count && !*touched; ++q) *touched = s.contact_dn[s.contact_list[q]] > 0;
+      *touched = *touched || s.watch_touched;
     }
-    first_sample = false;
-    const V3 f = (1.0 / s.force_count) * s.force_acc - at_rest.bias;
-    const double travel = prof.travel(t);
-    r.seq.samples.push_back({t, travel, f.x, f.y, f.z});
-    if (spec.record_arm_parts) {
-      ArmPartLoads loads;
-      for (int k = 0; k < kArmParts; ++k) {
-        const V3 c = (-1.0 / s.force_count) * s.part_acc[static_cast<size_t>(k)];
-        loads.f[static_cast<size_t>(k)] = {c.x, c.y, c.z};
-      }
-      V3 momentum{0, 0, 0};
-      for (int i = 0; i < n; ++i)
-        if (!m.scene->grasped[static_cast<size_t>(i)]) momentum += m.mass[static_cast<size_t>(i)] * s.v[static_cast<size_t>(i)];
-      loads.momentum = {momentum.x, momentum.y, momentum.z};
-      r.arm_parts.push_back(loads);
-    }
-    r.finite = all_finite(s);
-    if (r.contact_t < 0)
-      for (int i = 0; i < n; ++i)
-        if (s.contact_acc[i].x != 0 || s.contact_acc[i].y != 0 || s.contact_acc[i].z != 0) {
-          r.contact_t = t;
-          r.contact_travel = travel;
-          break;
-        }
-    if (std::abs(f.x) >= spec.force_limit || std::abs(f.z) >= spec.force_limit) {
-      r.stopped_by_force = true;
-      break;
-    }
-    if (travel >= spec.max_travel - 1e-12) {
-      full = true;
-      break;
-    }
+    p.t = t1;
+    maybe_frame(p, spec, frame_times, g1.x);
   }
-  r.wall_pull = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock1).count();
-  r.travel = prof.travel(t);
+  s.watch.clear();
+  s.watch_touched = false;
+  if (!p.arm.rigid()) {
+    V3 load{0, 0, 0};  // the cloth's force on the arm: minus the arm's on the cloth (eq. 2)
+    for (int i = 0; i < n; ++i) load -= s.contact_acc[i];
+    load = (1.0 / s.force_count) * load;
+    if (p.first_sample) p.arm_load0 = load;
+    p.arm.advance(load - p.arm_load0, 3 * m.dt);
+    r.arm_shift_max = std::max(r.arm_shift_max, norm(s.arm_shift));
+  }
+  p.first_sample = false;
+  const V3 f = (1.0 / s.force_count) * s.force_acc - at_rest.bias;
+  const double travel = prof.travel(p.t);
+  r.seq.samples.push_back({p.t, travel, f.x, f.y, f.z});
+  if (spec.record_arm_parts) {
+    ArmPartLoads loads;
+    for (int k = 0; k < kArmParts; ++k) {
+      const V3 c = (-1.0 / s.force_count) * s.part_acc[static_cast<size_t>(k)];
+      loads.f[static_cast<size_t>(k)] = {c.x, c.y, c.z};
+    }
+    V3 momentum{0, 0, 0};
+    for (int i = 0; i < n; ++i)
+      if (!m.scene->grasped[static_cast<size_t>(i)]) momentum += m.mass[static_cast<size_t>(i)] * s.v[static_cast<size_t>(i)];
+    loads.momentum = {momentum.x, momentum.y, momentum.z};
+    r.arm_parts.push_back(loads);
+  }
+  r.finite = all_finite(s);
+  if (r.contact_t < 0)
+    for (int i = 0; i < n; ++i)
+      if (s.contact_acc[i].x != 0 || s.contact_acc[i].y != 0 || s.contact_acc[i].z != 0) {
+        r.contact_t = p.t;
+        r.contact_travel = travel;
+        break;
+      }
+  const double max_time = spec.max_travel / spec.speed + spec.speed / spec.acceleration + 5.0;
+  if (std::abs(f.x) >= spec.force_limit || std::abs(f.z) >= spec.force_limit) {
+    r.stopped_by_force = true;
+    p.ended = true;
+  } else if (travel >= spec.max_travel - 1e-12) {
+    p.full = true;
+    p.ended = true;
+  } else if (!r.finite || p.t >= max_time) {
+    p.ended = true;
+  }
+  r.wall_pull += std::chrono::duration<double>(std::chrono::steady_clock::now() - clock).count();
+}
+
+// The label and the end-of-pull figures, once Pulling::ended.
+TrialResult finish_pull(const GownModel& m, Pulling& p, const TrialSpec& spec, const Settled& at_rest) {
+  GownState& s = p.s;
+  TrialResult& r = p.r;
+  const int n = static_cast<int>(s.x.size());
+  r.travel = Profile{spec.acceleration, spec.speed, spec.max_travel}.travel(p.t);
   r.self_pairs_dropped = s.pairs_dropped;
   r.d_max = 0;
-  if (!full) {
+  if (!p.full) {
     // The elbow where the (compliant) arm has it now.
     for (int v : at_rest.lower) r.d_max = std::max(r.d_max, std::abs(s.x[v].x - (m.elbow.x + s.arm_shift.x)));
   }
-  r.outcome = label_outcome(full, r.d_max);
+  r.outcome = label_outcome(p.full, r.d_max);
   r.seq.label = r.outcome;
   r.area_ratio = current_area(m, s) / m.scene->rest_area;
   r.arm_shift = {s.arm_shift.x, s.arm_shift.y, s.arm_shift.z};
@@ -333,7 +370,16 @@ void pull(const GownModel& m, GownState& s, const TrialSpec& spec, const Settled
       const V3 c = (-1.0 / s.force_count) * s.contact_acc[i];
       if (c.x != 0 || c.y != 0 || c.z != 0) r.contacts.push_back({i, {c.x, c.y, c.z}});
     }
-  if (spec.keep_frames && (r.frames.empty() || r.frames.back().t < t - 1e-9)) r.frames.push_back(make_frame(s, t, r.travel));
+  if (spec.keep_frames && (r.frames.empty() || r.frames.back().t < p.t - 1e-9))
+    r.frames.push_back(make_frame(s, p.t, r.travel));
+  return std::move(r);
+}
+
+// The whole pull of one trial from the settled state.
+TrialResult pull(const GownModel& m, GownState s, const TrialSpec& spec, const Settled& at_rest, TrialResult r) {
+  Pulling p = start_pull(m, std::move(s), spec, std::move(r));
+  while (!p.ended) pull_sample(m, p, spec, at_rest);
+  return finish_pull(m, p, spec, at_rest);
 }
 
 // Whether two trials' settlings are the same computation up to the arm's height.
@@ -355,9 +401,71 @@ TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const 
   TrialResult r;
   r.arm_offset = d.arm_offset;
   const Settled at_rest = settle(m, s, spec, d, {}, r);
-  pull(m, s, spec, at_rest, r);
-  return r;
+  return pull(m, std::move(s), spec, at_rest, std::move(r));
 }
+
+namespace {
+
+// Whether two trials' pulls are the same computation up to the arm (and where the rig's travel
+// ends, which pull_together() keeps out of the shared part).
+bool same_pull(const TrialSpec& a, const TrialSpec& b) {
+  return a.speed == b.speed && a.acceleration == b.acceleration && a.force_limit == b.force_limit &&
+         a.record_arm_parts == b.record_arm_parts && !a.keep_frames && !b.keep_frames;
+}
+
+// The pulls of `trials` (indices into specs/out; models[k] is trials[k]'s, rest the settled gown
+// they all start from, out[] what its settling wrote) pulled as one while no arm has touched the
+// gown: the first trial's pull, watching the other arms (watch_arms()), with a copy of it kept at
+// the start of every sample. In the sample where an arm touches the gown (or where the rig
+// would stop one of them), each trial goes on from that copy on its own. Until then no arm
+// corrected a vertex and every arm was at rest, so each trial would have computed the same bits.
+void pull_together(const std::vector<GownModel>& models, const std::vector<size_t>& trials,
+                   const std::vector<TrialSpec>& specs, const std::vector<double>& dz, GownState rest,
+                   const Settled& at_rest, std::vector<TrialResult>& out) {
+  const GownModel& m = models[0];
+  const TrialSpec& lead = specs[trials[0]];
+  std::vector<double> watch;
+  for (size_t k = 1; k < trials.size(); ++k)
+    if (dz[k] != dz[0]) watch.push_back(dz[k] - dz[0]);
+  Pulling common = start_pull(m, std::move(rest), lead, out[trials[0]]);
+  Pulling fork;
+  bool at_common = false;  // every trial goes on from `common` itself, not from `fork`
+  for (;;) {
+    // The rig's profile and its stops agree while no trial's end of travel (or time) is near.
+    const double t_next = common.t + 3 * m.dt;
+    const double travel_next = Profile{lead.acceleration, lead.speed, 1e300}.travel(t_next);
+    bool near_end = common.ended;
+    for (size_t b : trials)
+      near_end = near_end || travel_next >= specs[b].max_travel - 1e-9 ||
+                 t_next >= specs[b].max_travel / specs[b].speed + specs[b].speed / specs[b].acceleration + 5.0;
+    if (near_end) {
+      at_common = true;
+      break;
+    }
+    fork = common;  // vectors keep their storage: no allocation after the first sample
+    bool touched = false;
+    pull_sample(m, common, lead, at_rest, watch, &touched);
+    if (touched || common.ended) break;
+  }
+  const Pulling& base = at_common ? common : fork;
+  const double shared_travel = base.r.seq.samples.empty() ? 0.0 : base.r.seq.samples.back().travel;
+  for (size_t k = 0; k < trials.size(); ++k) {
+    const size_t b = trials[k];
+    Pulling p = base;
+    // The trial's own fields over the first trial's; its samples so far are the shared ones.
+    p.r.arm_offset = out[b].arm_offset;
+    p.r.settle_shared = out[b].settle_shared;
+    p.r.wall_settle = out[b].wall_settle;
+    if (k > 0) p.r.wall_pull = 0;
+    p.r.seq.height = specs[b].height;
+    p.r.seq.id = std::string("sim-") + std::string(arm_height_name(specs[b].height)) + "-" + std::to_string(specs[b].seed);
+    p.r.pull_shared_travel = k > 0 ? shared_travel : 0.0;
+    while (!p.ended) pull_sample(models[k], p, specs[b], at_rest);
+    out[b] = finish_pull(models[k], p, specs[b], at_rest);
+  }
+}
+
+}  // namespace
 
 std::vector<TrialResult> simulate_trials(const Scene& scene, const ClothParams& params,
                                          const std::vector<TrialSpec>& specs) {
@@ -386,27 +494,38 @@ std::vector<TrialResult> simulate_trials(const Scene& scene, const ClothParams& 
     r.arm_offset = draws[a].arm_offset;
     const Settled at_rest = settle(m, s, specs[a], draws[a], probe, r);
     done[a] = 1;
-    if (!group.empty()) {
-      // A trial of the group starts its pull from a copy of this settling when its arm is a's
-      // (the same model, the same bits), or when no arm touched the gown while it settled (then
-      // no arm acted on it, and every watched arm height would have settled to these bits;
-      // watch_arms()). The others settle on their own later, grouped among themselves.
-      const GownState rest_state = s;
-      for (size_t b : group) {
-        if (at_rest.arm_touched && arm_dz_of(sc, specs[b], draws[b].arm_offset) != dz_a) continue;
-        // r holds only what the settling wrote (weight, bias, settle_*; no frames in a group).
-        TrialResult& rb = out[b] = r;
-        rb.arm_offset = draws[b].arm_offset;
-        rb.wall_settle = 0;
-        rb.settle_shared = true;
-        GownModel mb = m;
-        place_arm(mb, arm_dz_of(sc, specs[b], draws[b].arm_offset));
-        GownState sb = rest_state;
-        pull(mb, sb, specs[b], at_rest, rb);
-        done[b] = 1;
+    // A trial of the group starts its pull from this settling when its arm is a's (the same
+    // model, the same bits), or when no arm touched the gown while it settled (then no arm acted
+    // on it, and every watched arm height would have settled to these bits; watch_arms()). The
+    // others settle on their own later, grouped among themselves. Of those starting here, the
+    // ones whose pulls agree with a's are pulled as one until an arm touches (pull_together()).
+    std::vector<size_t> together{a};
+    std::vector<GownModel> models{m};
+    std::vector<double> dz{dz_a};
+    for (size_t b : group) {
+      const double dz_b = arm_dz_of(sc, specs[b], draws[b].arm_offset);
+      if (at_rest.arm_touched && dz_b != dz_a) continue;
+      // r holds only what the settling wrote (weight, bias, settle_*; no frames in a group).
+      out[b] = r;
+      out[b].arm_offset = draws[b].arm_offset;
+      out[b].wall_settle = 0;
+      out[b].settle_shared = true;
+      done[b] = 1;
+      GownModel mb = m;
+      place_arm(mb, dz_b);
+      if (same_pull(specs[a], specs[b])) {
+        together.push_back(b);
+        models.push_back(std::move(mb));
+        dz.push_back(dz_b);
+      } else {
+        out[b] = pull(mb, s, specs[b], at_rest, std::move(out[b]));
       }
     }
-    pull(m, s, specs[a], at_rest, r);
+    if (together.size() > 1) {
+      pull_together(models, together, specs, dz, std::move(s), at_rest, out);
+    } else {
+      out[a] = pull(m, std::move(s), specs[a], at_rest, std::move(out[a]));
+    }
   }
   return out;
 }

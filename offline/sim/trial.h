@@ -207,6 +207,9 @@ struct TrialResult {
   // another trial's arm that this settling watched (watch_arms()). Reach is not touch: settlings
   // are shared unless an arm touched the gown.
   bool settle_arm_near = false;
+  // simulate_trials(): the travel [m] up to which this trial's pull was another's, pulled as one
+  // while no arm touched the gown (0: its own from the start).
+  double pull_shared_travel = 0;
 };
 
 // The arm (data README; paper IV: capsules, fixed, uniform friction). Spheres fist, wrist,
@@ -305,7 +308,11 @@ TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const 
 // bit), so each of those trials would have settled to those same bits on its own. In
 // calibration, where one cloth is pulled over 2-3 arm heights, that saves all settlings but one
 // while no arm touches the settling gown; in `predict`, the trials of one height share theirs
-// always (TrialResult::settle_shared, settle_arm_near).
+// always (TrialResult::settle_shared, settle_arm_near). The trials that start from one settling
+// at the same speed, acceleration and force limit are then pulled as one while no arm has
+// touched the gown (the same argument: an arm that corrects no vertex, and so stays at rest,
+// changes no bit), and each goes on alone from the start of the sample in which one touches
+// (TrialResult::pull_shared_travel); where the rig stops one of them, they part before.
 std::vector<TrialResult> simulate_trials(const Scene& scene, const ClothParams& params,
                                          const std::vector<TrialSpec>& specs);
 

@@ -365,6 +365,10 @@ void expect_same_trial(const TrialResult& a, const TrialResult& b, const char* w
   EXPECT_EQ(a.outcome, b.outcome) << what;
   EXPECT_EQ(a.d_max, b.d_max) << what;
   EXPECT_EQ(a.arm_offset, b.arm_offset) << what;
+  EXPECT_EQ(a.travel, b.travel) << what;
+  EXPECT_EQ(a.contact_travel, b.contact_travel) << what;
+  EXPECT_EQ(a.arm_shift, b.arm_shift) << what;
+  EXPECT_EQ(a.seq.id, b.seq.id) << what;
 }
 
 }  // namespace
@@ -485,6 +489,39 @@ TEST(SimTrial, SharedSettlingWhereAnArmCameNearButDidNotTouch) {
   }
   EXPECT_GT(near_shared, 0) << "no height where the arm came within reach without touching";
   EXPECT_GT(touched, 0) << "no height where the swinging tube touched the arm";
+}
+
+// Pulls that start from one settling at the same speed are the same computation until an arm
+// touches the gown: simulate_trials() pulls them as one that far and forks them in the sample of
+// the first touch, and each trial still has the bits of its own simulate_trial(). The fork comes
+// one sample (1 mm at 0.1 m/s) before the first contact of any of them; a trial at another speed
+// pulls alone, and a different end of travel (0.25 m) is no reason to fork before it.
+TEST(SimTrial, SharedPullUntilAnArmTouchesGivesEachTrialItsOwnBits) {
+  ClothParams cloth;
+  cloth.arm_compliance = 0.005;  // a compliant arm, at rest until touched
+  std::vector<TrialSpec> specs(4);
+  specs[0].height = ArmHeight::Low;  // first: the pull watches the arms that touch sooner
+  specs[1].height = ArmHeight::Middle;
+  specs[2].height = ArmHeight::High;
+  specs[3].height = ArmHeight::Low;
+  for (TrialSpec& s : specs) s.max_travel = 0.3;
+  specs[1].max_travel = 0.25;
+  specs[3].speed = 0.15;
+  const std::vector<TrialResult> together = simulate_trials(coarse_scene(), cloth, specs);
+  double first_contact = 1e9;
+  for (size_t i = 0; i < specs.size(); ++i) {
+    const TrialResult alone = simulate_trial(coarse_scene(), cloth, specs[i]);
+    expect_same_trial(together[i], alone, ("trial " + std::to_string(i)).c_str());
+    ASSERT_GT(alone.contact_travel, 0) << "trial " << i << " should touch the arm by 0.25 m";
+    if (i < 3) first_contact = std::min(first_contact, alone.contact_travel);
+  }
+  ASSERT_TRUE(together[1].settle_shared && together[2].settle_shared) << "the coarse gown settles clear of the arms";
+  EXPECT_EQ(together[0].pull_shared_travel, 0.0) << "the first trial's pull is its own";
+  for (int i : {1, 2}) {
+    EXPECT_LT(together[i].pull_shared_travel, first_contact) << "trial " << i << ": shared past the first touch";
+    EXPECT_GT(together[i].pull_shared_travel, first_contact - 0.0011) << "trial " << i << ": forked before the sample of the first touch";
+  }
+  EXPECT_EQ(together[3].pull_shared_travel, 0.0) << "another speed pulls alone";
 }
 
 namespace {
