@@ -25,7 +25,7 @@
 //     objective, and the projection to the paper's 50 x 32 budget from the measured pace. Under
 //     mpirun (e.g. -n 1 and -n 2 with --threads 1) the calibration's wall time gives the MPI
 //     scaling efficiency T1 / (2 T2). --baseline 1: the calibration once more with every trial
-//     settled on its own; --predict 1: the calibration's prediction of the other participants'
+//     settled and pulled on its own; --predict 1: the calibration's prediction of the other participants'
 //     trials with one settling per group of targets against one per target (same tables required).
 //
 // Everything runs through dg_calib's public API (the same code as the commands).
@@ -360,7 +360,7 @@ int run_timing(const std::map<std::string, std::string>& a) {
   t0 = std::chrono::steady_clock::now();
   const CalibrationResult r = calibrate(inputs, space, sim.trials, o, Comm::world());
   const double cal_s = seconds_since(t0);
-  // Baseline in the same run (--baseline 1): every trial settled on its own, as before
+  // Baseline in the same run (--baseline 1): every trial settled and pulled on its own, as before
   // simulate_trials; the same result, bit for bit, is required.
   double base_s = 0;
   bool same = true;
@@ -382,7 +382,7 @@ int run_timing(const std::map<std::string, std::string>& a) {
               o.population, inputs.size(), sims,
               thread_count(o.threads), cal_s, cal_s / sims, r.objective);
   if (base_s > 0)
-    std::printf("baseline, each trial settled on its own: %.1f s wall, %.2f s per simulation; shared settling is "
+    std::printf("baseline, each trial settled and pulled on its own: %.1f s wall, %.2f s per simulation; sharing them is "
                 "%.2fx faster; same result: %s\n", base_s, base_s / sims, base_s / cal_s, same ? "yes" : "NO");
   std::printf("projection to the paper's 50 x 32 (%.0f simulations) at this pace: %.1f h wall on this machine\n",
               full_sims, cal_s / sims * full_sims / 3600.0);
