@@ -135,6 +135,7 @@ ClothValues ParameterSpace::cloth(const Eigen::VectorXd& unit) const {
     set_person_value(c, i, person[i].fit ? from_unit(bounds.person[i], unit[k++]) : person[i].value);
   c.hem_width = hem_width;
   c.hem_bend_ratio = hem_bend_ratio;
+  c.areal_density = areal_density;
   return c;
 }
 
@@ -243,6 +244,8 @@ std::string fingerprint(const std::vector<HapticSequence>& inputs, const Paramet
   }
   // The cuff only when there is one (older checkpoints resume).
   if (space.hem_width > 0) f << ";hem=" << hexd(space.hem_width) << ',' << hexd(space.hem_bend_ratio);
+  // Likewise a density other than the paper's.
+  if (space.areal_density != kPaperArealDensity) f << ";density=" << hexd(space.areal_density);
   f << ";inputs=";
   for (const auto& s : inputs) f << s.id << '/' << s.samples.size() << ',';
   return f.str();
@@ -495,6 +498,7 @@ Json calibration_to_json(const Calibration& c) {
     cloth.set("hem_width", c.cloth.hem_width);
     cloth.set("hem_bend_ratio", c.cloth.hem_bend_ratio);
   }
+  if (c.cloth.areal_density != kPaperArealDensity) cloth.set("areal_density", c.cloth.areal_density);  // and the weight
   j.set("cloth", cloth);
   Json off = Json::object();
   for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
@@ -553,6 +557,11 @@ Calibration calibration_from_json(const Json& j, const std::filesystem::path& so
       c.cloth.hem_bend_ratio = j.at("cloth").at("hem_bend_ratio").number();
       if (!hem_in_range(c.cloth.hem_width, c.cloth.hem_bend_ratio))
         throw std::runtime_error("cloth.hem_width / hem_bend_ratio must be within [0, 0.2] m / [1, 10000]");
+    }
+    if (j.at("cloth").has("areal_density")) {
+      c.cloth.areal_density = j.at("cloth").at("areal_density").number();
+      if (!areal_density_in_range(c.cloth.areal_density))
+        throw std::runtime_error("cloth.areal_density must be above 0 and at most 1 kg/m^2");
     }
     for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
       const Json& e = j.at("arm_offsets").at(std::string(arm_height_name(h)));

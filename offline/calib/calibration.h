@@ -51,7 +51,14 @@ struct ClothValues {
   // further ahead of the jaws the sleeve opening's rim is than offline/gown/placement.h puts it
   // (kOpeningRimAhead, 4 cm on the measured gown). The study did not measure it.
   double rim_shift = 0.0;
+  // The gown's areal density [kg/m^2] (sim/trial.h ClothParams::areal_density). Held, never
+  // fitted (ParameterSpace::areal_density); the paper's simulator, and every calibration without
+  // one in its file, used kPaperArealDensity. The study did not weigh its gown.
+  double areal_density = 0.145;
 };
+inline constexpr double kPaperArealDensity = 0.145;
+// A density's limits: above 0, at most 1 kg/m^2 (a heavy canvas is about 0.5).
+inline bool areal_density_in_range(double d) { return d > 0 && d <= 1.0; }
 inline constexpr int kClothParams = 5;
 // A cuff's limits (sim/params.cpp checks the same): width in [0, 0.2] m, ratio in [1, 1e4].
 inline constexpr double kMaxHemWidth = 0.2, kMaxHemBendRatio = 1e4;
@@ -157,6 +164,8 @@ struct ParameterSpace {
   std::array<Person, kPersonParams> person{};
   // The gown's cuff every candidate is simulated with (ClothValues::hem_width, hem_bend_ratio).
   double hem_width = 0.0, hem_bend_ratio = 1.0;
+  // The gown's areal density every candidate is simulated with (ClothValues::areal_density).
+  double areal_density = kPaperArealDensity;
   int fitted_person_params() const {
     int n = 0;
     for (const Person& p : person) n += p.fit ? 1 : 0;

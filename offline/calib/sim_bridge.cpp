@@ -29,6 +29,7 @@ sim::ClothParams cloth_params_of(const ClothValues& c) {
   p.fist_shift = c.fist_shift;
   p.hem_width = c.hem_width;
   p.hem_bend_ratio = c.hem_bend_ratio;
+  p.areal_density = c.areal_density;
   return p;
 }
 
@@ -41,6 +42,8 @@ static_assert(kPersonParamInfo[kFistShift].highest == sim::kMaxFistShift &&
               "fist_shift's range differs between calibration.h and sim/trial.h");
 // The middle arm's nominal height below the high one (synthesis.h) is the simulator's.
 constexpr double kSimMiddleBelowHigh = sim::ArmGeometry{}.z_rel[0] - sim::ArmGeometry{}.z_rel[1];
+static_assert(kPaperArealDensity == sim::ClothParams{}.areal_density,
+              "the paper's areal density differs between calibration.h and sim/trial.h");
 static_assert(kMaxHemWidth == sim::kMaxHemWidth && kMaxHemBendRatio == sim::kMaxHemBendRatio,
               "the cuff's limits differ between calibration.h and sim/trial.h");
 static_assert(kSimMiddleBelowHigh - kMiddleBelowHigh < 1e-12 && kMiddleBelowHigh - kSimMiddleBelowHigh < 1e-12,
@@ -135,9 +138,8 @@ ClothSimulator make_cloth_simulator(const std::string& gown) {
   };
   // The bending length is the mesh's: a grasp moves the gown, it does not change its triangles.
   const double factor = sim::bend_mesh_factor(scenes->own()->data());
-  const double density = sim::ClothParams{}.areal_density;
-  cs.bending_length = [factor, density](double bend) {
-    return sim::bending_length(sim::bending_rigidity(bend, factor), density);
+  cs.bending_length = [factor](double bend, double areal_density) {
+    return sim::bending_length(sim::bending_rigidity(bend, factor), areal_density);
   };
   return cs;
 }

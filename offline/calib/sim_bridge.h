@@ -23,7 +23,7 @@ struct ClothSimulator {
   TrialBatchSimulator trials;
   // Peirce's bending length [m] that a bend value gives on this simulator's gown mesh
   // (sim::bending_length in offline/sim/model.h): what the calibrated `bend` means as a fabric.
-  std::function<double(double bend)> bending_length;
+  std::function<double(double bend, double areal_density)> bending_length;
 };
 
 // "full" (the measured 20k-triangle gown), "reduced" (the default for calibration and synthesis)

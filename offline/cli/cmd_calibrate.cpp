@@ -60,6 +60,9 @@ int run_calibrate(int argc, char** argv) {
         "  --hem W,R           the gown's cuff: bending R x stiffer within W metres of the sleeve\n"
         "                      opening (held, not fitted; recorded in CAL.json, so synthesis uses\n"
         "                      it too; offline/sim/README.md, \"How stiff the gown is\"). Default none\n"
+        "  --density D         the gown's areal density in kg/m^2 (held, recorded in CAL.json like\n"
+        "                      --hem; default 0.145, the paper's; offline/sim/README.md, \"The gown's\n"
+        "                      weight\")\n"
         "  --gown full|reduced|coarse   simulator gown (default reduced)\n"
         "  --threads N         threads per process (default: all cores)\n"
         "  --checkpoint FILE   default CAL.json.ckpt; an existing one is resumed\n"
@@ -71,7 +74,8 @@ int run_calibrate(int argc, char** argv) {
   }
   args.allow_only({"help", "json", "no-arm-offset", "data", "participant", "profile", "bounds", "start", "seed", "out",
                    "checkpoint", "objective", "gown", "threads", "generations", "population",
-                   "stop-after-generations", "arm-compliance", "fist-shift", "rim-shift", "sigma0", "hem"});
+                   "stop-after-generations", "arm-compliance", "fist-shift", "rim-shift", "sigma0", "hem",
+                   "density"});
   const std::string data = args.require("data");
   const std::string participant = args.require("participant");
   const std::string out = args.require("out");
@@ -114,6 +118,11 @@ int run_calibrate(int argc, char** argv) {
                        *hem + "'");
     space.hem_width = w;
     space.hem_bend_ratio = r;
+  }
+  if (const auto d = args.get("density")) {
+    space.areal_density = args.number("density", kPaperArealDensity);
+    if (!areal_density_in_range(space.areal_density))
+      throw UsageError("--density must be above 0 and at most 1 kg/m^2, not '" + *d + "'");
   }
   space.bounds = args.get("bounds") ? read_bounds(*args.get("bounds")) : default_bounds();
   if (const auto start = args.get("start")) {
@@ -211,7 +220,8 @@ int run_calibrate(int argc, char** argv) {
         std::printf("  %-13s %.4f", kClothParamNames[i], cloth_value(r.cloth, i));
         // What bend means as a fabric (light woven fabrics: 1.5-3 cm; offline/sim/README.md).
         if (std::string(kClothParamNames[i]) == "bend" && sim.bending_length)
-          std::printf("  (bending length %.1f cm on this gown)", 100 * sim.bending_length(cloth_value(r.cloth, i)));
+          std::printf("  (bending length %.1f cm on this gown)",
+                      100 * sim.bending_length(cloth_value(r.cloth, i), r.cloth.areal_density));
         std::printf("\n");
       }
       for (int i = 0; i < kPersonParams; ++i)
@@ -219,6 +229,8 @@ int run_calibrate(int argc, char** argv) {
           std::printf("  %-14s %.4f%s\n", kPersonParamInfo[i].name, person_value(r.cloth, i), space.person[i].fit ? "" : " (held)");
       if (r.cloth.hem_width > 0)
         std::printf("  hem           %.3f m, bending x %g (held)\n", r.cloth.hem_width, r.cloth.hem_bend_ratio);
+      if (r.cloth.areal_density != kPaperArealDensity)
+        std::printf("  areal_density %.4f kg/m^2 (held)\n", r.cloth.areal_density);
       for (ArmHeight h : space.offset_heights)
         std::printf("  arm offset %-6s %+.4f m\n", std::string(arm_height_name(h)).c_str(), r.offsets[static_cast<int>(h)]);
       std::printf("wrote %s and %s.curves.csv\n", out.c_str(), out.c_str());

@@ -246,6 +246,10 @@ TEST(Calibration, CheckpointOfAnotherRunIsRefused) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("different calibration"), std::string::npos) << e.what();
   }
+  auto light = space;  // and on a lighter gown
+  light.areal_density = 0.1;
+  EXPECT_EQ(light.cloth(light.initial_unit()).areal_density, 0.1);
+  EXPECT_THROW(calibrate(inputs, light, testing::fake_simulate, o, Comm::world()), InputError);
   EXPECT_NO_THROW(calibrate(inputs, space, testing::fake_simulate, o, Comm::world()));  // its own run resumes
   write_file_atomic(o.checkpoint, "garbage\n");
   EXPECT_THROW(calibrate(inputs, space, testing::fake_simulate, o, Comm::world()), InputError);
@@ -400,6 +404,24 @@ TEST(Calibration, CalibrationFileRoundTripAndErrors) {
   }
   c.cloth.hem_width = 0;
   c.cloth.hem_bend_ratio = 1;
+  // The density: absent is the paper's 0.145 (not written); another reads back; out of range
+  // names the file and the field.
+  EXPECT_EQ(read_file(dir / "cal_fist.json").find("areal_density"), std::string::npos);
+  EXPECT_EQ(d.cloth.areal_density, kPaperArealDensity);
+  c.cloth.areal_density = 0.1;
+  write_calibration(dir / "cal_density.json", c);
+  EXPECT_EQ(read_calibration(dir / "cal_density.json").cloth.areal_density, 0.1);
+  text = read_file(dir / "cal_density.json");
+  text.replace(text.find("\"areal_density\": 0.1"), 20, "\"areal_density\": -0.1");
+  write_file_atomic(dir / "cal_density_bad.json", text);
+  try {
+    read_calibration(dir / "cal_density_bad.json");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cal_density_bad.json"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("areal_density"), std::string::npos) << e.what();
+  }
+  c.cloth.areal_density = kPaperArealDensity;
   EXPECT_EQ(d.participant, "4");
   EXPECT_EQ(d.cloth.self_friction, 0.5);
   EXPECT_EQ(d.offsets[2], 0.011);

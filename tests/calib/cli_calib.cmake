@@ -25,6 +25,7 @@ expect_fail("calibrate with a rim behind the jaws" "--rim-shift must be fit, fix
 expect_fail("calibrate with the fist past the elbow" "--fist-shift must be fit, fixed or a value (fist_shift must be within +-0.2 m" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --fist-shift 0.3)
 expect_fail("calibrate with a bad --hem" "--hem" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --hem 0.03)
 expect_fail("calibrate with a softening --hem" "--hem" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --hem 0.03,0.5)
+expect_fail("calibrate with a weightless gown" "--density must be above 0" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --density 0)
 expect_fail("calibrate on a missing dataset" "manifest.csv" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json)
 file(WRITE ${WORK}/bad.json "{\"format\": \"dressguard-calibration 1\",\n\"participant\": 4,\n}")
 expect_fail("synthesize with a bad calibration file" "bad.json" synthesize --calibration ${WORK}/bad.json --out ${WORK}/s)

@@ -18,9 +18,10 @@ namespace dressguard::calib {
 namespace {
 
 // A calibration's values reach the simulator whole: the five cloth values, the person's arm and
-// the gown's cuff (calibrate --hem records it in the file, synthesis simulates with it).
+// the gown's cuff and its density (calibrate --hem / --density record them in the file,
+// synthesis simulates with them).
 TEST(SimCalibration, ClothParamsCarryEveryCalibratedValue) {
-  ClothValues c{0.1, 0.2, 0.3, 0.4, 0.5, 0.006, 0.05, 0.03, 30};
+  ClothValues c{0.1, 0.2, 0.3, 0.4, 0.5, 0.006, 0.05, 0.03, 30, 0.0, 0.1};
   const sim::ClothParams p = cloth_params_of(c);
   EXPECT_EQ(p.stretch, 0.1);
   EXPECT_EQ(p.self_friction, 0.5);
@@ -28,6 +29,7 @@ TEST(SimCalibration, ClothParamsCarryEveryCalibratedValue) {
   EXPECT_EQ(p.fist_shift, 0.05);
   EXPECT_EQ(p.hem_width, 0.03);
   EXPECT_EQ(p.hem_bend_ratio, 30.0);
+  EXPECT_EQ(p.areal_density, 0.1);
   EXPECT_EQ(p.damping, sim::ClothParams{}.damping);  // not calibrated (paper IV-B.2)
 }
 
