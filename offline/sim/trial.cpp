@@ -226,6 +226,12 @@ Settled settle(GownModel& m, GownState& s, const TrialSpec& spec, const TrialDra
   return out;
 }
 
+// The pull's time limit [s]: past the rig's whole travel by 5 s (a guard; the travel or the
+// force limit ends every pull first).
+double max_time_of(const TrialSpec& spec) {
+  return spec.max_travel / spec.speed + spec.speed / spec.acceleration + 5.0;
+}
+
 // A pull under way: everything its sample loop carries from one sample to the next, so that
 // trials whose pulls agree so far can go on from a copy of it (simulate_trials()).
 struct Pulling {
@@ -335,14 +341,13 @@ void pull_sample(const GownModel& m, Pulling& p, const TrialSpec& spec, const Se
         r.contact_travel = travel;
         break;
       }
-  const double max_time = spec.max_travel / spec.speed + spec.speed / spec.acceleration + 5.0;
   if (std::abs(f.x) >= spec.force_limit || std::abs(f.z) >= spec.force_limit) {
     r.stopped_by_force = true;
     p.ended = true;
   } else if (travel >= spec.max_travel - 1e-12) {
     p.full = true;
     p.ended = true;
-  } else if (!r.finite || p.t >= max_time) {
+  } else if (!r.finite || p.t >= max_time_of(spec)) {
     p.ended = true;
   }
   r.wall_pull += std::chrono::duration<double>(std::chrono::steady_clock::now() - clock).count();
@@ -436,8 +441,7 @@ void pull_together(const std::vector<GownModel>& models, const std::vector<size_
     const double travel_next = Profile{lead.acceleration, lead.speed, 1e300}.travel(t_next);
     bool near_end = common.ended;
     for (size_t b : trials)
-      near_end = near_end || travel_next >= specs[b].max_travel - 1e-9 ||
-                 t_next >= specs[b].max_travel / specs[b].speed + specs[b].speed / specs[b].acceleration + 5.0;
+      near_end = near_end || travel_next >= specs[b].max_travel - 1e-9 || t_next >= max_time_of(specs[b]);
     if (near_end) {
       at_common = true;
       break;
@@ -500,7 +504,7 @@ std::vector<TrialResult> simulate_trials(const Scene& scene, const ClothParams& 
     // others settle on their own later, grouped among themselves. Of those starting here, the
     // ones whose pulls agree with a's are pulled as one until an arm touches (pull_together()).
     std::vector<size_t> together{a};
-    std::vector<GownModel> models{m};
+    std::vector<GownModel> models;  // together's, a's first once another joins
     std::vector<double> dz{dz_a};
     for (size_t b : group) {
       const double dz_b = arm_dz_of(sc, specs[b], draws[b].arm_offset);
@@ -514,6 +518,7 @@ std::vector<TrialResult> simulate_trials(const Scene& scene, const ClothParams& 
       GownModel mb = m;
       place_arm(mb, dz_b);
       if (same_pull(specs[a], specs[b])) {
+        if (models.empty()) models.push_back(m);
         together.push_back(b);
         models.push_back(std::move(mb));
         dz.push_back(dz_b);
