@@ -413,7 +413,9 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
         GenerationProgress p;
         p.generation = done;
         p.generations = options.generations;
-        p.best = std::min(es.best_f(), start_f);
+        const bool start_best = !(es.best_f() <= start_f);  // as the result chooses, below
+        p.best = start_best ? start_f : es.best_f();
+        p.best_fits = start_best ? start_fits : best_fits;
         p.generation_best = f[arg];
         p.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         p.eta_s = p.elapsed_s / done_here * std::max(0, options.generations - done);

@@ -207,6 +207,7 @@ struct GenerationProgress {
   int generation = 0;       // 1-based, generations done
   int generations = 0;      // total planned
   double best = 0;          // best objective so far
+  std::vector<double> best_fits;  // its objective per input sequence, in the inputs' order (they sum to best)
   double generation_best = 0;
   double elapsed_s = 0;     // this process
   double eta_s = 0;         // estimated remaining, from this process's pace

@@ -149,8 +149,15 @@ int run_calibrate(int argc, char** argv) {
                  o.generations, o.population, comm.size(), thread_count(o.threads), gown.c_str());
   }
   const CalibrationResult r = calibrate(inputs, space, sim.trials, o, comm, [&](const GenerationProgress& p) {
-    std::fprintf(stderr, "generation %d/%d  best L %.4f  (this generation %.4f)  elapsed %s  ETA %s\n", p.generation,
-                 p.generations, p.best, p.generation_best, minutes(p.elapsed_s).c_str(), minutes(p.eta_s).c_str());
+    std::string per;  // the best point's L per sequence
+    for (std::size_t k = 0; k < p.best_fits.size() && k < inputs.size(); ++k) {
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "%s%s %.3f", k ? ", " : "", inputs[k].id.c_str(), p.best_fits[k]);
+      per += buf;
+    }
+    std::fprintf(stderr, "generation %d/%d  best L %.4f (%s)  (this generation %.4f)  elapsed %s  ETA %s\n",
+                 p.generation, p.generations, p.best, per.c_str(), p.generation_best, minutes(p.elapsed_s).c_str(),
+                 minutes(p.eta_s).c_str());
   });
   if (!r.complete) {
     if (comm.is_root()) {

@@ -215,6 +215,11 @@ TEST(Calibration, ResumeFromCheckpointGivesTheUninterruptedResult) {
                                  [&](const GenerationProgress& p) {
                                    if (!first_reported) first_reported = p.generation;
                                    EXPECT_TRUE(p.resumed);
+                                   // The best point's objective per sequence, summed as the search sums it.
+                                   ASSERT_EQ(p.best_fits.size(), inputs.size());
+                                   double sum = 0.0;
+                                   for (double e : p.best_fits) sum += e;
+                                   EXPECT_EQ(sum, p.best);
                                  });
   EXPECT_EQ(first_reported, 6);  // continued with generation 6, not from scratch
   EXPECT_TRUE(resumed.complete);

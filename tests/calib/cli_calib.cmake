@@ -50,6 +50,15 @@ if(STUDY)
   expect_fail("calibrate with a bad bounds file" "bounds.txt:2: unknown parameter 'stiffness'"
               calibrate --data ${WORK}/study --participant 4 --out ${WORK}/c.json --bounds ${WORK}/bounds.txt)
   expect_fail("calibrate an absent participant" "participant '42'" calibrate --data ${WORK}/study --participant 42 --out ${WORK}/c.json)
+  # One generation of 4 on the coarse gown (~10 s): the calibration file and its curves, and a
+  # progress line with the best point's L and each sequence's share of it.
+  execute_process(COMMAND ${DG} calibrate --data ${WORK}/study --participant 4 --out ${WORK}/c1.json --gown coarse
+                          --generations 1 --population 4 --threads 2 --seed 1
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/c1.json OR NOT EXISTS ${WORK}/c1.json.curves.csv
+     OR NOT err MATCHES "generation 1/1  best L [0-9.]+ \\(s4-good-3 [0-9.]+, s4-miss-2 [0-9.]+\\)  \\(this generation")
+    message(FATAL_ERROR "calibrate on the coarse gown (${rc}):\n${out}\n${err}")
+  endif()
   # predict: participant 4's calibration on the other six participants' 20 trials (coarse gown, ~40 s).
   execute_process(COMMAND ${DG} predict --calibration ${WORK}/cal4.json --data ${WORK}/study --out ${WORK}/pred --json
                   RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
