@@ -1,6 +1,6 @@
 # The calibrate / synthesize / build-model commands: bad input exits 2 with one line naming the
 # problem (file and line where there is one); build-model --data trains a model from a dataset.
-# -DDG=<dressguard> -DWORK=<dir> -DSTUDY=<study dir or empty>
+# -DDG=<dressguard> -DWORK=<dir> -DSTUDY=<study dir or empty> -DPLOT=<tools/plot/calib_overlay.py>
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 
@@ -58,6 +58,13 @@ if(STUDY)
   if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/c1.json OR NOT EXISTS ${WORK}/c1.json.curves.csv
      OR NOT err MATCHES "generation 1/1  best L [0-9.]+ \\(s4-good-3 [0-9.]+, s4-miss-2 [0-9.]+\\)  \\(this generation")
     message(FATAL_ERROR "calibrate on the coarse gown (${rc}):\n${out}\n${err}")
+  endif()
+  # Its progress as a picture (tools/plot/calib_overlay.py progress reads the kept stderr).
+  file(WRITE ${WORK}/c1.log "${err}")
+  execute_process(COMMAND /usr/bin/python3 ${PLOT} progress ${WORK}/c1.log --out ${WORK}/c1-progress.png
+                  RESULT_VARIABLE rc ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/c1-progress.png)
+    message(FATAL_ERROR "calib_overlay.py progress on calibrate's log (${rc}): ${err}")
   endif()
   # predict: participant 4's calibration on the other six participants' 20 trials (coarse gown, ~40 s).
   execute_process(COMMAND ${DG} predict --calibration ${WORK}/cal4.json --data ${WORK}/study --out ${WORK}/pred --json

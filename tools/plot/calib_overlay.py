@@ -20,12 +20,17 @@ Modes:
             deviation) and the simulated mean (black); windows where the simulation is further from
             the people's mean than they are from each other are shaded red (what the simulation
             gets wrong, offline/calib/prediction.h).
-Reads only the CSVs that dressguard writes (calibrate's curves file; dataset folders).
+  progress: calib_overlay.py progress CALIBRATE.log --out progress.png
+            `dressguard calibrate`'s progress lines (its stderr, kept in a file): the best L so far
+            and each generation's best against the generation, and the best point's L per sequence
+            where the lines name them. A resumed run's log may repeat a generation: the last wins.
+Reads only what dressguard writes (calibrate's curves file and progress lines; dataset folders).
 """
 import argparse
 import csv
 import collections
 import os
+import re
 
 import matplotlib
 
@@ -177,6 +182,48 @@ def plot_residual(args):
     fig.savefig(args.out, dpi=100)
 
 
+PROGRESS = re.compile(r"^generation (\d+)/(\d+)\s+best L ([0-9.eE+-]+|inf)(?: \(([^)]*)\))?\s+"
+                      r"\(this generation ([0-9.eE+-]+|inf)\)")
+
+
+def read_progress(path):
+    """{generation: (best, generation_best, {sequence: L})} from calibrate's progress lines."""
+    gens = {}
+    with open(path) as f:
+        for line in f:
+            m = PROGRESS.match(line)
+            if not m:
+                continue
+            per = {}
+            for part in (m.group(4) or "").split(", "):
+                if part:
+                    name, value = part.rsplit(" ", 1)
+                    per[name] = float(value)
+            gens[int(m.group(1))] = (float(m.group(3)), float(m.group(5)), per)
+    if not gens:
+        raise SystemExit(f"{path}: no 'generation G/N  best L ...' lines (calibrate's stderr)")
+    return gens
+
+
+def plot_progress(args):
+    gens = read_progress(args.log)
+    g = sorted(gens)
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.plot(g, [gens[k][1] for k in g], "o", ms=3, color="tab:gray", label="the generation's best")
+    ax.plot(g, [gens[k][0] for k in g], "-", lw=2, color="black", drawstyle="steps-post", label="best so far")
+    names = sorted({n for k in g for n in gens[k][2]})
+    for n in names:
+        pts = [(k, gens[k][2][n]) for k in g if n in gens[k][2]]
+        ax.plot([p[0] for p in pts], [p[1] for p in pts], "--.", lw=1.2, drawstyle="steps-post", label=f"best so far: {n}")
+    ax.set_yscale("log")
+    ax.set_xlabel("generation")
+    ax.set_ylabel("L (paper eq. 3-5)")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(args.out, dpi=110)
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="mode", required=True)
@@ -195,8 +242,12 @@ def main():
     r = sub.add_parser("residual")
     r.add_argument("prefix")
     r.add_argument("--out", required=True)
+    g = sub.add_parser("progress")
+    g.add_argument("log")
+    g.add_argument("--out", required=True)
     args = p.parse_args()
-    {"fit": plot_fit, "dataset": plot_dataset, "predict": plot_predict, "residual": plot_residual}[args.mode](args)
+    {"fit": plot_fit, "dataset": plot_dataset, "predict": plot_predict, "residual": plot_residual,
+     "progress": plot_progress}[args.mode](args)
 
 
 if __name__ == "__main__":
