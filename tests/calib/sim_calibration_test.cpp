@@ -9,6 +9,7 @@
 #include "fake_sim.h"
 #include "prediction.h"
 #include "gown.h"
+#include "objective.h"
 #include "gown_scene.h"
 #include "sim_bridge.h"
 #include "synthesis.h"
@@ -186,6 +187,38 @@ TEST(SimCalibration, Participant4sTrialsShareTheirSettlingAndPullPrefix) {
   ASSERT_GT(r[0].contact_travel, 0) << "the high arm should touch the gown by 0.2 m";
   EXPECT_GT(r[1].pull_shared_travel, r[0].contact_travel - 0.0011);
   EXPECT_LT(r[1].pull_shared_travel, r[0].contact_travel);
+}
+
+// Participant 4's calibration at the paper's budget (50 x 32, models/participant4-paper-budget.json)
+// fits his own two sequences at L <= 0.3 each, near the floor of two repeats of one person's
+// trial (issue 4: 0.09 good, 0.22 missed). Its two trials simulated again from the file give the
+// objectives the search recorded, to the bit: the file holds everything the simulation needs,
+// and the simulator has not changed since the search.
+TEST(SimCalibration, Participant4sPaperBudgetCalibrationFitsHisSequences) {
+  const auto dir = study_dir();
+  if (dir.empty()) GTEST_SKIP() << "shared/data/kapusta2016-calibration-trials not present";
+  if (gown::measured_gown_path().empty()) GTEST_SKIP() << "shared/data/gown not present (calibrated on the measured gown)";
+  const Calibration cal =
+      read_calibration(std::filesystem::path(DRESSGUARD_SOURCE_DIR) / "models/participant4-paper-budget.json");
+  // The inputs as `dressguard import` then `calibrate --data` read them: through the dataset's
+  // CSV files, whose rounding moves L in the ninth digit.
+  const std::filesystem::path data = std::filesystem::path(::testing::TempDir()) / "dg_p4_paper_budget";
+  std::filesystem::remove_all(data);
+  save_dataset(import_study(dir), data);
+  const auto inputs = select_inputs(load_dataset(data), "4", 1);
+  std::filesystem::remove_all(data);
+  ASSERT_EQ(inputs.size(), cal.fits.size());
+  std::vector<TrialRequest> rs;
+  for (const auto& in : inputs) rs.push_back(request_for(in, cal.offsets));
+  const std::vector<SimulatedTrial> sts = make_cloth_simulator(cal.gown).trials(cal.cloth, rs);
+  ASSERT_EQ(sts.size(), inputs.size());
+  for (std::size_t k = 0; k < inputs.size(); ++k) {
+    ASSERT_EQ(cal.fits[k].trial_id, inputs[k].id);
+    const double L = area_objective(sts[k].samples, inputs[k].samples);
+    std::printf("  %s: L = %.4f (recorded %.4f)\n", inputs[k].id.c_str(), L, cal.fits[k].objective);
+    EXPECT_EQ(L, cal.fits[k].objective);
+    EXPECT_LE(L, 0.3);
+  }
 }
 
 // One generation on participant 4's sequences (the paper's public code calibrated on the same
