@@ -17,18 +17,29 @@ model::OutcomeModel build_outcome_model(const std::vector<const HapticSequence*>
 }
 
 StcAxes choose_stc_axes(const std::vector<SequenceFit>& fits) {
+  if (fits.empty()) return {true, "F_motion and F_vertical (no calibration sequences)"};
   double error = 0, zero = 0;
+  const SequenceFit* worst = nullptr;  // the sequence where the simulation is furthest behind zero
   for (const auto& f : fits) {
     if (!f.vertical.measured()) return {true, "F_motion and F_vertical (the calibration has no axis fits)"};
     error += f.vertical.error;
     zero += f.vertical.zero;
+    if (!(f.vertical.error < f.vertical.zero) &&
+        (!worst || f.vertical.error - f.vertical.zero > worst->vertical.error - worst->vertical.zero))
+      worst = &f;
   }
-  if (fits.empty()) return {true, "F_motion and F_vertical (no calibration sequences)"};
-  char buf[200];
-  const bool use = error < zero;
-  std::snprintf(buf, sizeof buf, "%s: the calibrated F_vertical is %.3f N m from the measured one, a zero force %.3f N m",
-                use ? "F_motion and F_vertical" : "F_motion alone", error, zero);
-  return {use, buf};
+  char buf[240];
+  if (worst)
+    std::snprintf(buf, sizeof buf,
+                  "F_motion alone: on %s the calibrated F_vertical is %.3f N m from the measured one, a zero force "
+                  "%.3f N m",
+                  worst->trial_id.c_str(), worst->vertical.error, worst->vertical.zero);
+  else
+    std::snprintf(buf, sizeof buf,
+                  "F_motion and F_vertical: the calibrated F_vertical is nearer the measured one than a zero force on "
+                  "every sequence (%.3f against %.3f N m in all)",
+                  error, zero);
+  return {worst == nullptr, buf};
 }
 
 double accuracy(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials, double truncate_at,

@@ -20,11 +20,15 @@ struct StcOptions {
 };
 
 // Which forces an STC should model, from its calibration: F_vertical only where the calibrated
-// simulator predicts it better than a zero force does over the calibration's own sequences (sum
-// of AxisFit::error < sum of AxisFit::zero, calibration.h). The paper's HMMs are bivariate, but
+// simulator predicts it better than a zero force does on every one of the calibration's own
+// sequences (AxisFit::error < AxisFit::zero, calibration.h). The paper's HMMs are bivariate, but
 // a force the simulator gets wrong (our sleeve-pulling gown hangs on the arm and lifts the
 // gripper where the measured vertical force stays near 0; offline/calib/README.md) teaches the
-// classifier a difference between simulation and reality instead of one between outcomes.
+// classifier a difference between simulation and reality instead of one between outcomes. Every
+// sequence, not their sum: each outcome's HMM learns mostly from one arm height, so a force
+// wrong at one height is wrong in that class (participant 4's paper-budget calibration: right at
+// the low arm, wrong at the high one, better in sum; its bivariate STC scored 15-20 % at
+// 0.20-0.25 m of travel, F_motion alone 45 %; offline/calib/README.md, session 15).
 // Both forces when the fits were not measured (a calibration file written before 2026-11-23).
 struct StcAxes {
   bool use_vertical = true;
