@@ -198,6 +198,16 @@ TrialRequest request_for(const HapticSequence& input, const std::array<double, 3
   return r;
 }
 
+std::vector<SimulatedTrial> simulate_inputs(const TrialBatchSimulator& sim, const ClothValues& cloth,
+                                            const std::array<double, 3>& offsets,
+                                            const std::vector<HapticSequence>& inputs) {
+  std::vector<TrialRequest> rs;
+  for (const HapticSequence& in : inputs) rs.push_back(request_for(in, offsets));
+  std::vector<SimulatedTrial> sts = sim(cloth, rs);
+  if (sts.size() != inputs.size()) throw std::logic_error("calibrate: the simulator returned a wrong count");
+  return sts;
+}
+
 bool stopped_by_force(const HapticSequence& s) { return ended_at_force_limit(s.samples); }
 
 double rig_travel_of(const std::vector<HapticSequence>& inputs) {
@@ -363,10 +373,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   // coarser grain still keeps 2 cores busy.
   auto evaluate = [&](const std::vector<Eigen::VectorXd>& xs) {
     return run_batch(static_cast<int>(xs.size()), K, thread_count(options.threads), comm, [&](int c, double* out) {
-      std::vector<TrialRequest> rs;
-      for (int k = 0; k < K; ++k) rs.push_back(request_for(inputs[k], space.offsets(xs[c])));
-      const std::vector<SimulatedTrial> sts = sim(space.cloth(xs[c]), rs);
-      if (static_cast<int>(sts.size()) != K) throw std::logic_error("calibrate: the simulator returned a wrong count");
+      const std::vector<SimulatedTrial> sts = simulate_inputs(sim, space.cloth(xs[c]), space.offsets(xs[c]), inputs);
       for (int k = 0; k < K; ++k) {
         const SimulatedTrial& st = sts[k];
         double v = std::numeric_limits<double>::infinity();

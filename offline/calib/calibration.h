@@ -270,6 +270,13 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
 // 0.85 m would charge w = 20 on ~0.1 m of travel that the rig never made.
 TrialRequest request_for(const HapticSequence& input, const std::array<double, 3>& offsets);
 
+// The calibration's inputs simulated with one cloth and its offsets (request_for each, one batch:
+// the search's evaluation of a candidate and the curves `calibrate` writes are this call), in the
+// inputs' order. Throws std::logic_error when the simulator returns another count.
+std::vector<SimulatedTrial> simulate_inputs(const TrialBatchSimulator& sim, const ClothValues& cloth,
+                                            const std::array<double, 3>& offsets,
+                                            const std::vector<HapticSequence>& inputs);
+
 // True when a measured trial ended at the force threshold (|F| >= 9.5 N on motion or vertical at
 // its last sample; the rig's limit is 10 N, the last sample may sit just under it).
 bool stopped_by_force(const HapticSequence& s);

@@ -205,9 +205,7 @@ int run_calibrate(int argc, char** argv) {
   // The best candidate's curves, simulated again (deterministic: the same as during the search).
   std::vector<SimulatedTrial> curves(inputs.size());
   if (comm.is_root()) {
-    std::vector<TrialRequest> requests;
-    for (std::size_t k = 0; k < inputs.size(); ++k) requests.push_back(request_for(inputs[k], r.offsets));
-    curves = sim.trials(r.cloth, requests);
+    curves = simulate_inputs(sim.trials, r.cloth, r.offsets, inputs);
     measure_axis_fits(cal.fits, inputs, curves);
     write_calibration(out, cal);
     write_file_atomic(out + ".curves.csv",

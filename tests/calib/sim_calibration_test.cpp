@@ -208,9 +208,7 @@ TEST(SimCalibration, Participant4sPaperBudgetCalibrationFitsHisSequences) {
   const auto inputs = select_inputs(load_dataset(data), "4", 1);
   std::filesystem::remove_all(data);
   ASSERT_EQ(inputs.size(), cal.fits.size());
-  std::vector<TrialRequest> rs;
-  for (const auto& in : inputs) rs.push_back(request_for(in, cal.offsets));
-  const std::vector<SimulatedTrial> sts = make_cloth_simulator(cal.gown).trials(cal.cloth, rs);
+  const std::vector<SimulatedTrial> sts = simulate_inputs(make_cloth_simulator(cal.gown).trials, cal.cloth, cal.offsets, inputs);
   ASSERT_EQ(sts.size(), inputs.size());
   for (std::size_t k = 0; k < inputs.size(); ++k) {
     ASSERT_EQ(cal.fits[k].trial_id, inputs[k].id);
