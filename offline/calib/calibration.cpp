@@ -39,7 +39,8 @@ double person_value(const ClothValues& c, int i) {
   switch (i) {
     case kArmCompliance: return c.arm_compliance;
     case kFistShift: return c.fist_shift;
-    default: return c.rim_shift;
+    case kRimShift: return c.rim_shift;
+    default: return c.areal_density;
   }
 }
 
@@ -47,7 +48,8 @@ void set_person_value(ClothValues& c, int i, double v) {
   switch (i) {
     case kArmCompliance: c.arm_compliance = v; break;
     case kFistShift: c.fist_shift = v; break;
-    default: c.rim_shift = v; break;
+    case kRimShift: c.rim_shift = v; break;
+    default: c.areal_density = v; break;
   }
 }
 
@@ -68,6 +70,7 @@ Bounds default_bounds() {
   b.person[kArmCompliance] = {0.0, 0.01, 0.004};
   b.person[kFistShift] = {-0.05, 0.15, 0.0};
   b.person[kRimShift] = {-0.04, 0.04, 0.0};
+  b.person[kArealDensity] = {0.04, 0.25, kPaperArealDensity};
   return b;
 }
 
@@ -104,7 +107,7 @@ Bounds read_bounds(const std::filesystem::path& path) {
     if (!target)
       throw_input_error(path, n,
                         "unknown parameter '" + name +
-                            "' (expected stretch, shear, bend, friction, self_friction, arm_offset, arm_compliance, fist_shift or rim_shift)");
+                            "' (expected stretch, shear, bend, friction, self_friction, arm_offset, arm_compliance, fist_shift, rim_shift or areal_density)");
     *target = pb;
   }
   return b;
@@ -135,7 +138,6 @@ ClothValues ParameterSpace::cloth(const Eigen::VectorXd& unit) const {
     set_person_value(c, i, person[i].fit ? from_unit(bounds.person[i], unit[k++]) : person[i].value);
   c.hem_width = hem_width;
   c.hem_bend_ratio = hem_bend_ratio;
-  c.areal_density = areal_density;
   return c;
 }
 
@@ -159,7 +161,7 @@ bool set_person_param(ParameterSpace& space, int i, const std::string& word) {
     space.person[i].fit = true;
     return true;
   }
-  double v = 0.0;
+  double v = kPersonParamInfo[i].paper;
   if (word != "fixed") {
     char* end = nullptr;
     v = std::strtod(word.c_str(), &end);
@@ -244,18 +246,20 @@ std::string fingerprint(const std::vector<HapticSequence>& inputs, const Paramet
   for (int h = 0; h < 3; ++h)
     if (space.bounds.offset_initial[h])
       f << ",offset" << h << '=' << hexd(*space.bounds.offset_initial[h]);
-  // A person parameter only when it is not the paper's arm (older checkpoints resume).
+  // A person parameter only when it is fitted or held at other than the paper's value (older
+  // checkpoints resume). A held density comes after the cuff, where it was before it could be
+  // fitted.
+  const auto held = [&](int i) { return !space.person[i].fit && space.person[i].value != kPersonParamInfo[i].paper; };
   for (int i = 0; i < kPersonParams; ++i) {
     const ParamBound& b = space.bounds.person[i];
     if (space.person[i].fit)
       f << ',' << kPersonParamInfo[i].name << ':' << hexd(b.lower) << ',' << hexd(b.upper) << ',' << hexd(b.initial);
-    else if (space.person[i].value != 0)
+    else if (held(i) && i != kArealDensity)
       f << ',' << kPersonParamInfo[i].name << '=' << hexd(space.person[i].value);
   }
   // The cuff only when there is one (older checkpoints resume).
   if (space.hem_width > 0) f << ";hem=" << hexd(space.hem_width) << ',' << hexd(space.hem_bend_ratio);
-  // Likewise a density other than the paper's.
-  if (space.areal_density != kPaperArealDensity) f << ";density=" << hexd(space.areal_density);
+  if (held(kArealDensity)) f << ";density=" << hexd(space.person[kArealDensity].value);
   f << ";inputs=";
   for (const auto& s : inputs) f << s.id << '/' << s.samples.size() << ',';
   return f.str();
@@ -500,14 +504,17 @@ Json calibration_to_json(const Calibration& c) {
   Json cloth = Json::object();
   for (int i = 0; i < kClothParams; ++i) cloth.set(kClothParamNames[i], cloth_value(c.cloth, i));
   // Only a person parameter other than the paper's is written: a file without one is the paper's
-  // arm (and synthesis folders made from such a calibration keep their record, so they resume).
+  // arm and gown (and synthesis folders made from such a calibration keep their record, so they
+  // resume). The density comes after the cuff, where it was before it could be fitted: the
+  // records compare the text.
+  const auto other = [&](int i) { return person_value(c.cloth, i) != kPersonParamInfo[i].paper; };
   for (int i = 0; i < kPersonParams; ++i)
-    if (person_value(c.cloth, i) != 0) cloth.set(kPersonParamInfo[i].name, person_value(c.cloth, i));
+    if (i != kArealDensity && other(i)) cloth.set(kPersonParamInfo[i].name, person_value(c.cloth, i));
   if (c.cloth.hem_width > 0) {  // likewise the cuff: none is the paper's uniform cloth
     cloth.set("hem_width", c.cloth.hem_width);
     cloth.set("hem_bend_ratio", c.cloth.hem_bend_ratio);
   }
-  if (c.cloth.areal_density != kPaperArealDensity) cloth.set("areal_density", c.cloth.areal_density);  // and the weight
+  if (other(kArealDensity)) cloth.set(kPersonParamInfo[kArealDensity].name, c.cloth.areal_density);
   j.set("cloth", cloth);
   Json off = Json::object();
   for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
@@ -552,7 +559,7 @@ Calibration calibration_from_json(const Json& j, const std::filesystem::path& so
       if (!std::isfinite(v)) throw std::runtime_error(std::string("cloth.") + kClothParamNames[i] + " is not finite");
       set_cloth_value(c.cloth, i, v);
     }
-    // Files without one have the paper's arm (0) they were calibrated with.
+    // Files without one have the paper's arm and gown they were calibrated with.
     for (int i = 0; i < kPersonParams; ++i) {
       const PersonParamInfo& info = kPersonParamInfo[i];
       if (!j.at("cloth").has(info.name)) continue;
@@ -566,11 +573,6 @@ Calibration calibration_from_json(const Json& j, const std::filesystem::path& so
       c.cloth.hem_bend_ratio = j.at("cloth").at("hem_bend_ratio").number();
       if (!hem_in_range(c.cloth.hem_width, c.cloth.hem_bend_ratio))
         throw std::runtime_error("cloth.hem_width / hem_bend_ratio must be within [0, 0.2] m / [1, 10000]");
-    }
-    if (j.at("cloth").has("areal_density")) {
-      c.cloth.areal_density = j.at("cloth").at("areal_density").number();
-      if (!areal_density_in_range(c.cloth.areal_density))
-        throw std::runtime_error("cloth.areal_density must be above 0 and at most 1 kg/m^2");
     }
     for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
       const Json& e = j.at("arm_offsets").at(std::string(arm_height_name(h)));

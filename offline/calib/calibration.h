@@ -51,14 +51,12 @@ struct ClothValues {
   // further ahead of the jaws the sleeve opening's rim is than offline/gown/placement.h puts it
   // (kOpeningRimAhead, 4 cm on the measured gown). The study did not measure it.
   double rim_shift = 0.0;
-  // The gown's areal density [kg/m^2] (sim/trial.h ClothParams::areal_density). Held, never
-  // fitted (ParameterSpace::areal_density); the paper's simulator, and every calibration without
-  // one in its file, used kPaperArealDensity. The study did not weigh its gown.
+  // The gown's areal density [kg/m^2] (sim/trial.h ClothParams::areal_density; kArealDensity
+  // below). The paper's simulator, and every calibration without one in its file, used
+  // kPaperArealDensity. The study did not weigh its gown.
   double areal_density = 0.145;
 };
 inline constexpr double kPaperArealDensity = 0.145;
-// A density's limits: above 0, at most 1 kg/m^2 (a heavy canvas is about 0.5).
-inline bool areal_density_in_range(double d) { return d > 0 && d <= 1.0; }
 inline constexpr int kClothParams = 5;
 // A cuff's limits (sim/params.cpp checks the same): width in [0, 0.2] m, ratio in [1, 1e4].
 inline constexpr double kMaxHemWidth = 0.2, kMaxHemBendRatio = 1e4;
@@ -70,24 +68,28 @@ inline constexpr std::array<const char*, kClothParams> kClothParamNames = {"stre
 double cloth_value(const ClothValues& c, int i);
 void set_cloth_value(ClothValues& c, int i, double v);
 
-// Parameters of the person's arm and of the robot's grasp rather than the cloth's, each fitted
-// within its bounds or held at a value (ParameterSpace::person); none is among the paper's five,
-// and 0 is the paper's arm and the gown's own placement.
+// Parameters beyond the paper's five cloth values: the person's arm, the robot's grasp and the
+// gown's weight. Each is fitted within its bounds or held at a value (ParameterSpace::person);
+// held, each defaults to `paper`, the value of the paper's simulator (its arm, the gown's own
+// placement, its density).
 // `lowest`/`highest` bound every box and held value (the simulator's own limits); `range` says so
 // in an error message.
 struct PersonParamInfo {
   const char* name;
   double lowest, highest;
+  double paper;
   const char* range;
 };
-inline constexpr int kPersonParams = 3;
+inline constexpr int kPersonParams = 4;
 inline constexpr int kArmCompliance = 0;  // [m/N] sim/arm_spring.h
 inline constexpr int kFistShift = 1;      // [m] sim/trial.h ClothParams::fist_shift
 inline constexpr int kRimShift = 2;       // [m] ClothValues::rim_shift (the grasp, sim_bridge.h)
+inline constexpr int kArealDensity = 3;   // [kg/m^2] sim/trial.h ClothParams::areal_density
 inline constexpr std::array<PersonParamInfo, kPersonParams> kPersonParamInfo = {{
-    {"arm_compliance", 0.0, 1.0, "cannot be negative (0 is a fixed arm) nor above 1 m/N"},
-    {"fist_shift", -0.2, 0.2, "must be within +-0.2 m (the forearm is 0.31 m)"},
-    {"rim_shift", -0.04, 0.06, "must be within -0.04 and +0.06 m (the rim 0 to 10 cm ahead of the jaws)"},
+    {"arm_compliance", 0.0, 1.0, 0.0, "cannot be negative (0 is a fixed arm) nor above 1 m/N"},
+    {"fist_shift", -0.2, 0.2, 0.0, "must be within +-0.2 m (the forearm is 0.31 m)"},
+    {"rim_shift", -0.04, 0.06, 0.0, "must be within -0.04 and +0.06 m (the rim 0 to 10 cm ahead of the jaws)"},
+    {"areal_density", 0.01, 1.0, kPaperArealDensity, "must be within 0.01 and 1 kg/m^2 (a heavy canvas is about 0.5)"},
 }};
 double person_value(const ClothValues& c, int i);
 void set_person_value(ClothValues& c, int i, double v);
@@ -141,7 +143,8 @@ struct Bounds {
 // (sim/arm_spring.h) and a held-out forearm softer; fist shift in [-0.05, 0.15] m (start 0, the
 // paper's arm): a fist-to-elbow length of 0.16-0.36 m; rim shift in [-0.04, 0.04] m (start 0):
 // the measured gown's rim held 0 to 8 cm ahead of the jaws (beyond 8 cm the jaws' 8 cm run off
-// the reduced gown's sleeve top).
+// the reduced gown's sleeve top); areal density in [0.04, 0.25] kg/m^2 (start 0.145, the
+// paper's): from a spunbond disposable gown to a heavy woven cotton one.
 Bounds default_bounds();
 // Bounds file: one "name lower upper [initial]" per line, '#' starts a comment, names as in
 // kClothParamNames plus "arm_offset" and kPersonParamInfo's; unnamed parameters keep their
@@ -156,16 +159,20 @@ Bounds read_bounds(const std::filesystem::path& path);
 struct ParameterSpace {
   Bounds bounds;
   std::vector<ArmHeight> offset_heights;  // heights with an optimised offset; empty: --no-arm-offset
-  // Each person parameter: fitted within bounds.person[i], or held at `value` (0: the paper's arm).
+  // Each person parameter: fitted within bounds.person[i], or held at `value` (default
+  // kPersonParamInfo[i].paper).
   struct Person {
     bool fit = false;
     double value = 0.0;
   };
-  std::array<Person, kPersonParams> person{};
+  static std::array<Person, kPersonParams> paper_person() {
+    std::array<Person, kPersonParams> p{};
+    for (int i = 0; i < kPersonParams; ++i) p[i] = {false, kPersonParamInfo[i].paper};
+    return p;
+  }
+  std::array<Person, kPersonParams> person = paper_person();
   // The gown's cuff every candidate is simulated with (ClothValues::hem_width, hem_bend_ratio).
   double hem_width = 0.0, hem_bend_ratio = 1.0;
-  // The gown's areal density every candidate is simulated with (ClothValues::areal_density).
-  double areal_density = kPaperArealDensity;
   int fitted_person_params() const {
     int n = 0;
     for (const Person& p : person) n += p.fit ? 1 : 0;
@@ -179,7 +186,7 @@ struct ParameterSpace {
 };
 
 // Person parameter i of `space` from a command line's word: "fit" (search bounds.person[i]),
-// "fixed" or "0" (the paper's arm), or a value held during the search. False when the word is
+// "fixed" (kPersonParamInfo[i].paper), or a value held during the search. False when the word is
 // none of these (or a non-finite number or one outside kPersonParamInfo[i]'s range).
 bool set_person_param(ParameterSpace& space, int i, const std::string& word);
 

@@ -60,9 +60,10 @@ int run_calibrate(int argc, char** argv) {
         "  --hem W,R           the gown's cuff: bending R x stiffer within W metres of the sleeve\n"
         "                      opening (held, not fitted; recorded in CAL.json, so synthesis uses\n"
         "                      it too; offline/sim/README.md, \"How stiff the gown is\"). Default none\n"
-        "  --density D         the gown's areal density in kg/m^2 (held, recorded in CAL.json like\n"
-        "                      --hem; default 0.145, the paper's; offline/sim/README.md, \"The gown's\n"
-        "                      weight\")\n"
+        "  --density fit|fixed|D   the gown's areal density [kg/m^2]: fit it too (one more parameter,\n"
+        "                      in [0.04, 0.25] by default), hold it at the paper's 0.145 (the default)\n"
+        "                      or at D; recorded in CAL.json, so synthesis uses it too\n"
+        "                      (offline/sim/README.md, \"The gown's weight\")\n"
         "  --gown full|reduced|coarse   simulator gown (default reduced)\n"
         "  --threads N         threads per process (default: all cores)\n"
         "  --checkpoint FILE   default CAL.json.ckpt; an existing one is resumed\n"
@@ -104,8 +105,9 @@ int run_calibrate(int argc, char** argv) {
   if (gown != "full" && gown != "reduced" && gown != "coarse") throw UsageError("--gown must be full, reduced or coarse");
 
   ParameterSpace space;
-  // --arm-compliance, --fist-shift, --rim-shift, in kPersonParamInfo order.
-  static constexpr std::array<const char*, kPersonParams> kPersonFlags = {"arm-compliance", "fist-shift", "rim-shift"};
+  // --arm-compliance, --fist-shift, --rim-shift, --density, in kPersonParamInfo order.
+  static constexpr std::array<const char*, kPersonParams> kPersonFlags = {"arm-compliance", "fist-shift", "rim-shift",
+                                                                          "density"};
   for (int i = 0; i < kPersonParams; ++i)
     if (const auto v = args.get(kPersonFlags[i]); v && !set_person_param(space, i, *v))
       throw UsageError(std::string("--") + kPersonFlags[i] + " must be fit, fixed or a value (" +
@@ -118,11 +120,6 @@ int run_calibrate(int argc, char** argv) {
                        *hem + "'");
     space.hem_width = w;
     space.hem_bend_ratio = r;
-  }
-  if (const auto d = args.get("density")) {
-    space.areal_density = args.number("density", kPaperArealDensity);
-    if (!areal_density_in_range(space.areal_density))
-      throw UsageError("--density must be above 0 and at most 1 kg/m^2, not '" + *d + "'");
   }
   space.bounds = args.get("bounds") ? read_bounds(*args.get("bounds")) : default_bounds();
   if (const auto start = args.get("start")) {
@@ -230,12 +227,10 @@ int run_calibrate(int argc, char** argv) {
         std::printf("\n");
       }
       for (int i = 0; i < kPersonParams; ++i)
-        if (space.person[i].fit || person_value(r.cloth, i) != 0)
+        if (space.person[i].fit || person_value(r.cloth, i) != kPersonParamInfo[i].paper)
           std::printf("  %-14s %.4f%s\n", kPersonParamInfo[i].name, person_value(r.cloth, i), space.person[i].fit ? "" : " (held)");
       if (r.cloth.hem_width > 0)
         std::printf("  hem           %.3f m, bending x %g (held)\n", r.cloth.hem_width, r.cloth.hem_bend_ratio);
-      if (r.cloth.areal_density != kPaperArealDensity)
-        std::printf("  areal_density %.4f kg/m^2 (held)\n", r.cloth.areal_density);
       for (ArmHeight h : space.offset_heights)
         std::printf("  arm offset %-6s %+.4f m\n", std::string(arm_height_name(h)).c_str(), r.offsets[static_cast<int>(h)]);
       std::printf("wrote %s and %s.curves.csv\n", out.c_str(), out.c_str());

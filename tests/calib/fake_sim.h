@@ -6,13 +6,16 @@
 // offset (bend and self-friction shift it); a compliant arm (arm_compliance) gives way, so the
 // drag grows over a longer travel; a fist further along the arm (fist_shift) starts the drag that
 // much later; the rim meets the fist at 0.15 m of travel plus fist_shift minus rim_shift (the
-// rim held further ahead of the jaws meets it earlier), a 0.5 N bump of drag there; the pull
-// stops at 10 N or 0.85 m like the rig. Every
+// rim held further ahead of the jaws meets it earlier), a 0.5 N bump of drag there; a gown
+// heavier than the paper's hangs more on the forearm from 0.3 m of travel on (areal_density, a
+// kink in the vertical force that no polynomial term of the others makes); the pull stops at 10 N
+// or 0.85 m like the rig. Every
 // parameter changes the curves, so a calibration against curves made at known parameters must
 // find a near-zero objective. The gown noise adds a seeded, smooth disturbance. Deterministic
 // and thread-safe (no state).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
 #include "calibration.h"
@@ -32,7 +35,9 @@ inline SimulatedTrial fake_simulate(const ClothValues& c, const TrialRequest& r)
     const double drag = (1.5 * c.friction + 2.0 * c.stretch) * xa * (1.0 + 12.0 * catchiness * xa * xa) +
                         0.6 * c.shear * std::sin(6.0 * x) + noise_amp * std::sin(20.0 * x + r.seed % 7) +
                         0.5 * std::exp(-std::pow((x - (0.15 + c.fist_shift - c.rim_shift)) / 0.03, 2));
-    const double vert = (0.5 + 10.0 * arm) * x * (0.5 + c.bend) - 0.8 * c.self_friction * x * x;
+    const double heavier = (c.areal_density - kPaperArealDensity) / kPaperArealDensity;  // 0 for the paper's gown
+    const double vert = (0.5 + 10.0 * arm) * x * (0.5 + c.bend) - 0.8 * c.self_friction * x * x -
+                        8.0 * heavier * std::max(0.0, x - 0.3);
     out.samples.push_back({t, x, -drag, 0.0, vert});
     if (drag >= 10.0 || std::abs(vert) >= 10.0) {
       out.outcome = arm > -0.05 ? Outcome::Good : Outcome::Caught;
