@@ -76,6 +76,7 @@ void set_cloth_value(ClothValues& c, int i, double v);
 // in an error message.
 struct PersonParamInfo {
   const char* name;
+  const char* flag;  // the command-line option, without its "--" (dressguard calibrate)
   double lowest, highest;
   double paper;
   const char* range;
@@ -86,10 +87,10 @@ inline constexpr int kFistShift = 1;      // [m] sim/trial.h ClothParams::fist_s
 inline constexpr int kRimShift = 2;       // [m] ClothValues::rim_shift (the grasp, sim_bridge.h)
 inline constexpr int kArealDensity = 3;   // [kg/m^2] sim/trial.h ClothParams::areal_density
 inline constexpr std::array<PersonParamInfo, kPersonParams> kPersonParamInfo = {{
-    {"arm_compliance", 0.0, 1.0, 0.0, "cannot be negative (0 is a fixed arm) nor above 1 m/N"},
-    {"fist_shift", -0.2, 0.2, 0.0, "must be within +-0.2 m (the forearm is 0.31 m)"},
-    {"rim_shift", -0.04, 0.06, 0.0, "must be within -0.04 and +0.06 m (the rim 0 to 10 cm ahead of the jaws)"},
-    {"areal_density", 0.01, 1.0, kPaperArealDensity, "must be within 0.01 and 1 kg/m^2 (a heavy canvas is about 0.5)"},
+    {"arm_compliance", "arm-compliance", 0.0, 1.0, 0.0, "cannot be negative (0 is a fixed arm) nor above 1 m/N"},
+    {"fist_shift", "fist-shift", -0.2, 0.2, 0.0, "must be within +-0.2 m (the forearm is 0.31 m)"},
+    {"rim_shift", "rim-shift", -0.04, 0.06, 0.0, "must be within -0.04 and +0.06 m (the rim 0 to 10 cm ahead of the jaws)"},
+    {"areal_density", "density", 0.01, 1.0, kPaperArealDensity, "must be within 0.01 and 1 kg/m^2 (a heavy canvas is about 0.5)"},
 }};
 double person_value(const ClothValues& c, int i);
 void set_person_value(ClothValues& c, int i, double v);

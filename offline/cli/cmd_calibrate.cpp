@@ -105,12 +105,10 @@ int run_calibrate(int argc, char** argv) {
   if (gown != "full" && gown != "reduced" && gown != "coarse") throw UsageError("--gown must be full, reduced or coarse");
 
   ParameterSpace space;
-  // --arm-compliance, --fist-shift, --rim-shift, --density, in kPersonParamInfo order.
-  static constexpr std::array<const char*, kPersonParams> kPersonFlags = {"arm-compliance", "fist-shift", "rim-shift",
-                                                                          "density"};
+  // --arm-compliance, --fist-shift, --rim-shift, --density.
   for (int i = 0; i < kPersonParams; ++i)
-    if (const auto v = args.get(kPersonFlags[i]); v && !set_person_param(space, i, *v))
-      throw UsageError(std::string("--") + kPersonFlags[i] + " must be fit, fixed or a value (" +
+    if (const auto v = args.get(kPersonParamInfo[i].flag); v && !set_person_param(space, i, *v))
+      throw UsageError(std::string("--") + kPersonParamInfo[i].flag + " must be fit, fixed or a value (" +
                        kPersonParamInfo[i].name + " " + kPersonParamInfo[i].range + "), not '" + *v + "'");
   if (const auto hem = args.get("hem")) {
     double w = 0, r = 0;

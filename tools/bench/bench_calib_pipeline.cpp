@@ -3,6 +3,7 @@
 //   bench_calib_pipeline eval [--participants 0,1,...] [--generations G --population N]
 //                             [--per-height M] [--gown coarse|reduced|full] [--work DIR] [--threads T]
 //                             [--arm-compliance fit|fixed|C] [--fist-shift fit|fixed|M]
+//                             [--rim-shift fit|fixed|M] [--density fit|fixed|D]
 //                             [--bounds FILE] [--sigma0 S]
 //     Per participant P of the measured study: calibrate on P's 2-3 sequences (from the bounds
 //     file's initial values, default_bounds() without one); predict the other participants'
@@ -17,10 +18,11 @@
 //     71%, 83%, 94%, 100% at the four cuts). Prints one row per participant and the means, and
 //     writes DIR/eval.json after each participant (plot: tools/plot/calib_eval.py); a rerun with
 //     the same DIR resumes from the calibration checkpoints and synthesized trials.
-//     --arm-compliance, --fist-shift: the person's arm in the calibration (calibration.h, set_person_param):
-//     fixed (the paper's, default), fit (one more parameter each) or a compliance in m/N, a shift in m.
+//     --arm-compliance, --fist-shift, --rim-shift, --density: the person's arm, the grasp and the
+//     gown's weight in the calibration, as `dressguard calibrate` takes them (calibration.h,
+//     kPersonParamInfo): fixed (the paper's, default), fit (one more parameter each) or a value.
 //   bench_calib_pipeline timing [--gown ...] [--generations G --population N] [--threads T]
-//                               [--arm-compliance ...]
+//                               [--arm-compliance ... --fist-shift ... --rim-shift ... --density ...]
 //     Wall time per simulation and of a G x N calibration of participant 4, with the final
 //     objective, and the projection to the paper's 50 x 32 budget from the measured pace. Under
 //     mpirun (e.g. -n 1 and -n 2 with --threads 1) the calibration's wall time gives the MPI
@@ -30,6 +32,7 @@
 //
 // Everything runs through dg_calib's public API (the same code as the commands).
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -79,6 +82,23 @@ std::string get(const std::map<std::string, std::string>& a, const std::string& 
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The person parameters from their `dressguard calibrate` options (kPersonParamInfo[i].flag), each
+// "fixed" unless given, into `space` and `words` (as given, for the report). False, with a
+// message, on a word set_person_param refuses.
+bool set_person_flags(const std::map<std::string, std::string>& a, ParameterSpace& space,
+                      std::array<std::string, kPersonParams>& words) {
+  for (int i = 0; i < kPersonParams; ++i) {
+    const PersonParamInfo& info = kPersonParamInfo[i];
+    words[i] = get(a, info.flag, "fixed");
+    if (!set_person_param(space, i, words[i])) {
+      std::fprintf(stderr, "--%s must be fit, fixed or a value (%s %s), not '%s'\n", info.flag, info.name, info.range,
+                   words[i].c_str());
+      return false;
+    }
+  }
+  return true;
 }
 
 // The force curve of a trial cut at `cut` m of travel, linearly interpolated every 5 mm on
@@ -149,25 +169,17 @@ int run_eval(const std::map<std::string, std::string>& a) {
   so.per_height = std::stoi(get(a, "per-height", "100"));
   so.threads = co.threads;
   const std::string gown = get(a, "gown", "reduced");
-  const std::string arm = get(a, "arm-compliance", "fixed");
-  const std::string fist = get(a, "fist-shift", "fixed");
-  {
-    ParameterSpace check;
-    if (!set_person_param(check, kArmCompliance, arm)) {
-      std::fprintf(stderr, "--arm-compliance must be fit, fixed or a compliance in m/N, not '%s'\n", arm.c_str());
-      return 2;
-    }
-    if (!set_person_param(check, kFistShift, fist)) {
-      std::fprintf(stderr, "--fist-shift must be fit, fixed or a shift in [-0.2, 0.2] m, not '%s'\n", fist.c_str());
-      return 2;
-    }
-  }
+  ParameterSpace person;  // the person parameters of every participant's space
+  std::array<std::string, kPersonParams> person_words;
+  if (!set_person_flags(a, person, person_words)) return 2;
   const fs::path work = get(a, "work", "calib-eval");
   const std::string bounds_file = get(a, "bounds", "");
   const Bounds bounds = bounds_file.empty() ? default_bounds() : read_bounds(bounds_file);
   const ClothSimulator sim = make_cloth_simulator(gown);
-  std::printf("evaluation: %zu participants, calibration %d x %d, %d trials per height, gown %s, arm %s, fist %s\n",
-              chosen.size(), co.generations, co.population, so.per_height, gown.c_str(), arm.c_str(), fist.c_str());
+  std::printf("evaluation: %zu participants, calibration %d x %d, %d trials per height, gown %s", chosen.size(),
+              co.generations, co.population, so.per_height, gown.c_str());
+  for (int i = 0; i < kPersonParams; ++i) std::printf(", %s %s", kPersonParamInfo[i].name, person_words[i].c_str());
+  std::printf("\n");
 
   std::vector<const HapticSequence*> all;
   for (const auto& t : ds.trials) all.push_back(&t);
@@ -191,8 +203,7 @@ int run_eval(const std::map<std::string, std::string>& a) {
     out.set("population", co.population);
     out.set("per_height", so.per_height);
     out.set("gown", gown);
-    out.set("arm_compliance", arm);
-    out.set("fist_shift", fist);
+    for (int i = 0; i < kPersonParams; ++i) out.set(kPersonParamInfo[i].name, person_words[i]);
     out.set("bounds", bounds_file.empty() ? std::string("default") : bounds_file);
     out.set("sigma0", co.sigma0);
     write_file_atomic(work / "eval.json", out.dump() + "\n");
@@ -202,11 +213,9 @@ int run_eval(const std::map<std::string, std::string>& a) {
   for (const auto& p : chosen) {
     const auto t0 = std::chrono::steady_clock::now();
     const auto inputs = select_inputs(ds, p, co.seed);
-    ParameterSpace space;
+    ParameterSpace space = person;
     space.bounds = bounds;
     for (const auto& s : inputs) space.offset_heights.push_back(s.height);
-    set_person_param(space, kArmCompliance, arm);
-    set_person_param(space, kFistShift, fist);
     auto o = co;
     o.checkpoint = work / ("p" + p + ".ckpt");
     const CalibrationResult r = calibrate(inputs, space, sim.trials, o, Comm::world());
@@ -290,12 +299,19 @@ int run_eval(const std::map<std::string, std::string>& a) {
     char params[64];
     std::snprintf(params, sizeof params, "%.2f %.2f %.2f %.2f %.2f", r.cloth.stretch, r.cloth.shear, r.cloth.bend,
                   r.cloth.friction, r.cloth.self_friction);
+    std::string person_values;  // the person parameters fitted or held off the paper's
+    for (int i = 0; i < kPersonParams; ++i)
+      if (space.person[i].fit || person_value(r.cloth, i) != kPersonParamInfo[i].paper) {
+        char v[64];
+        std::snprintf(v, sizeof v, "%s %.4g, ", kPersonParamInfo[i].name, person_value(r.cloth, i));
+        person_values += v;
+      }
     std::printf("%-4s %-8.3f %-28s | %5.0f %5.0f %5.0f %5.0f %5.0f   | %5.0f %5.0f %5.0f %5.0f %5.0f   | %5.0f %5.0f %5.0f "
-                "%5.0f %5.0f  (%.0f s) arm compliance %.4f m/N, fist shift %+.3f m; STC classes %s, forces %s%s%s\n",
+                "%5.0f %5.0f  (%.0f s) %sSTC classes %s, forces %s%s%s\n",
                 p.c_str(), r.objective, params, 100 * stc[0], 100 * stc[1], 100 * stc[2], 100 * stc[3], 100 * stc[4],
                 100 * stc2[0], 100 * stc2[1], 100 * stc2[2], 100 * stc2[3], 100 * stc2[4],
                 100 * bc[0], 100 * bc[1], 100 * bc[2], 100 * bc[3], 100 * bc[4], seconds_since(t0),
-                r.cloth.arm_compliance, r.cloth.fist_shift, stc_classes.c_str(), axes.reason.c_str(), stc_error.empty() ? "" : (" STC failed: " + stc_error).c_str(),
+                person_values.c_str(), stc_classes.c_str(), axes.reason.c_str(), stc_error.empty() ? "" : (" STC failed: " + stc_error).c_str(),
                 bc_error.empty() ? "" : (" BC failed: " + bc_error).c_str());
     std::fflush(stdout);
     Json row = calibration_to_json(cal);
@@ -353,10 +369,8 @@ int run_timing(const std::map<std::string, std::string>& a) {
   ParameterSpace space;
   space.bounds = default_bounds();
   for (const auto& s : inputs) space.offset_heights.push_back(s.height);
-  if (!set_person_param(space, kArmCompliance, get(a, "arm-compliance", "fixed"))) {
-    std::fprintf(stderr, "--arm-compliance must be fit, fixed or a compliance in m/N\n");
-    return 2;
-  }
+  std::array<std::string, kPersonParams> person_words;
+  if (!set_person_flags(a, space, person_words)) return 2;
   t0 = std::chrono::steady_clock::now();
   const CalibrationResult r = calibrate(inputs, space, sim.trials, o, Comm::world());
   const double cal_s = seconds_since(t0);
