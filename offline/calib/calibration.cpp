@@ -247,19 +247,16 @@ std::string fingerprint(const std::vector<HapticSequence>& inputs, const Paramet
     if (space.bounds.offset_initial[h])
       f << ",offset" << h << '=' << hexd(*space.bounds.offset_initial[h]);
   // A person parameter only when it is fitted or held at other than the paper's value (older
-  // checkpoints resume). A held density comes after the cuff, where it was before it could be
-  // fitted.
-  const auto held = [&](int i) { return !space.person[i].fit && space.person[i].value != kPersonParamInfo[i].paper; };
+  // checkpoints resume; those of runs with a held density, before it could be fitted, do not).
   for (int i = 0; i < kPersonParams; ++i) {
     const ParamBound& b = space.bounds.person[i];
     if (space.person[i].fit)
       f << ',' << kPersonParamInfo[i].name << ':' << hexd(b.lower) << ',' << hexd(b.upper) << ',' << hexd(b.initial);
-    else if (held(i) && i != kArealDensity)
+    else if (space.person[i].value != kPersonParamInfo[i].paper)
       f << ',' << kPersonParamInfo[i].name << '=' << hexd(space.person[i].value);
   }
   // The cuff only when there is one (older checkpoints resume).
   if (space.hem_width > 0) f << ";hem=" << hexd(space.hem_width) << ',' << hexd(space.hem_bend_ratio);
-  if (held(kArealDensity)) f << ";density=" << hexd(space.person[kArealDensity].value);
   f << ";inputs=";
   for (const auto& s : inputs) f << s.id << '/' << s.samples.size() << ',';
   return f.str();
@@ -503,18 +500,17 @@ Json calibration_to_json(const Calibration& c) {
   j.set("participant", c.participant);
   Json cloth = Json::object();
   for (int i = 0; i < kClothParams; ++i) cloth.set(kClothParamNames[i], cloth_value(c.cloth, i));
-  // Only a person parameter other than the paper's is written: a file without one is the paper's
-  // arm and gown (and synthesis folders made from such a calibration keep their record, so they
-  // resume). The density comes after the cuff, where it was before it could be fitted: the
-  // records compare the text.
-  const auto other = [&](int i) { return person_value(c.cloth, i) != kPersonParamInfo[i].paper; };
-  for (int i = 0; i < kPersonParams; ++i)
-    if (i != kArealDensity && other(i)) cloth.set(kPersonParamInfo[i].name, person_value(c.cloth, i));
-  if (c.cloth.hem_width > 0) {  // likewise the cuff: none is the paper's uniform cloth
+  // Only a cuff and the person parameters other than the paper's are written: a file without
+  // them is the paper's uniform cloth, arm and gown (and synthesis folders made from such a
+  // calibration keep their record, which compares the text, so they resume). The cuff comes
+  // first, so the density stays where it was before it could be fitted.
+  if (c.cloth.hem_width > 0) {
     cloth.set("hem_width", c.cloth.hem_width);
     cloth.set("hem_bend_ratio", c.cloth.hem_bend_ratio);
   }
-  if (other(kArealDensity)) cloth.set(kPersonParamInfo[kArealDensity].name, c.cloth.areal_density);
+  for (int i = 0; i < kPersonParams; ++i)
+    if (person_value(c.cloth, i) != kPersonParamInfo[i].paper)
+      cloth.set(kPersonParamInfo[i].name, person_value(c.cloth, i));
   j.set("cloth", cloth);
   Json off = Json::object();
   for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
