@@ -312,21 +312,38 @@ std::vector<ResidualWindow> residual_windows(const Prediction& p, const Dataset&
   return out;
 }
 
+namespace {
+
+// Calls emit(i, j) for every run [i, j) of consecutive windows (each `from` the previous `to`)
+// that begins where starts(v[i]) holds and goes on while joins(v[i], v[k]) holds: the findings'
+// runs of a height and force.
+template <class Window, class Starts, class Joins, class Emit>
+void for_each_run(const std::vector<Window>& v, Starts starts, Joins joins, Emit emit) {
+  std::size_t i = 0;
+  while (i < v.size()) {
+    if (!starts(v[i])) {
+      ++i;
+      continue;
+    }
+    std::size_t j = i + 1;
+    while (j < v.size() && joins(v[i], v[j]) && std::fabs(v[j].from - v[j - 1].to) < 1e-9) ++j;
+    emit(i, j);
+    i = j;
+  }
+}
+
+}  // namespace
+
 std::vector<ResidualFinding> residual_findings(const std::vector<ResidualWindow>& windows) {
   std::vector<ResidualFinding> out;
   for (int ax = 0; ax < 2; ++ax) {
-    std::size_t i = 0;
-    while (i < windows.size()) {
+    // A run: windows of one height, outside the people, residuals of one sign.
+    const auto starts = [ax](const ResidualWindow& w) { return w.outside(ax); };
+    const auto joins = [ax](const ResidualWindow& a, const ResidualWindow& w) {
+      return w.height == a.height && w.outside(ax) && (w.residual(ax) > 0) == (a.residual(ax) > 0);
+    };
+    for_each_run(windows, starts, joins, [&](std::size_t i, std::size_t j) {
       const ResidualWindow& a = windows[i];
-      if (!a.outside(ax)) {
-        ++i;
-        continue;
-      }
-      // Extend the run over the following windows of the same height, outside, same sign.
-      std::size_t j = i + 1;
-      while (j < windows.size() && windows[j].height == a.height && windows[j].outside(ax) &&
-             (windows[j].residual(ax) > 0) == (a.residual(ax) > 0) && std::fabs(windows[j].from - windows[j - 1].to) < 1e-9)
-        ++j;
       ResidualFinding f;
       f.height = a.height;
       f.axis = ax;
@@ -347,8 +364,7 @@ std::vector<ResidualFinding> residual_findings(const std::vector<ResidualWindow>
                     ax == 0 ? "F_motion" : "F_vertical", f.from, f.to, what, f.residual, f.measured, f.spread, f.trials);
       f.text = buf;
       out.push_back(f);
-      i = j;
-    }
+    });
   }
   std::stable_sort(out.begin(), out.end(), [](const ResidualFinding& x, const ResidualFinding& y) {
     return std::fabs(x.residual) * (x.to - x.from) > std::fabs(y.residual) * (y.to - y.from);
@@ -366,6 +382,133 @@ std::string residual_csv(const std::vector<ResidualWindow>& windows) {
     for (int ax = 0; ax < 2; ++ax)
       o << ',' << w.measured[ax] << ',' << w.spread[ax] << ',' << w.simulated[ax] << ',' << w.residual(ax) << ','
         << (w.outside(ax) ? 1 : 0);
+    o << '\n';
+  }
+  return o.str();
+}
+
+
+// ---- the contrast between the heights ------------------------------------------------------------
+
+std::string_view contrast_verdict_name(ContrastVerdict v) {
+  switch (v) {
+    case ContrastVerdict::NoContrast: return "none";
+    case ContrastVerdict::Agrees: return "agrees";
+    case ContrastVerdict::Misses: return "misses";
+    case ContrastVerdict::Reverses: return "reverses";
+  }
+  return "?";
+}
+
+namespace {
+
+// The simulator's verdict on one window's contrast (prediction.h).
+ContrastVerdict judge_contrast(double measured, double standard_error, double simulated, bool enough) {
+  if (!enough || !std::isfinite(measured) || !std::isfinite(standard_error) ||
+      !(std::fabs(measured) > std::max(kResidualFloor, 2 * standard_error)))
+    return ContrastVerdict::NoContrast;
+  if (!(std::fabs(simulated) > kResidualFloor)) return ContrastVerdict::Misses;
+  return (simulated > 0) == (measured > 0) ? ContrastVerdict::Agrees : ContrastVerdict::Reverses;
+}
+
+}  // namespace
+
+std::vector<HeightContrast> height_contrasts(const std::vector<ResidualWindow>& windows) {
+  std::vector<HeightContrast> out;
+  for (ArmHeight lower : {ArmHeight::Middle, ArmHeight::Low})
+    for (const ResidualWindow& lo : windows) {
+      if (lo.height != lower) continue;
+      // The high arm's window at the same travel (every height's windows line up: residual_windows).
+      const auto hi = std::find_if(windows.begin(), windows.end(), [&](const ResidualWindow& w) {
+        return w.height == ArmHeight::High && std::fabs(w.from - lo.from) < 1e-9;
+      });
+      if (hi == windows.end()) continue;
+      HeightContrast c;
+      c.lower = lower;
+      c.from = lo.from;
+      c.to = lo.to;
+      c.trials_high = hi->trials;
+      c.trials_lower = lo.trials;
+      const bool enough = hi->trials >= kResidualMinTrials && lo.trials >= kResidualMinTrials;
+      for (int ax = 0; ax < 2; ++ax) {
+        c.measured[ax] = hi->measured[ax] - lo.measured[ax];
+        c.simulated[ax] = hi->simulated[ax] - lo.simulated[ax];
+        c.standard_error[ax] = enough ? std::sqrt(hi->spread[ax] * hi->spread[ax] / hi->trials +
+                                                  lo.spread[ax] * lo.spread[ax] / lo.trials)
+                                      : kNaN;
+        c.verdict[ax] = judge_contrast(c.measured[ax], c.standard_error[ax], c.simulated[ax], enough);
+      }
+      out.push_back(c);
+    }
+  return out;
+}
+
+std::vector<ContrastFinding> contrast_findings(const std::vector<HeightContrast>& contrasts) {
+  std::vector<ContrastFinding> out;
+  for (int ax = 0; ax < 2; ++ax) {
+    // A run: windows of one lower height, one verdict (misses or reverses), the people's
+    // contrast of one sign.
+    const auto starts = [ax](const HeightContrast& c) {
+      return c.verdict[ax] == ContrastVerdict::Misses || c.verdict[ax] == ContrastVerdict::Reverses;
+    };
+    const auto joins = [ax](const HeightContrast& a, const HeightContrast& c) {
+      return c.lower == a.lower && c.verdict[ax] == a.verdict[ax] && (c.measured[ax] > 0) == (a.measured[ax] > 0);
+    };
+    for_each_run(contrasts, starts, joins, [&](std::size_t i, std::size_t j) {
+      const HeightContrast& a = contrasts[i];
+      const ContrastVerdict v = a.verdict[ax];
+      ContrastFinding f;
+      f.lower = a.lower;
+      f.axis = ax;
+      f.verdict = v;
+      f.from = a.from;
+      f.to = contrasts[j - 1].to;
+      for (std::size_t k = i; k < j; ++k) {
+        f.measured += contrasts[k].measured[ax] / static_cast<double>(j - i);
+        f.simulated += contrasts[k].simulated[ax] / static_cast<double>(j - i);
+      }
+      const std::string lower_name(arm_height_name(f.lower));
+      char buf[320];
+      std::snprintf(buf, sizeof buf,
+                    "%s, high against %s, %.2f-%.2f m: the people's high arm reads %+.2f N against their %s arm; "
+                    "the simulator's %+.2f N (%s)",
+                    ax == 0 ? "F_motion" : "F_vertical", lower_name.c_str(), f.from, f.to, f.measured,
+                    lower_name.c_str(), f.simulated,
+                    v == ContrastVerdict::Reverses ? "reverses: a classifier trained on it learns the opposite here"
+                                                   : "misses: a classifier trained on it learns nothing here");
+      f.text = buf;
+      out.push_back(f);
+    });
+  }
+  std::stable_sort(out.begin(), out.end(), [](const ContrastFinding& x, const ContrastFinding& y) {
+    return x.from != y.from ? x.from < y.from : x.axis < y.axis;
+  });
+  return out;
+}
+
+ContrastTally tally_contrasts(const std::vector<HeightContrast>& contrasts, double up_to) {
+  ContrastTally t;
+  for (const auto& c : contrasts) {
+    if (c.to > up_to + 1e-9) continue;
+    for (ContrastVerdict v : c.verdict) {
+      t.agrees += v == ContrastVerdict::Agrees;
+      t.misses += v == ContrastVerdict::Misses;
+      t.reverses += v == ContrastVerdict::Reverses;
+    }
+  }
+  return t;
+}
+
+std::string contrast_csv(const std::vector<HeightContrast>& contrasts) {
+  std::ostringstream o;
+  o.precision(7);
+  o << "lower,from,to,trials_high,trials_lower,measured_motion,standard_error_motion,simulated_motion,verdict_motion,"
+       "measured_vertical,standard_error_vertical,simulated_vertical,verdict_vertical\n";
+  for (const auto& c : contrasts) {
+    o << arm_height_name(c.lower) << ',' << c.from << ',' << c.to << ',' << c.trials_high << ',' << c.trials_lower;
+    for (int ax = 0; ax < 2; ++ax)
+      o << ',' << c.measured[ax] << ',' << c.standard_error[ax] << ',' << c.simulated[ax] << ','
+        << contrast_verdict_name(c.verdict[ax]);
     o << '\n';
   }
   return o.str();

@@ -148,4 +148,64 @@ std::vector<ResidualFinding> residual_findings(const std::vector<ResidualWindow>
 // F_vertical (tools/plot/calib_overlay.py residual).
 std::string residual_csv(const std::vector<ResidualWindow>& windows);
 
+// ---- what a simulation-trained classifier learns wrong: the contrast between the heights ----------
+//
+// The STC tells the classes apart by how the forces differ between the arm heights that produce
+// them: good at the high arm, missed at the middle and low ones (the classes the measured files
+// hold). Cut early (issue 4: 0.15-0.30 m of travel) little else is left to tell them by, and a
+// simulator whose residual is moderate at every height can still order the heights the wrong
+// way round there, so that a classifier trained on it learns the opposite of what people show.
+//
+// Per travel window, force and lower height (middle, low), from the residual windows:
+//   contrast = mean(high) - mean(lower height),
+// for the people (measured) and for the simulator (its predictions of the same trials). The
+// people show a contrast where both heights hold kResidualMinTrials trials and
+//   |contrast| > max(kResidualFloor, 2 SE),  SE = sqrt(s_high^2 / n_high + s_low^2 / n_low)
+// (s the people's spread of each height's window: the difference of two means is then more than
+// twice its standard error, and above the sensor's drift). The simulator then
+//   agrees     same sign and |simulated contrast| > kResidualFloor,
+//   misses it  |simulated contrast| <= kResidualFloor (no cue: the classifier learns nothing here),
+//   reverses   opposite sign and |simulated contrast| > kResidualFloor (a wrong cue).
+enum class ContrastVerdict { NoContrast, Agrees, Misses, Reverses };
+std::string_view contrast_verdict_name(ContrastVerdict v);  // "none", "agrees", "misses", "reverses"
+
+struct HeightContrast {
+  ArmHeight lower = ArmHeight::Low;  // the height compared with the high arm
+  double from = 0, to = 0;           // [m] travel
+  int trials_high = 0, trials_lower = 0;
+  // [0] F_motion, [1] F_vertical: high minus lower [N]; NaN where either height has no trial
+  double measured[2] = {0, 0}, standard_error[2] = {0, 0}, simulated[2] = {0, 0};
+  ContrastVerdict verdict[2] = {ContrastVerdict::NoContrast, ContrastVerdict::NoContrast};
+};
+
+// One entry per window and lower height that both heights have windows for (in the windows'
+// order: middle first, then low).
+std::vector<HeightContrast> height_contrasts(const std::vector<ResidualWindow>& windows);
+
+// Runs of consecutive windows of one lower height and force where the people show a contrast
+// of one sign and the simulator misses or reverses it (one verdict per run), as one line each,
+// e.g. "F_vertical, high against low, 0.20-0.30 m: the people's high arm reads +0.17 N against
+// their low arm; the simulator's -0.31 N (reverses: a classifier trained on it learns the
+// opposite here)". Sorted by the run's start, then by force.
+struct ContrastFinding {
+  ArmHeight lower = ArmHeight::Low;
+  int axis = 0;  // 0 F_motion, 1 F_vertical
+  ContrastVerdict verdict = ContrastVerdict::Reverses;
+  double from = 0, to = 0, measured = 0, simulated = 0;  // means over the run's windows
+  std::string text;
+};
+std::vector<ContrastFinding> contrast_findings(const std::vector<HeightContrast>& contrasts);
+
+// The verdicts counted over the windows that end at or before `up_to` metres (both forces, both
+// lower heights): what a sequence cut there holds. kLatestCut is issue 4's latest cut.
+inline constexpr double kLatestCut = 0.30;  // [m]
+struct ContrastTally {
+  int agrees = 0, misses = 0, reverses = 0;  // NoContrast windows are not counted
+};
+ContrastTally tally_contrasts(const std::vector<HeightContrast>& contrasts, double up_to = kLatestCut);
+
+// CSV: lower,from,to,trials_high,trials_lower, then measured/standard_error/simulated/verdict for
+// F_motion and for F_vertical (tools/plot/calib_overlay.py contrast).
+std::string contrast_csv(const std::vector<HeightContrast>& contrasts);
+
 }  // namespace dressguard::calib

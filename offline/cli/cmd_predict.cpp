@@ -43,9 +43,13 @@ int run_predict(int argc, char** argv) {
         "  and what the simulation gets wrong: per height and travel window, the simulated mean\n"
         "  force against the measured mean and the people's spread; the runs of windows where the\n"
         "  simulation is further from the people's mean than they are from each other are listed,\n"
-        "  largest first (offline/calib/prediction.h, residual_windows).\n"
-        "  --out PREFIX   write PREFIX.csv (per trial), PREFIX.curves.csv and PREFIX.residual.csv\n"
-        "                 (for tools/plot/calib_overlay.py predict and residual)\n"
+        "  largest first (offline/calib/prediction.h, residual_windows). Then the heights' contrast:\n"
+        "  where the people's high arm (good) differs from their middle or low arm (missed), whether\n"
+        "  the simulator's differs the same way, not at all, or the other way round; what a\n"
+        "  classifier trained on it learns from cut sequences (prediction.h, height_contrasts).\n"
+        "  --out PREFIX   write PREFIX.csv (per trial), PREFIX.curves.csv, PREFIX.residual.csv and\n"
+        "                 PREFIX.contrast.csv (for tools/plot/calib_overlay.py predict, residual and\n"
+        "                 contrast)\n"
         "  --window M     [m] travel window of the residual (default 0.05)\n"
         "  --gown G       override the calibration's gown (full, reduced, coarse)\n"
         "  --threads N    threads per process (default: all cores); under mpirun every rank runs a share\n"
@@ -85,7 +89,12 @@ int run_predict(int argc, char** argv) {
   }
   const std::vector<ResidualWindow> windows = residual_windows(p, ds, window);
   const std::vector<ResidualFinding> findings = residual_findings(windows);
-  if (const auto prefix = args.get("out")) write_file_atomic(*prefix + ".residual.csv", residual_csv(windows));
+  const std::vector<HeightContrast> contrasts = height_contrasts(windows);
+  const std::vector<ContrastFinding> contrast = contrast_findings(contrasts);
+  if (const auto prefix = args.get("out")) {
+    write_file_atomic(*prefix + ".residual.csv", residual_csv(windows));
+    write_file_atomic(*prefix + ".contrast.csv", contrast_csv(contrasts));
+  }
   const std::vector<PredictionSummary> sum = summarize(p);
   if (args.has("json")) {
     std::printf("{\"participant\": \"%s\", \"trials\": %zu, \"heights\": [", p.participant.c_str(), p.trials.size());
@@ -109,7 +118,20 @@ int run_predict(int argc, char** argv) {
                   number(f.spread).c_str(), f.trials);
       first = false;
     }
-    std::printf("]}\n");
+    std::printf("], \"contrast_findings\": [");
+    first = true;
+    for (const auto& f : contrast) {
+      std::printf("%s{\"force\": \"%s\", \"lower\": \"%s\", \"from_m\": %s, \"to_m\": %s, \"verdict\": \"%s\", "
+                  "\"measured_n\": %s, \"simulated_n\": %s}",
+                  first ? "" : ", ", f.axis == 0 ? "motion" : "vertical", std::string(arm_height_name(f.lower)).c_str(),
+                  number(f.from).c_str(), number(f.to).c_str(), std::string(contrast_verdict_name(f.verdict)).c_str(),
+                  number(f.measured).c_str(), number(f.simulated).c_str());
+      first = false;
+    }
+    const ContrastTally early = tally_contrasts(contrasts);
+    std::printf("], \"contrast_up_to_m\": %s, \"contrast_agrees\": %d, \"contrast_misses\": %d, "
+                "\"contrast_reverses\": %d}\n",
+                number(kLatestCut).c_str(), early.agrees, early.misses, early.reverses);
     return 0;
   }
   std::printf("the simulator calibrated on participant '%s', on %zu trials of other participants (L: %s objective)\n",
@@ -137,8 +159,22 @@ int run_predict(int argc, char** argv) {
   for (std::size_t i = 0; i < findings.size() && i < kShown; ++i) std::printf("  %s\n", findings[i].text.c_str());
   if (findings.size() > kShown)
     std::printf("  ... %zu smaller ones (--json lists all; --out writes every window)\n", findings.size() - kShown);
+  // What an STC learns from the heights' difference, in travel order (the early windows are what
+  // the cut sequences keep).
+  if (contrast.empty())
+    std::printf("the heights' contrast: wherever the people's high arm differs from a lower one, the simulator's "
+                "differs the same way\n");
+  else
+    std::printf("the heights' contrast (what a classifier trained on the simulator learns; %.2f m windows where the "
+                "people's heights differ by more than twice its standard error):\n", window);
+  for (const auto& f : contrast) std::printf("  %s\n", f.text.c_str());
+  const ContrastTally early = tally_contrasts(contrasts);
+  std::printf("up to %.2f m of travel (issue 4's latest cut), where the people's heights differ: the simulator "
+              "agrees in %d, misses %d and reverses %d of the window forces\n",
+              kLatestCut, early.agrees, early.misses, early.reverses);
   if (const auto prefix = args.get("out"))
-    std::printf("wrote %s.csv, %s.curves.csv and %s.residual.csv\n", prefix->c_str(), prefix->c_str(), prefix->c_str());
+    std::printf("wrote %s.csv, %s.curves.csv, %s.residual.csv and %s.contrast.csv\n", prefix->c_str(), prefix->c_str(),
+                prefix->c_str(), prefix->c_str());
   return 0;
 #endif
 }

@@ -77,7 +77,9 @@ if(STUDY)
                   RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT rc EQUAL 0 OR NOT out MATCHES "\"participant\": \"4\", \"trials\": 20" OR NOT out MATCHES "\"height\": \"middle\""
      OR NOT out MATCHES "\"residual_window_m\": 0.05, \"residual_findings\": \\["
-     OR NOT EXISTS ${WORK}/pred.csv OR NOT EXISTS ${WORK}/pred.curves.csv OR NOT EXISTS ${WORK}/pred.residual.csv)
+     OR NOT out MATCHES "\\], \"contrast_findings\": \\[[^]]*\\], \"contrast_up_to_m\": 0.3, \"contrast_agrees\": [0-9]+, \"contrast_misses\": [0-9]+, \"contrast_reverses\": [0-9]+}"
+     OR NOT EXISTS ${WORK}/pred.csv OR NOT EXISTS ${WORK}/pred.curves.csv OR NOT EXISTS ${WORK}/pred.residual.csv
+     OR NOT EXISTS ${WORK}/pred.contrast.csv)
     message(FATAL_ERROR "predict on the study (${rc}):\n${out}\n${err}")
   endif()
   # The residual table: a header and one row per 0.05 m window to the longest measured travel
@@ -87,6 +89,20 @@ if(STUDY)
   if(NOT n EQUAL 52)
     message(FATAL_ERROR "predict: pred.residual.csv has ${n} lines, not a header and 3 x 17 windows")
   endif()
+  # The heights' contrast: a header and one row per window for the middle and the low arm.
+  file(STRINGS ${WORK}/pred.contrast.csv rows)
+  list(LENGTH rows n)
+  if(NOT n EQUAL 35)
+    message(FATAL_ERROR "predict: pred.contrast.csv has ${n} lines, not a header and 2 x 17 windows")
+  endif()
+  # Both tables as pictures.
+  foreach(mode residual contrast)
+    execute_process(COMMAND /usr/bin/python3 ${PLOT} ${mode} ${WORK}/pred --out ${WORK}/pred-${mode}.png
+                    RESULT_VARIABLE rc ERROR_VARIABLE err)
+    if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/pred-${mode}.png)
+      message(FATAL_ERROR "calib_overlay.py ${mode} on predict's tables (${rc}): ${err}")
+    endif()
+  endforeach()
   file(STRINGS ${WORK}/pred.csv rows)
   list(LENGTH rows n)
   if(NOT n EQUAL 21)

@@ -276,6 +276,123 @@ TEST(Prediction, ResidualWindowsAndFindingsByHand) {
   EXPECT_TRUE(residual_findings(residual_windows(p, ds, 0.05)).empty());
 }
 
+// The heights' contrast by hand, 0.1 m windows to 0.41 m. Four people per height:
+// - high: F_motion -1, -1.2, -0.8, -1 N (mean -1, spread sqrt(0.08 / 3)), F_vertical +0.3 N;
+// - low: the same F_motion to 0.2 m, then 1 N more drag (contrast +1, SE sqrt(2 x 0.02 / 3) / 2
+//   = 0.115 N); F_vertical 0 to 0.2 m, then -0.2 N (contrast +0.3, then +0.5; no spread, SE 0);
+// - middle (three people): F_motion -1.5, -0.5, -0.5 (contrast -0.167 N, but SE 0.343 N, so
+//   no contrast), F_vertical +0.3 (contrast 0).
+// The simulator: high F_motion -1, F_vertical -0.2 everywhere; low F_vertical +0.1 (contrast
+// -0.3: reverses), -0.15 (-0.05: misses), then -0.6 (+0.4: agrees); low F_motion -1 to 0.2 m,
+// then -0.5 (-0.5: reverses the people's +1); middle -3 N of drag, a contrast the people lack.
+TEST(Prediction, HeightContrastsByHand) {
+  Dataset ds;
+  Prediction p;
+  p.participant = "1";
+  int person = 2;
+  auto add = [&](ArmHeight h, auto measured, auto simulated) {
+    HapticSequence m;
+    m.participant = std::to_string(person++);
+    m.id = "p" + m.participant + "-" + std::string(arm_height_name(h));
+    m.height = h;
+    m.label = h == ArmHeight::High ? Outcome::Good : Outcome::Missed;
+    m.samples = curve(0.41, measured);
+    ds.trials.push_back(m);
+    PredictedTrial t;
+    t.trial_id = m.id;
+    t.participant = m.participant;
+    t.height = h;
+    t.simulated = curve(0.41, simulated);
+    p.trials.push_back(t);
+  };
+  const double drags[4] = {-1, -1.2, -0.8, -1};
+  for (double d : drags) {
+    add(ArmHeight::High, [d](double) { return std::pair{d, 0.3}; }, [](double) { return std::pair{-1.0, -0.2}; });
+    add(ArmHeight::Low, [d](double x) { return std::pair{x < 0.2 ? d : d - 1, x < 0.2 ? 0.0 : -0.2}; },
+        [](double x) { return std::pair{x < 0.2 ? -1.0 : -0.5, x < 0.1 ? 0.1 : (x < 0.2 ? -0.15 : -0.6)}; });
+  }
+  for (double d : {-1.5, -0.5, -0.5})
+    add(ArmHeight::Middle, [d](double) { return std::pair{d, 0.3}; }, [](double) { return std::pair{-3.0, -0.2}; });
+
+  const std::vector<HeightContrast> c = height_contrasts(residual_windows(p, ds, 0.1));
+  ASSERT_EQ(c.size(), 10u);  // 5 windows x (middle, low)
+  using V = ContrastVerdict;
+  for (int k = 0; k < 5; ++k) {
+    const HeightContrast& m = c[static_cast<std::size_t>(k)];
+    EXPECT_EQ(m.lower, ArmHeight::Middle);
+    EXPECT_EQ(m.verdict[0], V::NoContrast) << k;  // within twice its standard error
+    EXPECT_EQ(m.verdict[1], V::NoContrast) << k;  // no difference
+    if (k < 4) {
+      EXPECT_NEAR(m.measured[0], -1.0 - (-2.5 / 3), 1e-12);
+      EXPECT_NEAR(m.standard_error[0], std::sqrt(0.08 / 3 / 4 + (1.0 / 3) / 3), 1e-12);
+      EXPECT_NEAR(m.simulated[0], 2.0, 1e-12);
+    }
+  }
+  const V motion[5] = {V::NoContrast, V::NoContrast, V::Reverses, V::Reverses, V::NoContrast};
+  const V vertical[5] = {V::Reverses, V::Misses, V::Agrees, V::Agrees, V::NoContrast};
+  const double vertical_people[4] = {0.3, 0.3, 0.5, 0.5}, vertical_sim[4] = {-0.3, -0.05, 0.4, 0.4};
+  for (int k = 0; k < 5; ++k) {
+    const HeightContrast& l = c[static_cast<std::size_t>(5 + k)];
+    EXPECT_EQ(l.lower, ArmHeight::Low);
+    EXPECT_NEAR(l.from, 0.1 * k, 1e-12);
+    EXPECT_EQ(l.verdict[0], motion[k]) << k;
+    EXPECT_EQ(l.verdict[1], vertical[k]) << k;
+    if (k == 4) {  // no trial reaches 0.5 m
+      EXPECT_EQ(l.trials_high, 0);
+      EXPECT_TRUE(std::isnan(l.measured[0]));
+      continue;
+    }
+    EXPECT_EQ(l.trials_high, 4);
+    EXPECT_EQ(l.trials_lower, 4);
+    EXPECT_NEAR(l.measured[0], k < 2 ? 0.0 : 1.0, 1e-12) << k;
+    EXPECT_NEAR(l.standard_error[0], std::sqrt(2 * 0.08 / 3 / 4), 1e-12) << k;
+    EXPECT_NEAR(l.simulated[0], k < 2 ? 0.0 : -0.5, 1e-12) << k;
+    EXPECT_NEAR(l.measured[1], vertical_people[k], 1e-12) << k;
+    EXPECT_NEAR(l.standard_error[1], 0.0, 1e-12) << k;
+    EXPECT_NEAR(l.simulated[1], vertical_sim[k], 1e-12) << k;
+  }
+
+  // Findings in travel order: F_vertical reversed over 0.0-0.1 m, missed over 0.1-0.2 m (one
+  // run per verdict), F_motion reversed over 0.2-0.4 m (one run); the middle arm gives none.
+  const std::vector<ContrastFinding> f = contrast_findings(c);
+  ASSERT_EQ(f.size(), 3u);
+  EXPECT_EQ(f[0].axis, 1);
+  EXPECT_EQ(f[0].verdict, V::Reverses);
+  EXPECT_NEAR(f[0].to, 0.1, 1e-12);
+  EXPECT_EQ(f[1].axis, 1);
+  EXPECT_EQ(f[1].verdict, V::Misses);
+  EXPECT_NEAR(f[1].from, 0.1, 1e-12);
+  EXPECT_NEAR(f[1].simulated, -0.05, 1e-12);
+  EXPECT_EQ(f[2].axis, 0);
+  EXPECT_EQ(f[2].lower, ArmHeight::Low);
+  EXPECT_EQ(f[2].verdict, V::Reverses);
+  EXPECT_NEAR(f[2].from, 0.2, 1e-12);
+  EXPECT_NEAR(f[2].to, 0.4, 1e-12);
+  EXPECT_NEAR(f[2].measured, 1.0, 1e-12);
+  EXPECT_NEAR(f[2].simulated, -0.5, 1e-12);
+  EXPECT_NE(f[2].text.find("learns the opposite"), std::string::npos) << f[2].text;
+  EXPECT_NE(f[1].text.find("learns nothing"), std::string::npos) << f[1].text;
+
+  // Counted to 0.30 m (three windows): F_vertical reverses, misses, agrees; F_motion reverses
+  // once (the middle arm has no contrast); to 0.41 m one more of each F_motion and F_vertical
+  // window.
+  const ContrastTally early = tally_contrasts(c);
+  EXPECT_EQ(early.agrees, 1);
+  EXPECT_EQ(early.misses, 1);
+  EXPECT_EQ(early.reverses, 2);
+  const ContrastTally all = tally_contrasts(c, 0.41);
+  EXPECT_EQ(all.agrees, 2);
+  EXPECT_EQ(all.misses, 1);
+  EXPECT_EQ(all.reverses, 3);
+
+  // The CSV: a header and one row per entry. A simulator that is the people has no finding.
+  const std::string csv = contrast_csv(c);
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 11);
+  EXPECT_EQ(csv.rfind("lower,from,to,trials_high,trials_lower,measured_motion", 0), 0u);
+  for (auto& t : p.trials) t.simulated = find(ds, t.trial_id).samples;
+  EXPECT_TRUE(contrast_findings(height_contrasts(residual_windows(p, ds, 0.1))).empty());
+}
+
 // The measured vertical force is +1 N over its first 0.4 m and -1 N over the next 0.4 m; a
 // simulation of constant +0.5 N has its sign on half of that travel, one of -0.5 N on the other
 // half; a simulation that ends at 0.2 m is asked only about its own travel; a measurement that

@@ -20,6 +20,13 @@ Modes:
             deviation) and the simulated mean (black); windows where the simulation is further from
             the people's mean than they are from each other are shaded red (what the simulation
             gets wrong, offline/calib/prediction.h).
+  contrast: calib_overlay.py contrast PREFIX --out contrast.png
+            `dressguard predict --out PREFIX`'s PREFIX.contrast.csv: per lower arm height (middle,
+            low) and force, the people's difference high minus that height per travel window with
+            +-2 standard errors (grey band) and the simulator's (black). Windows where the people
+            differ and the simulator does the opposite are shaded red, where it shows no difference
+            orange: what a classifier trained on the simulator learns wrong or not at all. Dotted
+            lines mark the cuts of issue 4 (0.15, 0.20, 0.25, 0.30 m).
   progress: calib_overlay.py progress CALIBRATE.log --out progress.png
             `dressguard calibrate`'s progress lines (its stderr, kept in a file): the best L so far
             and each generation's best against the generation, and the best point's L per sequence
@@ -182,6 +189,40 @@ def plot_residual(args):
     fig.savefig(args.out, dpi=100)
 
 
+def plot_contrast(args):
+    rows = list(csv.DictReader(open(args.prefix + ".contrast.csv", newline="")))
+    lowers = [h for h in ("middle", "low") if any(r["lower"] == h for r in rows)]
+    shade = {"reverses": ("tab:red", "simulator reverses it"), "misses": ("tab:orange", "simulator misses it")}
+    fig, axes = plt.subplots(len(lowers), 2, figsize=(12, 3.4 * len(lowers)), squeeze=False)
+    for i, h in enumerate(lowers):
+        mine = [r for r in rows if r["lower"] == h and int(r["trials_high"]) > 0 and int(r["trials_lower"]) > 0]
+        for col, (axis, name) in enumerate((("motion", "F_motion"), ("vertical", "F_vertical"))):
+            ax = axes[i][col]
+            for r in mine:
+                a, b = float(r["from"]), float(r["to"])
+                m, se, sim = (float(r[k + "_" + axis]) for k in ("measured", "standard_error", "simulated"))
+                if r["verdict_" + axis] in shade:
+                    ax.axvspan(a, b, color=shade[r["verdict_" + axis]][0], alpha=0.2, lw=0)
+                if se == se:
+                    ax.fill_between([a, b], [m - 2 * se] * 2, [m + 2 * se] * 2, color="gray", alpha=0.35, lw=0)
+                ax.plot([a, b], [m, m], color="tab:blue", lw=1.5)
+                ax.plot([a, b], [sim, sim], color="black", lw=1.5)
+            for cut in (0.15, 0.20, 0.25, 0.30):
+                ax.axvline(cut, color="gray", ls=":", lw=0.8)
+            ax.axhline(0, color="gray", lw=0.6)
+            ax.plot([], [], color="tab:blue", label="people (+-2 standard errors, grey)")
+            ax.plot([], [], color="black", label="simulator")
+            for colour, label in shade.values():
+                ax.fill_between([], [], [], color=colour, alpha=0.2, label=label)
+            ax.set_title(f"{name}: high arm (good) minus {h} arm (missed)")
+            ax.set_xlabel("travel [m]")
+            ax.set_ylabel(f"{name} difference [N]")
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=7, loc="lower left")
+    fig.tight_layout()
+    fig.savefig(args.out, dpi=100)
+
+
 PROGRESS = re.compile(r"^generation (\d+)/(\d+)\s+best L ([0-9.eE+-]+|inf)(?: \(([^)]*)\))?\s+"
                       r"\(this generation ([0-9.eE+-]+|inf)\)")
 
@@ -242,12 +283,15 @@ def main():
     r = sub.add_parser("residual")
     r.add_argument("prefix")
     r.add_argument("--out", required=True)
+    c = sub.add_parser("contrast")
+    c.add_argument("prefix")
+    c.add_argument("--out", required=True)
     g = sub.add_parser("progress")
     g.add_argument("log")
     g.add_argument("--out", required=True)
     args = p.parse_args()
     {"fit": plot_fit, "dataset": plot_dataset, "predict": plot_predict, "residual": plot_residual,
-     "progress": plot_progress}[args.mode](args)
+     "contrast": plot_contrast, "progress": plot_progress}[args.mode](args)
 
 
 if __name__ == "__main__":
