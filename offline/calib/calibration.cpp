@@ -236,7 +236,9 @@ std::string fingerprint(const std::vector<HapticSequence>& inputs, const Paramet
                         const CalibrationOptions& o) {
   std::ostringstream f;
   f << "seed=" << o.seed << ";population=" << o.population << ";generations=" << o.generations
-    << ";sigma0=" << hexd(o.sigma0) << ";objective=" << objective_name(o.objective) << ";names=";
+    << ";sigma0=" << hexd(o.sigma0) << ";objective=" << objective_name(o.objective);
+  if (o.contrast_weight > 0) f << ";contrast=" << hexd(o.contrast_weight);  // (older checkpoints resume)
+  f << ";names=";
   for (const auto& n : space.names()) f << n << ',';
   f << ";bounds=";
   for (const auto& b : space.bounds.cloth) f << hexd(b.lower) << ',' << hexd(b.upper) << ',' << hexd(b.initial) << ',';
@@ -315,6 +317,27 @@ TrialBatchSimulator one_by_one(TrialSimulator sim) {
   };
 }
 
+double contrast_term(const std::vector<HapticSequence>& inputs, const std::vector<SimulatedTrial>& simulated,
+                     double weight) {
+  if (!(weight > 0)) return 0.0;
+  const auto high = std::find_if(inputs.begin(), inputs.end(), [](const HapticSequence& s) {
+    return s.height == ArmHeight::High;
+  });
+  if (high == inputs.end()) return 0.0;
+  const std::size_t h = static_cast<std::size_t>(high - inputs.begin());
+  double c = 0.0;
+  for (std::size_t k = 0; k < inputs.size(); ++k) {
+    if (inputs[k].height == ArmHeight::High) continue;
+    const SimulatedTrial& sh = simulated[h];
+    const SimulatedTrial& sk = simulated[k];
+    // A blown-up simulation scores infinity, as in eq. 3-5.
+    if (!sh.finite || !sk.finite || sh.samples.empty() || sk.samples.empty())
+      return std::numeric_limits<double>::infinity();
+    c += contrast_error(sh.samples, sk.samples, inputs[h].samples, inputs[k].samples, kLatestCut);
+  }
+  return weight * c;
+}
+
 CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const ParameterSpace& space,
                             const TrialSimulator& sim, const CalibrationOptions& options, const Comm& comm,
                             const std::function<void(const GenerationProgress&)>& progress) {
@@ -329,6 +352,11 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
     throw std::invalid_argument("calibrate: need at least 1 generation and a population of 2");
   const auto t0 = std::chrono::steady_clock::now();
   const int K = static_cast<int>(inputs.size());
+  if (options.contrast_weight < 0 || !std::isfinite(options.contrast_weight))
+    throw std::invalid_argument("calibrate: the contrast weight must be 0 or positive");
+  // The terms of a candidate's objective: one per input sequence, then the contrast term when
+  // it is asked for (a run without one keeps its old layout, and its checkpoints resume).
+  const int T = K + (options.contrast_weight > 0 ? 1 : 0);
 
   CmaesSettings cs;
   cs.x0 = space.initial_unit();
@@ -341,7 +369,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   Cmaes es(cs);
 
   const std::string fp = fingerprint(inputs, space, options);
-  std::vector<double> best_fits(static_cast<std::size_t>(K), 0.0);
+  std::vector<double> best_fits(static_cast<std::size_t>(T), 0.0);
   int done = 0;
   bool resumed = false;
   // Resume: every rank reads rank 0's checkpoint text (broadcast), so all start from one state.
@@ -355,7 +383,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
         throw_input_error(options.checkpoint, 2,
                           "checkpoint belongs to a different calibration (inputs, seed, budget, bounds or "
                           "objective differ); remove it or choose another --checkpoint");
-      if (static_cast<int>(c.best_fits.size()) != K) throw_input_error(options.checkpoint, 4, "wrong number of fits");
+      if (static_cast<int>(c.best_fits.size()) != T) throw_input_error(options.checkpoint, 4, "wrong number of fits");
       try {
         es.restore_state(c.cmaes_state);
       } catch (const std::runtime_error& e) {
@@ -367,13 +395,13 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
     }
   }
 
-  // The candidates' objectives per input sequence (candidate c's at [c K, c K + K)).
+  // The candidates' objective terms (candidate c's at [c T, c T + T)).
   // One task per candidate, all its sequences in one batch: the cloth simulator settles the
   // gown once for them (sim::simulate_trials; 15-25% of a candidate's time). Session 2 ran one
   // task per (candidate, sequence) for finer grains; with 10-32 candidates a generation the
   // coarser grain still keeps 2 cores busy.
   auto evaluate = [&](const std::vector<Eigen::VectorXd>& xs) {
-    return run_batch(static_cast<int>(xs.size()), K, thread_count(options.threads), comm, [&](int c, double* out) {
+    return run_batch(static_cast<int>(xs.size()), T, thread_count(options.threads), comm, [&](int c, double* out) {
       const std::vector<SimulatedTrial> sts = simulate_inputs(sim, space.cloth(xs[c]), space.offsets(xs[c]), inputs);
       for (int k = 0; k < K; ++k) {
         const SimulatedTrial& st = sts[k];
@@ -381,6 +409,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
         if (st.finite && !st.samples.empty()) v = sequence_objective(options.objective, st.samples, inputs[k].samples);
         out[k] = std::isfinite(v) ? v : std::numeric_limits<double>::infinity();
       }
+      if (T > K) out[K] = contrast_term(inputs, sts, options.contrast_weight);
     });
   };
 
@@ -394,7 +423,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   const Eigen::VectorXd start = space.initial_unit();
   const std::vector<double> start_fits = evaluate({start});
   double start_f = 0.0;
-  for (int k = 0; k < K; ++k) start_f += start_fits[static_cast<std::size_t>(k)];  // the generations' order
+  for (int k = 0; k < T; ++k) start_f += start_fits[static_cast<std::size_t>(k)];  // the generations' order
 
   int done_here = 0;
   while (!es.stopped()) {
@@ -404,12 +433,12 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
     const std::vector<double> per = evaluate(xs);
     std::vector<double> f(static_cast<std::size_t>(lambda), 0.0);
     for (int c = 0; c < lambda; ++c)
-      for (int k = 0; k < K; ++k) f[c] += per[static_cast<std::size_t>(c) * K + k];  // fixed order: same bits
+      for (int k = 0; k < T; ++k) f[c] += per[static_cast<std::size_t>(c) * T + k];  // fixed order: same bits
     const double best_before = es.best_f();
     const int arg = static_cast<int>(std::min_element(f.begin(), f.end()) - f.begin());
     es.tell(f);
     if (f[arg] < best_before)
-      for (int k = 0; k < K; ++k) best_fits[k] = per[static_cast<std::size_t>(arg) * K + k];
+      for (int k = 0; k < T; ++k) best_fits[k] = per[static_cast<std::size_t>(arg) * T + k];
     ++done;
     ++done_here;
     if (comm.is_root()) {
@@ -424,6 +453,8 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
         const bool start_best = !(es.best_f() <= start_f);  // as the result chooses, below
         p.best = start_best ? start_f : es.best_f();
         p.best_fits = start_best ? start_fits : best_fits;
+        p.best_contrast = T > K ? p.best_fits.back() : 0.0;
+        p.best_fits.resize(static_cast<std::size_t>(K));
         p.generation_best = f[arg];
         p.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         p.eta_s = p.elapsed_s / done_here * std::max(0, options.generations - done);
@@ -446,6 +477,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   for (int k = 0; k < K; ++k)
     r.fits.push_back({inputs[k].id, inputs[k].height, inputs[k].speed,
                       keep_start ? start_fits[static_cast<std::size_t>(k)] : best_fits[k], {}, {}});
+  if (T > K) r.contrast = keep_start ? start_fits.back() : best_fits.back();
   r.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }
@@ -522,6 +554,11 @@ Json calibration_to_json(const Calibration& c) {
   j.set("arm_offsets", off);
   j.set("objective_kind", c.objective_kind);
   j.set("objective", c.objective);
+  // Only with a contrast term (files without one keep their text).
+  if (c.contrast_weight > 0) {
+    j.set("contrast_weight", c.contrast_weight);
+    j.set("contrast", c.contrast);
+  }
   Json fits = Json::array();
   for (const auto& f : c.fits) {
     Json e = Json::object();
@@ -578,6 +615,11 @@ Calibration calibration_from_json(const Json& j, const std::filesystem::path& so
     }
     c.objective_kind = j.at("objective_kind").string();
     c.objective = j.at("objective").number();
+    if (j.has("contrast_weight")) {
+      c.contrast_weight = j.at("contrast_weight").number();
+      c.contrast = j.at("contrast").number();
+      if (!(c.contrast_weight >= 0)) throw std::runtime_error("contrast_weight must not be negative");
+    }
     for (const Json& e : j.at("sequences").items()) {
       SequenceFit f;
       f.trial_id = e.at("trial_id").string();

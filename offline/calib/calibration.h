@@ -206,6 +206,9 @@ struct CalibrationOptions {
   double sigma0 = 0.3;             // in the unit box
   std::uint64_t seed = 1;
   ObjectiveKind objective = ObjectiveKind::Area;
+  // > 0: add this times the heights' contrast (objective.h, contrast_error) of the high input
+  // against each lower one, over the first kLatestCut metres, to the objective; 0: the paper's.
+  double contrast_weight = 0;
   int threads = 0;                 // 0 = all cores
   std::filesystem::path checkpoint;  // empty = none
   int stop_after_generations = 0;  // > 0: stop (as if killed) after this many generations in this process
@@ -215,7 +218,9 @@ struct GenerationProgress {
   int generation = 0;       // 1-based, generations done
   int generations = 0;      // total planned
   double best = 0;          // best objective so far
-  std::vector<double> best_fits;  // its objective per input sequence, in the inputs' order (they sum to best)
+  std::vector<double> best_fits;  // its objective per input sequence, in the inputs' order (with
+                                  // best_contrast, they sum to best)
+  double best_contrast = 0;       // its weighted contrast term (0 without one)
   double generation_best = 0;
   double elapsed_s = 0;     // this process
   double eta_s = 0;         // estimated remaining, from this process's pace
@@ -255,8 +260,15 @@ struct CalibrationResult {
   ClothValues cloth;
   std::array<double, 3> offsets{};  // [m] by ArmHeight
   std::vector<SequenceFit> fits;  // per selected sequence, for the best candidate
+  double contrast = 0;            // its weighted contrast term: objective = sum of fits + contrast
   double elapsed_s = 0;
 };
+
+// The weighted contrast term of options.contrast_weight for one candidate's simulated inputs
+// (0 when the weight is 0 or the inputs hold no high sequence or no lower one). Issue 4's
+// latest cut bounds the travel (prediction.h, kLatestCut).
+double contrast_term(const std::vector<HapticSequence>& inputs, const std::vector<SimulatedTrial>& simulated,
+                     double weight);
 
 // Runs (or resumes from options.checkpoint) the calibration. The start (the bounds' initial
 // values) is evaluated first, and is the result when no candidate of the search beats it. Every rank of `comm` must call it
@@ -301,8 +313,10 @@ struct Calibration {
   ClothValues cloth;
   std::array<double, 3> offsets{};            // [m] by ArmHeight
   std::array<bool, 3> offset_calibrated{};    // which offsets were optimised
-  double objective = 0;
+  double objective = 0;                       // what the search minimised: sum of fits + contrast
   std::vector<SequenceFit> fits;
+  double contrast_weight = 0;                 // calibrate --contrast-weight (0: the paper's objective)
+  double contrast = 0;                        // its weighted term (contrast_term)
   std::string objective_kind = "area";
   std::string gown = "reduced";               // which scene the simulator used
   double rig_travel = 0.85;                   // [m] end of travel for synthesis (rig_travel_of)

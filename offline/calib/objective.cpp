@@ -117,6 +117,27 @@ double vertical_sign_agreement(const std::vector<HapticSample>& sim, const std::
   return asked > 0 ? agreed / asked : std::numeric_limits<double>::quiet_NaN();
 }
 
+double contrast_error(const std::vector<HapticSample>& sim_high, const std::vector<HapticSample>& sim_lower,
+                      const std::vector<HapticSample>& measured_high, const std::vector<HapticSample>& measured_lower,
+                      double up_to) {
+  require_samples(sim_high, measured_high);
+  require_samples(sim_lower, measured_lower);
+  const double end = std::min({up_to, sim_high.back().travel, sim_lower.back().travel, measured_high.back().travel,
+                               measured_lower.back().travel});
+  double e = 0.0;
+  // x_j from the index, not accumulated, so that the grid is the same for every candidate.
+  for (int j = 0;; ++j) {
+    const double x = (j + 0.5) * kContrastStep;
+    if (!(x < end)) break;
+    for (ForceAxis a : {ForceAxis::Motion, ForceAxis::Vertical}) {
+      const double simulated = force_at(sim_high, x, a) - force_at(sim_lower, x, a);
+      const double measured = force_at(measured_high, x, a) - force_at(measured_lower, x, a);
+      e += kContrastStep * std::abs(simulated - measured);
+    }
+  }
+  return e;
+}
+
 double sequence_objective(ObjectiveKind kind, const std::vector<HapticSample>& sim,
                           const std::vector<HapticSample>& measured) {
   return kind == ObjectiveKind::Area ? area_objective(sim, measured) : position_weighted_objective(sim, measured);

@@ -66,6 +66,29 @@ double position_weighted_objective(const std::vector<HapticSample>& sim, const s
 double vertical_sign_agreement(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured,
                                double threshold = 0.2);
 
+// ---- the heights' contrast (an extension of the paper's objective; calibrate --contrast-weight) ---
+//
+// A classifier trained on the simulator tells good from missed by how the force differs between
+// the arm height that gives good (high) and the one that gives missed (middle, low), and cut
+// early (issue 4: up to 0.30 m) that difference is all it has. Eq. 3-5 scores each sequence on
+// its own, by area, and the forces at 0.2-0.3 m (a few tenths of a newton) weigh little against
+// the newtons of the late pull: calibrations that fit participant 4 and 5 at L <= 0.3 per
+// sequence order the heights the wrong way round there (prediction.h, height_contrasts). This
+// term scores that difference directly, for one high sequence H and one lower sequence W, each
+// simulated (S) and measured (R):
+//
+//   c(S, R) = sum_axes sum_j dx |(S_H(x_j) - S_W(x_j)) - (R_H(x_j) - R_W(x_j))|,   x_j = (j + 1/2) dx
+//
+// over x_j < min(up_to, the end of all four curves), each curve linearly interpolated on its
+// travel, dx = kContrastStep. A force both heights share (an offset of every curve alike) does
+// not count: only the difference does. [N m], like eq. 3.
+inline constexpr double kLatestCut = 0.30;     // [m] issue 4's latest cut of the measured sequences
+inline constexpr double kContrastStep = 0.005;  // [m]: 5 samples at 0.1 m/s, 100 Hz
+
+double contrast_error(const std::vector<HapticSample>& sim_high, const std::vector<HapticSample>& sim_lower,
+                      const std::vector<HapticSample>& measured_high, const std::vector<HapticSample>& measured_lower,
+                      double up_to);
+
 // The chosen objective for one pair.
 double sequence_objective(ObjectiveKind kind, const std::vector<HapticSample>& sim,
                           const std::vector<HapticSample>& measured);

@@ -197,8 +197,7 @@ struct ContrastFinding {
 std::vector<ContrastFinding> contrast_findings(const std::vector<HeightContrast>& contrasts);
 
 // The verdicts counted over the windows that end at or before `up_to` metres (both forces, both
-// lower heights): what a sequence cut there holds. kLatestCut is issue 4's latest cut.
-inline constexpr double kLatestCut = 0.30;  // [m]
+// lower heights): what a sequence cut there holds (kLatestCut: objective.h).
 struct ContrastTally {
   int agrees = 0, misses = 0, reverses = 0;  // NoContrast windows are not counted
 };

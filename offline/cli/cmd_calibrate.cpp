@@ -46,6 +46,10 @@ int run_calibrate(int argc, char** argv) {
         "                      about 0.1 from initial values known to fit, e.g. another calibration's)\n"
         "  --seed S            input selection and CMA-ES (default 1); same seed, same result\n"
         "  --objective area|position-weighted   (default area: paper eq. 3-5)\n"
+        "  --contrast-weight K   add K times the heights' contrast to the objective: how the high\n"
+        "                      sequence's forces differ from the lower one's over the first 0.30 m,\n"
+        "                      simulated against measured (offline/calib/objective.h, contrast_error;\n"
+        "                      what a classifier learns from cut sequences). Default 0: eq. 3-5 alone\n"
         "  --no-arm-offset     do not optimise the arm offsets (paper Fig. 9 comparison)\n"
         "  --arm-compliance fit|fixed|C   the person's arm: fit its compliance [m/N] too (one more\n"
         "                      parameter; offline/sim/arm_spring.h), hold it fixed (the paper's, the\n"
@@ -76,7 +80,7 @@ int run_calibrate(int argc, char** argv) {
   args.allow_only({"help", "json", "no-arm-offset", "data", "participant", "profile", "bounds", "start", "seed", "out",
                    "checkpoint", "objective", "gown", "threads", "generations", "population",
                    "stop-after-generations", "arm-compliance", "fist-shift", "rim-shift", "sigma0", "hem",
-                   "density"});
+                   "density", "contrast-weight"});
   const std::string data = args.require("data");
   const std::string participant = args.require("participant");
   const std::string out = args.require("out");
@@ -98,6 +102,11 @@ int run_calibrate(int argc, char** argv) {
   const auto kind = parse_objective(args.get("objective").value_or("area"));
   if (!kind) throw UsageError("--objective must be area or position-weighted");
   o.objective = *kind;
+  if (const auto cw = args.get("contrast-weight")) {
+    o.contrast_weight = args.number("contrast-weight", 0);
+    if (!(o.contrast_weight >= 0 && o.contrast_weight <= 1000))
+      throw UsageError("--contrast-weight must be in [0, 1000], not '" + *cw + "'");
+  }
   o.threads = static_cast<int>(args.integer("threads", 0));
   o.checkpoint = args.get("checkpoint").value_or(out + ".ckpt");
   o.stop_after_generations = static_cast<int>(args.integer("stop-after-generations", 0));
@@ -150,6 +159,11 @@ int run_calibrate(int argc, char** argv) {
       std::snprintf(buf, sizeof buf, "%s%s %.3f", k ? ", " : "", inputs[k].id.c_str(), p.best_fits[k]);
       per += buf;
     }
+    if (o.contrast_weight > 0) {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, ", contrast %.3f", p.best_contrast);
+      per += buf;
+    }
     std::fprintf(stderr, "generation %d/%d  best L %.4f (%s)  (this generation %.4f)  elapsed %s  ETA %s\n",
                  p.generation, p.generations, p.best, per.c_str(), p.generation_best, minutes(p.elapsed_s).c_str(),
                  minutes(p.eta_s).c_str());
@@ -172,6 +186,8 @@ int run_calibrate(int argc, char** argv) {
   for (ArmHeight h : space.offset_heights) cal.offset_calibrated[static_cast<int>(h)] = true;
   cal.objective = r.objective;
   cal.fits = r.fits;
+  cal.contrast_weight = o.contrast_weight;
+  cal.contrast = r.contrast;
   cal.objective_kind = std::string(objective_name(o.objective));
   cal.gown = gown;
   cal.rig_travel = rig_travel_of(inputs);
@@ -216,6 +232,9 @@ int run_calibrate(int argc, char** argv) {
         std::printf("  %-18s %-6s L = %.4f; over the common travel F_motion %.3f (zero force %.3f), F_vertical %.3f "
                     "(zero force %.3f) N m\n", f.trial_id.c_str(), std::string(arm_height_name(f.height)).c_str(),
                     f.objective, f.motion.error, f.motion.zero, f.vertical.error, f.vertical.zero);
+      if (o.contrast_weight > 0)
+        std::printf("  the heights' contrast to %.2f m: %.4f N m, times %g: %.4f of L\n", kLatestCut,
+                    r.contrast / o.contrast_weight, o.contrast_weight, r.contrast);
       for (int i = 0; i < kClothParams; ++i) {
         std::printf("  %-13s %.4f", kClothParamNames[i], cloth_value(r.cloth, i));
         // What bend means as a fabric (light woven fabrics: 1.5-3 cm; offline/sim/README.md).

@@ -243,6 +243,60 @@ TEST(Calibration, ResumeFromCheckpointGivesTheUninterruptedResult) {
   fs::remove_all(dir);
 }
 
+// The heights' contrast as a term of the objective (calibrate --contrast-weight): the best
+// point's term is the weight times contrast_error of its simulated high and low curves against
+// the measured ones; the objective is the sequences' terms plus it, in the search's order, in the
+// progress reports too; a run stopped and resumed ends as an uninterrupted one; and the term
+// changes the search (the weight-0 run ends elsewhere). A negative weight is refused.
+TEST(Calibration, ContrastTermJoinsTheObjective) {
+  Truth truth;
+  const auto inputs = fake_inputs(truth);
+  const auto space = space_for(inputs);
+  auto o = quick(8, 2);
+  o.contrast_weight = 5;
+  int reports = 0;
+  const auto r = calibrate(inputs, space, testing::fake_simulate, o, Comm::world(), [&](const GenerationProgress& p) {
+    ASSERT_EQ(p.best_fits.size(), inputs.size());
+    EXPECT_GT(p.best_contrast, 0.0);
+    EXPECT_EQ(p.best_fits[0] + p.best_fits[1] + p.best_contrast, p.best);
+    ++reports;
+  });
+  EXPECT_EQ(reports, 8);
+  ASSERT_EQ(r.fits.size(), 2u);
+  EXPECT_EQ(r.fits[0].objective + r.fits[1].objective + r.contrast, r.objective);
+  std::vector<SimulatedTrial> best;
+  for (const auto& s : inputs) {
+    TrialRequest q;
+    q.height = s.height;
+    q.arm_offset = r.offsets[static_cast<int>(s.height)];
+    q.speed = s.speed;
+    best.push_back(testing::fake_simulate(r.cloth, q));
+  }
+  EXPECT_EQ(contrast_term(inputs, best, 5), r.contrast);
+  EXPECT_NEAR(r.contrast, 5 * contrast_error(best[0].samples, best[1].samples, inputs[0].samples, inputs[1].samples,
+                                             kLatestCut), 1e-15);
+  EXPECT_EQ(contrast_term(inputs, best, 0), 0.0);
+  EXPECT_EQ(contrast_term({inputs[1]}, {best[1]}, 5), 0.0);  // no high sequence: no contrast
+
+  const fs::path dir = temp_dir("contrast");
+  auto part = o;
+  part.checkpoint = dir / "run.ckpt";
+  part.stop_after_generations = 3;
+  EXPECT_FALSE(calibrate(inputs, space, testing::fake_simulate, part, Comm::world()).complete);
+  part.stop_after_generations = 0;
+  const auto resumed = calibrate(inputs, space, testing::fake_simulate, part, Comm::world());
+  EXPECT_EQ(resumed.objective, r.objective);
+  EXPECT_EQ(resumed.contrast, r.contrast);
+  EXPECT_TRUE(resumed.best_unit == r.best_unit);
+  fs::remove_all(dir);
+
+  const auto plain = calibrate(inputs, space, testing::fake_simulate, quick(8, 2), Comm::world());
+  EXPECT_EQ(plain.contrast, 0.0);
+  EXPECT_FALSE(plain.best_unit == r.best_unit);
+  o.contrast_weight = -1;
+  EXPECT_THROW(calibrate(inputs, space, testing::fake_simulate, o, Comm::world()), std::invalid_argument);
+}
+
 TEST(Calibration, CheckpointOfAnotherRunIsRefused) {
   const auto inputs = fake_inputs(Truth{});
   const auto space = space_for(inputs);
@@ -270,6 +324,9 @@ TEST(Calibration, CheckpointOfAnotherRunIsRefused) {
   auto weighed = space;  // and one that fits the density
   ASSERT_TRUE(set_person_param(weighed, kArealDensity, "fit"));
   EXPECT_THROW(calibrate(inputs, weighed, testing::fake_simulate, o, Comm::world()), InputError);
+  o.contrast_weight = 1;  // and one with the heights' contrast in its objective
+  EXPECT_THROW(calibrate(inputs, space, testing::fake_simulate, o, Comm::world()), InputError);
+  o.contrast_weight = 0;
   EXPECT_NO_THROW(calibrate(inputs, space, testing::fake_simulate, o, Comm::world()));  // its own run resumes
   write_file_atomic(o.checkpoint, "garbage\n");
   EXPECT_THROW(calibrate(inputs, space, testing::fake_simulate, o, Comm::world()), InputError);
@@ -402,6 +459,17 @@ TEST(Calibration, CalibrationFileRoundTripAndErrors) {
   write_calibration(dir / "cal_rim.json", c);
   EXPECT_EQ(read_calibration(dir / "cal_rim.json").cloth.rim_shift, -0.015);
   c.cloth.rim_shift = 0.0;
+  // The contrast term: absent is the paper's objective alone; present, both values read back.
+  EXPECT_EQ(read_file(dir / "cal.json").find("contrast"), std::string::npos);
+  EXPECT_EQ(d.contrast_weight, 0.0);
+  c.contrast_weight = 5;
+  c.contrast = 0.125;
+  write_calibration(dir / "cal_contrast.json", c);
+  const Calibration cc = read_calibration(dir / "cal_contrast.json");
+  EXPECT_EQ(cc.contrast_weight, 5.0);
+  EXPECT_EQ(cc.contrast, 0.125);
+  c.contrast_weight = 0;
+  c.contrast = 0;
   // The cuff: absent is none (the paper's uniform cloth); present, it reads back; out of range names the file.
   EXPECT_EQ(read_file(dir / "cal_fist.json").find("hem_"), std::string::npos);
   EXPECT_EQ(d.cloth.hem_width, 0.0);

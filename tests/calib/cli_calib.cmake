@@ -25,6 +25,7 @@ expect_fail("calibrate with a rim behind the jaws" "--rim-shift must be fit, fix
 expect_fail("calibrate with the fist past the elbow" "--fist-shift must be fit, fixed or a value (fist_shift must be within +-0.2 m" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --fist-shift 0.3)
 expect_fail("calibrate with a bad --hem" "--hem" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --hem 0.03)
 expect_fail("calibrate with a softening --hem" "--hem" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --hem 0.03,0.5)
+expect_fail("calibrate with a negative contrast weight" "--contrast-weight must be in [0, 1000]" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --contrast-weight -1)
 expect_fail("calibrate with a weightless gown" "areal_density must be within 0.01 and 1 kg/m" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --density 0)
 expect_fail("calibrate on a missing dataset" "manifest.csv" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json)
 file(WRITE ${WORK}/bad.json "{\"format\": \"dressguard-calibration 1\",\n\"participant\": 4,\n}")
@@ -50,19 +51,22 @@ if(STUDY)
   expect_fail("calibrate with a bad bounds file" "bounds.txt:2: unknown parameter 'stiffness'"
               calibrate --data ${WORK}/study --participant 4 --out ${WORK}/c.json --bounds ${WORK}/bounds.txt)
   expect_fail("calibrate an absent participant" "participant '42'" calibrate --data ${WORK}/study --participant 42 --out ${WORK}/c.json)
-  # One generation of 4 on the coarse gown (~10 s), the density fitted too: the calibration file
-  # (its searched parameters end with the density) and its curves, the fitted density on stdout,
-  # and a progress line with the best point's L and each sequence's share of it.
+  # One generation of 4 on the coarse gown (~10 s), the density fitted too and the heights'
+  # contrast in the objective: the calibration file (its searched parameters end with the density;
+  # the contrast's weight and term) and its curves, the fitted density and the contrast on stdout,
+  # and a progress line with the best point's L and each sequence's and the contrast's share of it.
   execute_process(COMMAND ${DG} calibrate --data ${WORK}/study --participant 4 --out ${WORK}/c1.json --gown coarse
-                          --generations 1 --population 4 --threads 2 --seed 1 --density fit
+                          --generations 1 --population 4 --threads 2 --seed 1 --density fit --contrast-weight 5
                   RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(EXISTS ${WORK}/c1.json)
     file(READ ${WORK}/c1.json c1)
   endif()
   if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/c1.json OR NOT EXISTS ${WORK}/c1.json.curves.csv
      OR NOT c1 MATCHES "\"parameters\": \\[[^]]*\"arm_offset_low\", \"areal_density\"\\]"
+     OR NOT c1 MATCHES "\"contrast_weight\": 5,\n  \"contrast\": [0-9]"
      OR NOT out MATCHES "\n  areal_density +0\\.[0-9]+\n"
-     OR NOT err MATCHES "generation 1/1  best L [0-9.]+ \\(s4-good-3 [0-9.]+, s4-miss-2 [0-9.]+\\)  \\(this generation")
+     OR NOT out MATCHES "\n  the heights' contrast to 0.30 m: [0-9.]+ N m, times 5: [0-9.]+ of L\n"
+     OR NOT err MATCHES "generation 1/1  best L [0-9.]+ \\(s4-good-3 [0-9.]+, s4-miss-2 [0-9.]+, contrast [0-9.]+\\)  \\(this generation")
     message(FATAL_ERROR "calibrate on the coarse gown (${rc}):\n${out}\n${err}")
   endif()
   # Its progress as a picture (tools/plot/calib_overlay.py progress reads the kept stderr).

@@ -70,6 +70,29 @@ TEST(Objective, PositionWeightedClosedForm) {
   EXPECT_NEAR(position_weighted_objective(early_off, r), inside + tail2, 1e-9);
 }
 
+// The heights' contrast in closed form. Measured: high F_motion -0.3, F_vertical +0.2; low -0.5
+// and -0.1 (contrast +0.2, +0.3 N), both to 0.5 m (1 mm steps).
+// - A simulator 1 N off on every curve alike shows the same contrast: error 0.
+// - One whose vertical contrast is reversed (high -0.2, low +0.1: -0.3 N) is 0.6 N off over the
+//   first 0.30 m: 0.18 N m (60 cells of 5 mm), and nothing beyond the cut counts.
+// - Cut short by a simulated low curve that ends at 0.2 m: 0.6 x 0.2 = 0.12 N m.
+// - A ramp: simulated high F_motion 2x (x in m) over a measured contrast of 0 gives the area under
+//   2x to 0.3 m, 0.09 N m, exactly on the cell midpoints.
+TEST(Objective, ContrastErrorClosedForm) {
+  const auto mh = constant_curve(501, 0.001, -0.3, 0.2), ml = constant_curve(501, 0.001, -0.5, -0.1);
+  EXPECT_NEAR(contrast_error(constant_curve(501, 0.001, 0.7, 1.2), constant_curve(501, 0.001, 0.5, 0.9), mh, ml,
+                             kLatestCut), 0.0, 1e-12);
+  const auto sh = constant_curve(501, 0.001, -0.3, -0.2), sl = constant_curve(501, 0.001, -0.5, 0.1);
+  EXPECT_NEAR(contrast_error(sh, sl, mh, ml, kLatestCut), 0.18, 1e-12);
+  EXPECT_NEAR(contrast_error(sh, sl, mh, ml, 0.5), 0.30, 1e-12);
+  EXPECT_NEAR(contrast_error(sh, constant_curve(201, 0.001, -0.5, 0.1), mh, ml, kLatestCut), 0.12, 1e-12);
+  auto ramp = constant_curve(501, 0.001, 0.0, 0.0);
+  for (auto& x : ramp) x.f_motion = 2 * x.travel;
+  const auto flat = constant_curve(501, 0.001, 0.0, 0.0);
+  EXPECT_NEAR(contrast_error(ramp, flat, flat, flat, kLatestCut), 0.09, 1e-12);
+  EXPECT_THROW(contrast_error({}, flat, flat, flat, kLatestCut), std::invalid_argument);
+}
+
 TEST(Objective, ParseNames) {
   EXPECT_EQ(parse_objective("area"), ObjectiveKind::Area);
   EXPECT_EQ(parse_objective("position-weighted"), ObjectiveKind::PositionWeighted);
