@@ -266,7 +266,7 @@ struct CalibrationResult {
 
 // The weighted contrast term of options.contrast_weight for one candidate's simulated inputs
 // (0 when the weight is 0 or the inputs hold no high sequence or no lower one). Issue 4's
-// latest cut bounds the travel (prediction.h, kLatestCut).
+// latest cut bounds the travel (objective.h, kLatestCut).
 double contrast_term(const std::vector<HapticSequence>& inputs, const std::vector<SimulatedTrial>& simulated,
                      double weight);
 
