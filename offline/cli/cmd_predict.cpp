@@ -91,6 +91,7 @@ int run_predict(int argc, char** argv) {
   const std::vector<ResidualFinding> findings = residual_findings(windows);
   const std::vector<HeightContrast> contrasts = height_contrasts(windows);
   const std::vector<ContrastFinding> contrast = contrast_findings(contrasts);
+  const ContrastTally early = tally_contrasts(contrasts);  // up to issue 4's latest cut
   if (const auto prefix = args.get("out")) {
     write_file_atomic(*prefix + ".residual.csv", residual_csv(windows));
     write_file_atomic(*prefix + ".contrast.csv", contrast_csv(contrasts));
@@ -128,7 +129,6 @@ int run_predict(int argc, char** argv) {
                   number(f.measured).c_str(), number(f.simulated).c_str());
       first = false;
     }
-    const ContrastTally early = tally_contrasts(contrasts);
     std::printf("], \"contrast_up_to_m\": %s, \"contrast_agrees\": %d, \"contrast_misses\": %d, "
                 "\"contrast_reverses\": %d}\n",
                 number(kLatestCut).c_str(), early.agrees, early.misses, early.reverses);
@@ -168,7 +168,6 @@ int run_predict(int argc, char** argv) {
     std::printf("the heights' contrast (what a classifier trained on the simulator learns; %.2f m windows where the "
                 "people's heights differ by more than twice its standard error):\n", window);
   for (const auto& f : contrast) std::printf("  %s\n", f.text.c_str());
-  const ContrastTally early = tally_contrasts(contrasts);
   std::printf("up to %.2f m of travel (issue 4's latest cut), where the people's heights differ: the simulator "
               "agrees in %d, misses %d and reverses %d of the window forces\n",
               kLatestCut, early.agrees, early.misses, early.reverses);
