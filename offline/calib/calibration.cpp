@@ -40,6 +40,8 @@ double person_value(const ClothValues& c, int i) {
     case kArmCompliance: return c.arm_compliance;
     case kFistShift: return c.fist_shift;
     case kRimShift: return c.rim_shift;
+    case kArmLateral: return c.arm_lateral;
+    case kFistLateral: return c.fist_lateral;
     default: return c.areal_density;
   }
 }
@@ -49,6 +51,8 @@ void set_person_value(ClothValues& c, int i, double v) {
     case kArmCompliance: c.arm_compliance = v; break;
     case kFistShift: c.fist_shift = v; break;
     case kRimShift: c.rim_shift = v; break;
+    case kArmLateral: c.arm_lateral = v; break;
+    case kFistLateral: c.fist_lateral = v; break;
     default: c.areal_density = v; break;
   }
 }
@@ -71,6 +75,8 @@ Bounds default_bounds() {
   b.person[kFistShift] = {-0.05, 0.15, 0.0};
   b.person[kRimShift] = {-0.04, 0.04, 0.0};
   b.person[kArealDensity] = {0.04, 0.25, kPaperArealDensity};
+  b.person[kArmLateral] = {-0.05, 0.05, 0.0};
+  b.person[kFistLateral] = {-0.05, 0.05, 0.0};
   return b;
 }
 
@@ -238,6 +244,7 @@ std::string fingerprint(const std::vector<HapticSequence>& inputs, const Paramet
   f << "seed=" << o.seed << ";population=" << o.population << ";generations=" << o.generations
     << ";sigma0=" << hexd(o.sigma0) << ";objective=" << objective_name(o.objective);
   if (o.contrast_weight > 0) f << ";contrast=" << hexd(o.contrast_weight);  // (older checkpoints resume)
+  if (o.lateral_weight > 0) f << ";lateral=" << hexd(o.lateral_weight);     // likewise
   f << ";names=";
   for (const auto& n : space.names()) f << n << ',';
   f << ";bounds=";
@@ -338,6 +345,18 @@ double contrast_term(const std::vector<HapticSequence>& inputs, const std::vecto
   return weight * c;
 }
 
+double lateral_term(const std::vector<HapticSequence>& inputs, const std::vector<SimulatedTrial>& simulated,
+                    double weight) {
+  if (!(weight > 0)) return 0.0;
+  double l = 0.0;
+  for (std::size_t k = 0; k < inputs.size(); ++k) {
+    const SimulatedTrial& s = simulated[k];
+    if (!s.finite || s.samples.empty()) return std::numeric_limits<double>::infinity();  // as eq. 3-5
+    l += area_error(s.samples, inputs[k].samples, ForceAxis::Lateral, 0.0);
+  }
+  return weight * l;
+}
+
 CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const ParameterSpace& space,
                             const TrialSimulator& sim, const CalibrationOptions& options, const Comm& comm,
                             const std::function<void(const GenerationProgress&)>& progress) {
@@ -354,9 +373,14 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   const int K = static_cast<int>(inputs.size());
   if (options.contrast_weight < 0 || !std::isfinite(options.contrast_weight))
     throw std::invalid_argument("calibrate: the contrast weight must be 0 or positive");
-  // The terms of a candidate's objective: one per input sequence, then the contrast term when
-  // it is asked for (a run without one keeps its old layout, and its checkpoints resume).
-  const int T = K + (options.contrast_weight > 0 ? 1 : 0);
+  if (options.lateral_weight < 0 || !std::isfinite(options.lateral_weight))
+    throw std::invalid_argument("calibrate: the lateral weight must be 0 or positive");
+  // The terms of a candidate's objective: one per input sequence, then the contrast term and the
+  // lateral term when they are asked for, at `ic` and `il` (-1: none), so that a run without them
+  // keeps its old layout and its checkpoints resume.
+  const int ic = options.contrast_weight > 0 ? K : -1;
+  const int il = options.lateral_weight > 0 ? K + (ic >= 0 ? 1 : 0) : -1;
+  const int T = K + (ic >= 0 ? 1 : 0) + (il >= 0 ? 1 : 0);
 
   CmaesSettings cs;
   cs.x0 = space.initial_unit();
@@ -409,7 +433,8 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
         if (st.finite && !st.samples.empty()) v = sequence_objective(options.objective, st.samples, inputs[k].samples);
         out[k] = std::isfinite(v) ? v : std::numeric_limits<double>::infinity();
       }
-      if (T > K) out[K] = contrast_term(inputs, sts, options.contrast_weight);
+      if (ic >= 0) out[ic] = contrast_term(inputs, sts, options.contrast_weight);
+      if (il >= 0) out[il] = lateral_term(inputs, sts, options.lateral_weight);
     });
   };
 
@@ -453,7 +478,8 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
         const bool start_best = !(es.best_f() <= start_f);  // as the result chooses, below
         p.best = start_best ? start_f : es.best_f();
         p.best_fits = start_best ? start_fits : best_fits;
-        p.best_contrast = T > K ? p.best_fits.back() : 0.0;
+        p.best_contrast = ic >= 0 ? p.best_fits[static_cast<std::size_t>(ic)] : 0.0;
+        p.best_lateral = il >= 0 ? p.best_fits[static_cast<std::size_t>(il)] : 0.0;
         p.best_fits.resize(static_cast<std::size_t>(K));
         p.generation_best = f[arg];
         p.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -476,8 +502,10 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   r.offsets = space.offsets(r.best_unit);
   for (int k = 0; k < K; ++k)
     r.fits.push_back({inputs[k].id, inputs[k].height, inputs[k].speed,
-                      keep_start ? start_fits[static_cast<std::size_t>(k)] : best_fits[k], {}, {}});
-  if (T > K) r.contrast = keep_start ? start_fits.back() : best_fits.back();
+                      keep_start ? start_fits[static_cast<std::size_t>(k)] : best_fits[k], {}, {}, {}});
+  const std::vector<double>& terms = keep_start ? start_fits : best_fits;
+  if (ic >= 0) r.contrast = terms[static_cast<std::size_t>(ic)];
+  if (il >= 0) r.lateral = terms[static_cast<std::size_t>(il)];
   r.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }
@@ -496,6 +524,8 @@ void measure_axis_fits(std::vector<SequenceFit>& fits, const std::vector<HapticS
     fits[k].motion = {area_error(sim, measured, ForceAxis::Motion, 0.0), area_error(zero, measured, ForceAxis::Motion, 0.0)};
     fits[k].vertical = {area_error(sim, measured, ForceAxis::Vertical, 0.0),
                         area_error(zero, measured, ForceAxis::Vertical, 0.0)};
+    fits[k].lateral = {area_error(sim, measured, ForceAxis::Lateral, 0.0),
+                       area_error(zero, measured, ForceAxis::Lateral, 0.0)};
   }
 }
 
@@ -559,6 +589,10 @@ Json calibration_to_json(const Calibration& c) {
     j.set("contrast_weight", c.contrast_weight);
     j.set("contrast", c.contrast);
   }
+  if (c.lateral_weight > 0) {  // likewise
+    j.set("lateral_weight", c.lateral_weight);
+    j.set("lateral", c.lateral);
+  }
   Json fits = Json::array();
   for (const auto& f : c.fits) {
     Json e = Json::object();
@@ -571,6 +605,10 @@ Json calibration_to_json(const Calibration& c) {
       e.set("motion_zero", f.motion.zero);
       e.set("vertical_error", f.vertical.error);
       e.set("vertical_zero", f.vertical.zero);
+    }
+    if (f.lateral.measured()) {
+      e.set("lateral_error", f.lateral.error);
+      e.set("lateral_zero", f.lateral.zero);
     }
     fits.push(e);
   }
@@ -620,6 +658,11 @@ Calibration calibration_from_json(const Json& j, const std::filesystem::path& so
       c.contrast = j.at("contrast").number();
       if (!(c.contrast_weight >= 0)) throw std::runtime_error("contrast_weight must not be negative");
     }
+    if (j.has("lateral_weight")) {
+      c.lateral_weight = j.at("lateral_weight").number();
+      c.lateral = j.at("lateral").number();
+      if (!(c.lateral_weight >= 0)) throw std::runtime_error("lateral_weight must not be negative");
+    }
     for (const Json& e : j.at("sequences").items()) {
       SequenceFit f;
       f.trial_id = e.at("trial_id").string();
@@ -634,6 +677,11 @@ Calibration calibration_from_json(const Json& j, const std::filesystem::path& so
         if (!f.motion.measured() || !f.vertical.measured() || f.motion.error < 0 || f.vertical.error < 0 ||
             f.motion.zero < 0 || f.vertical.zero < 0)
           throw std::runtime_error("sequence " + f.trial_id + ": an axis fit is negative or not finite");
+      }
+      if (e.has("lateral_error")) {  // absent in files written before 2026-11-25
+        f.lateral = {e.at("lateral_error").number(), e.at("lateral_zero").number()};
+        if (!f.lateral.measured() || f.lateral.error < 0 || f.lateral.zero < 0)
+          throw std::runtime_error("sequence " + f.trial_id + ": the lateral fit is negative or not finite");
       }
       c.fits.push_back(f);
     }
@@ -660,17 +708,17 @@ Calibration read_calibration(const std::filesystem::path& path) {
 std::string overlay_csv(const std::vector<HapticSequence>& inputs, const std::vector<SimulatedTrial>& simulated,
                         const std::string& label) {
   std::ostringstream o;
-  o << "trial_id,height,source,travel,f_motion,f_vertical\n";
+  o << "trial_id,height,source,travel,f_motion,f_vertical,f_lateral\n";
   char buf[160];
   for (std::size_t k = 0; k < inputs.size(); ++k) {
     const std::string h(arm_height_name(inputs[k].height));
     for (const auto& s : inputs[k].samples) {
-      std::snprintf(buf, sizeof buf, ",%.6g,%.6g,%.6g\n", s.travel, s.f_motion, s.f_vertical);
+      std::snprintf(buf, sizeof buf, ",%.6g,%.6g,%.6g,%.6g\n", s.travel, s.f_motion, s.f_vertical, s.f_lateral);
       o << inputs[k].id << ',' << h << ",measured" << buf;
     }
     if (k < simulated.size())
       for (const auto& s : simulated[k].samples) {
-        std::snprintf(buf, sizeof buf, ",%.6g,%.6g,%.6g\n", s.travel, s.f_motion, s.f_vertical);
+        std::snprintf(buf, sizeof buf, ",%.6g,%.6g,%.6g,%.6g\n", s.travel, s.f_motion, s.f_vertical, s.f_lateral);
         o << inputs[k].id << ',' << h << ',' << label << buf;
       }
   }

@@ -55,6 +55,11 @@ struct ClothValues {
   // below). The paper's simulator, and every calibration without one in its file, used
   // kPaperArealDensity. The study did not weigh its gown.
   double areal_density = 0.145;
+  // [m] the person's arm sideways of the gripper's line, and the fist alone sideways of the
+  // elbow (sim/trial.h ClothParams::arm_lateral, fist_lateral; kArmLateral, kFistLateral below).
+  // Only the lateral force tells where they are (calibrate --lateral-weight).
+  double arm_lateral = 0.0;
+  double fist_lateral = 0.0;
 };
 inline constexpr double kPaperArealDensity = 0.145;
 inline constexpr int kClothParams = 5;
@@ -81,16 +86,20 @@ struct PersonParamInfo {
   double paper;
   const char* range;
 };
-inline constexpr int kPersonParams = 4;
+inline constexpr int kPersonParams = 6;
 inline constexpr int kArmCompliance = 0;  // [m/N] sim/arm_spring.h
 inline constexpr int kFistShift = 1;      // [m] sim/trial.h ClothParams::fist_shift
 inline constexpr int kRimShift = 2;       // [m] ClothValues::rim_shift (the grasp, sim_bridge.h)
 inline constexpr int kArealDensity = 3;   // [kg/m^2] sim/trial.h ClothParams::areal_density
+inline constexpr int kArmLateral = 4;     // [m] sim/trial.h ClothParams::arm_lateral
+inline constexpr int kFistLateral = 5;    // [m] sim/trial.h ClothParams::fist_lateral
 inline constexpr std::array<PersonParamInfo, kPersonParams> kPersonParamInfo = {{
     {"arm_compliance", "arm-compliance", 0.0, 1.0, 0.0, "cannot be negative (0 is a fixed arm) nor above 1 m/N"},
     {"fist_shift", "fist-shift", -0.2, 0.2, 0.0, "must be within +-0.2 m (the forearm is 0.31 m)"},
     {"rim_shift", "rim-shift", -0.04, 0.06, 0.0, "must be within -0.04 and +0.06 m (the rim 0 to 10 cm ahead of the jaws)"},
     {"areal_density", "density", 0.01, 1.0, kPaperArealDensity, "must be within 0.01 and 1 kg/m^2 (a heavy canvas is about 0.5)"},
+    {"arm_lateral", "arm-lateral", -0.1, 0.1, 0.0, "must be within +-0.1 m (beyond it the fist is beside the opening)"},
+    {"fist_lateral", "fist-lateral", -0.1, 0.1, 0.0, "must be within +-0.1 m (beyond it the fist is beside the opening)"},
 }};
 double person_value(const ClothValues& c, int i);
 void set_person_value(ClothValues& c, int i, double v);
@@ -145,7 +154,9 @@ struct Bounds {
 // paper's arm): a fist-to-elbow length of 0.16-0.36 m; rim shift in [-0.04, 0.04] m (start 0):
 // the measured gown's rim held 0 to 8 cm ahead of the jaws (beyond 8 cm the jaws' 8 cm run off
 // the reduced gown's sleeve top); areal density in [0.04, 0.25] kg/m^2 (start 0.145, the
-// paper's): from a spunbond disposable gown to a heavy woven cotton one.
+// paper's): from a spunbond disposable gown to a heavy woven cotton one; arm lateral and fist
+// lateral each in [-0.05, 0.05] m (start 0, the paper's arm under the jaws): the fist's 5 cm
+// radius, so that it stays in front of the opening (about 16 cm wide) at either end of the box.
 Bounds default_bounds();
 // Bounds file: one "name lower upper [initial]" per line, '#' starts a comment, names as in
 // kClothParamNames plus "arm_offset" and kPersonParamInfo's; unnamed parameters keep their
@@ -209,6 +220,9 @@ struct CalibrationOptions {
   // > 0: add this times the heights' contrast (objective.h, contrast_error) of the high input
   // against each lower one, over the first kLatestCut metres, to the objective; 0: the paper's.
   double contrast_weight = 0;
+  // > 0: add this times the lateral force's area error (lateral_term) to the objective; 0: the
+  // paper's, which scores F_motion and F_vertical only.
+  double lateral_weight = 0;
   int threads = 0;                 // 0 = all cores
   std::filesystem::path checkpoint;  // empty = none
   int stop_after_generations = 0;  // > 0: stop (as if killed) after this many generations in this process
@@ -221,6 +235,7 @@ struct GenerationProgress {
   std::vector<double> best_fits;  // its objective per input sequence, in the inputs' order (with
                                   // best_contrast, they sum to best)
   double best_contrast = 0;       // its weighted contrast term (0 without one)
+  double best_lateral = 0;        // its weighted lateral term (0 without one)
   double generation_best = 0;
   double elapsed_s = 0;     // this process
   double eta_s = 0;         // estimated remaining, from this process's pace
@@ -244,9 +259,10 @@ struct SequenceFit {
   double speed = 0.1;
   double objective = 0;      // this sequence's share of L
   AxisFit motion, vertical;  // filled by measure_axis_fits()
+  AxisFit lateral;           // likewise (not in files written before 2026-11-25: NaN)
 };
 
-// Fills fits[k].motion and .vertical from inputs[k] and the calibrated simulator's curve of it.
+// Fills fits[k].motion, .vertical and .lateral from inputs[k] and the calibrated simulator's curve of it.
 void measure_axis_fits(std::vector<SequenceFit>& fits, const std::vector<HapticSequence>& inputs,
                        const std::vector<SimulatedTrial>& curves);
 
@@ -260,7 +276,8 @@ struct CalibrationResult {
   ClothValues cloth;
   std::array<double, 3> offsets{};  // [m] by ArmHeight
   std::vector<SequenceFit> fits;  // per selected sequence, for the best candidate
-  double contrast = 0;            // its weighted contrast term: objective = sum of fits + contrast
+  double contrast = 0;            // its weighted contrast term: objective = sum of fits + contrast + lateral
+  double lateral = 0;             // its weighted lateral term
   double elapsed_s = 0;
 };
 
@@ -269,6 +286,20 @@ struct CalibrationResult {
 // latest cut bounds the travel (objective.h, kLatestCut).
 double contrast_term(const std::vector<HapticSequence>& inputs, const std::vector<SimulatedTrial>& simulated,
                      double weight);
+
+// The weighted lateral term of options.lateral_weight (an extension of eq. 5 by a third axis):
+//
+//   l = weight x sum_k e_0(S_k^lat, R_k^lat)
+//
+// with e_0 eq. 3 on F_lateral and w = 0, the area between the simulated and the measured lateral
+// force over the travel both cover [N m]. w = 0 because eq. 4's length penalty is already
+// charged on the other two axes. The paper leaves F_lateral out (its rig's pull and its arm lie
+// in one vertical plane), but the study's people did not: every good trial pulls the gripper
+// sideways by 0.05-0.15 N from 0.1 m on and every missed one does not (offline/sim/README.md,
+// "The lateral force"), and only this term lets a search place the arm sideways
+// (kArmLateral). 0 when the weight is 0; a simulation that did not finish scores infinity.
+double lateral_term(const std::vector<HapticSequence>& inputs, const std::vector<SimulatedTrial>& simulated,
+                    double weight);
 
 // Runs (or resumes from options.checkpoint) the calibration. The start (the bounds' initial
 // values) is evaluated first, and is the result when no candidate of the search beats it. Every rank of `comm` must call it
@@ -313,10 +344,12 @@ struct Calibration {
   ClothValues cloth;
   std::array<double, 3> offsets{};            // [m] by ArmHeight
   std::array<bool, 3> offset_calibrated{};    // which offsets were optimised
-  double objective = 0;                       // what the search minimised: sum of fits + contrast
+  double objective = 0;                       // what the search minimised: sum of fits + contrast + lateral
   std::vector<SequenceFit> fits;
   double contrast_weight = 0;                 // calibrate --contrast-weight (0: the paper's objective)
   double contrast = 0;                        // its weighted term (contrast_term)
+  double lateral_weight = 0;                  // calibrate --lateral-weight (0: the paper's objective)
+  double lateral = 0;                         // its weighted term (lateral_term)
   std::string objective_kind = "area";
   std::string gown = "reduced";               // which scene the simulator used
   double rig_travel = 0.85;                   // [m] end of travel for synthesis (rig_travel_of)
@@ -334,7 +367,8 @@ void write_calibration(const std::filesystem::path& path, const Calibration& c);
 Calibration read_calibration(const std::filesystem::path& path);
 
 // Measured and simulated curves of each input (for the overlay plots, paper Fig. 7-9): CSV with
-// columns trial_id,source,travel,f_motion,f_vertical; source "measured" or `label`.
+// columns trial_id,height,source,travel,f_motion,f_vertical,f_lateral; source "measured" or
+// `label` (f_lateral since 2026-11-25).
 std::string overlay_csv(const std::vector<HapticSequence>& inputs, const std::vector<SimulatedTrial>& simulated,
                         const std::string& label);
 

@@ -20,7 +20,13 @@ std::optional<ObjectiveKind> parse_objective(std::string_view s) {
 
 namespace {
 
-double force(const HapticSample& s, ForceAxis a) { return a == ForceAxis::Motion ? s.f_motion : s.f_vertical; }
+double force(const HapticSample& s, ForceAxis a) {
+  switch (a) {
+    case ForceAxis::Motion: return s.f_motion;
+    case ForceAxis::Lateral: return s.f_lateral;
+    default: return s.f_vertical;
+  }
+}
 
 // |x_i - x_{i-1}|: the travel between two frames (never negative, even if the stamp jitters).
 double step(const std::vector<HapticSample>& seq, std::size_t i) {

@@ -41,7 +41,7 @@ enum class ObjectiveKind { Area = 0, PositionWeighted = 1 };
 std::string_view objective_name(ObjectiveKind k);           // "area", "position-weighted"
 std::optional<ObjectiveKind> parse_objective(std::string_view s);
 
-enum class ForceAxis { Motion, Vertical };
+enum class ForceAxis { Motion, Vertical, Lateral };
 
 inline constexpr double kLengthPenaltyWeight = 20.0;  // w of eq. 4
 

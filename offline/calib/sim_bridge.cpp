@@ -27,6 +27,8 @@ sim::ClothParams cloth_params_of(const ClothValues& c) {
   p.self_friction = c.self_friction;
   p.arm_compliance = c.arm_compliance;
   p.fist_shift = c.fist_shift;
+  p.arm_lateral = c.arm_lateral;
+  p.fist_lateral = c.fist_lateral;
   p.hem_width = c.hem_width;
   p.hem_bend_ratio = c.hem_bend_ratio;
   p.areal_density = c.areal_density;
@@ -40,6 +42,12 @@ namespace {
 static_assert(kPersonParamInfo[kFistShift].highest == sim::kMaxFistShift &&
                   kPersonParamInfo[kFistShift].lowest == -sim::kMaxFistShift,
               "fist_shift's range differs between calibration.h and sim/trial.h");
+static_assert(kPersonParamInfo[kArmLateral].highest == sim::kMaxArmLateral &&
+                  kPersonParamInfo[kArmLateral].lowest == -sim::kMaxArmLateral,
+              "arm_lateral's range differs between calibration.h and sim/trial.h");
+static_assert(kPersonParamInfo[kFistLateral].highest == sim::kMaxArmLateral &&
+                  kPersonParamInfo[kFistLateral].lowest == -sim::kMaxArmLateral,
+              "fist_lateral's range differs between calibration.h and sim/trial.h");
 // The middle arm's nominal height below the high one (synthesis.h) is the simulator's.
 constexpr double kSimMiddleBelowHigh = sim::ArmGeometry{}.z_rel[0] - sim::ArmGeometry{}.z_rel[1];
 static_assert(kPaperArealDensity == sim::ClothParams{}.areal_density,

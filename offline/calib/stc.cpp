@@ -11,35 +11,75 @@ model::OutcomeModel build_outcome_model(const std::vector<const HapticSequence*>
   hmm::ModelOptions mo;
   mo.hmm.n_states = o.states;
   mo.uniform_priors = o.uniform_priors;
-  mo.features.axis[1] = o.use_vertical ? model::kAxisVertical : model::kAxisNone;
+  mo.features.axis[1] = o.second_axis;
   mo.source_dataset = o.source;
   return hmm::train_outcome_model(trials, mo);
 }
 
-StcAxes choose_stc_axes(const std::vector<SequenceFit>& fits) {
-  if (fits.empty()) return {true, "F_motion and F_vertical (no calibration sequences)"};
-  double error = 0, zero = 0;
-  const SequenceFit* worst = nullptr;  // the sequence where the simulation is furthest behind zero
-  for (const auto& f : fits) {
-    if (!f.vertical.measured()) return {true, "F_motion and F_vertical (the calibration has no axis fits)"};
-    error += f.vertical.error;
-    zero += f.vertical.zero;
-    if (!(f.vertical.error < f.vertical.zero) &&
-        (!worst || f.vertical.error - f.vertical.zero > worst->vertical.error - worst->vertical.zero))
-      worst = &f;
+const char* stc_forces_name(int second_axis) {
+  switch (second_axis) {
+    case model::kAxisVertical: return "motion,vertical";
+    case model::kAxisLateral: return "motion,lateral";
+    default: return "motion";
   }
-  char buf[240];
-  if (worst)
+}
+
+namespace {
+
+// Does the calibrated simulator predict this force better than a zero force on every sequence?
+// `worst` receives the sequence where it is furthest behind zero (null when it passes).
+struct AxisVerdict {
+  bool measured = true;
+  const SequenceFit* worst = nullptr;
+  double error = 0, zero = 0;  // summed over the sequences
+};
+AxisVerdict judge_axis(const std::vector<SequenceFit>& fits, AxisFit SequenceFit::*axis) {
+  AxisVerdict v;
+  for (const auto& f : fits) {
+    const AxisFit& a = f.*axis;
+    if (!a.measured()) return {false, nullptr, 0, 0};
+    v.error += a.error;
+    v.zero += a.zero;
+    if (!(a.error < a.zero) && (!v.worst || a.error - a.zero > (v.worst->*axis).error - (v.worst->*axis).zero))
+      v.worst = &f;
+  }
+  return v;
+}
+
+}  // namespace
+
+StcAxes choose_stc_axes(const std::vector<SequenceFit>& fits, bool lateral_fitted) {
+  if (fits.empty()) return {model::kAxisVertical, "F_motion and F_vertical (no calibration sequences)"};
+  char buf[400];
+  std::string lateral_note;  // why F_lateral was not taken, when the calibration fitted it
+  if (lateral_fitted) {
+    const AxisVerdict l = judge_axis(fits, &SequenceFit::lateral);
+    if (l.measured && !l.worst) {
+      std::snprintf(buf, sizeof buf,
+                    "F_motion and F_lateral: the calibration fitted the lateral force, and it is nearer the measured "
+                    "one than a zero force on every sequence (%.3f against %.3f N m in all)",
+                    l.error, l.zero);
+      return {model::kAxisLateral, buf};
+    }
+    if (l.worst) {
+      std::snprintf(buf, sizeof buf, " (F_lateral on %s: %.3f N m, a zero force %.3f N m)", l.worst->trial_id.c_str(),
+                    l.worst->lateral.error, l.worst->lateral.zero);
+      lateral_note = buf;
+    }
+  }
+  const AxisVerdict v = judge_axis(fits, &SequenceFit::vertical);
+  if (!v.measured) return {model::kAxisVertical, "F_motion and F_vertical (the calibration has no axis fits)"};
+  if (v.worst)
     std::snprintf(buf, sizeof buf,
                   "F_motion alone: on %s the calibrated F_vertical is %.3f N m from the measured one, a zero force "
-                  "%.3f N m",
-                  worst->trial_id.c_str(), worst->vertical.error, worst->vertical.zero);
+                  "%.3f N m%s",
+                  v.worst->trial_id.c_str(), v.worst->vertical.error, v.worst->vertical.zero, lateral_note.c_str());
   else
     std::snprintf(buf, sizeof buf,
                   "F_motion and F_vertical: the calibrated F_vertical is nearer the measured one than a zero force on "
-                  "every sequence (%.3f against %.3f N m in all)",
-                  error, zero);
-  return {worst == nullptr, buf};
+                  "every sequence (%.3f against %.3f N m in all)%s",
+                  v.error, v.zero, lateral_note.c_str());
+  return {v.worst ? model::kAxisNone : model::kAxisVertical, buf};
 }
 
 double accuracy(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials, double truncate_at,

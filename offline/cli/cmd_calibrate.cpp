@@ -50,6 +50,9 @@ int run_calibrate(int argc, char** argv) {
         "                      sequence's forces differ from the lower one's over the first 0.30 m,\n"
         "                      simulated against measured (offline/calib/objective.h, contrast_error;\n"
         "                      what a classifier learns from cut sequences). Default 0: eq. 3-5 alone\n"
+        "  --lateral-weight K  add K times the lateral force's area error to the objective (eq. 3\n"
+        "                      on F_lateral, over the travel both cover; offline/calib/calibration.h,\n"
+        "                      lateral_term). Default 0: eq. 3-5 alone, which cannot see --arm-lateral\n"
         "  --no-arm-offset     do not optimise the arm offsets (paper Fig. 9 comparison)\n"
         "  --arm-compliance fit|fixed|C   the person's arm: fit its compliance [m/N] too (one more\n"
         "                      parameter; offline/sim/arm_spring.h), hold it fixed (the paper's, the\n"
@@ -68,6 +71,12 @@ int run_calibrate(int argc, char** argv) {
         "                      in [0.04, 0.25] by default), hold it at the paper's 0.145 (the default)\n"
         "                      or at D; recorded in CAL.json, so synthesis uses it too\n"
         "                      (offline/sim/README.md, \"The gown's weight\")\n"
+        "  --arm-lateral fit|fixed|M   the person's arm sideways of the gripper's line (+y, away\n"
+        "                      from the body): fit it (one more parameter, in [-0.05, 0.05] m by\n"
+        "                      default; needs --lateral-weight), hold it under the jaws (the paper's,\n"
+        "                      the default) or at M metres (offline/sim/README.md, \"The lateral force\")\n"
+        "  --fist-lateral fit|fixed|M   the fist alone sideways, the elbow fixed (the forearm turned\n"
+        "                      about the elbow); as --arm-lateral\n"
         "  --gown full|reduced|coarse   simulator gown (default reduced)\n"
         "  --threads N         threads per process (default: all cores)\n"
         "  --checkpoint FILE   default CAL.json.ckpt; an existing one is resumed\n"
@@ -80,7 +89,7 @@ int run_calibrate(int argc, char** argv) {
   args.allow_only({"help", "json", "no-arm-offset", "data", "participant", "profile", "bounds", "start", "seed", "out",
                    "checkpoint", "objective", "gown", "threads", "generations", "population",
                    "stop-after-generations", "arm-compliance", "fist-shift", "rim-shift", "sigma0", "hem",
-                   "density", "contrast-weight"});
+                   "density", "contrast-weight", "lateral-weight", "arm-lateral", "fist-lateral"});
   const std::string data = args.require("data");
   const std::string participant = args.require("participant");
   const std::string out = args.require("out");
@@ -107,6 +116,11 @@ int run_calibrate(int argc, char** argv) {
     if (!(o.contrast_weight >= 0 && o.contrast_weight <= 1000))
       throw UsageError("--contrast-weight must be in [0, 1000], not '" + *cw + "'");
   }
+  if (const auto lw = args.get("lateral-weight")) {
+    o.lateral_weight = args.number("lateral-weight", 0);
+    if (!(o.lateral_weight >= 0 && o.lateral_weight <= 1000))
+      throw UsageError("--lateral-weight must be in [0, 1000], not '" + *lw + "'");
+  }
   o.threads = static_cast<int>(args.integer("threads", 0));
   o.checkpoint = args.get("checkpoint").value_or(out + ".ckpt");
   o.stop_after_generations = static_cast<int>(args.integer("stop-after-generations", 0));
@@ -114,11 +128,18 @@ int run_calibrate(int argc, char** argv) {
   if (gown != "full" && gown != "reduced" && gown != "coarse") throw UsageError("--gown must be full, reduced or coarse");
 
   ParameterSpace space;
-  // --arm-compliance, --fist-shift, --rim-shift, --density.
+  // --arm-compliance, --fist-shift, --rim-shift, --density, --arm-lateral, --fist-lateral.
   for (int i = 0; i < kPersonParams; ++i)
     if (const auto v = args.get(kPersonParamInfo[i].flag); v && !set_person_param(space, i, *v))
       throw UsageError(std::string("--") + kPersonParamInfo[i].flag + " must be fit, fixed or a value (" +
                        kPersonParamInfo[i].name + " " + kPersonParamInfo[i].range + "), not '" + *v + "'");
+  // Eq. 3-5 score F_motion and F_vertical, which are even in the arm's sideways place (the scene
+  // is symmetric about the gripper's line up to the upper arm): without the lateral term the
+  // search would wander along a flat direction.
+  for (int i : {kArmLateral, kFistLateral})
+    if (space.person[i].fit && !(o.lateral_weight > 0))
+      throw UsageError(std::string("--") + kPersonParamInfo[i].flag +
+                       " fit needs --lateral-weight K > 0 (only the lateral force tells where the arm is)");
   if (const auto hem = args.get("hem")) {
     double w = 0, r = 0;
     char tail = 0;
@@ -164,6 +185,11 @@ int run_calibrate(int argc, char** argv) {
       std::snprintf(buf, sizeof buf, ", contrast %.3f", p.best_contrast);
       per += buf;
     }
+    if (o.lateral_weight > 0) {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, ", lateral %.3f", p.best_lateral);
+      per += buf;
+    }
     std::fprintf(stderr, "generation %d/%d  best L %.4f (%s)  (this generation %.4f)  elapsed %s  ETA %s\n",
                  p.generation, p.generations, p.best, per.c_str(), p.generation_best, minutes(p.elapsed_s).c_str(),
                  minutes(p.eta_s).c_str());
@@ -188,6 +214,8 @@ int run_calibrate(int argc, char** argv) {
   cal.fits = r.fits;
   cal.contrast_weight = o.contrast_weight;
   cal.contrast = r.contrast;
+  cal.lateral_weight = o.lateral_weight;
+  cal.lateral = r.lateral;
   cal.objective_kind = std::string(objective_name(o.objective));
   cal.gown = gown;
   cal.rig_travel = rig_travel_of(inputs);
@@ -230,11 +258,15 @@ int run_calibrate(int argc, char** argv) {
                   r.start_objective);
       for (const auto& f : cal.fits)
         std::printf("  %-18s %-6s L = %.4f; over the common travel F_motion %.3f (zero force %.3f), F_vertical %.3f "
-                    "(zero force %.3f) N m\n", f.trial_id.c_str(), std::string(arm_height_name(f.height)).c_str(),
-                    f.objective, f.motion.error, f.motion.zero, f.vertical.error, f.vertical.zero);
+                    "(zero force %.3f), F_lateral %.3f (zero force %.3f) N m\n", f.trial_id.c_str(),
+                    std::string(arm_height_name(f.height)).c_str(), f.objective, f.motion.error, f.motion.zero,
+                    f.vertical.error, f.vertical.zero, f.lateral.error, f.lateral.zero);
       if (o.contrast_weight > 0)
         std::printf("  the heights' contrast to %.2f m: %.4f N m, times %g: %.4f of L\n", kLatestCut,
                     r.contrast / o.contrast_weight, o.contrast_weight, r.contrast);
+      if (o.lateral_weight > 0)
+        std::printf("  the lateral force over the common travel: %.4f N m, times %g: %.4f of L\n",
+                    r.lateral / o.lateral_weight, o.lateral_weight, r.lateral);
       for (int i = 0; i < kClothParams; ++i) {
         std::printf("  %-13s %.4f", kClothParamNames[i], cloth_value(r.cloth, i));
         // What bend means as a fabric (light woven fabrics: 1.5-3 cm; offline/sim/README.md).

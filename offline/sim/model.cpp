@@ -107,12 +107,13 @@ struct HalfEdge {
 }  // namespace
 
 // The arm's colliders and their names (ArmPartLoads order), one list so that they cannot drift.
-std::vector<RoundCone> arm_colliders(const SceneOptions& opt, double fist_shift, std::vector<std::string>* names) {
+std::vector<RoundCone> arm_colliders(const SceneOptions& opt, double fist_shift, double fist_lateral,
+                                     std::vector<std::string>* names) {
   const ArmGeometry& g = opt.arm;
   const V3 gp{opt.grasp_point[0], opt.grasp_point[1], opt.grasp_point[2]};
   const V3 fist0 = gp + V3{g.fist_x, 0, g.z_rel[0]};
   const V3 elbow = fist0 + V3{g.hand, 0, 0} + V3{g.forearm, 0, 0};
-  const V3 fist = fist0 + V3{fist_shift, 0, 0};  // fist0 itself when fist_shift is 0
+  const V3 fist = fist0 + V3{fist_shift, fist_lateral, 0};  // fist0 itself when both are 0
   const V3 wrist = fist + V3{g.hand, 0, 0};
   const V3 shoulder = elbow + V3{0, -g.upper_arm, 0};
   std::vector<RoundCone> arm;
@@ -247,7 +248,7 @@ Scene make_scene(const ClothMesh& mesh, const SceneOptions& opt) {
     d->planes.push_back({(1.0 / l) * nn, pl[3] / l});
   }
   if (opt.with_arm) {
-    d->arm = arm_colliders(opt, 0.0, &d->arm_names);
+    d->arm = arm_colliders(opt, 0.0, 0.0, &d->arm_names);
     d->elbow = d->arm[0].a;
   }
   return Scene(std::move(d));
@@ -303,6 +304,8 @@ GownModel make_model(const SceneData& s, const ClothParams& p, FrictionScheme sc
   m.self_friction = std::max(0.0, p.self_friction);
   m.arm_compliance = std::max(0.0, p.arm_compliance);
   m.fist_shift = p.fist_shift;
+  m.arm_lateral = p.arm_lateral;
+  m.fist_lateral = p.fist_lateral;
   m.hem_width = std::max(0.0, p.hem_width);
   m.hem_bend_ratio = p.hem_bend_ratio > 0 ? p.hem_bend_ratio : 1.0;
   m.damping_factor = std::exp(-std::max(0.0, p.damping) * m.h);

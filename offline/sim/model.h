@@ -153,6 +153,8 @@ struct GownModel {
   double friction = 0, self_friction = 0;
   double arm_compliance = 0;          // [m/N] ClothParams::arm_compliance (0: fixed arm)
   double fist_shift = 0;              // [m] ClothParams::fist_shift (place_arm)
+  double arm_lateral = 0;             // [m] ClothParams::arm_lateral (place_arm)
+  double fist_lateral = 0;            // [m] ClothParams::fist_lateral (place_arm)
   double hem_width = 0;               // [m] ClothParams::hem_width (refresh_constraints)
   double hem_bend_ratio = 1;          // ClothParams::hem_bend_ratio
   double damping_factor = 1;          // per substep
@@ -271,12 +273,15 @@ GownState make_state(const GownModel& m);
 void step(const GownModel& m, GownState& s, V3 grip_from, V3 grip_to, V3 grip_accel);
 
 // The arm's colliders (fist, hand when ArmGeometry::hand > 0, forearm, upper arm; the elbow's
-// sphere first, the label's reference), with the fist moved by fist_shift along the forearm and the
-// elbow where it was (ClothParams::fist_shift). `names` (may be null) gets each collider's name.
-std::vector<RoundCone> arm_colliders(const SceneOptions& opt, double fist_shift, std::vector<std::string>* names = nullptr);
+// sphere first, the label's reference), with the fist moved by fist_shift along the forearm and by
+// fist_lateral sideways, the elbow where it was (ClothParams::fist_shift, fist_lateral). `names`
+// (may be null) gets each collider's name.
+std::vector<RoundCone> arm_colliders(const SceneOptions& opt, double fist_shift, double fist_lateral,
+                                     std::vector<std::string>* names = nullptr);
 
-// The arm of the scene with its fist moved by m.fist_shift toward the elbow, then the whole arm
-// moved by arm_dz along z (the trial's height): m.arm and m.elbow.
+// The arm of the scene with its fist moved by m.fist_shift toward the elbow and by m.fist_lateral
+// sideways, then the whole arm
+// moved by m.arm_lateral along y and by arm_dz along z (the trial's height): m.arm and m.elbow.
 void place_arm(GownModel& m, double arm_dz);
 
 // Watching other placements of the arm while the gown settles: may trials with other arm heights

@@ -21,6 +21,8 @@ double* field(ClothParams& p, const std::string& name) {
   if (name == "areal_density") return &p.areal_density;
   if (name == "arm_compliance") return &p.arm_compliance;
   if (name == "fist_shift") return &p.fist_shift;
+  if (name == "arm_lateral") return &p.arm_lateral;
+  if (name == "fist_lateral") return &p.fist_lateral;
   if (name == "hem_width") return &p.hem_width;
   if (name == "hem_bend_ratio") return &p.hem_bend_ratio;
   return nullptr;
@@ -49,7 +51,7 @@ ClothParams parse_params(const std::string& text, const std::filesystem::path& f
       if (!(ws >> value)) throw_input_error(file, lineno, "parameter '" + name + "' has no value");
       if (ws >> extra) throw_input_error(file, lineno, "unexpected '" + extra + "' after " + name);
       double* f = field(p, name);
-      if (!f) throw_input_error(file, lineno, "unknown parameter '" + name + "' (stretch, shear, bend, friction, self_friction, damping, areal_density, arm_compliance, fist_shift, hem_width, hem_bend_ratio)");
+      if (!f) throw_input_error(file, lineno, "unknown parameter '" + name + "' (stretch, shear, bend, friction, self_friction, damping, areal_density, arm_compliance, fist_shift, arm_lateral, fist_lateral, hem_width, hem_bend_ratio)");
       double v = 0;
       auto [ptr, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
       if (ec != std::errc() || ptr != value.data() + value.size() || !std::isfinite(v))
@@ -61,6 +63,10 @@ ClothParams parse_params(const std::string& text, const std::filesystem::path& f
   if (p.arm_compliance < 0) throw_input_error(file, 0, "arm_compliance must be 0 (a fixed arm) or positive");
   if (!(std::abs(p.fist_shift) <= kMaxFistShift))
     throw_input_error(file, 0, "fist_shift must be within +-" + std::to_string(kMaxFistShift) + " m");
+  if (!(std::abs(p.arm_lateral) <= kMaxArmLateral))
+    throw_input_error(file, 0, "arm_lateral must be within +-" + std::to_string(kMaxArmLateral) + " m");
+  if (!(std::abs(p.fist_lateral) <= kMaxArmLateral))
+    throw_input_error(file, 0, "fist_lateral must be within +-" + std::to_string(kMaxArmLateral) + " m");
   if (!(p.hem_width >= 0 && p.hem_width <= kMaxHemWidth)) throw_input_error(file, 0, "hem_width must be within [0, 0.2] m");
   if (!(p.hem_bend_ratio >= 1 && p.hem_bend_ratio <= kMaxHemBendRatio))
     throw_input_error(file, 0, "hem_bend_ratio must be within [1, 10000] (a hem is stiffer than the fabric)");
@@ -73,9 +79,10 @@ std::string format_params(const ClothParams& p) {
   char b[768];
   std::snprintf(b, sizeof b,
                 "stretch %.17g\nshear %.17g\nbend %.17g\nfriction %.17g\nself_friction %.17g\ndamping %.17g\n"
-                "areal_density %.17g\narm_compliance %.17g\nfist_shift %.17g\nhem_width %.17g\nhem_bend_ratio %.17g\n",
+                "areal_density %.17g\narm_compliance %.17g\nfist_shift %.17g\narm_lateral %.17g\n"
+                "fist_lateral %.17g\nhem_width %.17g\nhem_bend_ratio %.17g\n",
                 p.stretch, p.shear, p.bend, p.friction, p.self_friction, p.damping, p.areal_density, p.arm_compliance,
-                p.fist_shift, p.hem_width, p.hem_bend_ratio);
+                p.fist_shift, p.arm_lateral, p.fist_lateral, p.hem_width, p.hem_bend_ratio);
   return b;
 }
 
@@ -84,17 +91,19 @@ std::string params_json(const ClothParams& p) {
   std::snprintf(b, sizeof b,
                 "{\"stretch\": %.17g, \"shear\": %.17g, \"bend\": %.17g, \"friction\": %.17g, \"self_friction\": %.17g, "
                 "\"damping\": %.17g, \"areal_density\": %.17g, \"arm_compliance\": %.17g, \"fist_shift\": %.17g, "
-                "\"hem_width\": %.17g, \"hem_bend_ratio\": %.17g}",
+                "\"arm_lateral\": %.17g, \"fist_lateral\": %.17g, \"hem_width\": %.17g, \"hem_bend_ratio\": %.17g}",
                 p.stretch, p.shear, p.bend, p.friction, p.self_friction, p.damping, p.areal_density, p.arm_compliance,
-                p.fist_shift, p.hem_width, p.hem_bend_ratio);
+                p.fist_shift, p.arm_lateral, p.fist_lateral, p.hem_width, p.hem_bend_ratio);
   return b;
 }
 
 std::string scene_json(const Scene& scene, const ClothParams& params, const TrialSpec& spec, const TrialResult& r) {
   const SceneData& sc = scene.data();
-  // The trial's own arm: the fist where params.fist_shift puts it (the scene's arm has it at 0).
-  const std::vector<RoundCone> arm = arm_colliders(sc.opt, params.fist_shift);
+  // The trial's own arm: the fist where params.fist_shift and fist_lateral put it (the scene's
+  // arm has it at 0).
+  const std::vector<RoundCone> arm = arm_colliders(sc.opt, params.fist_shift, params.fist_lateral);
   const double dz = sc.opt.arm.z_rel[static_cast<int>(spec.height)] - sc.opt.arm.z_rel[0] + r.arm_offset;
+  const double dy = params.arm_lateral;  // place_arm moves the whole arm by it
   std::ostringstream o;
   o.precision(6);
   o << "{\"tris\": [";
@@ -103,8 +112,8 @@ std::string scene_json(const Scene& scene, const ClothParams& params, const Tria
   o << "],\n\"arm\": [";
   for (size_t k = 0; k < arm.size(); ++k) {
     const RoundCone& c = arm[k];
-    o << (k ? "," : "") << "{\"a\": [" << c.a.x << ',' << c.a.y << ',' << c.a.z + dz << "], \"ra\": " << c.ra
-      << ", \"b\": [" << c.b.x << ',' << c.b.y << ',' << c.b.z + dz << "], \"rb\": " << c.rb << '}';
+    o << (k ? "," : "") << "{\"a\": [" << c.a.x << ',' << c.a.y + dy << ',' << c.a.z + dz << "], \"ra\": " << c.ra
+      << ", \"b\": [" << c.b.x << ',' << c.b.y + dy << ',' << c.b.z + dz << "], \"rb\": " << c.rb << '}';
   }
   // Each height's nominal arm axis (the scene's arm is at the high one), for the view from the fist.
   o << "],\n\"arm_axis_z\": [";

@@ -438,12 +438,15 @@ bool watch_arms(const GownModel& m, GownState& s, const std::vector<double>& dz)
 }
 
 void place_arm(GownModel& m, double arm_dz) {
-  m.arm = m.fist_shift == 0 || m.scene->arm.empty() ? m.scene->arm : arm_colliders(m.scene->opt, m.fist_shift);
+  m.arm = (m.fist_shift == 0 && m.fist_lateral == 0) || m.scene->arm.empty()
+              ? m.scene->arm
+              : arm_colliders(m.scene->opt, m.fist_shift, m.fist_lateral);
+  const V3 d{0, m.arm_lateral, arm_dz};
   for (auto& c : m.arm) {
-    c.a.z += arm_dz;
-    c.b.z += arm_dz;
+    c.a = c.a + d;
+    c.b = c.b + d;
   }
-  m.elbow = m.scene->elbow + V3{0, 0, arm_dz};
+  m.elbow = m.scene->elbow + d;
 }
 
 void step(const GownModel& m, GownState& s, V3 grip_from, V3 grip_to, V3 grip_accel) {

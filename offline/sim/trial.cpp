@@ -320,7 +320,7 @@ void pull_sample(const GownModel& m, Pulling& p, const TrialSpec& spec, const Se
   p.first_sample = false;
   const V3 f = (1.0 / s.force_count) * s.force_acc - at_rest.bias;
   const double travel = prof.travel(p.t);
-  r.seq.samples.push_back({p.t, travel, f.x, f.y, f.z});
+  r.seq.samples.push_back({p.t, travel, f.x, -f.y, f.z});  // the rig's lateral axis points to -y (trial.h)
   if (spec.record_arm_parts) {
     ArmPartLoads loads;
     for (int k = 0; k < kArmParts; ++k) {

@@ -8,8 +8,13 @@
 // Frame (world, metres): x = the gripper's direction of motion (from the fist toward the elbow),
 // y = lateral (the upper arm goes toward -y), z = up; gravity -9.81 m/s^2 along z. The gripper
 // starts at x = 0 and pulls along +x. The reported forces use the rig's convention (core/haptic.h):
-// f_motion = F.x (drag negative), f_lateral = F.y, f_vertical = F.z, with F the force that the
+// f_motion = F.x (drag negative), f_lateral = -F.y, f_vertical = F.z, with F the force that the
 // gown exerts on the gripper, biased to zero at the start of the pull like the real sensor.
+// F_lateral's sign: the data README does not give the rig's lateral axis. It points toward the
+// person's side (-y): at the end of 21 of the study's 22 trials, when the sleeve lies on the
+// forearm and reaches toward the upper arm, the measured F_lateral is positive (+0.05 to +0.83
+// N), and there the simulated gown pulls the gripper toward the upper arm (-y) at every arm
+// height (offline/sim/README.md, "The lateral force"). Before 2026-11-25 f_lateral was +F.y.
 //
 // Time (paper IV-A, V-A; Macklin et al. 2019 "small steps"): 300 Hz output steps, each split into
 // `substeps` (20) XPBD substeps that each integrate and solve every constraint once; collision
@@ -59,6 +64,17 @@ namespace dressguard::sim {
 // it). In the paper's simulator the gripper's start is placed from the elbow and the fist from
 // the forearm's length, so this is the person's fist-to-elbow length; the measured trials place
 // the elbow (the good trials' 10 N stop) but not the fist, and calibration may fit it per person.
+// arm_lateral [m]: the whole arm moved sideways along +y (away from the person's body; the upper
+// arm goes toward -y), the gripper's line of pull where it was. fist_lateral [m]: the fist (and
+// wrist) alone moved sideways, the elbow fixed: the forearm turned about the elbow by about
+// fist_lateral / 0.31 m. 0, the defaults and the paper's, put the forearm's axis under the jaws,
+// on the sleeve opening's plane of symmetry (its centre is within 1 mm of y = 0), so that the
+// gown's pull on the gripper has no lateral part until the cloth reaches the upper arm. The
+// people did not hold their arms there: all 8 good trials of the study pull the gripper sideways
+// by 0.05-0.15 N from 0.15 m of travel, and the 14 missed ones do not (offline/sim/README.md,
+// "The lateral force"). A fist beside the opening's centre does that: inside the opening it
+// pushes the rim toward its own side; below it, it deflects the sleeve toward the other side.
+// Calibration may fit both per person with the lateral force in its objective.
 // hem_width [m], hem_bend_ratio: the sleeve's cuff. A garment's opening is hemmed (the fabric
 // folded over twice and stitched: three layers, 3x to 27x the fabric's bending rigidity between
 // loose and bonded layers), so bending stencils whose hinge lies within hem_width of the sleeve
@@ -77,11 +93,15 @@ struct ClothParams {
   double areal_density = 0.145;
   double arm_compliance = 0.0;
   double fist_shift = 0.0;
+  double arm_lateral = 0.0;
+  double fist_lateral = 0.0;
   double hem_width = 0.0;
   double hem_bend_ratio = 1.0;
 };
 // |fist_shift| beyond this leaves no forearm worth the name (the paper's is 0.31 m).
 inline constexpr double kMaxFistShift = 0.2;
+// |arm_lateral| beyond this puts the fist (radius 5 cm) beside a 16 cm opening, not in front of it.
+inline constexpr double kMaxArmLateral = 0.1;  // and |fist_lateral|
 // A cuff's limits: width [m] and how much stiffer than the fabric it may be.
 inline constexpr double kMaxHemWidth = 0.2, kMaxHemBendRatio = 1e4;
 

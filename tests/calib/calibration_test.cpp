@@ -438,8 +438,8 @@ TEST(Calibration, CalibrationFileRoundTripAndErrors) {
   c.offsets = {-0.02, 0.0, 0.011};
   c.offset_calibrated = {true, false, true};
   c.objective = 0.4567;
-  c.fits = {{"s4-good-3", ArmHeight::High, 0.1, 0.22, {0.5, 1.25}, {0.375, 0.0625}},
-            {"s4-miss-2", ArmHeight::Low, 0.15, 0.2367, {}, {}}};  // the second without axis fits (older file)
+  c.fits = {{"s4-good-3", ArmHeight::High, 0.1, 0.22, {0.5, 1.25}, {0.375, 0.0625}, {}},
+            {"s4-miss-2", ArmHeight::Low, 0.15, 0.2367, {}, {}, {}}};  // the second without axis fits (older file)
   c.rig_travel = 0.72;
   c.provenance.set("seed", "1");
   const fs::path dir = temp_dir("calfile");
@@ -575,26 +575,55 @@ TEST(Calibration, StcModelsVerticalForceOnlyWhereTheSimulatorPredictsIt) {
   std::vector<SequenceFit> fits(2);
   fits[0].trial_id = "s4-good-3";
   fits[1].trial_id = "s4-miss-2";
-  EXPECT_TRUE(choose_stc_axes(fits).use_vertical);  // older calibration file: no axis fits
+  EXPECT_EQ(choose_stc_axes(fits).second_axis, model::kAxisVertical);  // older calibration file: no axis fits
   fits[0].motion = fits[1].motion = {0.1, 1.0};
   fits[0].vertical = {0.06, 0.3};
   fits[1].vertical = {0.5, 0.05};
   StcAxes a = choose_stc_axes(fits);  // worse than zero on the second (and in sum)
-  EXPECT_FALSE(a.use_vertical);
+  EXPECT_EQ(a.second_axis, model::kAxisNone);
   EXPECT_NE(a.reason.find("F_motion alone: on s4-miss-2"), std::string::npos) << a.reason;
   // Participant 4's paper-budget calibration: better than zero in sum (0.197 against 0.278) and
   // on the low arm, worse on the high arm.
   fits[0].vertical = {0.114, 0.076};
   fits[1].vertical = {0.083, 0.202};
   a = choose_stc_axes(fits);
-  EXPECT_FALSE(a.use_vertical);
+  EXPECT_EQ(a.second_axis, model::kAxisNone);
   EXPECT_NE(a.reason.find("on s4-good-3"), std::string::npos) << a.reason;
   fits[0].vertical = {0.07, 0.076};  // now better on both
   a = choose_stc_axes(fits);
-  EXPECT_TRUE(a.use_vertical);
+  EXPECT_EQ(a.second_axis, model::kAxisVertical);
   EXPECT_NE(a.reason.find("F_motion and F_vertical"), std::string::npos) << a.reason;
   fits[0].vertical = {0.076, 0.076};  // no better than zero is not better
-  EXPECT_FALSE(choose_stc_axes(fits).use_vertical);
+  EXPECT_EQ(choose_stc_axes(fits).second_axis, model::kAxisNone);
+  EXPECT_STREQ(stc_forces_name(model::kAxisNone), "motion");
+}
+
+// F_lateral comes first, but only from a calibration that fitted it (calibrate --lateral-weight)
+// and only where it beats a zero force on every sequence; otherwise the vertical rule decides,
+// and the reason says why the lateral force was passed over.
+TEST(Calibration, StcModelsLateralForceOnlyWhenTheCalibrationFittedIt) {
+  std::vector<SequenceFit> fits(2);
+  fits[0].trial_id = "s4-good-3";
+  fits[1].trial_id = "s4-miss-2";
+  for (auto& f : fits) f.motion = {0.1, 1.0};
+  fits[0].vertical = {0.07, 0.076};
+  fits[1].vertical = {0.083, 0.202};  // F_vertical passes
+  fits[0].lateral = {0.02, 0.05};
+  fits[1].lateral = {0.01, 0.03};  // and so does F_lateral
+  EXPECT_EQ(choose_stc_axes(fits, false).second_axis, model::kAxisVertical);  // not fitted: the paper's pair
+  StcAxes a = choose_stc_axes(fits, true);
+  EXPECT_EQ(a.second_axis, model::kAxisLateral);
+  EXPECT_NE(a.reason.find("F_motion and F_lateral"), std::string::npos) << a.reason;
+  EXPECT_NE(a.reason.find("0.030 against 0.080"), std::string::npos) << a.reason;
+  EXPECT_STREQ(stc_forces_name(a.second_axis), "motion,lateral");
+  fits[1].lateral = {0.04, 0.03};  // worse than zero on the missed sequence
+  a = choose_stc_axes(fits, true);
+  EXPECT_EQ(a.second_axis, model::kAxisVertical);
+  EXPECT_NE(a.reason.find("F_lateral on s4-miss-2: 0.040 N m, a zero force 0.030"), std::string::npos) << a.reason;
+  fits[0].vertical = {0.114, 0.076};  // and F_vertical fails too: F_motion alone
+  EXPECT_EQ(choose_stc_axes(fits, true).second_axis, model::kAxisNone);
+  fits[1].lateral = AxisFit{};  // a file without lateral fits: the vertical rule alone
+  EXPECT_EQ(choose_stc_axes(fits, true).second_axis, model::kAxisNone);
 }
 #endif
 
@@ -726,7 +755,7 @@ TEST(Synthesis, DatasetIsIndependentOfThreadsAndResumes) {
   // The calibration file rewritten with diagnostics that do not change the trials (axis fits,
   // provenance) still resumes; other settings or another cloth into the same folder are refused.
   Calibration annotated = cal;
-  annotated.fits.push_back({"s4-good-3", ArmHeight::High, 0.1, 0.22, {0.5, 1.25}, {0.375, 0.0625}});
+  annotated.fits.push_back({"s4-good-3", ArmHeight::High, 0.1, 0.22, {0.5, 1.25}, {0.375, 0.0625}, {}});
   annotated.provenance.set("note", "re-measured");
   EXPECT_EQ(synthesize(annotated, testing::fake_simulate, o, b, Comm::world()).resumed, 30);
   Calibration stiffer = cal;

@@ -26,6 +26,9 @@ expect_fail("calibrate with the fist past the elbow" "--fist-shift must be fit, 
 expect_fail("calibrate with a bad --hem" "--hem" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --hem 0.03)
 expect_fail("calibrate with a softening --hem" "--hem" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --hem 0.03,0.5)
 expect_fail("calibrate with a negative contrast weight" "--contrast-weight must be in [0, 1000]" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --contrast-weight -1)
+expect_fail("calibrate with a negative lateral weight" "--lateral-weight must be in [0, 1000]" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --lateral-weight -1)
+expect_fail("calibrate the arm's side without the lateral force" "--arm-lateral fit needs --lateral-weight" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --arm-lateral fit)
+expect_fail("calibrate with the arm beside the opening" "--arm-lateral must be fit, fixed or a value (arm_lateral must be within +-0.1 m" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --arm-lateral 0.15)
 expect_fail("calibrate with a weightless gown" "areal_density must be within 0.01 and 1 kg/m" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --density 0)
 expect_fail("calibrate on a missing dataset" "manifest.csv" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json)
 file(WRITE ${WORK}/bad.json "{\"format\": \"dressguard-calibration 1\",\n\"participant\": 4,\n}")
@@ -33,7 +36,7 @@ expect_fail("synthesize with a bad calibration file" "bad.json" synthesize --cal
 expect_fail("synthesize with --per-height 1" "--per-height" synthesize --calibration ${WORK}/bad.json --out ${WORK}/s --per-height 1)
 expect_fail("synthesize with an unknown middle placement" "--middle" synthesize --calibration ${WORK}/bad.json --out ${WORK}/s --middle centre)
 expect_fail("build-model with both inputs" "exactly one" build-model --calibration ${WORK}/bad.json --data ${WORK} --out ${WORK}/m.dgm)
-expect_fail("build-model with unknown forces" "--forces" build-model --data ${WORK} --forces lateral --out ${WORK}/m.dgm)
+expect_fail("build-model with unknown forces" "--forces" build-model --data ${WORK} --forces torque --out ${WORK}/m.dgm)
 expect_fail("predict without --calibration" "--calibration" predict --data ${WORK})
 expect_fail("predict with a bad calibration file" "bad.json" predict --calibration ${WORK}/bad.json --data ${WORK})
 # A calibration as `calibrate` writes it: participant 4, the plausibility grid's cloth, on the coarse gown.
@@ -51,22 +54,26 @@ if(STUDY)
   expect_fail("calibrate with a bad bounds file" "bounds.txt:2: unknown parameter 'stiffness'"
               calibrate --data ${WORK}/study --participant 4 --out ${WORK}/c.json --bounds ${WORK}/bounds.txt)
   expect_fail("calibrate an absent participant" "participant '42'" calibrate --data ${WORK}/study --participant 42 --out ${WORK}/c.json)
-  # One generation of 4 on the coarse gown (~10 s), the density fitted too and the heights'
-  # contrast in the objective: the calibration file (its searched parameters end with the density;
-  # the contrast's weight and term) and its curves, the fitted density and the contrast on stdout,
-  # and a progress line with the best point's L and each sequence's and the contrast's share of it.
+  # One generation of 4 on the coarse gown (~10 s), the density and the arm's side fitted too, the
+  # heights' contrast and the lateral force in the objective: the calibration file (its searched
+  # parameters end with the density and the arm's side; both terms' weights and values; each
+  # sequence's lateral fit) and its curves, the fitted values and both terms on stdout, and a
+  # progress line with the best point's L and each sequence's and each term's share of it.
   execute_process(COMMAND ${DG} calibrate --data ${WORK}/study --participant 4 --out ${WORK}/c1.json --gown coarse
                           --generations 1 --population 4 --threads 2 --seed 1 --density fit --contrast-weight 5
+                          --arm-lateral fit --lateral-weight 3
                   RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(EXISTS ${WORK}/c1.json)
     file(READ ${WORK}/c1.json c1)
   endif()
   if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/c1.json OR NOT EXISTS ${WORK}/c1.json.curves.csv
-     OR NOT c1 MATCHES "\"parameters\": \\[[^]]*\"arm_offset_low\", \"areal_density\"\\]"
-     OR NOT c1 MATCHES "\"contrast_weight\": 5,\n  \"contrast\": [0-9]"
-     OR NOT out MATCHES "\n  areal_density +0\\.[0-9]+\n"
+     OR NOT c1 MATCHES "\"parameters\": \\[[^]]*\"arm_offset_low\", \"areal_density\", \"arm_lateral\"\\]"
+     OR NOT c1 MATCHES "\"contrast_weight\": 5,\n  \"contrast\": [0-9.e-]+,\n  \"lateral_weight\": 3,\n  \"lateral\": [0-9]"
+     OR NOT c1 MATCHES "\"lateral_error\": [0-9.e-]+,\n      \"lateral_zero\": [0-9]"
+     OR NOT out MATCHES "\n  areal_density +0\\.[0-9]+\n  arm_lateral +-?0\\.[0-9]+\n"
      OR NOT out MATCHES "\n  the heights' contrast to 0.30 m: [0-9.]+ N m, times 5: [0-9.]+ of L\n"
-     OR NOT err MATCHES "generation 1/1  best L [0-9.]+ \\(s4-good-3 [0-9.]+, s4-miss-2 [0-9.]+, contrast [0-9.]+\\)  \\(this generation")
+     OR NOT out MATCHES "\n  the lateral force over the common travel: [0-9.]+ N m, times 3: [0-9.]+ of L\n"
+     OR NOT err MATCHES "generation 1/1  best L [0-9.]+ \\(s4-good-3 [0-9.]+, s4-miss-2 [0-9.]+, contrast [0-9.]+, lateral [0-9.]+\\)  \\(this generation")
     message(FATAL_ERROR "calibrate on the coarse gown (${rc}):\n${out}\n${err}")
   endif()
   # Its progress as a picture (tools/plot/calib_overlay.py progress reads the kept stderr).
@@ -75,6 +82,14 @@ if(STUDY)
                   RESULT_VARIABLE rc ERROR_VARIABLE err)
   if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/c1-progress.png)
     message(FATAL_ERROR "calib_overlay.py progress on calibrate's log (${rc}): ${err}")
+  endif()
+  # Its curves (with F_lateral since 2026-11-25) overlaid on the measured ones.
+  file(STRINGS ${WORK}/c1.json.curves.csv header LIMIT_COUNT 1)
+  execute_process(COMMAND /usr/bin/python3 ${PLOT} fit ${WORK}/c1.json.curves.csv --out ${WORK}/c1-fit.png
+                  RESULT_VARIABLE rc ERROR_VARIABLE err)
+  if(NOT header STREQUAL "trial_id,height,source,travel,f_motion,f_vertical,f_lateral" OR NOT rc EQUAL 0
+     OR NOT EXISTS ${WORK}/c1-fit.png)
+    message(FATAL_ERROR "calib_overlay.py fit on calibrate's curves (${rc}, header '${header}'): ${err}")
   endif()
   # predict: participant 4's calibration on the other six participants' 20 trials (coarse gown, ~40 s).
   execute_process(COMMAND ${DG} predict --calibration ${WORK}/cal4.json --data ${WORK}/study --out ${WORK}/pred --json
@@ -139,6 +154,14 @@ if(STUDY)
     if(NOT rc EQUAL 0 OR NOT out MATCHES "\"forces\": \"motion\"" OR NOT rc2 EQUAL 0
        OR NOT shown MATCHES "format 2" OR NOT shown MATCHES "feature 1 = none")
       message(FATAL_ERROR "build-model --forces motion (${rc}, ${rc2}):\n${out}\n${err}\n${shown}\n${err2}")
+    endif()
+    # F_motion and F_lateral: a model of format 1 whose second feature is the lateral force.
+    execute_process(COMMAND ${DG} build-model --data ${WORK}/study --out ${WORK}/ml.dgm --states 5 --forces lateral --json
+                    RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+    execute_process(COMMAND ${DG} model show ${WORK}/ml.dgm RESULT_VARIABLE rc2 OUTPUT_VARIABLE shown ERROR_VARIABLE err2)
+    if(NOT rc EQUAL 0 OR NOT out MATCHES "\"forces\": \"motion,lateral\"" OR NOT rc2 EQUAL 0
+       OR NOT shown MATCHES "feature 1 = \\([+-]f_lateral ")
+      message(FATAL_ERROR "build-model --forces lateral (${rc}, ${rc2}):\n${out}\n${err}\n${shown}\n${err2}")
     endif()
     # --created fixes the bytes: the same data twice give the same file (models/rebuild-default.sh).
     foreach(n 2 3)

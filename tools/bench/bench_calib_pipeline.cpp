@@ -270,20 +270,20 @@ int run_eval(const std::map<std::string, std::string>& a) {
       if (t.participant != p) test.push_back(&t);
     // The STC with the forces its calibration supports (stc.h: choose_stc_axes, the default of
     // `dressguard build-model`), and with both forces (the paper's bivariate HMMs) beside it.
-    const StcAxes axes = choose_stc_axes(cal.fits);
+    const StcAxes axes = choose_stc_axes(cal.fits, cal.lateral_weight > 0);
     double stc[5] = {}, stc2[5] = {}, bc[5] = {};
     std::string stc_error, bc_error, stc_classes;
     try {
       StcOptions stc_o;
       stc_o.source = synth.string();
-      stc_o.use_vertical = axes.use_vertical;
+      stc_o.second_axis = axes.second_axis;
       const auto m = build_outcome_model(strain, stc_o);
       for (const auto& c : m.classes) stc_classes += (stc_classes.empty() ? "" : "+") + c.name;
       accuracies(m, test, stc);
-      if (axes.use_vertical) {
+      if (axes.second_axis == model::kAxisVertical) {
         std::copy(stc, stc + 5, stc2);
       } else {
-        stc_o.use_vertical = true;
+        stc_o.second_axis = model::kAxisVertical;
         accuracies(build_outcome_model(strain, stc_o), test, stc2);
       }
     } catch (const std::exception& e) {
@@ -318,7 +318,7 @@ int run_eval(const std::map<std::string, std::string>& a) {
     Json js = Json::array(), js2 = Json::array(), jb = Json::array();
     for (int c = 0; c < 5; ++c) js.push(stc[c]), js2.push(stc2[c]), jb.push(bc[c]);
     row.set("stc_accuracy_whole_and_cuts", js);
-    row.set("stc_forces", axes.use_vertical ? "motion,vertical" : "motion");
+    row.set("stc_forces", stc_forces_name(axes.second_axis));
     row.set("stc_forces_reason", axes.reason);
     row.set("stc_both_forces_accuracy_whole_and_cuts", js2);
     row.set("bc_accuracy_whole_and_cuts", jb);

@@ -3,8 +3,8 @@
 
 Modes:
   fit:      calib_overlay.py fit CAL.json.curves.csv [--compare CAL0.json.curves.csv] --out fit.png
-            One row per calibration input, F_motion and F_vertical over travel: measured (red,
-            solid), simulated with the calibrated arm offsets (green, dashed) and, with --compare,
+            One row per calibration input, F_motion, F_vertical and (curve files since
+            2026-11-25) F_lateral over travel: measured (red, solid), simulated with the calibrated arm offsets (green, dashed) and, with --compare,
             the simulator calibrated without arm offsets (blue, dotted), as in Fig. 9.
   dataset:  calib_overlay.py dataset SYNTH_DIR --measured STUDY_DIR --participant P --out data.png
             All synthesized trials per outcome (thin) with the participant's measured trials (bold),
@@ -51,15 +51,20 @@ def read_curves(path):
         for row in csv.DictReader(f):
             key = (row["trial_id"], row["height"])
             curves.setdefault(key, collections.defaultdict(list))
+            # F_lateral since 2026-11-25 (older curve files: none).
+            lateral = float(row["f_lateral"]) if row.get("f_lateral") not in (None, "") else None
             curves[key][row["source"]].append(
-                (float(row["travel"]), float(row["f_motion"]), float(row["f_vertical"])))
+                (float(row["travel"]), float(row["f_motion"]), float(row["f_vertical"]), lateral))
     return curves
 
 
 def plot_fit(args):
     curves = read_curves(args.curves)
     other = read_curves(args.compare) if args.compare else {}
-    fig, axes = plt.subplots(len(curves), 2, figsize=(10, 3 * len(curves)), squeeze=False)
+    panels = [(1, "F_motion [N]"), (2, "F_vertical [N]")]
+    if all(p[3] is not None for sources in curves.values() for pts in sources.values() for p in pts):
+        panels.append((3, "F_lateral [N]"))
+    fig, axes = plt.subplots(len(curves), len(panels), figsize=(5 * len(panels), 3 * len(curves)), squeeze=False)
     styles = {"measured": ("tab:red", "-", "measured"),
               "simulated": ("tab:green", "--", "simulated, with arm offset"),
               "simulated-no-offset": ("tab:blue", ":", "simulated, without arm offset")}
@@ -68,9 +73,11 @@ def plot_fit(args):
         for src, pts in other.get(key, {}).items():
             if src != "measured":
                 merged[src] = pts
-        for col, (idx, name) in enumerate([(1, "F_motion [N]"), (2, "F_vertical [N]")]):
+        for col, (idx, name) in enumerate(panels):
             ax = axes[row][col]
             for src, pts in merged.items():
+                if pts[0][idx] is None:  # a --compare file without F_lateral
+                    continue
                 color, ls, label = styles.get(src, ("gray", "-", src))
                 ax.plot([p[0] for p in pts], [p[idx] for p in pts], color=color, ls=ls, lw=1.5, label=label)
             ax.set_title(f"{key[0]} ({key[1]} arm)")
