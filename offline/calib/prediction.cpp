@@ -19,11 +19,11 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // A simulated curve travels through run_batch's fixed-size blocks of doubles (so that the
 // prediction spreads over ranks like every other batch): the scores, the sample count, then the
-// samples' t, travel, F_motion, F_vertical in four fixed-size columns. The longest pull the rig
+// samples' t, travel, F_motion, F_vertical, F_lateral in five fixed-size columns. The longest pull the rig
 // makes, 0.85 m at 0.1 m/s after a 1 m/s^2 start, is 8.55 s: 856 samples at 100 Hz.
 constexpr int kMaxSamples = 1500;
 enum Slot { kObjective, kSign, kSimEnd, kOutcome, kCount, kColumns };
-constexpr int kBlock = kColumns + 4 * kMaxSamples;
+constexpr int kBlock = kColumns + 5 * kMaxSamples;  // t, travel, F_motion, F_vertical, F_lateral
 
 double median_of(std::vector<double> v) {
   v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return std::isnan(x); }), v.end());
@@ -141,6 +141,7 @@ Prediction predict_others(const Calibration& cal, const Dataset& ds, const Trial
         col[kMaxSamples + i] = st.samples[i].travel;
         col[2 * kMaxSamples + i] = st.samples[i].f_motion;
         col[3 * kMaxSamples + i] = st.samples[i].f_vertical;
+        col[4 * kMaxSamples + i] = st.samples[i].f_lateral;
       }
     }
     // Counted under the lock, so that the reports come in order.
@@ -173,7 +174,8 @@ Prediction predict_others(const Calibration& cal, const Dataset& ds, const Trial
     t.simulated_outcome = static_cast<Outcome>(static_cast<int>(b[kOutcome]));
     const double* col = b + kColumns;
     for (int i = 0; i < static_cast<int>(b[kCount]); ++i)
-      t.simulated.push_back({col[i], col[kMaxSamples + i], col[2 * kMaxSamples + i], 0.0, col[3 * kMaxSamples + i]});
+      t.simulated.push_back(
+          {col[i], col[kMaxSamples + i], col[2 * kMaxSamples + i], col[4 * kMaxSamples + i], col[3 * kMaxSamples + i]});
     p.trials.push_back(std::move(t));
   }
   return p;
@@ -237,18 +239,18 @@ bool ResidualWindow::outside(int axis) const {
 namespace {
 
 // Mean F_motion and F_vertical of the samples with from <= travel < to; false when there is none.
-bool window_mean(const std::vector<HapticSample>& s, double from, double to, double out[2]) {
-  double sum[2] = {0, 0};
+bool window_mean(const std::vector<HapticSample>& s, double from, double to, double out[kForces]) {
+  double sum[kForces] = {};
   int n = 0;
   for (const auto& x : s)
     if (x.travel >= from && x.travel < to) {
       sum[0] += x.f_motion;
       sum[1] += x.f_vertical;
+      sum[2] += x.f_lateral;
       ++n;
     }
   if (n == 0) return false;
-  out[0] = sum[0] / n;
-  out[1] = sum[1] / n;
+  for (int ax = 0; ax < kForces; ++ax) out[ax] = sum[ax] / n;
   return true;
 }
 
@@ -280,19 +282,19 @@ std::vector<ResidualWindow> residual_windows(const Prediction& p, const Dataset&
       w.height = h;
       w.from = k * window;
       w.to = (k + 1) * window;
-      std::vector<double> meas[2];
-      double sim_sum[2] = {0, 0};
+      std::vector<double> meas[kForces];
+      double sim_sum[kForces] = {};
       for (const Pair& q : pairs) {
         if (q.height != h || q.measured->back().travel < w.to || q.simulated->back().travel < w.to) continue;
-        double a[2], b[2];
+        double a[kForces], b[kForces];
         if (!window_mean(*q.measured, w.from, w.to, a) || !window_mean(*q.simulated, w.from, w.to, b)) continue;
-        for (int ax = 0; ax < 2; ++ax) {
+        for (int ax = 0; ax < kForces; ++ax) {
           meas[ax].push_back(a[ax]);
           sim_sum[ax] += b[ax];
         }
       }
       w.trials = static_cast<int>(meas[0].size());
-      for (int ax = 0; ax < 2; ++ax) {
+      for (int ax = 0; ax < kForces; ++ax) {
         if (w.trials == 0) {
           w.measured[ax] = w.spread[ax] = w.simulated[ax] = kNaN;
           continue;
@@ -336,7 +338,7 @@ void for_each_run(const std::vector<Window>& v, Starts starts, Joins joins, Emit
 
 std::vector<ResidualFinding> residual_findings(const std::vector<ResidualWindow>& windows) {
   std::vector<ResidualFinding> out;
-  for (int ax = 0; ax < 2; ++ax) {
+  for (int ax = 0; ax < kForces; ++ax) {
     // A run: windows of one height, outside the people, residuals of one sign.
     const auto starts = [ax](const ResidualWindow& w) { return w.outside(ax); };
     const auto joins = [ax](const ResidualWindow& a, const ResidualWindow& w) {
@@ -356,12 +358,14 @@ std::vector<ResidualFinding> residual_findings(const std::vector<ResidualWindow>
         f.spread += windows[k].spread[ax] / static_cast<double>(j - i);
         f.trials = std::min(f.trials, windows[k].trials);
       }
-      const char* what = ax == 0 ? (f.residual > 0 ? "too little drag" : "too much drag")
-                                 : (f.residual > 0 ? "pulls the gripper up too much" : "pulls the gripper down too much");
+      const char* what = ax == 0   ? (f.residual > 0 ? "too little drag" : "too much drag")
+                         : ax == 1 ? (f.residual > 0 ? "pulls the gripper up too much" : "pulls the gripper down too much")
+                                   : (f.residual > 0 ? "pulls the gripper toward the person too much"
+                                                     : "pulls the gripper away from the person too much");
       char buf[256];
       std::snprintf(buf, sizeof buf, "%s arm, %s, %.2f-%.2f m: %s, simulated %+.2f N from the people's mean %.2f N "
                     "(their spread %.2f N, %d trials)", std::string(arm_height_name(f.height)).c_str(),
-                    ax == 0 ? "F_motion" : "F_vertical", f.from, f.to, what, f.residual, f.measured, f.spread, f.trials);
+                    force_name(ax), f.from, f.to, what, f.residual, f.measured, f.spread, f.trials);
       f.text = buf;
       out.push_back(f);
     });
@@ -375,11 +379,13 @@ std::vector<ResidualFinding> residual_findings(const std::vector<ResidualWindow>
 std::string residual_csv(const std::vector<ResidualWindow>& windows) {
   std::ostringstream o;
   o.precision(7);
-  o << "height,from,to,trials,measured_motion,spread_motion,simulated_motion,residual_motion,outside_motion,"
-       "measured_vertical,spread_vertical,simulated_vertical,residual_vertical,outside_vertical\n";
+  o << "height,from,to,trials";
+  for (int ax = 0; ax < kForces; ++ax)
+    for (const char* k : {"measured", "spread", "simulated", "residual", "outside"}) o << ',' << k << '_' << force_column(ax);
+  o << '\n';
   for (const auto& w : windows) {
     o << arm_height_name(w.height) << ',' << w.from << ',' << w.to << ',' << w.trials;
-    for (int ax = 0; ax < 2; ++ax)
+    for (int ax = 0; ax < kForces; ++ax)
       o << ',' << w.measured[ax] << ',' << w.spread[ax] << ',' << w.simulated[ax] << ',' << w.residual(ax) << ','
         << (w.outside(ax) ? 1 : 0);
     o << '\n';
@@ -387,6 +393,16 @@ std::string residual_csv(const std::vector<ResidualWindow>& windows) {
   return o.str();
 }
 
+
+const char* force_name(int axis) {
+  static const char* const kNames[kForces] = {"F_motion", "F_vertical", "F_lateral"};
+  return axis >= 0 && axis < kForces ? kNames[axis] : "?";
+}
+
+const char* force_column(int axis) {
+  static const char* const kColumns[kForces] = {"motion", "vertical", "lateral"};
+  return axis >= 0 && axis < kForces ? kColumns[axis] : "?";
+}
 
 // ---- the contrast between the heights ------------------------------------------------------------
 
@@ -430,7 +446,7 @@ std::vector<HeightContrast> height_contrasts(const std::vector<ResidualWindow>& 
       c.trials_high = hi->trials;
       c.trials_lower = lo.trials;
       const bool enough = hi->trials >= kResidualMinTrials && lo.trials >= kResidualMinTrials;
-      for (int ax = 0; ax < 2; ++ax) {
+      for (int ax = 0; ax < kForces; ++ax) {
         c.measured[ax] = hi->measured[ax] - lo.measured[ax];
         c.simulated[ax] = hi->simulated[ax] - lo.simulated[ax];
         c.standard_error[ax] = enough ? std::sqrt(hi->spread[ax] * hi->spread[ax] / hi->trials +
@@ -445,7 +461,7 @@ std::vector<HeightContrast> height_contrasts(const std::vector<ResidualWindow>& 
 
 std::vector<ContrastFinding> contrast_findings(const std::vector<HeightContrast>& contrasts) {
   std::vector<ContrastFinding> out;
-  for (int ax = 0; ax < 2; ++ax) {
+  for (int ax = 0; ax < kForces; ++ax) {
     // A run: windows of one lower height, one verdict (misses or reverses), the people's
     // contrast of one sign.
     const auto starts = [ax](const HeightContrast& c) {
@@ -472,7 +488,7 @@ std::vector<ContrastFinding> contrast_findings(const std::vector<HeightContrast>
       std::snprintf(buf, sizeof buf,
                     "%s, high against %s, %.2f-%.2f m: the people's high arm reads %+.2f N against their %s arm; "
                     "the simulator's %+.2f N (%s)",
-                    ax == 0 ? "F_motion" : "F_vertical", lower_name.c_str(), f.from, f.to, f.measured,
+                    force_name(ax), lower_name.c_str(), f.from, f.to, f.measured,
                     lower_name.c_str(), f.simulated,
                     v == ContrastVerdict::Reverses ? "reverses: a classifier trained on it learns the opposite here"
                                                    : "misses: a classifier trained on it learns nothing here");
@@ -502,11 +518,13 @@ ContrastTally tally_contrasts(const std::vector<HeightContrast>& contrasts, doub
 std::string contrast_csv(const std::vector<HeightContrast>& contrasts) {
   std::ostringstream o;
   o.precision(7);
-  o << "lower,from,to,trials_high,trials_lower,measured_motion,standard_error_motion,simulated_motion,verdict_motion,"
-       "measured_vertical,standard_error_vertical,simulated_vertical,verdict_vertical\n";
+  o << "lower,from,to,trials_high,trials_lower";
+  for (int ax = 0; ax < kForces; ++ax)
+    for (const char* k : {"measured", "standard_error", "simulated", "verdict"}) o << ',' << k << '_' << force_column(ax);
+  o << '\n';
   for (const auto& c : contrasts) {
     o << arm_height_name(c.lower) << ',' << c.from << ',' << c.to << ',' << c.trials_high << ',' << c.trials_lower;
-    for (int ax = 0; ax < 2; ++ax)
+    for (int ax = 0; ax < kForces; ++ax)
       o << ',' << c.measured[ax] << ',' << c.standard_error[ax] << ',' << c.simulated[ax] << ','
         << contrast_verdict_name(c.verdict[ax]);
     o << '\n';

@@ -116,12 +116,20 @@ std::string prediction_curves_csv(const Prediction& p, const Dataset& ds);
 inline constexpr int kResidualMinTrials = 3;
 inline constexpr double kResidualFloor = 0.1;  // [N]
 
+// The forces the residual and the contrast look at, by index: [0] F_motion, [1] F_vertical (the
+// paper's two) and [2] F_lateral (positive toward the person: sim/trial.h). F_lateral since
+// 2026-11-25: the people's good and missed trials differ in it from 0.15 m of travel on
+// (offline/sim/README.md, "The lateral force").
+inline constexpr int kForces = 3;
+const char* force_name(int axis);    // "F_motion", "F_vertical", "F_lateral"
+const char* force_column(int axis);  // "motion", "vertical", "lateral" (the CSV columns' suffixes)
+
 struct ResidualWindow {
   ArmHeight height = ArmHeight::High;
   double from = 0, to = 0;  // [m] travel
   int trials = 0;
-  // [0] F_motion, [1] F_vertical; NaN when no trial covers the window
-  double measured[2] = {0, 0}, spread[2] = {0, 0}, simulated[2] = {0, 0};
+  // by force (kForces); NaN when no trial covers the window
+  double measured[kForces] = {}, spread[kForces] = {}, simulated[kForces] = {};
   double residual(int axis) const { return simulated[axis] - measured[axis]; }
   bool outside(int axis) const;
 };
@@ -137,15 +145,15 @@ std::vector<ResidualWindow> residual_windows(const Prediction& p, const Dataset&
 // the run's length (its share of eq. 3's area), largest first.
 struct ResidualFinding {
   ArmHeight height = ArmHeight::High;
-  int axis = 0;  // 0 F_motion, 1 F_vertical
+  int axis = 0;  // force_name(axis)
   double from = 0, to = 0, residual = 0, measured = 0, spread = 0;
   int trials = 0;
   std::string text;
 };
 std::vector<ResidualFinding> residual_findings(const std::vector<ResidualWindow>& windows);
 
-// CSV: height,from,to,trials, then measured/spread/simulated/residual/outside for F_motion and for
-// F_vertical (tools/plot/calib_overlay.py residual).
+// CSV: height,from,to,trials, then measured/spread/simulated/residual/outside for F_motion, for
+// F_vertical and for F_lateral (tools/plot/calib_overlay.py residual).
 std::string residual_csv(const std::vector<ResidualWindow>& windows);
 
 // ---- what a simulation-trained classifier learns wrong: the contrast between the heights ----------
@@ -173,9 +181,10 @@ struct HeightContrast {
   ArmHeight lower = ArmHeight::Low;  // the height compared with the high arm
   double from = 0, to = 0;           // [m] travel
   int trials_high = 0, trials_lower = 0;
-  // [0] F_motion, [1] F_vertical: high minus lower [N]; NaN where either height has no trial
-  double measured[2] = {0, 0}, standard_error[2] = {0, 0}, simulated[2] = {0, 0};
-  ContrastVerdict verdict[2] = {ContrastVerdict::NoContrast, ContrastVerdict::NoContrast};
+  // by force (kForces): high minus lower [N]; NaN where either height has no trial
+  double measured[kForces] = {}, standard_error[kForces] = {}, simulated[kForces] = {};
+  ContrastVerdict verdict[kForces] = {ContrastVerdict::NoContrast, ContrastVerdict::NoContrast,
+                                      ContrastVerdict::NoContrast};
 };
 
 // One entry per window and lower height that both heights have windows for (in the windows'
@@ -189,22 +198,23 @@ std::vector<HeightContrast> height_contrasts(const std::vector<ResidualWindow>& 
 // opposite here)". Sorted by the run's start, then by force.
 struct ContrastFinding {
   ArmHeight lower = ArmHeight::Low;
-  int axis = 0;  // 0 F_motion, 1 F_vertical
+  int axis = 0;  // force_name(axis)
   ContrastVerdict verdict = ContrastVerdict::Reverses;
   double from = 0, to = 0, measured = 0, simulated = 0;  // means over the run's windows
   std::string text;
 };
 std::vector<ContrastFinding> contrast_findings(const std::vector<HeightContrast>& contrasts);
 
-// The verdicts counted over the windows that end at or before `up_to` metres (both forces, both
-// lower heights): what a sequence cut there holds (kLatestCut: objective.h).
+// The verdicts counted over the windows that end at or before `up_to` metres (every force, both
+// lower heights): what a sequence cut there holds (kLatestCut: objective.h). Since 2026-11-25 with
+// F_lateral's windows.
 struct ContrastTally {
   int agrees = 0, misses = 0, reverses = 0;  // NoContrast windows are not counted
 };
 ContrastTally tally_contrasts(const std::vector<HeightContrast>& contrasts, double up_to = kLatestCut);
 
 // CSV: lower,from,to,trials_high,trials_lower, then measured/standard_error/simulated/verdict for
-// F_motion and for F_vertical (tools/plot/calib_overlay.py contrast).
+// F_motion, for F_vertical and for F_lateral (tools/plot/calib_overlay.py contrast).
 std::string contrast_csv(const std::vector<HeightContrast>& contrasts);
 
 }  // namespace dressguard::calib

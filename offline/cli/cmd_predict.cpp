@@ -40,8 +40,9 @@ int run_predict(int argc, char** argv) {
         "  objective from every real trial of a third participant at that height: the simulator\n"
         "  predicts a trial no worse than another real person would when its L is at most that.\n"
         "  Also the share of the travel where the simulated vertical force has the measured sign,\n"
-        "  and what the simulation gets wrong: per height and travel window, the simulated mean\n"
-        "  force against the measured mean and the people's spread; the runs of windows where the\n"
+        "  and what the simulation gets wrong: per height, travel window and force (F_motion,\n"
+        "  F_vertical, F_lateral), the simulated mean force against the measured mean and the\n"
+        "  people's spread; the runs of windows where the\n"
         "  simulation is further from the people's mean than they are from each other are listed,\n"
         "  largest first (offline/calib/prediction.h, residual_windows). Then the heights' contrast:\n"
         "  where the people's high arm (good) differs from their middle or low arm (missed), whether\n"
@@ -114,7 +115,7 @@ int run_predict(int argc, char** argv) {
     for (const auto& f : findings) {
       std::printf("%s{\"height\": \"%s\", \"force\": \"%s\", \"from_m\": %s, \"to_m\": %s, \"residual_n\": %s, "
                   "\"measured_n\": %s, \"spread_n\": %s, \"trials\": %d}",
-                  first ? "" : ", ", std::string(arm_height_name(f.height)).c_str(), f.axis == 0 ? "motion" : "vertical",
+                  first ? "" : ", ", std::string(arm_height_name(f.height)).c_str(), force_column(f.axis),
                   number(f.from).c_str(), number(f.to).c_str(), number(f.residual).c_str(), number(f.measured).c_str(),
                   number(f.spread).c_str(), f.trials);
       first = false;
@@ -124,7 +125,7 @@ int run_predict(int argc, char** argv) {
     for (const auto& f : contrast) {
       std::printf("%s{\"force\": \"%s\", \"lower\": \"%s\", \"from_m\": %s, \"to_m\": %s, \"verdict\": \"%s\", "
                   "\"measured_n\": %s, \"simulated_n\": %s}",
-                  first ? "" : ", ", f.axis == 0 ? "motion" : "vertical", std::string(arm_height_name(f.lower)).c_str(),
+                  first ? "" : ", ", force_column(f.axis), std::string(arm_height_name(f.lower)).c_str(),
                   number(f.from).c_str(), number(f.to).c_str(), std::string(contrast_verdict_name(f.verdict)).c_str(),
                   number(f.measured).c_str(), number(f.simulated).c_str());
       first = false;

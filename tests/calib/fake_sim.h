@@ -8,8 +8,10 @@
 // much later; the rim meets the fist at 0.15 m of travel plus fist_shift minus rim_shift (the
 // rim held further ahead of the jaws meets it earlier), a 0.5 N bump of drag there; a gown
 // heavier than the paper's hangs more on the forearm from 0.3 m of travel on (areal_density, a
-// kink in the vertical force that no polynomial term of the others makes); the pull stops at 10 N
-// or 0.85 m like the rig. Every
+// kink in the vertical force that no polynomial term of the others makes); the lateral force
+// grows with travel by the arm's height and turns with the arm and the fist sideways
+// (arm_lateral, fist_lateral) over the first 0.3 m; the pull stops at 10 N or 0.85 m like the rig.
+// Every
 // parameter changes the curves, so a calibration against curves made at known parameters must
 // find a near-zero objective. The gown noise adds a seeded, smooth disturbance. Deterministic
 // and thread-safe (no state).
@@ -38,7 +40,8 @@ inline SimulatedTrial fake_simulate(const ClothValues& c, const TrialRequest& r)
     const double heavier = (c.areal_density - kPaperArealDensity) / kPaperArealDensity;  // 0 for the paper's gown
     const double vert = (0.5 + 10.0 * arm) * x * (0.5 + c.bend) - 0.8 * c.self_friction * x * x -
                         8.0 * heavier * std::max(0.0, x - 0.3);
-    out.samples.push_back({t, x, -drag, 0.0, vert});
+    const double lateral = 0.1 * (1.0 + 4.0 * arm) * x - 2.0 * (c.arm_lateral + c.fist_lateral) * std::min(x, 0.3);
+    out.samples.push_back({t, x, -drag, lateral, vert});
     if (drag >= 10.0 || std::abs(vert) >= 10.0) {
       out.outcome = arm > -0.05 ? Outcome::Good : Outcome::Caught;
       break;

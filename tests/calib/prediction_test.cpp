@@ -124,6 +124,17 @@ TEST(Prediction, SameResultsOnAnyThreadCount) {
   const Prediction two = predict_others(calibration_of(kB), ds, testing::fake_simulate, 2, Comm::world());
   EXPECT_EQ(prediction_csv(one), prediction_csv(two));
   EXPECT_EQ(prediction_curves_csv(one, ds), prediction_curves_csv(two, ds));
+  // Every force of every sample comes through the batch's blocks (F_lateral too: the residual and
+  // the contrast read it).
+  const Calibration cal = calibration_of(kB);
+  for (const PredictedTrial& t : two.trials) {
+    const SimulatedTrial direct = testing::fake_simulate(cal.cloth, request_for(find(ds, t.trial_id), cal.offsets));
+    ASSERT_EQ(t.simulated.size(), direct.samples.size()) << t.trial_id;
+    for (std::size_t i = 0; i < direct.samples.size(); ++i) {
+      EXPECT_EQ(t.simulated[i].f_lateral, direct.samples[i].f_lateral) << t.trial_id << " sample " << i;
+      EXPECT_EQ(t.simulated[i].f_vertical, direct.samples[i].f_vertical) << t.trial_id << " sample " << i;
+    }
+  }
 }
 
 // The batch form: the targets go to the batch simulator in groups of one height (one arm), at
@@ -391,6 +402,80 @@ TEST(Prediction, HeightContrastsByHand) {
   EXPECT_EQ(csv.rfind("lower,from,to,trials_high,trials_lower,measured_motion", 0), 0u);
   for (auto& t : p.trials) t.simulated = find(ds, t.trial_id).samples;
   EXPECT_TRUE(contrast_findings(height_contrasts(residual_windows(p, ds, 0.1))).empty());
+}
+
+// F_lateral is judged like the other two (prediction.h, kForces): the people's high arm reads
+// -0.1 N and their low arm +0.05 N on every window (contrast -0.15 N, no spread), the simulator's
+// +0.1 and -0.1 N (+0.2 N: reversed) to 0.2 m and then the people's values (agrees). One finding,
+// named F_lateral; one residual finding per height over 0-0.2 m (the simulation is 0.2 and 0.15 N
+// off where the people agree to the last bit), named by which way it pulls; the CSVs' lateral
+// columns.
+TEST(Prediction, LateralForceInTheResidualAndTheContrast) {
+  Dataset ds;
+  Prediction p;
+  p.participant = "1";
+  int person = 2;
+  auto lateral_curve = [](auto fl) {
+    std::vector<HapticSample> s;
+    for (int k = 0; k < 410; ++k) {
+      const double x = (k + 0.5) / 1000.0;
+      s.push_back({x / 0.1, x, -1.0, fl(x), 0.0});
+    }
+    return s;
+  };
+  auto add = [&](ArmHeight h, double people, double sim) {
+    HapticSequence m;
+    m.participant = std::to_string(person++);
+    m.id = "p" + m.participant + "-" + std::string(arm_height_name(h));
+    m.height = h;
+    m.label = h == ArmHeight::High ? Outcome::Good : Outcome::Missed;
+    m.samples = lateral_curve([people](double) { return people; });
+    ds.trials.push_back(m);
+    PredictedTrial t;
+    t.trial_id = m.id;
+    t.participant = m.participant;
+    t.height = h;
+    t.simulated = lateral_curve([people, sim](double x) { return x < 0.2 ? sim : people; });
+    p.trials.push_back(t);
+  };
+  for (int k = 0; k < 3; ++k) {
+    add(ArmHeight::High, -0.1, 0.1);
+    add(ArmHeight::Low, 0.05, -0.1);
+  }
+  const std::vector<ResidualWindow> w = residual_windows(p, ds, 0.1);
+  const std::vector<HeightContrast> c = height_contrasts(w);
+  ASSERT_EQ(c.size(), 5u);  // 5 windows x (low)
+  using V = ContrastVerdict;
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_NEAR(c[k].measured[2], -0.15, 1e-12) << k;
+    EXPECT_NEAR(c[k].simulated[2], k < 2 ? 0.2 : -0.15, 1e-12) << k;
+    EXPECT_EQ(c[k].verdict[2], k < 2 ? V::Reverses : V::Agrees) << k;
+    EXPECT_EQ(c[k].verdict[0], V::NoContrast) << k;
+    EXPECT_EQ(c[k].verdict[1], V::NoContrast) << k;
+  }
+  const std::vector<ContrastFinding> f = contrast_findings(c);
+  ASSERT_EQ(f.size(), 1u);
+  EXPECT_EQ(f[0].axis, 2);
+  EXPECT_NEAR(f[0].to, 0.2, 1e-12);
+  EXPECT_EQ(f[0].text.rfind("F_lateral, high against low, 0.00-0.20 m", 0), 0u) << f[0].text;
+  const ContrastTally t = tally_contrasts(c);
+  EXPECT_EQ(t.reverses, 2);
+  EXPECT_EQ(t.agrees, 1);
+  const std::vector<ResidualFinding> r = residual_findings(w);
+  ASSERT_EQ(r.size(), 2u);
+  for (const ResidualFinding& x : r) {
+    EXPECT_EQ(x.axis, 2);
+    const bool high = x.height == ArmHeight::High;
+    EXPECT_NEAR(x.residual, high ? 0.2 : -0.15, 1e-12);
+    EXPECT_NE(x.text.find(high ? "F_lateral, 0.00-0.20 m: pulls the gripper toward the person too much"
+                               : "F_lateral, 0.00-0.20 m: pulls the gripper away from the person too much"),
+              std::string::npos)
+        << x.text;
+  }
+  EXPECT_NE(contrast_csv(c).find(",measured_lateral,standard_error_lateral,simulated_lateral,verdict_lateral\n"),
+            std::string::npos);
+  EXPECT_NE(residual_csv(w).find(",measured_lateral,spread_lateral,simulated_lateral,residual_lateral,outside_lateral\n"),
+            std::string::npos);
 }
 
 // The measured vertical force is +1 N over its first 0.4 m and -1 N over the next 0.4 m; a

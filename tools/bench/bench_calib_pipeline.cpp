@@ -21,6 +21,10 @@
 //     --arm-compliance, --fist-shift, --rim-shift, --density: the person's arm, the grasp and the
 //     gown's weight in the calibration, as `dressguard calibrate` takes them (calibration.h,
 //     kPersonParamInfo): fixed (the paper's, default), fit (one more parameter each) or a value.
+//   bench_calib_pipeline baseline
+//     The 1-NN baseline alone, on each force and on sets of them (F_motion, F_vertical,
+//     F_lateral; both of the paper's; all three): which force tells the people's good trials from
+//     their missed ones at each cut (offline/sim/README.md, "The lateral force"). Seconds.
 //   bench_calib_pipeline timing [--gown ...] [--generations G --population N] [--threads T]
 //                               [--arm-compliance ... --fist-shift ... --rim-shift ... --density ...]
 //     Wall time per simulation and of a G x N calibration of participant 4, with the final
@@ -101,9 +105,17 @@ bool set_person_flags(const std::map<std::string, std::string>& a, ParameterSpac
   return true;
 }
 
+// Which forces the 1-NN compares.
+struct NnForces {
+  const char* name;
+  bool motion, vertical, lateral;
+};
+constexpr NnForces kPaperForces{"F_motion + F_vertical", true, true, false};
+
 // The force curve of a trial cut at `cut` m of travel, linearly interpolated every 5 mm on
-// [0, cut] (the last sample held beyond the trial's end), both axes: the 1-NN's feature vector.
-std::vector<double> curve_features(const HapticSequence& t, double cut) {
+// [0, cut] (the last sample held beyond the trial's end), the chosen forces: the 1-NN's feature
+// vector.
+std::vector<double> curve_features(const HapticSequence& t, double cut, const NnForces& use) {
   std::vector<double> f;
   std::size_t j = 0;
   for (int k = 0; k * 0.005 <= cut + 1e-9; ++k) {
@@ -113,22 +125,23 @@ std::vector<double> curve_features(const HapticSequence& t, double cut) {
     const HapticSample& b = t.samples[std::min(j + 1, t.samples.size() - 1)];
     const double span = b.travel - a.travel;
     const double u = span > 1e-12 ? std::clamp((x - a.travel) / span, 0.0, 1.0) : 0.0;
-    f.push_back(a.f_motion + u * (b.f_motion - a.f_motion));
-    f.push_back(a.f_vertical + u * (b.f_vertical - a.f_vertical));
+    if (use.motion) f.push_back(a.f_motion + u * (b.f_motion - a.f_motion));
+    if (use.vertical) f.push_back(a.f_vertical + u * (b.f_vertical - a.f_vertical));
+    if (use.lateral) f.push_back(a.f_lateral + u * (b.f_lateral - a.f_lateral));
   }
   return f;
 }
 
 // Leave-one-participant-out 1-NN (Euclidean on curve_features): the accuracy over all trials.
-double one_nn_accuracy(const std::vector<const HapticSequence*>& all, double cut) {
+double one_nn_accuracy(const std::vector<const HapticSequence*>& all, double cut, const NnForces& use = kPaperForces) {
   int right = 0;
   for (const auto* q : all) {
-    const auto fq = curve_features(*q, cut);
+    const auto fq = curve_features(*q, cut, use);
     double best = std::numeric_limits<double>::infinity();
     const HapticSequence* nn = nullptr;
     for (const auto* r : all) {
       if (r->participant == q->participant) continue;
-      const auto fr = curve_features(*r, cut);
+      const auto fr = curve_features(*r, cut, use);
       double d = 0;
       for (std::size_t i = 0; i < fq.size(); ++i) d += (fq[i] - fr[i]) * (fq[i] - fr[i]);
       if (d < best) best = d, nn = r;
@@ -142,6 +155,29 @@ double one_nn_accuracy(const std::vector<const HapticSequence*>& all, double cut
 void accuracies(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& test, double out[5]) {
   out[0] = accuracy(m, test, std::numeric_limits<double>::infinity());
   for (int c = 0; c < 4; ++c) out[c + 1] = accuracy(m, test, kCuts[c]);
+}
+
+int run_baseline() {
+  const fs::path study = study_dir();
+  if (study.empty()) {
+    std::fprintf(stderr, "shared/data not found (set DRESSGUARD_SHARED_DIR)\n");
+    return 2;
+  }
+  const Dataset ds = import_study(study);
+  std::vector<const HapticSequence*> all;
+  for (const auto& t : ds.trials) all.push_back(&t);
+  std::printf("1-NN on force curves, leave one participant out, %zu trials: right at 0.15 / 0.20 / 0.25 / 0.30 m\n",
+              all.size());
+  const NnForces sets[] = {{"F_motion", true, false, false},     {"F_vertical", false, true, false},
+                           {"F_lateral", false, false, true},    kPaperForces,
+                           {"F_motion + F_lateral", true, false, true}, {"all three", true, true, true}};
+  for (const NnForces& s : sets) {
+    std::printf("  %-22s", s.name);
+    for (double cut : kCuts) std::printf(" %4.0f%%", 100 * one_nn_accuracy(all, cut, s));
+    std::printf("\n");
+  }
+  std::printf("  (the issue's reference, forces unnamed: 71 / 83 / 94 / 100%%)\n");
+  return 0;
 }
 
 int run_eval(const std::map<std::string, std::string>& a) {
@@ -428,8 +464,9 @@ int run_timing(const std::map<std::string, std::string>& a) {
 
 int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  if (argc >= 2 && std::strcmp(argv[1], "baseline") == 0) return run_baseline();
   if (argc < 2 || (std::strcmp(argv[1], "eval") && std::strcmp(argv[1], "timing"))) {
-    std::fprintf(stderr, "usage: bench_calib_pipeline eval|timing [--option value ...] (see the source's header)\n");
+    std::fprintf(stderr, "usage: bench_calib_pipeline eval|timing|baseline [--option value ...] (see the source's header)\n");
     return 2;
   }
   const auto a = parse_args(argc, argv, 2);

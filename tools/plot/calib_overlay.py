@@ -167,13 +167,19 @@ def plot_predict(args):
     fig.savefig(args.out, dpi=100)
 
 
+def present_forces(rows):
+    """The forces a residual or contrast table holds, in its order (F_lateral since 2026-11-25)."""
+    return [a for a in ("motion", "vertical", "lateral") if rows and "measured_" + a in rows[0]]
+
+
 def plot_residual(args):
     rows = list(csv.DictReader(open(args.prefix + ".residual.csv", newline="")))
     heights = [h for h in ("high", "middle", "low") if any(r["height"] == h for r in rows)]
-    fig, axes = plt.subplots(len(heights), 2, figsize=(12, 3.4 * len(heights)), squeeze=False)
+    forces = present_forces(rows)
+    fig, axes = plt.subplots(len(heights), len(forces), figsize=(6 * len(forces), 3.4 * len(heights)), squeeze=False)
     for i, h in enumerate(heights):
         mine = [r for r in rows if r["height"] == h and int(r["trials"]) > 0]
-        for col, (axis, name) in enumerate((("motion", "F_motion [N]"), ("vertical", "F_vertical [N]"))):
+        for col, (axis, name) in enumerate((a, f"F_{a} [N]") for a in forces):
             ax = axes[i][col]
             for r in mine:
                 a, b = float(r["from"]), float(r["to"])
@@ -200,10 +206,11 @@ def plot_contrast(args):
     rows = list(csv.DictReader(open(args.prefix + ".contrast.csv", newline="")))
     lowers = [h for h in ("middle", "low") if any(r["lower"] == h for r in rows)]
     shade = {"reverses": ("tab:red", "simulator reverses it"), "misses": ("tab:orange", "simulator misses it")}
-    fig, axes = plt.subplots(len(lowers), 2, figsize=(12, 3.4 * len(lowers)), squeeze=False)
+    forces = present_forces(rows)
+    fig, axes = plt.subplots(len(lowers), len(forces), figsize=(6 * len(forces), 3.4 * len(lowers)), squeeze=False)
     for i, h in enumerate(lowers):
         mine = [r for r in rows if r["lower"] == h and int(r["trials_high"]) > 0 and int(r["trials_lower"]) > 0]
-        for col, (axis, name) in enumerate((("motion", "F_motion"), ("vertical", "F_vertical"))):
+        for col, (axis, name) in enumerate((a, f"F_{a}") for a in forces):
             ax = axes[i][col]
             for r in mine:
                 a, b = float(r["from"]), float(r["to"])
