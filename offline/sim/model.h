@@ -280,8 +280,8 @@ std::vector<RoundCone> arm_colliders(const SceneOptions& opt, double fist_shift,
                                      std::vector<std::string>* names = nullptr);
 
 // The arm of the scene with its fist moved by m.fist_shift toward the elbow and by m.fist_lateral
-// sideways, then the whole arm
-// moved by m.arm_lateral along y and by arm_dz along z (the trial's height): m.arm and m.elbow.
+// sideways, then the whole arm moved by m.arm_lateral along y and by arm_dz along z (the trial's
+// height): m.arm and m.elbow.
 void place_arm(GownModel& m, double arm_dz);
 
 // Watching other placements of the arm while the gown settles: may trials with other arm heights
