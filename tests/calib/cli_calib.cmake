@@ -50,6 +50,12 @@ expect_fail("predict with a bad --window" "--window" predict --calibration ${WOR
 
 if(STUDY)
   execute_process(COMMAND ${DG} import --study ${STUDY} --out ${WORK}/study RESULT_VARIABLE rc)
+  # The people's outcomes over travel in all three forces, as a picture.
+  execute_process(COMMAND /usr/bin/python3 ${PLOT} classes ${WORK}/study --out ${WORK}/classes.png
+                  RESULT_VARIABLE rc ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/classes.png)
+    message(FATAL_ERROR "calib_overlay.py classes on the study (${rc}): ${err}")
+  endif()
   file(WRITE ${WORK}/bounds.txt "friction 0 2\nstiffness 0 1\n")
   expect_fail("calibrate with a bad bounds file" "bounds.txt:2: unknown parameter 'stiffness'"
               calibrate --data ${WORK}/study --participant 4 --out ${WORK}/c.json --bounds ${WORK}/bounds.txt)

@@ -27,6 +27,11 @@ Modes:
             differ and the simulator does the opposite are shaded red, where it shows no difference
             orange: what a classifier trained on the simulator learns wrong or not at all. Dotted
             lines mark the cuts of issue 4 (0.15, 0.20, 0.25, 0.30 m).
+  classes:  calib_overlay.py classes DATASET [--up-to 0.4] --out classes.png
+            Every labelled trial of a dataset (`dressguard import`'s study, or a synthesized one)
+            over travel, one colour per outcome, for F_motion, F_vertical and F_lateral, with the
+            cuts of issue 4 dotted: where the outcomes part (the people's part first in
+            F_lateral; offline/sim/README.md, "The lateral force").
   progress: calib_overlay.py progress CALIBRATE.log --out progress.png
             `dressguard calibrate`'s progress lines (its stderr, kept in a file): the best L so far
             and each generation's best against the generation, and the best point's L per sequence
@@ -96,9 +101,34 @@ def read_dataset(folder):
             pts = []
             with open(os.path.join(folder, row["file"]), newline="") as g:
                 for r in csv.DictReader(g):
-                    pts.append((float(r["travel"]), float(r["f_motion"]), float(r["f_vertical"])))
+                    pts.append((float(r["travel"]), float(r["f_motion"]), float(r["f_vertical"]),
+                                float(r["f_lateral"])))
             trials.append((row, pts))
     return trials
+
+
+def plot_classes(args):
+    trials = [t for t in read_dataset(args.dataset) if t[0]["label"] in ("good", "missed", "caught")]
+    colors = {"good": "tab:green", "missed": "tab:blue", "caught": "tab:orange"}
+    fig, axes = plt.subplots(1, 3, figsize=(16, 4.2))
+    for col, (idx, name) in enumerate([(1, "F_motion [N]"), (2, "F_vertical [N]"), (3, "F_lateral [N]")]):
+        ax = axes[col]
+        for row, pts in trials:
+            pts = [p for p in pts if p[0] <= args.up_to]
+            ax.plot([p[0] for p in pts], [p[idx] for p in pts], color=colors[row["label"]], lw=1.0, alpha=0.7)
+        for cut in (0.15, 0.20, 0.25, 0.30):
+            if cut <= args.up_to:
+                ax.axvline(cut, color="gray", ls=":", lw=0.8)
+        ax.axhline(0, color="gray", lw=0.6)
+        ax.set_xlabel("travel [m]")
+        ax.set_ylabel(name)
+        ax.grid(alpha=0.3)
+    counts = {k: sum(1 for r, _ in trials if r["label"] == k) for k in colors}
+    handles = [plt.Line2D([], [], color=c, label=f"{k} ({counts[k]} trials)") for k, c in colors.items() if counts[k]]
+    axes[0].legend(handles=handles, fontsize=8, loc="lower left")
+    fig.suptitle(f"{args.dataset}: every labelled trial to {args.up_to:.2f} m of travel (dotted: issue 4's cuts)")
+    fig.tight_layout()
+    fig.savefig(args.out, dpi=110)
 
 
 def plot_dataset(args):
@@ -300,12 +330,16 @@ def main():
     c = sub.add_parser("contrast")
     c.add_argument("prefix")
     c.add_argument("--out", required=True)
+    k = sub.add_parser("classes")
+    k.add_argument("dataset")
+    k.add_argument("--up-to", type=float, default=0.4)
+    k.add_argument("--out", required=True)
     g = sub.add_parser("progress")
     g.add_argument("log")
     g.add_argument("--out", required=True)
     args = p.parse_args()
     {"fit": plot_fit, "dataset": plot_dataset, "predict": plot_predict, "residual": plot_residual,
-     "contrast": plot_contrast, "progress": plot_progress}[args.mode](args)
+     "contrast": plot_contrast, "progress": plot_progress, "classes": plot_classes}[args.mode](args)
 
 
 if __name__ == "__main__":
