@@ -52,7 +52,7 @@ int run_calibrate(int argc, char** argv) {
         "                      what a classifier learns from cut sequences). Default 0: eq. 3-5 alone\n"
         "  --lateral-weight K  add K times the lateral force's area error to the objective (eq. 3\n"
         "                      on F_lateral, over the travel both cover; offline/calib/calibration.h,\n"
-        "                      lateral_term). Default 0: eq. 3-5 alone, which cannot see --arm-lateral\n"
+        "                      lateral_term). Default 0: eq. 3-5 alone\n"
         "  --no-arm-offset     do not optimise the arm offsets (paper Fig. 9 comparison)\n"
         "  --arm-compliance fit|fixed|C   the person's arm: fit its compliance [m/N] too (one more\n"
         "                      parameter; offline/sim/arm_spring.h), hold it fixed (the paper's, the\n"
@@ -73,8 +73,9 @@ int run_calibrate(int argc, char** argv) {
         "                      (offline/sim/README.md, \"The gown's weight\")\n"
         "  --arm-lateral fit|fixed|M   the person's arm sideways of the gripper's line (+y, away\n"
         "                      from the body): fit it (one more parameter, in [-0.05, 0.05] m by\n"
-        "                      default; needs --lateral-weight), hold it under the jaws (the paper's,\n"
-        "                      the default) or at M metres (offline/sim/README.md, \"The lateral force\")\n"
+        "                      default; --lateral-weight lets the lateral force judge it), hold it\n"
+        "                      under the jaws (the paper's, the default) or at M metres\n"
+        "                      (offline/sim/README.md, \"The lateral force\")\n"
         "  --fist-lateral fit|fixed|M   the fist alone sideways, the elbow fixed (the forearm turned\n"
         "                      about the elbow); as --arm-lateral\n"
         "  --gown full|reduced|coarse   simulator gown (default reduced)\n"
@@ -133,13 +134,6 @@ int run_calibrate(int argc, char** argv) {
     if (const auto v = args.get(kPersonParamInfo[i].flag); v && !set_person_param(space, i, *v))
       throw UsageError(std::string("--") + kPersonParamInfo[i].flag + " must be fit, fixed or a value (" +
                        kPersonParamInfo[i].name + " " + kPersonParamInfo[i].range + "), not '" + *v + "'");
-  // Eq. 3-5 score F_motion and F_vertical, which are even in the arm's sideways place (the scene
-  // is symmetric about the gripper's line up to the upper arm): without the lateral term the
-  // search would wander along a flat direction.
-  for (int i : {kArmLateral, kFistLateral})
-    if (space.person[i].fit && !(o.lateral_weight > 0))
-      throw UsageError(std::string("--") + kPersonParamInfo[i].flag +
-                       " fit needs --lateral-weight K > 0 (only the lateral force tells where the arm is)");
   if (const auto hem = args.get("hem")) {
     double w = 0, r = 0;
     char tail = 0;

@@ -27,7 +27,6 @@ expect_fail("calibrate with a bad --hem" "--hem" calibrate --data ${WORK}/nothin
 expect_fail("calibrate with a softening --hem" "--hem" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --hem 0.03,0.5)
 expect_fail("calibrate with a negative contrast weight" "--contrast-weight must be in [0, 1000]" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --contrast-weight -1)
 expect_fail("calibrate with a negative lateral weight" "--lateral-weight must be in [0, 1000]" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --lateral-weight -1)
-expect_fail("calibrate the arm's side without the lateral force" "--arm-lateral fit needs --lateral-weight" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --arm-lateral fit)
 expect_fail("calibrate with the arm beside the opening" "--arm-lateral must be fit, fixed or a value (arm_lateral must be within +-0.1 m" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --arm-lateral 0.15)
 expect_fail("calibrate with a weightless gown" "areal_density must be within 0.01 and 1 kg/m" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --density 0)
 expect_fail("calibrate on a missing dataset" "manifest.csv" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json)
