@@ -42,6 +42,8 @@ double person_value(const ClothValues& c, int i) {
     case kRimShift: return c.rim_shift;
     case kArmLateral: return c.arm_lateral;
     case kFistLateral: return c.fist_lateral;
+    case kSupportDepth: return c.support_depth;
+    case kSupportLateral: return c.support_lateral;
     default: return c.areal_density;
   }
 }
@@ -53,6 +55,8 @@ void set_person_value(ClothValues& c, int i, double v) {
     case kRimShift: c.rim_shift = v; break;
     case kArmLateral: c.arm_lateral = v; break;
     case kFistLateral: c.fist_lateral = v; break;
+    case kSupportDepth: c.support_depth = v; break;
+    case kSupportLateral: c.support_lateral = v; break;
     default: c.areal_density = v; break;
   }
 }
@@ -77,6 +81,8 @@ Bounds default_bounds() {
   b.person[kArealDensity] = {0.04, 0.25, kPaperArealDensity};
   b.person[kArmLateral] = {-0.05, 0.05, 0.0};
   b.person[kFistLateral] = {-0.05, 0.05, 0.0};
+  b.person[kSupportDepth] = {0.5, 0.8, 0.65};
+  b.person[kSupportLateral] = {-0.2, 0.05, -0.1};
   return b;
 }
 
@@ -110,10 +116,11 @@ Bounds read_bounds(const std::filesystem::path& path) {
           throw_input_error(path, n, name + " " + kPersonParamInfo[i].range);
         target = &b.person[i];
       }
-    if (!target)
-      throw_input_error(path, n,
-                        "unknown parameter '" + name +
-                            "' (expected stretch, shear, bend, friction, self_friction, arm_offset, arm_compliance, fist_shift, rim_shift or areal_density)");
+    if (!target) {
+      std::string known = "stretch, shear, bend, friction, self_friction, arm_offset";
+      for (const PersonParamInfo& info : kPersonParamInfo) known += std::string(", ") + info.name;
+      throw_input_error(path, n, "unknown parameter '" + name + "' (expected " + known + ")");
+    }
     *target = pb;
   }
   return b;
@@ -542,8 +549,12 @@ void start_from(Bounds& b, const Calibration& c) {
     b.cloth[i].initial = cloth_value(c.cloth, i);
   }
   for (int i = 0; i < kPersonParams; ++i) {
-    check(b.person[i], person_value(c.cloth, i), kPersonParamInfo[i].name);
-    b.person[i].initial = person_value(c.cloth, i);
+    // The paper's value outside the box (no support, where the box holds one) keeps the box's
+    // own start: the start file simply did not have it.
+    const double v = person_value(c.cloth, i);
+    if (v == kPersonParamInfo[i].paper && !(v >= b.person[i].lower && v <= b.person[i].upper)) continue;
+    check(b.person[i], v, kPersonParamInfo[i].name);
+    b.person[i].initial = v;
   }
   // The offsets share one box; each calibrated height starts from its own value.
   for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {

@@ -60,6 +60,10 @@ struct ClothValues {
   // Only the lateral force tells where they are (calibrate --lateral-weight).
   double arm_lateral = 0.0;
   double fist_lateral = 0.0;
+  // [m] the support under the gown (sim/trial.h ClothParams::support_depth, support_lateral;
+  // kSupportDepth, kSupportLateral below): its axis below the grasp (0: none) and sideways.
+  double support_depth = 0.0;
+  double support_lateral = 0.0;
 };
 inline constexpr double kPaperArealDensity = 0.145;
 inline constexpr int kClothParams = 5;
@@ -86,13 +90,15 @@ struct PersonParamInfo {
   double paper;
   const char* range;
 };
-inline constexpr int kPersonParams = 6;
+inline constexpr int kPersonParams = 8;
 inline constexpr int kArmCompliance = 0;  // [m/N] sim/arm_spring.h
 inline constexpr int kFistShift = 1;      // [m] sim/trial.h ClothParams::fist_shift
 inline constexpr int kRimShift = 2;       // [m] ClothValues::rim_shift (the grasp, sim_bridge.h)
 inline constexpr int kArealDensity = 3;   // [kg/m^2] sim/trial.h ClothParams::areal_density
 inline constexpr int kArmLateral = 4;     // [m] sim/trial.h ClothParams::arm_lateral
 inline constexpr int kFistLateral = 5;    // [m] sim/trial.h ClothParams::fist_lateral
+inline constexpr int kSupportDepth = 6;    // [m] sim/trial.h ClothParams::support_depth
+inline constexpr int kSupportLateral = 7;  // [m] sim/trial.h ClothParams::support_lateral
 inline constexpr std::array<PersonParamInfo, kPersonParams> kPersonParamInfo = {{
     {"arm_compliance", "arm-compliance", 0.0, 1.0, 0.0, "cannot be negative (0 is a fixed arm) nor above 1 m/N"},
     {"fist_shift", "fist-shift", -0.2, 0.2, 0.0, "must be within +-0.2 m (the forearm is 0.31 m)"},
@@ -100,6 +106,8 @@ inline constexpr std::array<PersonParamInfo, kPersonParams> kPersonParamInfo = {
     {"areal_density", "density", 0.01, 1.0, kPaperArealDensity, "must be within 0.01 and 1 kg/m^2 (a heavy canvas is about 0.5)"},
     {"arm_lateral", "arm-lateral", -0.1, 0.1, 0.0, "must be within +-0.1 m (beyond it the fist is beside the opening)"},
     {"fist_lateral", "fist-lateral", -0.1, 0.1, 0.0, "must be within +-0.1 m (beyond it the fist is beside the opening)"},
+    {"support_depth", "support-depth", 0.0, 1.5, 0.0, "must be within 0 (no support) and 1.5 m below the grasp"},
+    {"support_lateral", "support-lateral", -0.3, 0.3, 0.0, "must be within +-0.3 m"},
 }};
 double person_value(const ClothValues& c, int i);
 void set_person_value(ClothValues& c, int i, double v);
@@ -156,7 +164,11 @@ struct Bounds {
 // the reduced gown's sleeve top); areal density in [0.04, 0.25] kg/m^2 (start 0.145, the
 // paper's): from a spunbond disposable gown to a heavy woven cotton one; arm lateral and fist
 // lateral each in [-0.05, 0.05] m (start 0, the paper's arm under the jaws): the fist's 5 cm
-// radius, so that it stays in front of the opening (about 16 cm wide) at either end of the box.
+// radius, so that it stays in front of the opening (about 16 cm wide) at either end of the box;
+// support depth in [0.5, 0.8] m (start 0.65) and support lateral in [-0.2, 0.05] m (start -0.1):
+// around the support that brought participant 4's middle arm nearest the people (sim README,
+// "What holds the gown on the person's side"), its top 5 cm below the low arm's fist at the
+// least and the person's side favoured.
 Bounds default_bounds();
 // Bounds file: one "name lower upper [initial]" per line, '#' starts a comment, names as in
 // kClothParamNames plus "arm_offset" and kPersonParamInfo's; unnamed parameters keep their

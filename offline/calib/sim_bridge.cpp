@@ -29,6 +29,8 @@ sim::ClothParams cloth_params_of(const ClothValues& c) {
   p.fist_shift = c.fist_shift;
   p.arm_lateral = c.arm_lateral;
   p.fist_lateral = c.fist_lateral;
+  p.support_depth = c.support_depth;
+  p.support_lateral = c.support_lateral;
   p.hem_width = c.hem_width;
   p.hem_bend_ratio = c.hem_bend_ratio;
   p.areal_density = c.areal_density;
@@ -48,6 +50,10 @@ static_assert(kPersonParamInfo[kArmLateral].highest == sim::kMaxArmLateral &&
 static_assert(kPersonParamInfo[kFistLateral].highest == sim::kMaxArmLateral &&
                   kPersonParamInfo[kFistLateral].lowest == -sim::kMaxArmLateral,
               "fist_lateral's range differs between calibration.h and sim/trial.h");
+static_assert(kPersonParamInfo[kSupportDepth].highest == sim::kMaxSupportDepth && kPersonParamInfo[kSupportDepth].lowest == 0 &&
+                  kPersonParamInfo[kSupportLateral].highest == sim::kMaxSupportLateral &&
+                  kPersonParamInfo[kSupportLateral].lowest == -sim::kMaxSupportLateral,
+              "the support's range differs between calibration.h and sim/trial.h");
 // The middle arm's nominal height below the high one (synthesis.h) is the simulator's.
 constexpr double kSimMiddleBelowHigh = sim::ArmGeometry{}.z_rel[0] - sim::ArmGeometry{}.z_rel[1];
 static_assert(kPaperArealDensity == sim::ClothParams{}.areal_density,

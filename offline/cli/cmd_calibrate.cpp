@@ -78,6 +78,13 @@ int run_calibrate(int argc, char** argv) {
         "                      (offline/sim/README.md, \"The lateral force\")\n"
         "  --fist-lateral fit|fixed|M   the fist alone sideways, the elbow fixed (the forearm turned\n"
         "                      about the elbow); as --arm-lateral\n"
+        "  --support-depth fit|fixed|M   a support under the gown that carries part of its body\n"
+        "                      (a 15 cm capsule under the arm; offline/sim/README.md, \"What holds the\n"
+        "                      gown on the person's side\"): fit how far below the grasp its axis is\n"
+        "                      (one more parameter, in [0.5, 0.8] m by default), none (the paper's,\n"
+        "                      the default) or at M metres (0: none)\n"
+        "  --support-lateral fit|fixed|M   the support sideways (negative: toward the person; in\n"
+        "                      [-0.2, 0.05] m by default when fitted); only with a support\n"
         "  --gown full|reduced|coarse   simulator gown (default reduced)\n"
         "  --threads N         threads per process (default: all cores)\n"
         "  --checkpoint FILE   default CAL.json.ckpt; an existing one is resumed\n"
@@ -90,7 +97,8 @@ int run_calibrate(int argc, char** argv) {
   args.allow_only({"help", "json", "no-arm-offset", "data", "participant", "profile", "bounds", "start", "seed", "out",
                    "checkpoint", "objective", "gown", "threads", "generations", "population",
                    "stop-after-generations", "arm-compliance", "fist-shift", "rim-shift", "sigma0", "hem",
-                   "density", "contrast-weight", "lateral-weight", "arm-lateral", "fist-lateral"});
+                   "density", "contrast-weight", "lateral-weight", "arm-lateral", "fist-lateral", "support-depth",
+                   "support-lateral"});
   const std::string data = args.require("data");
   const std::string participant = args.require("participant");
   const std::string out = args.require("out");
@@ -134,6 +142,10 @@ int run_calibrate(int argc, char** argv) {
     if (const auto v = args.get(kPersonParamInfo[i].flag); v && !set_person_param(space, i, *v))
       throw UsageError(std::string("--") + kPersonParamInfo[i].flag + " must be fit, fixed or a value (" +
                        kPersonParamInfo[i].name + " " + kPersonParamInfo[i].range + "), not '" + *v + "'");
+  const ParameterSpace::Person& depth = space.person[kSupportDepth];
+  const ParameterSpace::Person& side = space.person[kSupportLateral];
+  if ((side.fit || side.value != 0) && !depth.fit && depth.value == 0)
+    throw UsageError("--support-lateral needs a support: --support-depth fit or a depth");
   if (const auto hem = args.get("hem")) {
     double w = 0, r = 0;
     char tail = 0;

@@ -130,6 +130,12 @@ std::vector<RoundCone> arm_colliders(const SceneOptions& opt, double fist_shift,
   return arm;
 }
 
+RoundCone support_collider(const SceneOptions& opt, const ClothParams& p) {
+  const V3 gp{opt.grasp_point[0], opt.grasp_point[1], opt.grasp_point[2]};
+  const V3 mid = gp + V3{0, p.support_lateral, -p.support_depth};
+  return make_round_cone(mid - V3{kSupportBehind, 0, 0}, kSupportRadius, mid + V3{kSupportAhead, 0, 0}, kSupportRadius);
+}
+
 const char* friction_scheme_name(FrictionScheme s) {
   switch (s) {
     case FrictionScheme::Stock: return "stock";
@@ -306,6 +312,8 @@ GownModel make_model(const SceneData& s, const ClothParams& p, FrictionScheme sc
   m.fist_shift = p.fist_shift;
   m.arm_lateral = p.arm_lateral;
   m.fist_lateral = p.fist_lateral;
+  m.has_support = p.support_depth > 0;
+  if (m.has_support) m.support = support_collider(s.opt, p);
   m.hem_width = std::max(0.0, p.hem_width);
   m.hem_bend_ratio = p.hem_bend_ratio > 0 ? p.hem_bend_ratio : 1.0;
   m.damping_factor = std::exp(-std::max(0.0, p.damping) * m.h);
@@ -470,6 +478,7 @@ GownState make_state(const GownModel& m) {
   s.contact_list.assign(n, 0);
   s.contact_n.assign(n, {});
   s.contact_dn.assign(n, 0.0);
+  s.support_cand.assign(n, 0);
   s.contact_acc.assign(n, {});
   s.ext_force.assign(n, {});
   size_t table = 1;

@@ -162,6 +162,10 @@ struct GownModel {
   bool self_collision = true;
   std::vector<RoundCone> arm;         // placed at the trial's height
   V3 elbow;
+  // The support under the gown (ClothParams::support_depth), where it ends up; it does not move
+  // with the arm. GownState::support_lift says how far below that it is.
+  bool has_support = false;
+  RoundCone support;
   V3 gravity{0, 0, -9.81};
   // Derived by refresh_constraints() (call it again after changing mass, w or a compliance).
   KernelPath path = KernelPath::Scalar;
@@ -239,6 +243,16 @@ struct GownState {
   // The same per arm collider (index of m.arm; m dx / h^2 of its corrections): which part of the
   // arm carries the load (TrialResult::arm_parts).
   std::array<V3, kArmParts> part_acc{};
+  // An arm collider (or a test plane) corrected a vertex during the last step(): the arm touched
+  // the gown (the support, which is not the arm, does not count).
+  bool arm_corrected = false;
+  // The support (GownModel::support): the free vertices within its reach this output step, and
+  // how far below its place it is, linearly from support_lift_from to support_lift_to over the
+  // step's substeps (settle() raises it; 0 during the pull). support_acc: the sum over substeps of
+  // its force on the gown (m dx / h^2), as force_acc is the gripper's.
+  std::vector<uint8_t> support_cand;
+  double support_lift_from = 0, support_lift_to = 0;
+  V3 support_acc{0, 0, 0};
   std::vector<V3> ext_force;          // per-vertex external force (the perturbation)
   bool ext_force_on = false;          // any non-zero ext_force this output step (set by step())
   // Self-collision: spatial hash and pair list, capacities fixed in make_state().
@@ -278,6 +292,10 @@ void step(const GownModel& m, GownState& s, V3 grip_from, V3 grip_to, V3 grip_ac
 // (may be null) gets each collider's name.
 std::vector<RoundCone> arm_colliders(const SceneOptions& opt, double fist_shift, double fist_lateral,
                                      std::vector<std::string>* names = nullptr);
+
+// The support under the gown where it ends up (ClothParams::support_depth > 0; trial.h): a
+// capsule of radius kSupportRadius along x under the grasp point, fixed in the world.
+RoundCone support_collider(const SceneOptions& opt, const ClothParams& p);
 
 // The arm of the scene with its fist moved by m.fist_shift toward the elbow and by m.fist_lateral
 // sideways, then the whole arm moved by m.arm_lateral along y and by arm_dz along z (the trial's

@@ -25,6 +25,8 @@ double* field(ClothParams& p, const std::string& name) {
   if (name == "fist_lateral") return &p.fist_lateral;
   if (name == "hem_width") return &p.hem_width;
   if (name == "hem_bend_ratio") return &p.hem_bend_ratio;
+  if (name == "support_depth") return &p.support_depth;
+  if (name == "support_lateral") return &p.support_lateral;
   return nullptr;
 }
 
@@ -51,7 +53,7 @@ ClothParams parse_params(const std::string& text, const std::filesystem::path& f
       if (!(ws >> value)) throw_input_error(file, lineno, "parameter '" + name + "' has no value");
       if (ws >> extra) throw_input_error(file, lineno, "unexpected '" + extra + "' after " + name);
       double* f = field(p, name);
-      if (!f) throw_input_error(file, lineno, "unknown parameter '" + name + "' (stretch, shear, bend, friction, self_friction, damping, areal_density, arm_compliance, fist_shift, arm_lateral, fist_lateral, hem_width, hem_bend_ratio)");
+      if (!f) throw_input_error(file, lineno, "unknown parameter '" + name + "' (stretch, shear, bend, friction, self_friction, damping, areal_density, arm_compliance, fist_shift, arm_lateral, fist_lateral, hem_width, hem_bend_ratio, support_depth, support_lateral)");
       double v = 0;
       auto [ptr, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
       if (ec != std::errc() || ptr != value.data() + value.size() || !std::isfinite(v))
@@ -70,6 +72,10 @@ ClothParams parse_params(const std::string& text, const std::filesystem::path& f
   if (!(p.hem_width >= 0 && p.hem_width <= kMaxHemWidth)) throw_input_error(file, 0, "hem_width must be within [0, 0.2] m");
   if (!(p.hem_bend_ratio >= 1 && p.hem_bend_ratio <= kMaxHemBendRatio))
     throw_input_error(file, 0, "hem_bend_ratio must be within [1, 10000] (a hem is stiffer than the fabric)");
+  if (!(p.support_depth >= 0 && p.support_depth <= kMaxSupportDepth))
+    throw_input_error(file, 0, "support_depth must be within [0, 1.5] m below the grasp (0: no support)");
+  if (!(std::abs(p.support_lateral) <= kMaxSupportLateral))
+    throw_input_error(file, 0, "support_lateral must be within +-0.3 m");
   return p;
 }
 
@@ -80,9 +86,10 @@ std::string format_params(const ClothParams& p) {
   std::snprintf(b, sizeof b,
                 "stretch %.17g\nshear %.17g\nbend %.17g\nfriction %.17g\nself_friction %.17g\ndamping %.17g\n"
                 "areal_density %.17g\narm_compliance %.17g\nfist_shift %.17g\narm_lateral %.17g\n"
-                "fist_lateral %.17g\nhem_width %.17g\nhem_bend_ratio %.17g\n",
+                "fist_lateral %.17g\nhem_width %.17g\nhem_bend_ratio %.17g\nsupport_depth %.17g\nsupport_lateral %.17g\n",
                 p.stretch, p.shear, p.bend, p.friction, p.self_friction, p.damping, p.areal_density, p.arm_compliance,
-                p.fist_shift, p.arm_lateral, p.fist_lateral, p.hem_width, p.hem_bend_ratio);
+                p.fist_shift, p.arm_lateral, p.fist_lateral, p.hem_width, p.hem_bend_ratio, p.support_depth,
+                p.support_lateral);
   return b;
 }
 
@@ -91,9 +98,11 @@ std::string params_json(const ClothParams& p) {
   std::snprintf(b, sizeof b,
                 "{\"stretch\": %.17g, \"shear\": %.17g, \"bend\": %.17g, \"friction\": %.17g, \"self_friction\": %.17g, "
                 "\"damping\": %.17g, \"areal_density\": %.17g, \"arm_compliance\": %.17g, \"fist_shift\": %.17g, "
-                "\"arm_lateral\": %.17g, \"fist_lateral\": %.17g, \"hem_width\": %.17g, \"hem_bend_ratio\": %.17g}",
+                "\"arm_lateral\": %.17g, \"fist_lateral\": %.17g, \"hem_width\": %.17g, \"hem_bend_ratio\": %.17g, "
+                "\"support_depth\": %.17g, \"support_lateral\": %.17g}",
                 p.stretch, p.shear, p.bend, p.friction, p.self_friction, p.damping, p.areal_density, p.arm_compliance,
-                p.fist_shift, p.arm_lateral, p.fist_lateral, p.hem_width, p.hem_bend_ratio);
+                p.fist_shift, p.arm_lateral, p.fist_lateral, p.hem_width, p.hem_bend_ratio, p.support_depth,
+                p.support_lateral);
   return b;
 }
 
@@ -110,15 +119,24 @@ std::string scene_json(const Scene& scene, const ClothParams& params, const Tria
   for (size_t t = 0; t < sc.mesh.tris.size(); ++t)
     o << (t ? "," : "") << '[' << sc.mesh.tris[t][0] << ',' << sc.mesh.tris[t][1] << ',' << sc.mesh.tris[t][2] << ']';
   o << "],\n\"arm\": [";
+  auto cone = [&o](const RoundCone& c, double dy, double dz) {
+    o << "{\"a\": [" << c.a.x << ',' << c.a.y + dy << ',' << c.a.z + dz << "], \"ra\": " << c.ra << ", \"b\": ["
+      << c.b.x << ',' << c.b.y + dy << ',' << c.b.z + dz << "], \"rb\": " << c.rb << '}';
+  };
   for (size_t k = 0; k < arm.size(); ++k) {
-    const RoundCone& c = arm[k];
-    o << (k ? "," : "") << "{\"a\": [" << c.a.x << ',' << c.a.y + dy << ',' << c.a.z + dz << "], \"ra\": " << c.ra
-      << ", \"b\": [" << c.b.x << ',' << c.b.y + dy << ',' << c.b.z + dz << "], \"rb\": " << c.rb << '}';
+    o << (k ? "," : "");
+    cone(arm[k], dy, dz);
   }
   // Each height's nominal arm axis (the scene's arm is at the high one), for the view from the fist.
   o << "],\n\"arm_axis_z\": [";
   for (int k = 0; k < 3; ++k) o << (k ? "," : "") << arm[0].a.z + sc.opt.arm.z_rel[k] - sc.opt.arm.z_rel[0];
-  o << "],\n\"grip\": [" << sc.opt.grasp_point[0] << ',' << sc.opt.grasp_point[1] << ',' << sc.opt.grasp_point[2] << "],";
+  o << "],\n\"support\": ";
+  if (params.support_depth > 0) {
+    cone(support_collider(sc.opt, params), 0, 0);  // fixed in the world
+  } else {
+    o << "null";
+  }
+  o << ",\n\"grip\": [" << sc.opt.grasp_point[0] << ',' << sc.opt.grasp_point[1] << ',' << sc.opt.grasp_point[2] << "],";
   o << "\"jaw_half\": [" << sc.opt.jaw_half[0] << ',' << sc.opt.jaw_half[1] << ',' << sc.opt.jaw_half[2] << "],";
   o << "\"grasped\": [";
   for (size_t k = 0; k < sc.grasp_list.size(); ++k) o << (k ? "," : "") << sc.grasp_list[k];

@@ -62,7 +62,16 @@ void detect_arm(const GownModel& m, GownState& s) {
         sc.grasped[i] || m.arm.empty() ? ArmCandidates{} : arm_candidates(m, s.x[i] - shift, s.v[i], arm_travel);
     s.cand[i] = c;
     if (c.c[0] < 0) s.anchored[i] = 0;
-    if (!sc.grasped[i] && (c.c[0] >= 0 || planes)) s.contact_list[s.contact_count++] = i;
+    // The support where the step starts; the margin wider by the step's rise.
+    bool near_support = false;
+    if (m.has_support && !sc.grasped[i]) {
+      const double margin = sc.opt.contact_offset + 0.01 + 2.0 * norm(s.v[i]) * m.dt +
+                            std::abs(s.support_lift_from - s.support_lift_to);
+      V3 nrm;
+      near_support = round_cone_distance(m.support, s.x[i] + V3{0, 0, s.support_lift_from}, &nrm) < margin;
+    }
+    s.support_cand[i] = near_support;
+    if (!sc.grasped[i] && (c.c[0] >= 0 || planes || near_support)) s.contact_list[s.contact_count++] = i;
   }
 }
 
@@ -309,7 +318,7 @@ inline void collide_static(const GownModel& m, GownState& s, int i, double phi, 
 // Contacts with the arm's candidate round cones and the test planes, for the vertices listed by
 // detect_arm(); the collision force on each vertex (paper eq. 2: f = m dx_col / h^2) is
 // accumulated for the per-vertex contact map.
-void solve_contacts(const GownModel& m, GownState& s, double inv_h2) {
+void solve_contacts(const GownModel& m, GownState& s, double inv_h2, double lift, V3 support_move) {
   const SceneData& sc = *m.scene;
   const double off = sc.opt.contact_offset;
   for (size_t q = 0; q < s.contact_count; ++q) {
@@ -330,7 +339,18 @@ void solve_contacts(const GownModel& m, GownState& s, double inv_h2) {
       if (phi - off > 1e-3) s.anchored[i] = 0;
       collide_static(m, s, i, phi, pl.n, V3{0, 0, 0});
     }
-    if (s.contact_dn[i] > dn_before) s.contact_acc[i] += (m.mass[i] * inv_h2) * (s.x[i] - before);
+    if (s.contact_dn[i] > dn_before) {
+      s.contact_acc[i] += (m.mass[i] * inv_h2) * (s.x[i] - before);
+      s.arm_corrected = true;
+    }
+    // The support: not the arm, so neither in the contact map nor in what the arm touched.
+    if (s.support_cand[i]) {
+      V3 nrm;
+      const V3 pre = s.x[i];
+      const double dn_arm = s.contact_dn[i];
+      collide_static(m, s, i, round_cone_distance(m.support, s.x[i] + V3{0, 0, lift}, &nrm), nrm, support_move);
+      if (s.contact_dn[i] > dn_arm) s.support_acc += (m.mass[i] * inv_h2) * (s.x[i] - pre);
+    }
   }
 }
 
@@ -400,7 +420,7 @@ void check_watched_arms(const GownModel& m, GownState& s) {
 
 // One substep; `first`: the step's first substep (the velocities are current), else the
 // previous substep's velocity update is fused into the integration.
-void substep(const GownModel& m, GownState& s, V3 grip, V3 grip_accel, bool first) {
+void substep(const GownModel& m, GownState& s, V3 grip, V3 grip_accel, bool first, double lift, V3 support_move) {
   const SceneData& sc = *m.scene;
   const double inv_h2 = 1.0 / (m.h * m.h);
   if (first) {
@@ -413,7 +433,7 @@ void substep(const GownModel& m, GownState& s, V3 grip, V3 grip_accel, bool firs
              force);
   solve_kind(m, s, m.shear_blocks, m.shear_spans, shear_scalar, shear_free_avx2, shear_careful_avx2, inv_h2, force);
   solve_kind(m, s, m.bend_blocks, m.bend_spans, bend_scalar, bend_free_avx2, bend_careful_avx2, inv_h2, force);
-  solve_contacts(m, s, inv_h2);
+  solve_contacts(m, s, inv_h2, lift, support_move);
   if (!s.watch.empty() && !s.watch_touched) check_watched_arms(m, s);
   if (m.self_collision) solve_self(m, s, inv_h2, force);
   // The grasped vertices' own weight and inertia also load the gripper.
@@ -455,6 +475,8 @@ void step(const GownModel& m, GownState& s, V3 grip_from, V3 grip_to, V3 grip_ac
   detect_arm(m, s);
   if (m.self_collision) detect_self(m, s);
   std::fill(s.contact_dn.begin(), s.contact_dn.end(), 0.0);
+  s.arm_corrected = false;
+  double lift = s.support_lift_from;
   for (int k = 0; k < m.substeps; ++k) {
     const double f = static_cast<double>(k + 1) / m.substeps;
     const V3 grip = grip_from + f * (grip_to - grip_from);
@@ -462,7 +484,9 @@ void step(const GownModel& m, GownState& s, V3 grip_from, V3 grip_to, V3 grip_ac
     const V3 arm = s.arm_shift_from + f * (s.arm_shift_to - s.arm_shift_from);
     s.arm_move = arm - s.arm_shift;
     s.arm_shift = arm;
-    substep(m, s, grip, grip_accel, k == 0);
+    const double lift_next = s.support_lift_from + f * (s.support_lift_to - s.support_lift_from);
+    substep(m, s, grip, grip_accel, k == 0, lift_next, V3{0, 0, lift - lift_next});
+    lift = lift_next;
   }
   update_velocities(m, s);
   if (m.scheme == FrictionScheme::Stock) stock_friction(m, s);

@@ -155,8 +155,13 @@ Settled settle(GownModel& m, GownState& s, const TrialSpec& spec, const TrialDra
     m.damping_factor = on ? cloth_decay : settle_decay;
     if (k % 3 == 0) {  // the bias sample is the last 3 steps before the pull (settling ends on k % 3 == 0)
       s.force_acc = zero;
+      s.support_acc = zero;
       s.force_count = 0;
     }
+    // The support comes up into its place over its first kSupportRiseSteps steps (trial.h).
+    auto lift_at = [](int step) { return kSupportDrop * std::max(0.0, 1.0 - static_cast<double>(step) / kSupportRiseSteps); };
+    s.support_lift_from = lift_at(k);
+    s.support_lift_to = lift_at(k + 1);
     const int close = sc.opt.jaw_close_steps;
     s.jaw_closed = close > 0 ? std::min(1.0, (k + 1.0) / close) : 1.0;
     if (!out.arm_touched && watch_arms(m, s, probe_dz)) r.settle_arm_near = true;
@@ -164,9 +169,10 @@ Settled settle(GownModel& m, GownState& s, const TrialSpec& spec, const TrialDra
     if (!out.arm_touched) {
       // The own arm corrected a vertex when a normal correction was made this step (a
       // candidate that stayed outside the contact offset moved nothing).
-      bool own_touched = !own_arm_probe;
-      for (size_t q = 0; q < s.contact_count && !own_touched; ++q) own_touched = s.contact_dn[s.contact_list[q]] > 0;
-      if (s.contact_count > 0) r.settle_arm_near = true;
+      const bool own_touched = !own_arm_probe || s.arm_corrected;
+      // Listed for the arm (or the planes), not only for the support.
+      for (size_t q = 0; q < s.contact_count && !r.settle_arm_near; ++q)
+        r.settle_arm_near = !own_arm_probe || s.cand[s.contact_list[q]].c[0] >= 0;
       if (own_touched || s.watch_touched) {
         out.arm_touched = true;
         s.watch.clear();
@@ -212,6 +218,9 @@ Settled settle(GownModel& m, GownState& s, const TrialSpec& spec, const TrialDra
   // The sensor is biased at the start of the trial (data README): the settled gown's force,
   // mainly its weight, is removed from every sample.
   out.bias = s.force_count ? (1.0 / s.force_count) * s.force_acc : zero;
+  // The support pushes the gown up by what the gown lays on it (the same last 3 steps).
+  r.support_load = s.force_count ? s.support_acc.z / s.force_count : 0.0;
+  s.support_lift_from = s.support_lift_to = 0;
   r.bias = {out.bias.x, out.bias.y, out.bias.z};
   // The lower half of the sleeve opening as it hangs after settling (paper Fig. 3b, red dots).
   if (!sc.opening.empty()) {
@@ -301,8 +310,7 @@ void pull_sample(const GownModel& m, Pulling& p, const TrialSpec& spec, const Se
     if (touched && !*touched) watch_arms(m, s, watch_dz);
     step(m, s, g0, g1, V3{prof.accel(p.t), 0, 0});
     if (touched && !*touched) {
-      for (size_t q = 0; q < s.contact_count && !*touched; ++q) *touched = s.contact_dn[s.contact_list[q]] > 0;
-      *touched = *touched || s.watch_touched;
+      *touched = s.arm_corrected || s.watch_touched;
     }
     p.t = t1;
     maybe_frame(p, spec, frame_times, g1.x);

@@ -83,6 +83,15 @@ namespace dressguard::sim {
 // below the mesh's scale; stitched layers do not, and a softened cuff shrank its rim by 9-22 %).
 // 0 and 1, the defaults, are the paper's uniform cloth. A hem holds an opening of soft fabric
 // open the way a stiff `bend` holds the whole gown (offline/sim/README.md, "How stiff the gown is").
+// support_depth [m], support_lateral [m]: something under the gown that carries part of its body,
+// as the people's small late lateral force says something does in the study (offline/sim/README.md,
+// "What holds the gown on the person's side"): a horizontal capsule of radius kSupportRadius along
+// x, from kSupportBehind behind the grasp point to kSupportAhead ahead of it (the paper's elbow),
+// its axis support_depth below the grasp point and support_lateral along y (negative: toward the
+// person). It stays where it is whatever the arm's height or place, and comes up from
+// kSupportDrop below its place over the first kSupportRiseSteps output steps of settling, so that
+// the hanging gown comes to lie on it rather than starting inside it. Its contact has the arm's
+// friction. support_depth 0, the default and the paper's, is no support.
 struct ClothParams {
   double stretch = 0.8;
   double shear = 0.5;
@@ -97,7 +106,19 @@ struct ClothParams {
   double fist_lateral = 0.0;
   double hem_width = 0.0;
   double hem_bend_ratio = 1.0;
+  double support_depth = 0.0;
+  double support_lateral = 0.0;
 };
+// The support's shape and its rise during settling (ClothParams::support_depth). Its radius and
+// length are those of the variant that brought participant 4's middle arm nearest the people.
+inline constexpr double kSupportRadius = 0.15;   // [m]
+inline constexpr double kSupportBehind = 0.13;   // [m] along -x from the grasp point
+inline constexpr double kSupportAhead = 0.57;    // [m] along +x from the grasp point
+inline constexpr double kSupportDrop = 1.2;      // [m] below its place when settling starts
+inline constexpr int kSupportRiseSteps = 300;    // output steps (1 s); settling takes at least 500
+// support_depth within [0, kMaxSupportDepth] (0: none; the support's top 0.15 m above its axis);
+// |support_lateral| <= kMaxSupportLateral.
+inline constexpr double kMaxSupportDepth = 1.5, kMaxSupportLateral = 0.3;
 // |fist_shift| beyond this leaves no forearm worth the name (the paper's is 0.31 m).
 inline constexpr double kMaxFistShift = 0.2;
 // |arm_lateral| beyond this puts the fist (radius 5 cm) beside a 16 cm opening, not in front of it.
@@ -207,6 +228,7 @@ struct TrialResult {
   double contact_t = -1;            // [s] first sample with cloth-arm contact (-1: none)
   double contact_travel = -1;       // [m] travel then
   double weight = 0;                // [N] gown weight m g
+  double support_load = 0;          // [N] the settled gown's downward force on the support (0: none)
   std::array<double, 3> bias{};     // [N] raw force at the start of the pull, removed from samples
   int settle_steps = 0;             // output steps of settling done
   double settle_time = 0;           // [s] their duration

@@ -500,6 +500,18 @@ TEST(Calibration, StartFromACalibration) {
   Calibration high = c;
   high.offsets[0] = 0.1;
   EXPECT_NE(refused(high).find("arm_offset_high 0.1"), std::string::npos) << refused(high);
+  // A start without a support (the paper's 0, outside the support's box) keeps the box's own
+  // start; one with a support starts from it; a support outside the box is refused.
+  ASSERT_TRUE(set_person_param(s, kSupportDepth, "fit"));
+  EXPECT_NEAR(s.cloth(s.initial_unit()).support_depth, default_bounds().person[kSupportDepth].initial, 1e-15);
+  Calibration held = c;
+  held.cloth.support_depth = 0.7;
+  start_from(s.bounds, held);
+  EXPECT_NEAR(s.cloth(s.initial_unit()).support_depth, 0.7, 1e-15);
+  Calibration shallow = c;
+  shallow.cloth.support_depth = 0.3;
+  EXPECT_NE(refused(shallow).find("support_depth 0.3 is outside its bounds [0.5, 0.8]"), std::string::npos)
+      << refused(shallow);
 }
 
 // Paper IV-B.1 on the measured data: one sequence per height, caught never chosen (the study

@@ -168,6 +168,10 @@ TEST(SimParams, ParseFormats) {
   EXPECT_EQ(parse_params("arm_lateral -0.02\nfist_lateral 0.03\n", "x").fist_lateral, 0.03);
   EXPECT_THROW(parse_params("arm_lateral 0.15\n", "p.txt"), InputError);  // beyond kMaxArmLateral
   EXPECT_THROW(parse_params("fist_lateral -0.15\n", "p.txt"), InputError);
+  EXPECT_EQ(parse_params("support_depth 0.6\nsupport_lateral -0.1\n", "x").support_lateral, -0.1);
+  EXPECT_THROW(parse_params("support_depth 1.6\n", "p.txt"), InputError);  // beyond kMaxSupportDepth
+  EXPECT_THROW(parse_params("support_depth -0.1\n", "p.txt"), InputError);
+  EXPECT_THROW(parse_params("support_lateral 0.4\n", "p.txt"), InputError);  // beyond kMaxSupportLateral
   try {
     parse_params("friction 0.3\nbend x\n", "p.txt");
     FAIL();
@@ -332,6 +336,48 @@ TEST(SimTrial, HangingGownWeightOnTheGripper) {
   EXPECT_NEAR(std::hypot(r.bias[0], r.bias[1]), 0.0, 0.01 * r.weight);
 }
 
+// The support under the gown (ClothParams::support_depth) carries what the gown lays on it and
+// the gripper the rest: at rest their vertical forces add up to the gown's weight (statics; 1 %,
+// as for the gown hanging from the gripper alone), and the support carries a real share of it. It
+// rose into its place while the gown settled, so at the start of the pull no vertex lies inside
+// it (within the contact offset, 1 mm for the last substep's slack). Without one it carries
+// nothing. The arm is 2 m below, out of the way.
+TEST(SimTrial, SupportAndGripperShareTheGownsWeight) {
+  TrialSpec spec;
+  spec.max_travel = 1e-4;
+  spec.arm_offset = -2.0;
+  spec.keep_frames = true;
+  spec.frame_times = {0.0};
+  ClothParams p;
+  p.support_depth = 0.6;
+  p.support_lateral = -0.1;
+  const TrialResult r = simulate_trial(coarse_scene(), p, spec);
+  ASSERT_TRUE(r.settled) << "RMS speed " << r.settle_speed << " m/s after " << r.settle_time << " s";
+  std::printf("weight %.4f N: gripper %.4f N, support %.4f N\n", r.weight, -r.bias[2], r.support_load);
+  EXPECT_GT(r.support_load, 0.1 * r.weight);
+  EXPECT_NEAR(-r.bias[2] + r.support_load, r.weight, 0.01 * r.weight);
+  const SceneData& sc = coarse_scene().data();
+  const RoundCone support = support_collider(sc.opt, p);
+  EXPECT_NEAR(support.a.z, sc.opt.grasp_point[2] - 0.6, 1e-12);
+  EXPECT_NEAR(support.a.y, -0.1, 1e-12);
+  EXPECT_NEAR(support.ra, kSupportRadius, 0);
+  ASSERT_GE(r.frames.size(), 1u);
+  ASSERT_EQ(r.frames[0].t, 0.0);
+  const std::vector<float>& x = r.frames[0].xyz;
+  double nearest = 1e9;
+  int touching = 0;
+  for (size_t i = 0; i + 2 < x.size(); i += 3) {
+    V3 n;
+    const double phi = round_cone_distance(support, V3{x[i], x[i + 1], x[i + 2]}, &n);
+    nearest = std::min(nearest, phi);
+    touching += phi < sc.opt.contact_offset + 0.005;
+  }
+  EXPECT_GT(nearest, sc.opt.contact_offset - 0.001);
+  EXPECT_GT(touching, 10) << "the gown lies on the support";
+  const TrialResult none = simulate_trial(coarse_scene(), ClothParams{}, spec);
+  EXPECT_EQ(none.support_load, 0.0);
+}
+
 // Where the opening hangs (TrialResult::opening) is measured once the gown has settled, from this
 // trial's own fist: with the arm far below the gown (it settles alike at both heights) the
 // opening is the same, its rim keeps its length within 10 % (the default cloth), and its lowest
@@ -391,6 +437,18 @@ TEST(SimTrial, GownAtRestWhenThePullStarts) {
 
 namespace {
 
+// One trial per arm height (high, middle, low), pulled to `max_travel`.
+std::vector<TrialSpec> three_heights(double max_travel) {
+  std::vector<TrialSpec> specs;
+  for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
+    TrialSpec s;
+    s.height = h;
+    s.max_travel = max_travel;
+    specs.push_back(s);
+  }
+  return specs;
+}
+
 void expect_same_trial(const TrialResult& a, const TrialResult& b, const char* what) {
   ASSERT_EQ(a.seq.samples.size(), b.seq.samples.size()) << what;
   ASSERT_FALSE(a.seq.samples.empty()) << what;
@@ -415,13 +473,7 @@ void expect_same_trial(const TrialResult& a, const TrialResult& b, const char* w
 // settling is shared too (same push; the arm noise moves only the arm); a different seed's push
 // is not.
 TEST(SimTrial, SharedSettlingGivesEachTrialItsOwnBits) {
-  std::vector<TrialSpec> specs;
-  for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
-    TrialSpec s;
-    s.height = h;
-    s.max_travel = 0.12;
-    specs.push_back(s);
-  }
+  std::vector<TrialSpec> specs = three_heights(0.12);
   TrialSpec pushed = specs[0];
   pushed.gown_noise = true;
   pushed.arm_noise = true;
@@ -448,6 +500,27 @@ TEST(SimTrial, SharedSettlingGivesEachTrialItsOwnBits) {
     EXPECT_TRUE(together[4].settle_shared) << "the same seed pushes the same way";
   }
   EXPECT_FALSE(together[5].settle_shared) << "another seed pushes another way";
+}
+
+// The support is not the arm: it touches the gown in every settling, and the three heights'
+// trials still start from one settling when no arm touched the gown, each with its own bits, and
+// pull as one until an arm touches it (SharedSettlingGivesEachTrialItsOwnBits with a support).
+// 0.8 m down: on the coarse gown a support at 0.6 m lifts the hem's cloth within reach of the high
+// arm while it settles, and then (rightly) nothing is shared.
+TEST(SimTrial, SettlingOnTheSupportIsShared) {
+  ClothParams p;
+  p.support_depth = 0.8;
+  p.support_lateral = -0.1;
+  const std::vector<TrialSpec> specs = three_heights(0.12);
+  const std::vector<TrialResult> together = simulate_trials(coarse_scene(), p, specs);
+  ASSERT_EQ(together.size(), specs.size());
+  for (size_t i = 0; i < specs.size(); ++i) {
+    const TrialResult alone = simulate_trial(coarse_scene(), p, specs[i]);
+    expect_same_trial(together[i], alone, ("trial " + std::to_string(i)).c_str());
+    EXPECT_GT(alone.support_load, 0.0);
+  }
+  EXPECT_TRUE(together[1].settle_shared) << "middle should start from high's settling";
+  EXPECT_TRUE(together[2].settle_shared) << "low should start from high's settling";
 }
 
 // Where an arm touches the gown while it settles, no settling is shared between different arm

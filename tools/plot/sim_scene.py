@@ -52,6 +52,10 @@ def draw(ax, sc, frame, title):
     for c in sc["arm"]:
         xs, ys, zs = round_cone_mesh(c["a"], c["ra"], c["b"], c["rb"])
         ax.plot_surface(xs, ys, zs, color=(0.9, 0.65, 0.5), alpha=0.9, linewidth=0, shade=True)
+    if sc.get("support"):  # the support under the gown (sim/trial.h support_depth)
+        c = sc["support"]
+        xs, ys, zs = round_cone_mesh(c["a"], c["ra"], c["b"], c["rb"])
+        ax.plot_surface(xs, ys, zs, color=(0.6, 0.6, 0.6), alpha=0.6, linewidth=0, shade=True)
     op = np.array(sc["opening"], dtype=int)
     if len(op):
         ax.scatter(X[op, 0], X[op, 1], X[op, 2], color="red", s=4)
@@ -77,11 +81,11 @@ def side(ax, sc, frame):
     X = np.array(frame["x"]).reshape(-1, 3)
     tris = np.array(sc["tris"])
     ax.triplot(X[:, 0], X[:, 2], tris, color=(0.3, 0.45, 0.7), linewidth=0.15)
-    for c in sc["arm"]:
+    for c, colour in [(c, "peru") for c in sc["arm"]] + ([(sc["support"], "grey")] if sc.get("support") else []):
         for p, r in ((c["a"], c["ra"]), (c["b"], c["rb"])):
-            ax.add_patch(plt.Circle((p[0], p[2]), r, fill=False, color="peru", linewidth=1.5))
-        ax.plot([c["a"][0], c["b"][0]], [c["a"][2] + c["ra"], c["b"][2] + c["rb"]], color="peru")
-        ax.plot([c["a"][0], c["b"][0]], [c["a"][2] - c["ra"], c["b"][2] - c["rb"]], color="peru")
+            ax.add_patch(plt.Circle((p[0], p[2]), r, fill=False, color=colour, linewidth=1.5))
+        ax.plot([c["a"][0], c["b"][0]], [c["a"][2] + c["ra"], c["b"][2] + c["rb"]], color=colour)
+        ax.plot([c["a"][0], c["b"][0]], [c["a"][2] - c["ra"], c["b"][2] - c["rb"]], color=colour)
     op = np.array(sc["opening"], dtype=int)
     if len(op):
         ax.plot(X[op, 0], X[op, 2], ".", color="red", markersize=3)
