@@ -81,7 +81,7 @@ Bounds default_bounds() {
   b.person[kArealDensity] = {0.04, 0.25, kPaperArealDensity};
   b.person[kArmLateral] = {-0.05, 0.05, 0.0};
   b.person[kFistLateral] = {-0.05, 0.05, 0.0};
-  b.person[kSupportDepth] = {0.5, 0.8, 0.65};
+  b.person[kSupportDepth] = {0.6, 1.0, 0.85};
   b.person[kSupportLateral] = {-0.2, 0.05, -0.1};
   return b;
 }

@@ -165,10 +165,11 @@ struct Bounds {
 // paper's): from a spunbond disposable gown to a heavy woven cotton one; arm lateral and fist
 // lateral each in [-0.05, 0.05] m (start 0, the paper's arm under the jaws): the fist's 5 cm
 // radius, so that it stays in front of the opening (about 16 cm wide) at either end of the box;
-// support depth in [0.5, 0.8] m (start 0.65) and support lateral in [-0.2, 0.05] m (start -0.1):
-// around the support that brought participant 4's middle arm nearest the people (sim README,
-// "What holds the gown on the person's side"), its top 5 cm below the low arm's fist at the
-// least and the person's side favoured.
+// support depth in [0.6, 1.0] m (start 0.85) and support lateral in [-0.2, 0.05] m (start -0.1):
+// around the support that brought participant 4's middle arm nearest the people with his
+// calibrated cloth and kept his high arm good (sim README, "What holds the gown on the person's
+// side"), its top 0.45-0.85 m below the grasp (at 0.6-0.75 m that cloth's high arm
+// catches); the person's side favoured.
 Bounds default_bounds();
 // Bounds file: one "name lower upper [initial]" per line, '#' starts a comment, names as in
 // kClothParamNames plus "arm_offset" and kPersonParamInfo's; unnamed parameters keep their

@@ -81,7 +81,7 @@ int run_calibrate(int argc, char** argv) {
         "  --support-depth fit|fixed|M   a support under the gown that carries part of its body\n"
         "                      (a 15 cm capsule under the arm; offline/sim/README.md, \"What holds the\n"
         "                      gown on the person's side\"): fit how far below the grasp its axis is\n"
-        "                      (one more parameter, in [0.5, 0.8] m by default), none (the paper's,\n"
+        "                      (one more parameter, in [0.6, 1.0] m by default), none (the paper's,\n"
         "                      the default) or at M metres (0: none)\n"
         "  --support-lateral fit|fixed|M   the support sideways (negative: toward the person; in\n"
         "                      [-0.2, 0.05] m by default when fitted); only with a support\n"
