@@ -146,6 +146,8 @@ Settled settle(GownModel& m, GownState& s, const TrialSpec& spec, const TrialDra
   std::vector<std::pair<int, Frame>> snaps;  // (steps done, positions)
   std::vector<V3> x_window = s.x;
   const bool own_arm_probe = sc.planes.empty();  // with planes every free vertex is a contact
+  // The support comes up into its place over the first kSupportRiseSteps steps (trial.h).
+  auto lift_at = [](int step) { return kSupportDrop * std::max(0.0, 1.0 - static_cast<double>(step) / kSupportRiseSteps); };
   int k = 0;
   for (;;) {
     const bool on = spec.gown_noise && k >= perturb_from && k < perturb_to;
@@ -158,8 +160,6 @@ Settled settle(GownModel& m, GownState& s, const TrialSpec& spec, const TrialDra
       s.support_acc = zero;
       s.force_count = 0;
     }
-    // The support comes up into its place over its first kSupportRiseSteps steps (trial.h).
-    auto lift_at = [](int step) { return kSupportDrop * std::max(0.0, 1.0 - static_cast<double>(step) / kSupportRiseSteps); };
     s.support_lift_from = lift_at(k);
     s.support_lift_to = lift_at(k + 1);
     const int close = sc.opt.jaw_close_steps;
