@@ -7,13 +7,18 @@
 
 namespace dressguard::cli {
 
-std::set<std::string> split_list(const std::string& s) {
-  std::set<std::string> out;
+std::vector<std::string> split_in_order(const std::string& s) {
+  std::vector<std::string> out;
   std::stringstream in(s);
   std::string item;
   while (std::getline(in, item, ','))
-    if (!item.empty()) out.insert(item);
+    if (!item.empty()) out.push_back(item);
   return out;
+}
+
+std::set<std::string> split_list(const std::string& s) {
+  const auto items = split_in_order(s);
+  return {items.begin(), items.end()};
 }
 
 Args::Args(int argc, char** argv, std::set<std::string> flags) {

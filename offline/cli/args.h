@@ -20,6 +20,9 @@ class UsageError : public std::runtime_error {
 
 // "a,b,,c" -> {"a", "b", "c"}: the comma-separated lists of options like --participant 1,4.
 std::set<std::string> split_list(const std::string& s);
+// "a,b,,c" -> {"a", "b", "c"} in the order given: lists whose order matters, like the datasets of
+// a pooled training set (--data A,B), whose order is the order of the trials HMM training sums.
+std::vector<std::string> split_in_order(const std::string& s);
 
 class Args {
  public:

@@ -1,6 +1,8 @@
 // dressguard build-model: the simulation-trained classifier (STC) from a calibration (synthesize,
 // then train three HMMs) or from an existing dataset (paper V-B).
+#include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <optional>
 #include <vector>
 
@@ -26,18 +28,22 @@ int run_build_model(int argc, char** argv) {
   Args args(argc - 1, argv + 1, {"help", "json", "no-gown-noise", "no-arm-noise"});
   if (args.has("help")) {
     std::puts(
-        "usage: dressguard build-model (--calibration CAL.json | --data DATASET) --out MODEL.dgm [options]\n"
+        "usage: dressguard build-model (--calibration CAL.json[,CAL...] | --data DATASET[,DATASET...])\n"
+        "                              --out MODEL.dgm [options]\n"
         "  With --calibration: synthesizes the training data first (into --synth-dir, default\n"
         "  MODEL.dgm.synth/, resumable; the synthesize options apply), then trains one 10-state\n"
         "  left-right bivariate HMM per outcome (paper V-B) and writes the model file.\n"
-        "  With --data: trains on the labelled trials of an existing dataset.\n"
+        "  Several calibrations (several people's simulators, paper VII) each synthesize their\n"
+        "  own set, into SYNTH-DIR/<calibration file's name>/, and the HMMs learn from all of them.\n"
+        "  With --data: trains on the labelled trials of existing datasets (several are pooled).\n"
         "  --states N   hidden states per HMM (default 10, paper VI)\n"
         "  --forces F   auto | both | lateral | motion: the second force beside F_motion\n"
         "               (F_vertical, F_lateral or none). Default auto: with --calibration,\n"
         "               F_lateral when the calibration fitted it (--lateral-weight), else\n"
         "               F_vertical, each only where the calibrated simulator predicts it better\n"
         "               than a zero force on every one of the calibration's sequences\n"
-        "               (offline/calib/stc.h); with --data, both\n"
+        "               (offline/calib/stc.h; pooled: on every sequence of every\n"
+        "               calibration); with --data, both\n"
         "  --per-height N --no-gown-noise --no-arm-noise --middle M --seed S --threads N --gown G\n"
         "               (synthesis; see dressguard synthesize --help)\n"
         "  --created T  creation time to record (default now, UTC); fixes the model's bytes\n"
@@ -53,23 +59,51 @@ int run_build_model(int argc, char** argv) {
   const std::string forces = args.get("forces").value_or("auto");
   if (forces != "auto" && forces != "both" && forces != "motion" && forces != "lateral")
     throw UsageError("--forces must be auto, both, lateral or motion");
-  std::string data;
+  // The training sets: one per calibration (synthesized here) or the datasets given.
+  std::vector<std::filesystem::path> sets;
   std::optional<std::vector<SequenceFit>> calibration_fits;
   bool lateral_fitted = false;
   if (args.has("calibration")) {
-    const Calibration cal = read_calibration(*args.get("calibration"));
-    calibration_fits = cal.fits;
-    lateral_fitted = cal.lateral_weight > 0;
-    data = args.get("synth-dir").value_or(out + ".synth");
-    run_synthesis(cal, args.get("gown").value_or(cal.gown), synthesis_options_from(args), data);
+    const auto files = split_in_order(*args.get("calibration"));
+    if (files.empty()) throw UsageError("--calibration names no file");
+    std::vector<Calibration> cals;
+    for (const auto& f : files) cals.push_back(read_calibration(f));  // every file checked before any synthesis
+    const std::filesystem::path synth = args.get("synth-dir").value_or(out + ".synth");
+    for (std::size_t i = 0; i < files.size(); ++i) {
+      if (files.size() == 1) {
+        sets.push_back(synth);
+        continue;
+      }
+      // One folder per calibration, named after its file: resumable per simulator, and a second
+      // file of the same name would write into the first one's trials.
+      const std::filesystem::path dir = synth / std::filesystem::path(files[i]).stem();
+      if (std::find(sets.begin(), sets.end(), dir) != sets.end())
+        throw UsageError("--calibration: two files are named " + std::filesystem::path(files[i]).stem().string() +
+                         ": their synthesized sets would share " + dir.string());
+      sets.push_back(dir);
+    }
+    calibration_fits.emplace();
+    lateral_fitted = true;
+    const SynthesisOptions so = synthesis_options_from(args);
+    for (std::size_t i = 0; i < cals.size(); ++i) {
+      calibration_fits->insert(calibration_fits->end(), cals[i].fits.begin(), cals[i].fits.end());
+      lateral_fitted = lateral_fitted && cals[i].lateral_weight > 0;
+      if (cals.size() > 1 && Comm::world().is_root())
+        std::fprintf(stderr, "build-model: simulator %zu of %zu, %s -> %s\n", i + 1, cals.size(), files[i].c_str(),
+                     sets[i].string().c_str());
+      run_synthesis(cals[i], args.get("gown").value_or(cals[i].gown), so, sets[i]);
+    }
   } else {
-    data = *args.get("data");
+    for (const auto& d : split_in_order(*args.get("data"))) sets.emplace_back(d);
+    if (sets.empty()) throw UsageError("--data names no dataset");
   }
   if (!Comm::world().is_root()) return 0;  // training is one process's job (seconds)
 #ifndef DRESSGUARD_HAVE_HMM
   throw UsageError("this dressguard was built without the HMM module (offline/hmm); build-model needs it");
 #else
-  const Dataset ds = load_dataset(data);
+  std::string data;  // the training sets' names, for the model's metadata and the summary
+  for (const auto& d : sets) data += (data.empty() ? "" : ",") + d.string();
+  const Dataset ds = load_datasets(sets);
   std::vector<const HapticSequence*> trials;
   for (const auto& t : ds.trials) trials.push_back(&t);
   StcAxes axes{model::kAxisVertical, "F_motion and F_vertical (training data given directly)"};
@@ -87,9 +121,9 @@ int run_build_model(int argc, char** argv) {
   model::write_model(out, m);
   const double acc = accuracy(m, trials, std::numeric_limits<double>::infinity());
   if (args.has("json")) {
-    std::printf("{\"model\": \"%s\", \"classes\": %zu, \"training_trials\": %zu, \"training_accuracy\": %.4f, "
-                "\"forces\": \"%s\"}\n",
-                out.c_str(), m.classes.size(), trials.size(), acc, stc_forces_name(axes.second_axis));
+    std::printf("{\"model\": \"%s\", \"classes\": %zu, \"training_trials\": %zu, \"training_sets\": %zu, "
+                "\"training_accuracy\": %.4f, \"forces\": \"%s\"}\n",
+                out.c_str(), m.classes.size(), trials.size(), sets.size(), acc, stc_forces_name(axes.second_axis));
   } else {
     std::printf("wrote %s: %zu classes (", out.c_str(), m.classes.size());
     for (std::size_t i = 0; i < m.classes.size(); ++i) std::printf("%s%s", i ? ", " : "", m.classes[i].name.c_str());

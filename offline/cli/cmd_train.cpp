@@ -18,9 +18,10 @@ int run_train(int argc, char** argv) {
   Args args(argc - 1, argv + 1, {"help", "json", "uniform-priors"});
   if (args.has("help")) {
     std::puts(
-        "usage: dressguard train --data DATASET --out MODEL.dgm [options] [--json]\n"
+        "usage: dressguard train --data DATASET[,DATASET...] --out MODEL.dgm [options] [--json]\n"
         "  Trains one left-right HMM per labelled outcome (good, missed, caught) on F_motion and\n"
         "  F_vertical (paper V-B): equal-segment initialisation, Baum-Welch to convergence.\n"
+        "  Several datasets (comma-separated) are pooled, their trials in the order given.\n"
         "  --states N              states per HMM (default 10, the paper; the study's code used 5)\n"
         "  --band W                left-right width: state i may go to i..i+W (default 1)\n"
         "  --cov-floor V           minimum covariance eigenvalue in scaled feature units (default 0.05)\n"
@@ -56,8 +57,10 @@ int run_train(int argc, char** argv) {
   if (!(stop_threshold > 0 && stop_threshold < 1)) throw UsageError("--stop-threshold must be in (0, 1)");
   if (stop_consecutive < 1 || stop_consecutive > 100000) throw UsageError("--stop-consecutive must be 1..100000");
   const auto excluded = split_list(args.get("exclude-participant").value_or(""));
+  const auto dirs = split_in_order(data);
+  if (dirs.empty()) throw UsageError("--data names no dataset");
 
-  const Dataset ds = load_dataset(data);
+  const Dataset ds = load_datasets({dirs.begin(), dirs.end()});
   std::vector<const HapticSequence*> trials;
   for (const auto& t : ds.trials)
     if (!excluded.count(t.participant)) trials.push_back(&t);

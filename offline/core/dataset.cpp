@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 #include <map>
 #include <sstream>
 
@@ -149,6 +150,16 @@ Dataset load_dataset(const fs::path& dir) {
     ds.trials.push_back(std::move(seq));
   });
   return ds;
+}
+
+Dataset load_datasets(const std::vector<fs::path>& dirs) {
+  Dataset all;
+  for (const auto& dir : dirs) {
+    Dataset one = load_dataset(dir);
+    all.trials.insert(all.trials.end(), std::make_move_iterator(one.trials.begin()),
+                      std::make_move_iterator(one.trials.end()));
+  }
+  return all;
 }
 
 void save_dataset(const Dataset& ds, const fs::path& dir) {

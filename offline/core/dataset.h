@@ -27,6 +27,11 @@ std::string format_trial_csv(const std::vector<HapticSample>& samples);
 // Reads manifest.csv and every trial it names.
 Dataset load_dataset(const std::filesystem::path& dir);
 
+// Several datasets read as one, their trials in the order given (a pooled training set: the
+// synthesized trials of several people's simulators). Trial ids may repeat from one dataset to
+// the next (every synthesized set names its trials sim-high-000, ...); within one they may not.
+Dataset load_datasets(const std::vector<std::filesystem::path>& dirs);
+
 // Writes every trial file and then the manifest, each atomically: an interrupted save leaves
 // the previous manifest in place. Trial files are named <id>.csv.
 void save_dataset(const Dataset& ds, const std::filesystem::path& dir);

@@ -49,6 +49,70 @@ file(WRITE ${WORK}/cal4.json "{\"format\": \"dressguard-calibration 1\", \"parti
 expect_fail("predict with a bad --gown" "--gown" predict --calibration ${WORK}/cal4.json --data ${WORK} --gown fine)
 expect_fail("predict with a bad --window" "--window" predict --calibration ${WORK}/cal4.json --data ${WORK} --window 0)
 
+# The pooled STC (paper VII: simulators of several people): build-model with two calibrations
+# synthesizes one set per calibration, each the very set `synthesize` makes alone, into a folder
+# named after its file, and trains on both in the order given; --data A,B pools datasets alike.
+# Coarse gown, 2 trials per height each (~20 s on two cores).
+if(HMM)
+  file(READ ${WORK}/cal4.json cal4)
+  string(REPLACE "\"friction\": 0.35" "\"friction\": 0.6" calB "${cal4}")
+  string(REPLACE "\"high\": {\"offset_m\": 0.0" "\"high\": {\"offset_m\": -0.02" calB "${calB}")
+  file(WRITE ${WORK}/calB.json "${calB}")
+  file(MAKE_DIRECTORY ${WORK}/twin)
+  file(WRITE ${WORK}/twin/cal4.json "${cal4}")
+  expect_fail("build-model with two calibrations of one name" "two files are named cal4"
+              build-model --calibration ${WORK}/cal4.json,${WORK}/twin/cal4.json --out ${WORK}/p.dgm)
+  expect_fail("build-model with no calibration in the list" "--calibration names no file"
+              build-model --calibration , --out ${WORK}/p.dgm)
+  set(synth_opts --per-height 2 --seed 3 --threads 2)
+  execute_process(COMMAND ${DG} build-model --calibration ${WORK}/cal4.json,${WORK}/calB.json --out ${WORK}/pooled.dgm
+                          ${synth_opts} --states 3 --forces motion --created 2026-01-02T03:04:05Z --json
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR NOT out MATCHES "\"training_trials\": 12, \"training_sets\": 2,"
+     OR NOT EXISTS ${WORK}/pooled.dgm.synth/cal4/manifest.csv OR NOT EXISTS ${WORK}/pooled.dgm.synth/calB/manifest.csv
+     OR NOT err MATCHES "simulator 2 of 2, [^\n]*calB.json -> [^\n]*pooled.dgm.synth/calB\n")
+    message(FATAL_ERROR "build-model with two calibrations (${rc}):\n${out}\n${err}")
+  endif()
+  execute_process(COMMAND ${DG} synthesize --calibration ${WORK}/calB.json --out ${WORK}/sB ${synth_opts}
+                  RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)
+  file(READ ${WORK}/sB/manifest.csv alone)
+  file(READ ${WORK}/pooled.dgm.synth/calB/manifest.csv pooled)
+  file(GLOB trials RELATIVE ${WORK}/sB ${WORK}/sB/sim-*.csv)
+  list(LENGTH trials n)
+  set(same TRUE)
+  foreach(t IN LISTS trials)
+    file(SHA256 ${WORK}/sB/${t} a)
+    file(SHA256 ${WORK}/pooled.dgm.synth/calB/${t} b)
+    if(NOT a STREQUAL b)
+      set(same FALSE)
+    endif()
+  endforeach()
+  if(NOT rc EQUAL 0 OR NOT n EQUAL 6 OR NOT same OR NOT alone STREQUAL pooled)
+    message(FATAL_ERROR "the pooled build's set of calB is not what synthesize makes alone (${rc}, ${n} trials):\n${err}")
+  endif()
+  # The model from the two sets given as data: the same bytes.
+  execute_process(COMMAND ${DG} build-model --data ${WORK}/pooled.dgm.synth/cal4,${WORK}/sB --out ${WORK}/pooled2.dgm
+                          --states 3 --forces motion --created 2026-01-02T03:04:05Z
+                  RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)
+  file(SHA256 ${WORK}/pooled.dgm h1)
+  file(SHA256 ${WORK}/pooled2.dgm h2)
+  execute_process(COMMAND ${DG} model show ${WORK}/pooled2.dgm OUTPUT_VARIABLE shown2)
+  execute_process(COMMAND ${DG} model show ${WORK}/pooled.dgm OUTPUT_VARIABLE shown1)
+  string(REPLACE "pooled.dgm.synth/calB" "sB" shown1 "${shown1}")
+  string(REPLACE "pooled2.dgm" "pooled.dgm" shown2 "${shown2}")
+  if(NOT rc EQUAL 0 OR NOT shown1 STREQUAL shown2)
+    message(FATAL_ERROR "build-model --data A,B against the pooled build (${rc}):\n${shown1}\n---\n${shown2}\n${err}")
+  endif()
+  # train pools alike, and names a missing set's manifest.
+  execute_process(COMMAND ${DG} train --data ${WORK}/pooled.dgm.synth/cal4,${WORK}/sB --out ${WORK}/t.dgm --states 3 --json
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR NOT out MATCHES "\"trials\": 12,")
+    message(FATAL_ERROR "train on two datasets (${rc}):\n${out}\n${err}")
+  endif()
+  expect_fail("train with a missing second dataset" "nothing/manifest.csv"
+              train --data ${WORK}/sB,${WORK}/nothing --out ${WORK}/t2.dgm)
+endif()
+
 if(STUDY)
   execute_process(COMMAND ${DG} import --study ${STUDY} --out ${WORK}/study RESULT_VARIABLE rc)
   # The people's outcomes over travel in all three forces, as a picture.
