@@ -25,6 +25,19 @@
 //     The 1-NN baseline alone, on each force and on sets of them (F_motion, F_vertical,
 //     F_lateral; both of the paper's; all three): which force tells the people's good trials from
 //     their missed ones at each cut (offline/sim/README.md, "The lateral force"). Seconds.
+//   bench_calib_pipeline pooled --calibrations A.json,B.json,... [--synth DIR] [--per-height N]
+//                               [--seed S] [--threads T] [--states K]
+//     The pooled STC (paper VII: HMMs trained on the simulators of several people and tested on a
+//     person none of them was calibrated on) against each calibration's own STC and the 1-NN on
+//     the people's real trials. Each calibration synthesizes its set into DIR/<file's name>/, as
+//     `dressguard build-model --calibration A,B,...` does (resumable; default DIR pooled-stc,
+//     40 per height, seed 1). For each force set (F_motion; F_motion + F_lateral; the paper's
+//     F_motion + F_vertical), every measured trial of participant P is classified, whole and cut
+//     at 0.15/0.20/0.25/0.30 m, by: the pooled STC of the calibrations of people other than P;
+//     the same pool cut to one set's size (calibration j of k keeps the trials whose index is j
+//     mod k: more simulators, not more trials); and each single calibration's STC (over the
+//     trials of the people other than its own). Prints the table, writes DIR/pooled.json (plot:
+//     tools/plot/pooled_stc.py).
 //   bench_calib_pipeline timing [--gown ...] [--generations G --population N] [--threads T]
 //                               [--arm-compliance ... --fist-shift ... --rim-shift ... --density ...]
 //     Wall time per simulation and of a G x N calibration of participant 4, with the final
@@ -460,17 +473,208 @@ int run_timing(const std::map<std::string, std::string>& a) {
   return 0;
 }
 
+
+// Correct classifications of a model over `test`, whole and at the four cuts (out[0] whole).
+void count_right(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& test, int out[5]) {
+  double acc[5];
+  accuracies(m, test, acc);
+  for (int c = 0; c < 5; ++c) out[c] += static_cast<int>(std::lround(acc[c] * test.size()));
+}
+
+// The index of a synthesized trial, from its id (synthesis_trial_id: "sim-high-007" -> 7).
+int synthesized_index(const std::string& id) {
+  const auto dash = id.rfind('-');
+  return std::stoi(id.substr(dash + 1));
+}
+
+int run_pooled(const std::map<std::string, std::string>& a) {
+  const fs::path study = study_dir();
+  if (study.empty()) {
+    std::fprintf(stderr, "shared/data not found (set DRESSGUARD_SHARED_DIR)\n");
+    return 2;
+  }
+  if (!a.count("calibrations")) {
+    std::fprintf(stderr, "pooled needs --calibrations A.json,B.json,...\n");
+    return 2;
+  }
+  const Dataset ds = import_study(study);
+  std::vector<const HapticSequence*> all;
+  for (const auto& t : ds.trials) all.push_back(&t);
+  std::set<std::string> people;
+  for (const auto& t : ds.trials) people.insert(t.participant);
+
+  SynthesisOptions so;
+  so.per_height = std::stoi(get(a, "per-height", "40"));
+  so.seed = std::stoull(get(a, "seed", "1"));
+  so.threads = std::stoi(get(a, "threads", "0"));
+  const int states = std::stoi(get(a, "states", "10"));
+  const fs::path work = get(a, "synth", "pooled-stc");
+
+  // Each calibration's synthesized set, its trials kept for the whole run.
+  struct Source {
+    std::string file, participant;
+    Dataset set;
+  };
+  std::vector<Source> sources;
+  std::stringstream list(a.at("calibrations"));
+  for (std::string f; std::getline(list, f, ',');) {
+    if (f.empty()) continue;
+    const Calibration cal = read_calibration(f);
+    const fs::path dir = work / fs::path(f).stem();
+    const auto t0 = std::chrono::steady_clock::now();
+    synthesize(cal, make_cloth_simulator(cal.gown).trial, so, dir, Comm::world());
+    std::printf("%s (participant %s): %d per height in %s, %.0f s\n", f.c_str(), cal.participant.c_str(), so.per_height,
+                dir.string().c_str(), seconds_since(t0));
+    sources.push_back({f, cal.participant, load_dataset(dir)});
+  }
+  const int k_all = static_cast<int>(sources.size());
+
+  struct ForceSet {
+    const char* name;
+    int second_axis;
+    NnForces nn;
+  };
+  const ForceSet force_sets[] = {
+      {"F_motion", model::kAxisNone, {"F_motion", true, false, false}},
+      {"F_motion + F_lateral", model::kAxisLateral, {"F_motion + F_lateral", true, false, true}},
+      {"F_motion + F_vertical", model::kAxisVertical, kPaperForces},
+  };
+  auto train = [&](const std::vector<const HapticSequence*>& trials, int second_axis, const std::string& what) {
+    StcOptions o;
+    o.states = states;
+    o.second_axis = second_axis;
+    o.source = what;
+    return build_outcome_model(trials, o);
+  };
+  auto pct = [](const int right[5], int n) {
+    Json j = Json::array();
+    for (int c = 0; c < 5; ++c) j.push(n ? static_cast<double>(right[c]) / n : 0.0);
+    return j;
+  };
+  auto print_row = [](const char* name, const int right[5], int n) {
+    std::printf("  %-44s", name);
+    for (int c = 0; c < 5; ++c) std::printf(" %4.0f%%", n ? 100.0 * right[c] / n : 0.0);
+    std::printf("   (%d trials)\n", n);
+  };
+
+  Json out = Json::object();
+  out.set("per_height", so.per_height);
+  out.set("seed", static_cast<double>(so.seed));
+  out.set("states", states);
+  Json jsources = Json::array();
+  for (const auto& src : sources) {
+    Json j = Json::object();
+    j.set("calibration", src.file);
+    j.set("participant", src.participant);
+    int labels[kOutcomeCount] = {};
+    for (const auto& t : src.set.trials)
+      if (t.label) ++labels[static_cast<int>(*t.label)];
+    for (int l = 0; l < kOutcomeCount; ++l) j.set(std::string(outcome_name(static_cast<Outcome>(l))), labels[l]);
+    jsources.push(j);
+  }
+  out.set("sources", jsources);
+  Json jsets = Json::array();
+  std::printf("right, whole / 0.15 / 0.20 / 0.25 / 0.30 m, every measured trial of a person by classifiers that never "
+              "saw that person:\n");
+  for (const ForceSet& fs_ : force_sets) {
+    std::printf("%s\n", fs_.name);
+    Json jset = Json::object();
+    jset.set("forces", std::string(fs_.name));
+    // Each calibration's own STC, on the trials of everyone else.
+    int single_sum[5] = {}, single_n = 0;
+    Json jsingles = Json::array();
+    for (const auto& src : sources) {
+      std::vector<const HapticSequence*> tr, test;
+      for (const auto& t : src.set.trials) tr.push_back(&t);
+      for (const auto* t : all)
+        if (t->participant != src.participant) test.push_back(t);
+      int right[5] = {};
+      count_right(train(tr, fs_.second_axis, src.file), test, right);
+      for (int c = 0; c < 5; ++c) single_sum[c] += right[c];
+      single_n += static_cast<int>(test.size());
+      const std::string name = "alone: " + fs::path(src.file).stem().string();
+      print_row(name.c_str(), right, static_cast<int>(test.size()));
+      Json j = Json::object();
+      j.set("calibration", src.file);
+      j.set("accuracy_whole_and_cuts", pct(right, static_cast<int>(test.size())));
+      jsingles.push(j);
+    }
+    print_row("alone, all of them", single_sum, single_n);
+    jset.set("single", jsingles);
+    jset.set("single_accuracy_whole_and_cuts", pct(single_sum, single_n));
+    // The pools: per test person, every calibration of someone else; the same pool cut to one
+    // set's size beside it. Models are cached by their pool.
+    int pooled_right[5] = {}, equal_right[5] = {}, n = 0;
+    std::map<std::string, std::pair<model::OutcomeModel, model::OutcomeModel>> cache;
+    Json jper = Json::array();
+    for (const auto& p : people) {
+      std::vector<const HapticSequence*> test;
+      for (const auto* t : all)
+        if (t->participant == p) test.push_back(t);
+      std::vector<const Source*> pool;
+      std::string key;
+      for (const auto& src : sources)
+        if (src.participant != p) pool.push_back(&src), key += src.file + ";";
+      if (pool.empty()) continue;
+      auto it = cache.find(key);
+      if (it == cache.end()) {
+        std::vector<const HapticSequence*> full, equal;
+        const int k = static_cast<int>(pool.size());
+        for (int j = 0; j < k; ++j)
+          for (const auto& t : pool[j]->set.trials) {
+            full.push_back(&t);
+            if (synthesized_index(t.id) % k == j) equal.push_back(&t);
+          }
+        it = cache.emplace(key, std::make_pair(train(full, fs_.second_axis, key), train(equal, fs_.second_axis, key)))
+                 .first;
+      }
+      int right[5] = {}, right_eq[5] = {};
+      count_right(it->second.first, test, right);
+      count_right(it->second.second, test, right_eq);
+      for (int c = 0; c < 5; ++c) pooled_right[c] += right[c], equal_right[c] += right_eq[c];
+      n += static_cast<int>(test.size());
+      Json j = Json::object();
+      j.set("participant", p);
+      j.set("pool", static_cast<int>(pool.size()));
+      j.set("accuracy_whole_and_cuts", pct(right, static_cast<int>(test.size())));
+      j.set("equal_size_accuracy_whole_and_cuts", pct(right_eq, static_cast<int>(test.size())));
+      jper.push(j);
+    }
+    char name[80];
+    std::snprintf(name, sizeof name, "pooled (%d or %d simulators)", k_all - 1, k_all);
+    print_row(name, pooled_right, n);
+    print_row("pooled, cut to one set's size", equal_right, n);
+    double nn[4];  // the 1-NN compares curves cut at the same travel: scored at the cuts only
+    for (int c = 0; c < 4; ++c) nn[c] = one_nn_accuracy(all, kCuts[c], fs_.nn);
+    std::printf("  %-44s     -", "1-NN on the other people's measured curves");
+    for (double v : nn) std::printf(" %4.0f%%", 100.0 * v);
+    std::printf("   (%zu trials)\n", all.size());
+    jset.set("per_participant", jper);
+    jset.set("pooled_accuracy_whole_and_cuts", pct(pooled_right, n));
+    jset.set("pooled_equal_size_accuracy_whole_and_cuts", pct(equal_right, n));
+    Json jnn = Json::array();
+    for (double v : nn) jnn.push(v);
+    jset.set("one_nn_accuracy_at_cuts", jnn);
+    jsets.push(jset);
+  }
+  out.set("force_sets", jsets);
+  write_file_atomic(work / "pooled.json", out.dump() + "\n");
+  std::printf("wrote %s\n", (work / "pooled.json").string().c_str());
+  return 0;
+}
 }  // namespace
 
 int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   if (argc >= 2 && std::strcmp(argv[1], "baseline") == 0) return run_baseline();
-  if (argc < 2 || (std::strcmp(argv[1], "eval") && std::strcmp(argv[1], "timing"))) {
-    std::fprintf(stderr, "usage: bench_calib_pipeline eval|timing|baseline [--option value ...] (see the source's header)\n");
+  if (argc < 2 || (std::strcmp(argv[1], "eval") && std::strcmp(argv[1], "timing") && std::strcmp(argv[1], "pooled"))) {
+    std::fprintf(stderr,
+                 "usage: bench_calib_pipeline eval|timing|baseline|pooled [--option value ...] (see the source's header)\n");
     return 2;
   }
   const auto a = parse_args(argc, argv, 2);
   try {
+    if (std::strcmp(argv[1], "pooled") == 0) return run_pooled(a);
     return std::strcmp(argv[1], "eval") == 0 ? run_eval(a) : run_timing(a);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_calib_pipeline: %s\n", e.what());

@@ -1,0 +1,68 @@
+#!/usr/bin/python3
+"""Accuracy against travel of the pooled STC (paper VII: HMMs trained on the simulators of
+several people, tested on a person none of them was calibrated on), beside each calibration's
+own STC and the 1-nearest-neighbour classifier on the other people's measured curves.
+
+usage: pooled_stc.py POOLED.json OUT.png
+POOLED.json is what `bench_calib_pipeline pooled` writes (DIR/pooled.json). One panel per force
+set; "whole" is drawn at the right end, after the cuts.
+"""
+import json
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+
+CUTS = [0.15, 0.20, 0.25, 0.30]
+WHOLE_X = 0.35  # where "whole sequence" is drawn
+
+
+def cuts_then_whole(v):  # the file holds whole first, then the cuts
+    return [100 * a for a in v[1:] + v[:1]]
+
+
+def main(argv):
+    if len(argv) != 3:
+        sys.stderr.write(__doc__)
+        return 2
+    with open(argv[1]) as f:
+        d = json.load(f)
+    sets = d["force_sets"]
+    if not sets:
+        sys.stderr.write(f"{argv[1]}: no force sets\n")
+        return 1
+    xs = CUTS + [WHOLE_X]
+    fig, axes = plt.subplots(1, len(sets), figsize=(5.2 * len(sets), 4.2), sharey=True, squeeze=False)
+    for ax, s in zip(axes[0], sets):
+        for i, single in enumerate(s["single"]):
+            ax.plot(xs, cuts_then_whole(single["accuracy_whole_and_cuts"]), color="0.75", lw=1,
+                    label="one person's simulator" if i == 0 else None)
+        ax.plot(xs, cuts_then_whole(s["single_accuracy_whole_and_cuts"]), color="0.45", lw=1.5, ls="--",
+                label="one person's simulator, all trials")
+        ax.plot(xs, cuts_then_whole(s["pooled_equal_size_accuracy_whole_and_cuts"]), color="tab:orange", lw=1.5,
+                marker="s", ms=4, label="pooled, one set's size")
+        ax.plot(xs, cuts_then_whole(s["pooled_accuracy_whole_and_cuts"]), color="tab:blue", lw=2.2, marker="o",
+                ms=5, label="pooled simulators")
+        ax.plot(CUTS, [100 * a for a in s["one_nn_accuracy_at_cuts"]], color="tab:green", lw=1.5, ls=":", marker="^",
+                ms=5, label="1-NN on other people's curves")
+        ax.set_title(s["forces"], fontsize=10)
+        ax.set_xticks(xs)
+        ax.set_xticklabels([f"{c:.2f}" for c in CUTS] + ["whole"])
+        ax.set_xlabel("travel at which the trial is cut [m]")
+        ax.set_ylim(0, 102)
+        ax.axvline((CUTS[-1] + WHOLE_X) / 2, color="0.85", lw=0.8)
+        ax.grid(alpha=0.3)
+    axes[0][0].set_ylabel("measured trials classified right [%]")
+    axes[0][0].legend(fontsize=7, loc="lower left")
+    n = len(d["sources"])
+    fig.suptitle(f"STCs on people no simulator was calibrated on: {n} calibrations, {d['per_height']} trials per "
+                 f"height each", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(argv[2], dpi=110)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
