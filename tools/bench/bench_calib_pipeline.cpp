@@ -487,6 +487,26 @@ int synthesized_index(const std::string& id) {
   return std::stoi(id.substr(dash + 1));
 }
 
+
+// The early cue a classifier of cut sequences can learn: the mean force over a window of travel,
+// good trials minus missed ones (each trial's mean over its samples in [lo, hi), then the mean
+// over the trials of each label). NaN when either label has no sample there.
+double good_minus_missed(const std::vector<const HapticSequence*>& trials, double lo, double hi,
+                         double HapticSample::*force) {
+  double sum[2] = {}, n[2] = {};
+  for (const auto* t : trials) {
+    if (!t->label || (*t->label != Outcome::Good && *t->label != Outcome::Missed)) continue;
+    double s = 0;
+    int k = 0;
+    for (const auto& x : t->samples)
+      if (x.travel >= lo && x.travel < hi) s += x.*force, ++k;
+    if (k == 0) continue;
+    const int c = *t->label == Outcome::Good ? 0 : 1;
+    sum[c] += s / k, n[c] += 1;
+  }
+  return n[0] > 0 && n[1] > 0 ? sum[0] / n[0] - sum[1] / n[1] : std::numeric_limits<double>::quiet_NaN();
+}
+
 int run_pooled(const std::map<std::string, std::string>& a) {
   const fs::path study = study_dir();
   if (study.empty()) {
@@ -573,6 +593,57 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     jsources.push(j);
   }
   out.set("sources", jsources);
+  // Why a simulator's STC is right or wrong on cut sequences: the people's early cue (good minus
+  // missed, per window and force) beside each simulator's. A simulator whose sign is the
+  // people's teaches the cue; one whose sign is reversed teaches its opposite, and a pool of
+  // both teaches neither.
+  {
+    const double windows[4][2] = {{0.10, 0.15}, {0.15, 0.20}, {0.20, 0.25}, {0.25, 0.30}};
+    const std::pair<const char*, double HapticSample::*> forces[3] = {
+        {"F_motion", &HapticSample::f_motion}, {"F_lateral", &HapticSample::f_lateral},
+        {"F_vertical", &HapticSample::f_vertical}};
+    // Differences below kFaint are taken as none: a third of the people's smallest beyond 0.15 m.
+    constexpr double kFaint = 0.02;
+    std::printf("good minus missed, mean force [N] over 0.10-0.15 / 0.15-0.20 / 0.20-0.25 / 0.25-0.30 m of travel "
+                "(* the sign reversed against the people's, ~ under %.2f N where the people's is not):\n", kFaint);
+    Json jcue = Json::array();
+    auto row = [&](const std::string& who, const std::vector<const HapticSequence*>& trials, const double* people) {
+      Json j = Json::object();
+      j.set("who", who);
+      std::printf("  %-24s", who.c_str());
+      int reversed = 0, faint = 0;
+      for (int f = 0; f < 3; ++f) {
+        Json jf = Json::array();
+        std::printf(" %s", forces[f].first);
+        for (int w = 0; w < 4; ++w) {
+          const double d = good_minus_missed(trials, windows[w][0], windows[w][1], forces[f].second);
+          const double ref = people ? people[4 * f + w] : 0.0;
+          const bool cue = people && std::isfinite(d) && std::abs(ref) >= kFaint;
+          const bool wrong = cue && std::abs(d) >= kFaint && (d > 0) != (ref > 0);
+          const bool weak = cue && std::abs(d) < kFaint;
+          reversed += wrong, faint += weak;
+          std::printf(" %+5.2f%s", d, wrong ? "*" : weak ? "~" : " ");
+          jf.push(std::isfinite(d) ? d : 0.0);
+        }
+        j.set(forces[f].first, jf);
+      }
+      if (people) std::printf("  (%d reversed, %d faint)", reversed, faint);
+      std::printf("\n");
+      j.set("reversed", reversed);
+      j.set("faint", faint);
+      jcue.push(j);
+    };
+    double people[12];
+    for (int f = 0; f < 3; ++f)
+      for (int w = 0; w < 4; ++w) people[4 * f + w] = good_minus_missed(all, windows[w][0], windows[w][1], forces[f].second);
+    row("the people (measured)", all, nullptr);
+    for (const auto& src : sources) {
+      std::vector<const HapticSequence*> tr;
+      for (const auto& t : src.set.trials) tr.push_back(&t);
+      row(fs::path(src.file).stem().string(), tr, people);
+    }
+    out.set("early_cue_good_minus_missed", jcue);
+  }
   Json jsets = Json::array();
   std::printf("right, whole / 0.15 / 0.20 / 0.25 / 0.30 m, every measured trial of a person by classifiers that never "
               "saw that person:\n");

@@ -34,7 +34,7 @@ def main(argv):
         sys.stderr.write(f"{argv[1]}: no force sets\n")
         return 1
     xs = CUTS + [WHOLE_X]
-    fig, axes = plt.subplots(1, len(sets), figsize=(5.2 * len(sets), 4.2), sharey=True, squeeze=False)
+    fig, axes = plt.subplots(1, len(sets), figsize=(5.2 * len(sets), 4.6), sharey=True, squeeze=False)
     for ax, s in zip(axes[0], sets):
         for i, single in enumerate(s["single"]):
             ax.plot(xs, cuts_then_whole(single["accuracy_whole_and_cuts"]), color="0.75", lw=1,
@@ -55,11 +55,12 @@ def main(argv):
         ax.axvline((CUTS[-1] + WHOLE_X) / 2, color="0.85", lw=0.8)
         ax.grid(alpha=0.3)
     axes[0][0].set_ylabel("measured trials classified right [%]")
-    axes[0][0].legend(fontsize=7, loc="lower left")
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=len(labels), fontsize=8, frameon=False)
     n = len(d["sources"])
     fig.suptitle(f"STCs on people no simulator was calibrated on: {n} calibrations, {d['per_height']} trials per "
                  f"height each", fontsize=10)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.07, 1, 1))
     fig.savefig(argv[2], dpi=110)
     return 0
 
