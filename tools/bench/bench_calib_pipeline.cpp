@@ -36,7 +36,9 @@
 //     at 0.15/0.20/0.25/0.30 m, by: the pooled STC of the calibrations of people other than P;
 //     the same pool cut to one set's size (calibration j of k keeps the trials whose index is j
 //     mod k: more simulators, not more trials); and each single calibration's STC (over the
-//     trials of the people other than its own). Prints the table, writes DIR/pooled.json (plot:
+//     trials of the people other than its own), beside the baseline classifier BC trained on the
+//     2-3 measured sequences each calibration was fitted to (paper VI-B.1). Prints the table and
+//     each simulator's early cue against the people's, writes DIR/pooled.json (plot:
 //     tools/plot/pooled_stc.py).
 //   bench_calib_pipeline timing [--gown ...] [--generations G --population N] [--threads T]
 //                               [--arm-compliance ... --fist-shift ... --rim-shift ... --density ...]
@@ -673,6 +675,31 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     print_row("alone, all of them", single_sum, single_n);
     jset.set("single", jsingles);
     jset.set("single_accuracy_whole_and_cuts", pct(single_sum, single_n));
+    // The baseline classifier (paper VI-B.1): the same HMMs trained on the 2-3 measured sequences
+    // that each calibration was fitted to, on the same trials (the study holds no caught trial,
+    // so BC knows good and missed only).
+    int bc_sum[5] = {}, bc_n = 0;
+    Json jbcs = Json::array();
+    for (const auto& src : sources) {
+      const auto inputs = select_inputs(ds, src.participant, 1);
+      std::vector<const HapticSequence*> tr, test;
+      for (const auto& t : inputs) tr.push_back(&t);
+      for (const auto* t : all)
+        if (t->participant != src.participant) test.push_back(t);
+      int right[5] = {};
+      count_right(train(tr, fs_.second_axis, "measured inputs of participant " + src.participant), test, right);
+      for (int c = 0; c < 5; ++c) bc_sum[c] += right[c];
+      bc_n += static_cast<int>(test.size());
+      const std::string name = "BC: participant " + src.participant + "'s measured inputs";
+      print_row(name.c_str(), right, static_cast<int>(test.size()));
+      Json j = Json::object();
+      j.set("participant", src.participant);
+      j.set("accuracy_whole_and_cuts", pct(right, static_cast<int>(test.size())));
+      jbcs.push(j);
+    }
+    print_row("BC, all of them", bc_sum, bc_n);
+    jset.set("bc", jbcs);
+    jset.set("bc_accuracy_whole_and_cuts", pct(bc_sum, bc_n));
     // The pools: per test person, every calibration of someone else; the same pool cut to one
     // set's size beside it. Models are cached by their pool.
     int pooled_right[5] = {}, equal_right[5] = {}, n = 0;

@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Accuracy against travel of the pooled STC (paper VII: HMMs trained on the simulators of
 several people, tested on a person none of them was calibrated on), beside each calibration's
-own STC and the 1-nearest-neighbour classifier on the other people's measured curves.
+own STC, the baseline classifier on each calibration's 2-3 measured inputs, and the
+1-nearest-neighbour classifier on the other people's measured curves.
 
 usage: pooled_stc.py POOLED.json OUT.png
 POOLED.json is what `bench_calib_pipeline pooled` writes (DIR/pooled.json). One panel per force
@@ -41,6 +42,9 @@ def main(argv):
                     label="one person's simulator" if i == 0 else None)
         ax.plot(xs, cuts_then_whole(s["single_accuracy_whole_and_cuts"]), color="0.45", lw=1.5, ls="--",
                 label="one person's simulator, all trials")
+        if "bc_accuracy_whole_and_cuts" in s:
+            ax.plot(xs, cuts_then_whole(s["bc_accuracy_whole_and_cuts"]), color="tab:purple", lw=1.2, ls="-.",
+                    label="BC: the 2-3 measured inputs, all")
         ax.plot(xs, cuts_then_whole(s["pooled_equal_size_accuracy_whole_and_cuts"]), color="tab:orange", lw=1.5,
                 marker="s", ms=4, label="pooled, one set's size")
         ax.plot(xs, cuts_then_whole(s["pooled_accuracy_whole_and_cuts"]), color="tab:blue", lw=2.2, marker="o",
