@@ -57,6 +57,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <map>
 #include <set>
@@ -653,53 +654,42 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     std::printf("%s\n", fs_.name);
     Json jset = Json::object();
     jset.set("forces", std::string(fs_.name));
-    // Each calibration's own STC, on the trials of everyone else.
-    int single_sum[5] = {}, single_n = 0;
-    Json jsingles = Json::array();
-    for (const auto& src : sources) {
-      std::vector<const HapticSequence*> tr, test;
-      for (const auto& t : src.set.trials) tr.push_back(&t);
-      for (const auto* t : all)
-        if (t->participant != src.participant) test.push_back(t);
-      int right[5] = {};
-      count_right(train(tr, fs_.second_axis, src.file), test, right);
-      for (int c = 0; c < 5; ++c) single_sum[c] += right[c];
-      single_n += static_cast<int>(test.size());
-      const std::string name = "alone: " + fs::path(src.file).stem().string();
-      print_row(name.c_str(), right, static_cast<int>(test.size()));
-      Json j = Json::object();
-      j.set("calibration", src.file);
-      j.set("accuracy_whole_and_cuts", pct(right, static_cast<int>(test.size())));
-      jsingles.push(j);
-    }
-    print_row("alone, all of them", single_sum, single_n);
-    jset.set("single", jsingles);
-    jset.set("single_accuracy_whole_and_cuts", pct(single_sum, single_n));
+    // One classifier per calibration, each on the trials of everyone but the calibration's person:
+    // its row, and the sums over all of them into `key` (rows) and `key`_accuracy_whole_and_cuts.
+    auto per_calibration = [&](const char* key, const char* all_name,
+                               const std::function<std::vector<HapticSequence>(const Source&)>& training,
+                               const std::function<std::string(const Source&)>& name) {
+      int sum[5] = {}, n_all = 0;
+      Json rows = Json::array();
+      for (const auto& src : sources) {
+        const std::vector<HapticSequence> owned = training(src);
+        std::vector<const HapticSequence*> tr, test;
+        for (const auto& t : owned) tr.push_back(&t);
+        for (const auto* t : all)
+          if (t->participant != src.participant) test.push_back(t);
+        int right[5] = {};
+        count_right(train(tr, fs_.second_axis, name(src)), test, right);
+        for (int c = 0; c < 5; ++c) sum[c] += right[c];
+        n_all += static_cast<int>(test.size());
+        print_row(name(src).c_str(), right, static_cast<int>(test.size()));
+        Json j = Json::object();
+        j.set("calibration", src.file);
+        j.set("participant", src.participant);
+        j.set("accuracy_whole_and_cuts", pct(right, static_cast<int>(test.size())));
+        rows.push(j);
+      }
+      print_row(all_name, sum, n_all);
+      jset.set(key, rows);
+      jset.set(std::string(key) + "_accuracy_whole_and_cuts", pct(sum, n_all));
+    };
+    // Each calibration's own STC.
+    per_calibration("single", "alone, all of them", [](const Source& src) { return src.set.trials; },
+                    [](const Source& src) { return "alone: " + fs::path(src.file).stem().string(); });
     // The baseline classifier (paper VI-B.1): the same HMMs trained on the 2-3 measured sequences
-    // that each calibration was fitted to, on the same trials (the study holds no caught trial,
-    // so BC knows good and missed only).
-    int bc_sum[5] = {}, bc_n = 0;
-    Json jbcs = Json::array();
-    for (const auto& src : sources) {
-      const auto inputs = select_inputs(ds, src.participant, 1);
-      std::vector<const HapticSequence*> tr, test;
-      for (const auto& t : inputs) tr.push_back(&t);
-      for (const auto* t : all)
-        if (t->participant != src.participant) test.push_back(t);
-      int right[5] = {};
-      count_right(train(tr, fs_.second_axis, "measured inputs of participant " + src.participant), test, right);
-      for (int c = 0; c < 5; ++c) bc_sum[c] += right[c];
-      bc_n += static_cast<int>(test.size());
-      const std::string name = "BC: participant " + src.participant + "'s measured inputs";
-      print_row(name.c_str(), right, static_cast<int>(test.size()));
-      Json j = Json::object();
-      j.set("participant", src.participant);
-      j.set("accuracy_whole_and_cuts", pct(right, static_cast<int>(test.size())));
-      jbcs.push(j);
-    }
-    print_row("BC, all of them", bc_sum, bc_n);
-    jset.set("bc", jbcs);
-    jset.set("bc_accuracy_whole_and_cuts", pct(bc_sum, bc_n));
+    // that each calibration was fitted to (the study holds no caught trial, so BC knows good and
+    // missed only).
+    per_calibration("bc", "BC, all of them", [&](const Source& src) { return select_inputs(ds, src.participant, 1); },
+                    [](const Source& src) { return "BC: participant " + src.participant + "'s measured inputs"; });
     // The pools: per test person, every calibration of someone else; the same pool cut to one
     // set's size beside it. Models are cached by their pool.
     int pooled_right[5] = {}, equal_right[5] = {}, n = 0;
