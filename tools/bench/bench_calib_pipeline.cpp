@@ -693,6 +693,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     // The pools: per test person, every calibration of someone else; the same pool cut to one
     // set's size beside it. Models are cached by their pool.
     int pooled_right[5] = {}, equal_right[5] = {}, n = 0;
+    int fewest = k_all, most = 0;  // simulators in a pool
     std::map<std::string, std::pair<model::OutcomeModel, model::OutcomeModel>> cache;
     Json jper = Json::array();
     for (const auto& p : people) {
@@ -704,6 +705,8 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       for (const auto& src : sources)
         if (src.participant != p) pool.push_back(&src), key += src.file + ";";
       if (pool.empty()) continue;
+      fewest = std::min(fewest, static_cast<int>(pool.size()));
+      most = std::max(most, static_cast<int>(pool.size()));
       auto it = cache.find(key);
       if (it == cache.end()) {
         std::vector<const HapticSequence*> full, equal;
@@ -729,7 +732,10 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       jper.push(j);
     }
     char name[80];
-    std::snprintf(name, sizeof name, "pooled (%d or %d simulators)", k_all - 1, k_all);
+    if (fewest == most)
+      std::snprintf(name, sizeof name, "pooled (%d simulators)", most);
+    else
+      std::snprintf(name, sizeof name, "pooled (%d to %d simulators)", fewest, most);
     print_row(name, pooled_right, n);
     print_row("pooled, cut to one set's size", equal_right, n);
     double nn[4];  // the 1-NN compares curves cut at the same travel: scored at the cuts only
