@@ -69,13 +69,10 @@ int run_build_model(int argc, char** argv) {
     std::vector<Calibration> cals;
     for (const auto& f : files) cals.push_back(read_calibration(f));  // every file checked before any synthesis
     const std::filesystem::path synth = args.get("synth-dir").value_or(out + ".synth");
-    for (std::size_t i = 0; i < files.size(); ++i) {
-      if (files.size() == 1) {
-        sets.push_back(synth);
-        continue;
-      }
-      // One folder per calibration, named after its file: resumable per simulator, and a second
-      // file of the same name would write into the first one's trials.
+    if (files.size() == 1) sets.push_back(synth);
+    // Several: one folder per calibration, named after its file: resumable per simulator, and a
+    // second file of the same name would write into the first one's trials.
+    for (std::size_t i = 0; files.size() > 1 && i < files.size(); ++i) {
       const std::filesystem::path dir = synth / std::filesystem::path(files[i]).stem();
       if (std::find(sets.begin(), sets.end(), dir) != sets.end())
         throw UsageError("--calibration: two files are named " + std::filesystem::path(files[i]).stem().string() +
