@@ -82,14 +82,21 @@ StcAxes choose_stc_axes(const std::vector<SequenceFit>& fits, bool lateral_fitte
   return {v.worst ? model::kAxisNone : model::kAxisVertical, buf};
 }
 
-double accuracy(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials, double truncate_at,
-                int* counted) {
+int count_correct(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials, double truncate_at,
+                  int* counted) {
   std::vector<const HapticSequence*> labelled;
   for (const auto* t : trials)
     if (t->label && !t->samples.empty()) labelled.push_back(t);
-  const hmm::Evaluation e = hmm::evaluate(m, labelled, truncate_at);
   if (counted) *counted = static_cast<int>(labelled.size());
-  return labelled.empty() ? 0.0 : static_cast<double>(e.correct) / labelled.size();
+  return labelled.empty() ? 0 : hmm::evaluate(m, labelled, truncate_at).correct;
+}
+
+double accuracy(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials, double truncate_at,
+                int* counted) {
+  int n = 0;
+  const int right = count_correct(m, trials, truncate_at, &n);
+  if (counted) *counted = n;
+  return n ? static_cast<double>(right) / n : 0.0;
 }
 
 }  // namespace dressguard::calib

@@ -50,10 +50,14 @@ const char* stc_forces_name(int second_axis);
 // Trains the HMMs of every outcome present among the labelled trials.
 model::OutcomeModel build_outcome_model(const std::vector<const HapticSequence*>& trials, const StcOptions& o);
 
-// The fraction of the labelled `trials` whose label the model predicts, with every trial cut
-// after `truncate_at` metres of travel (infinity: whole). A trial whose label is not a class of
-// the model counts as wrong (a model trained on simulated data without any "good" trial cannot
-// be right about a good trial); `counted` receives the number of labelled trials.
+// How many of the labelled `trials` the model gets right, with every trial cut after
+// `truncate_at` metres of travel (infinity: whole). A trial whose label is not a class of the
+// model counts as wrong (a model trained on simulated data without any "good" trial cannot be
+// right about a good trial); `counted` receives the number of labelled trials.
+int count_correct(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials,
+                  double truncate_at, int* counted = nullptr);
+
+// The same as a fraction of the labelled trials (0 when there are none).
 double accuracy(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials,
                 double truncate_at, int* counted = nullptr);
 

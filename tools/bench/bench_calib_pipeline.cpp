@@ -479,9 +479,8 @@ int run_timing(const std::map<std::string, std::string>& a) {
 
 // Correct classifications of a model over `test`, whole and at the four cuts (out[0] whole).
 void count_right(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& test, int out[5]) {
-  double acc[5];
-  accuracies(m, test, acc);
-  for (int c = 0; c < 5; ++c) out[c] += static_cast<int>(std::lround(acc[c] * test.size()));
+  out[0] += count_correct(m, test, std::numeric_limits<double>::infinity());
+  for (int c = 0; c < 4; ++c) out[c + 1] += count_correct(m, test, kCuts[c]);
 }
 
 // The index of a synthesized trial, from its id (synthesis_trial_id: "sim-high-007" -> 7).
