@@ -1,5 +1,6 @@
-// dressguard classify: an outcome model and a labelled dataset -> per-trial classes, accuracy and
-// the confusion matrix; optionally cut at a travel distance (paper Fig. 6) or swept over many.
+// dressguard classify: an outcome model (or a committee of them) and a labelled dataset ->
+// per-trial classes, accuracy and the confusion matrix; optionally cut at a travel distance
+// (paper Fig. 6) or swept over many.
 #include <unistd.h>
 
 #include <cmath>
@@ -64,15 +65,26 @@ std::filesystem::path find_plot_script() {
   return {};
 }
 
+// The accuracy line and the confusion matrix.
+void print_summary(const hmm::Evaluation& ev, size_t models) {
+  std::printf("\naccuracy %.4f (%d/%d)%s%s\n", ev.accuracy(), ev.correct, ev.total,
+              models > 1 ? (", a vote of " + std::to_string(models) + " models").c_str() : "",
+              ev.skipped ? (", " + std::to_string(ev.skipped) + " trials skipped (unlabelled, label not in the model, or empty)").c_str() : "");
+  std::printf("%s", hmm::confusion_text(ev).c_str());
+}
+
 }  // namespace
 
 int run_classify(int argc, char** argv) {
   Args args(argc - 1, argv + 1, {"help", "json", "no-plot"});
   if (args.has("help")) {
     std::puts(
-        "usage: dressguard classify --model MODEL.dgm --data DATASET [options] [--json]\n"
+        "usage: dressguard classify --model MODEL.dgm[,MODEL2.dgm,...] --data DATASET [options] [--json]\n"
         "  Classifies every labelled trial by the highest posterior (log-likelihood + log prior) and\n"
         "  prints per-trial results, the accuracy and the confusion matrix (rows truth, columns predicted).\n"
+        "  With several models, they vote (a committee, e.g. the STCs of several people's simulators):\n"
+        "  each model classifies the trial, the class most of them pick wins, a tie goes to the larger\n"
+        "  sum of their posteriors; classes are matched by name.\n"
         "  --truncate-at DIST      cut each trial after the last sample with travel <= DIST metres\n"
         "  --sweep A:B:STEP        accuracy at every truncation distance A, A+STEP, ..., B (metres)\n"
         "  --sweep-out PREFIX      with --sweep: write PREFIX.csv and PREFIX.png (tools/plot/hmm_sweep.py)\n"
@@ -82,7 +94,7 @@ int run_classify(int argc, char** argv) {
     return 0;
   }
   args.allow_only({"help", "json", "no-plot", "model", "data", "truncate-at", "sweep", "sweep-out", "participant"});
-  const std::string model_path = args.require("model"), data = args.require("data");
+  const std::string model_list = args.require("model"), data = args.require("data");
   const double truncate = args.number("truncate-at", std::numeric_limits<double>::infinity());
   if (!(truncate > 0)) throw UsageError("--truncate-at must be positive");
   std::vector<double> sweep;
@@ -95,25 +107,36 @@ int run_classify(int argc, char** argv) {
   }
   const auto only = split_list(args.get("participant").value_or(""));
 
-  model::OutcomeModel m;
-  try {
-    m = model::read_model(model_path);
-  } catch (const model::ModelError& e) {
-    throw InputError(e.what());
+  std::vector<model::OutcomeModel> models;
+  const std::vector<std::string> model_paths = split_in_order(model_list);
+  for (const auto& path : model_paths) {
+    try {
+      models.push_back(model::read_model(path));
+    } catch (const model::ModelError& e) {
+      throw InputError(e.what());
+    }
   }
+  if (models.empty()) throw UsageError("--model needs at least one model file");
+  std::vector<const model::OutcomeModel*> committee;
+  for (const auto& m : models) committee.push_back(&m);
+  // One model classifies as it always did (its log-likelihoods in the JSON); several vote.
+  const model::OutcomeModel* single = models.size() == 1 ? &models[0] : nullptr;
   const Dataset ds = load_dataset(data);
   std::vector<const HapticSequence*> trials;
   for (const auto& t : ds.trials)
     if (only.empty() || only.count(t.participant)) trials.push_back(&t);
   if (trials.empty()) throw InputError(data + ": no trials" + (only.empty() ? "" : " of the given participants"));
   const bool json = args.has("json");
+  auto evaluate_at = [&](double d) {
+    return single ? hmm::evaluate(*single, trials, d) : hmm::evaluate_vote(committee, trials, d);
+  };
 
   if (!sweep.empty()) {
     const std::string prefix = *args.get("sweep-out");
     std::string csv = "travel_m,accuracy,correct,total\n";
     std::string rows_json;
     for (double d : sweep) {
-      const auto ev = hmm::evaluate(m, trials, d);
+      const auto ev = evaluate_at(d);
       char line[128];
       std::snprintf(line, sizeof line, "%.6g,%.6f,%d,%d\n", d, ev.accuracy(), ev.correct, ev.total);
       csv += line;
@@ -146,25 +169,63 @@ int run_classify(int argc, char** argv) {
     return 0;
   }
 
+  if (!single) {
+    // The committee: per trial the votes and the models' posterior sums.
+    std::vector<hmm::Vote> per;
+    const auto ev = hmm::evaluate_vote(committee, trials, truncate, &per);
+    if (json) {
+      std::string rows, paths;
+      for (size_t i = 0; i < per.size(); ++i) {
+        const auto& v = per[i];
+        if (v.predicted < 0) continue;
+        std::string votes, sums;
+        for (size_t c = 0; c < v.classes.size(); ++c) {
+          votes += (c ? ", " : "") + std::to_string(v.votes[c]);
+          sums += (c ? ", " : "") + hmm::json_number(v.posterior_sum[c]);
+        }
+        rows += (rows.empty() ? "" : ", ") + std::string("{\"id\": ") + hmm::json_string(trials[i]->id) +
+                ", \"participant\": " + hmm::json_string(trials[i]->participant) + ", \"samples\": " +
+                std::to_string(v.samples) + ", \"truth\": " + hmm::json_string(outcome_name(*trials[i]->label)) +
+                ", \"predicted\": " + hmm::json_string(v.classes[v.predicted]) + ", \"votes\": [" + votes +
+                "], \"posterior_sum\": [" + sums + "]}";
+      }
+      for (const auto& path : model_paths) paths += (paths.empty() ? "" : ", ") + hmm::json_string(path);
+      std::printf("{\"models\": [%s], \"data\": %s, \"truncate_at\": %s, \"trials\": [%s], \"evaluation\": %s}\n",
+                  paths.c_str(), hmm::json_string(data).c_str(), hmm::json_number(truncate).c_str(), rows.c_str(),
+                  hmm::evaluation_json(ev).c_str());
+      return 0;
+    }
+    std::printf("%-24s %-6s %7s %-8s %-8s %6s\n", "trial", "part.", "samples", "truth", "predicted", "votes");
+    for (size_t i = 0; i < per.size(); ++i) {
+      const auto& v = per[i];
+      if (v.predicted < 0) continue;
+      const std::string truth(outcome_name(*trials[i]->label));
+      std::printf("%-24s %-6s %7zu %-8s %-8s %3d/%-2zu%s\n", trials[i]->id.c_str(), trials[i]->participant.c_str(),
+                  v.samples, truth.c_str(), v.classes[v.predicted].c_str(), v.votes[v.predicted], committee.size(),
+                  truth == v.classes[v.predicted] ? "" : "   WRONG");
+    }
+    print_summary(ev, committee.size());
+    return 0;
+  }
   std::vector<hmm::TrialResult> per;
-  const auto ev = hmm::evaluate(m, trials, truncate, &per);
+  const auto ev = hmm::evaluate(*single, trials, truncate, &per);
   if (json) {
     std::string rows;
     for (const auto& r : per) {
       if (r.truth < 0) continue;
       std::string ll, post;
-      for (size_t c = 0; c < m.classes.size(); ++c) {
+      for (size_t c = 0; c < single->classes.size(); ++c) {
         ll += (c ? ", " : "") + hmm::json_number(r.result.log_likelihood[c]);
         post += (c ? ", " : "") + hmm::json_number(r.result.posterior[c]);
       }
       rows += (rows.empty() ? "" : ", ") + std::string("{\"id\": ") + hmm::json_string(r.trial->id) +
               ", \"participant\": " + hmm::json_string(r.trial->participant) + ", \"samples\": " + std::to_string(r.samples) +
-              ", \"truth\": " + hmm::json_string(m.classes[r.truth].name) + ", \"predicted\": " +
-              hmm::json_string(m.classes[r.result.predicted].name) + ", \"log_likelihood\": [" + ll + "], \"posterior\": [" +
+              ", \"truth\": " + hmm::json_string(single->classes[r.truth].name) + ", \"predicted\": " +
+              hmm::json_string(single->classes[r.result.predicted].name) + ", \"log_likelihood\": [" + ll + "], \"posterior\": [" +
               post + "]}";
     }
     std::printf("{\"model\": %s, \"data\": %s, \"truncate_at\": %s, \"trials\": [%s], \"evaluation\": %s}\n",
-                hmm::json_string(model_path).c_str(), hmm::json_string(data).c_str(), hmm::json_number(truncate).c_str(),
+                hmm::json_string(model_list).c_str(), hmm::json_string(data).c_str(), hmm::json_number(truncate).c_str(),
                 rows.c_str(), hmm::evaluation_json(ev).c_str());
     return 0;
   }
@@ -172,12 +233,10 @@ int run_classify(int argc, char** argv) {
   for (const auto& r : per) {
     if (r.truth < 0) continue;
     std::printf("%-24s %-6s %7zu %-8s %-8s %9.4f%s\n", r.trial->id.c_str(), r.trial->participant.c_str(), r.samples,
-                m.classes[r.truth].name.c_str(), m.classes[r.result.predicted].name.c_str(),
+                single->classes[r.truth].name.c_str(), single->classes[r.result.predicted].name.c_str(),
                 r.result.posterior[r.result.predicted], r.truth == r.result.predicted ? "" : "   WRONG");
   }
-  std::printf("\naccuracy %.4f (%d/%d)%s\n", ev.accuracy(), ev.correct, ev.total,
-              ev.skipped ? (", " + std::to_string(ev.skipped) + " trials skipped (unlabelled, label not in the model, or empty)").c_str() : "");
-  std::printf("%s", hmm::confusion_text(ev).c_str());
+  print_summary(ev, 1);
   return 0;
 }
 

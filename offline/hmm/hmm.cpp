@@ -614,4 +614,64 @@ Evaluation evaluate(const model::OutcomeModel& m, const std::vector<const Haptic
   return ev;
 }
 
+namespace {
+
+// The union of the models' class names, in the order they are first named.
+std::vector<std::string> committee_classes(const std::vector<const model::OutcomeModel*>& models) {
+  std::vector<std::string> names;
+  for (const auto* m : models)
+    for (const auto& h : m->classes)
+      if (std::find(names.begin(), names.end(), h.name) == names.end()) names.push_back(h.name);
+  return names;
+}
+
+int index_of(const std::vector<std::string>& names, const std::string& name) {
+  const auto it = std::find(names.begin(), names.end(), name);
+  return it == names.end() ? -1 : static_cast<int>(it - names.begin());
+}
+
+}  // namespace
+
+Vote vote(const std::vector<const model::OutcomeModel*>& models, const HapticSequence& trial, double truncate_at) {
+  Vote v;
+  v.classes = committee_classes(models);
+  v.votes.assign(v.classes.size(), 0);
+  v.posterior_sum.assign(v.classes.size(), 0.0);
+  for (const auto* m : models) {
+    const FeatureSequence seq = features_of(trial, m->features, truncate_at);
+    v.samples = seq.size();  // the cut is by travel, the same for every model
+    if (seq.size() == 0) return v;
+    const Classification c = classify(*m, seq);
+    for (size_t k = 0; k < m->classes.size(); ++k) v.posterior_sum[index_of(v.classes, m->classes[k].name)] += c.posterior[k];
+    ++v.votes[index_of(v.classes, m->classes[c.predicted].name)];
+  }
+  for (size_t k = 0; k < v.classes.size(); ++k) {
+    const int b = v.predicted;
+    if (b < 0 || v.votes[k] > v.votes[b] || (v.votes[k] == v.votes[b] && v.posterior_sum[k] > v.posterior_sum[b]))
+      v.predicted = static_cast<int>(k);
+  }
+  return v;
+}
+
+Evaluation evaluate_vote(const std::vector<const model::OutcomeModel*>& models,
+                         const std::vector<const HapticSequence*>& trials, double truncate_at,
+                         std::vector<Vote>* per_trial) {
+  Evaluation ev;
+  ev.classes = committee_classes(models);
+  ev.confusion.assign(ev.classes.size(), std::vector<int>(ev.classes.size(), 0));
+  for (const auto* t : trials) {
+    const int truth = t->label ? index_of(ev.classes, std::string(outcome_name(*t->label))) : -1;
+    Vote v = truth >= 0 ? vote(models, *t, truncate_at) : Vote{};
+    if (truth < 0 || v.predicted < 0) {
+      ++ev.skipped;
+    } else {
+      ev.confusion[truth][v.predicted]++;
+      ev.total++;
+      if (v.predicted == truth) ev.correct++;
+    }
+    if (per_trial) per_trial->push_back(std::move(v));
+  }
+  return ev;
+}
+
 }  // namespace dressguard::hmm

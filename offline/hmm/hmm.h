@@ -156,4 +156,34 @@ Evaluation evaluate(const model::OutcomeModel& m, const std::vector<const Haptic
                     double truncate_at = std::numeric_limits<double>::infinity(),
                     std::vector<TrialResult>* per_trial = nullptr);
 
+// ---- a committee of outcome models -----------------------------------------------------------
+
+// The vote of several outcome models on one trial: a committee of simulation-trained classifiers,
+// one per person's simulator (offline/calib/README.md, session 22). Each model classifies the
+// trial, cut at `truncate_at`, in its own features (classify()); the class that most models pick
+// wins, a tie goes to the larger sum of the models' posteriors for the tied classes, and then to
+// the class named first. Classes are matched by name; `classes` is their union in the order the
+// models first name them, so a model that never saw a class (a simulator that never catches)
+// simply gives it no vote.
+// Why votes, not one HMM of everyone's trials or a mixture of the likelihoods: a trial that one
+// simulator explains far better than the others decides a mixture alone, and a pooled HMM learns
+// the average of cues that some simulators have reversed; a vote counts each simulator once.
+struct Vote {
+  std::vector<std::string> classes;
+  std::vector<int> votes;             // per class: how many models predict it
+  std::vector<double> posterior_sum;  // per class: the sum of the models' posteriors
+  size_t samples = 0;                 // after the cut
+  int predicted = -1;                 // index into classes; -1 when the cut leaves no sample
+};
+Vote vote(const std::vector<const model::OutcomeModel*>& models, const HapticSequence& trial,
+          double truncate_at = std::numeric_limits<double>::infinity());
+
+// evaluate() for a committee: the confusion matrix over the union of the models' classes, every
+// labelled trial whose label one of the models knows. `per_trial` (may be null) gets every trial's
+// vote, skipped trials included (predicted -1).
+Evaluation evaluate_vote(const std::vector<const model::OutcomeModel*>& models,
+                         const std::vector<const HapticSequence*>& trials,
+                         double truncate_at = std::numeric_limits<double>::infinity(),
+                         std::vector<Vote>* per_trial = nullptr);
+
 }  // namespace dressguard::hmm

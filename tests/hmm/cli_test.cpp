@@ -98,6 +98,35 @@ TEST_F(CliTest, TrainClassifyShowOnSyntheticData) {
   EXPECT_EQ(json_field(showj.out, "states"), 5.0);
 }
 
+// A committee (--model A,B,C) votes: with two right models and one trained on swapped good and
+// missed labels, the majority is right on every trial; with the liar twice, the good and missed
+// trials go the liar's way and only the caught ones stay right. A bad file in the list is named.
+TEST_F(CliTest, CommitteeOfModelsVotes) {
+  save_dataset(fx::synthetic_dataset(12, 300, 500, 55, 5, "a"), dir / "train");
+  Dataset swapped = fx::synthetic_dataset(12, 300, 500, 56, 5, "s");
+  for (auto& t : swapped.trials)
+    if (t.label == Outcome::Good || t.label == Outcome::Missed)
+      t.label = t.label == Outcome::Good ? Outcome::Missed : Outcome::Good;
+  save_dataset(swapped, dir / "swapped");
+  save_dataset(fx::synthetic_dataset(6, 300, 500, 57, 5, "b"), dir / "test");
+  const std::string m = (dir / "m.dgm").string(), liar = (dir / "liar.dgm").string(), test = (dir / "test").string();
+  ASSERT_EQ(run("train --data " + (dir / "train").string() + " --out " + m + " --states 5").code, 0);
+  ASSERT_EQ(run("train --data " + (dir / "swapped").string() + " --out " + liar + " --states 5").code, 0);
+
+  const auto two_right = run("classify --model " + m + "," + m + "," + liar + " --data " + test + " --json");
+  ASSERT_EQ(two_right.code, 0) << two_right.err;
+  EXPECT_EQ(json_field(two_right.out, "accuracy"), 1.0) << two_right.out;
+  EXPECT_NE(two_right.out.find("\"votes\": ["), std::string::npos) << two_right.out;
+  const auto two_liars = run("classify --model " + m + "," + liar + "," + liar + " --data " + test);
+  ASSERT_EQ(two_liars.code, 0) << two_liars.err;
+  EXPECT_NE(two_liars.out.find("accuracy 0.3333 (6/18), a vote of 3 models"), std::string::npos) << two_liars.out;
+  EXPECT_NE(two_liars.out.find("2/3"), std::string::npos) << two_liars.out;
+
+  const auto missing = run("classify --model " + m + "," + (dir / "none.dgm").string() + " --data " + test);
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_NE(missing.err.find("none.dgm"), std::string::npos) << missing.err;
+}
+
 // The sweep writes accuracy against travel as CSV (one row per distance) and a PNG.
 TEST_F(CliTest, SweepWritesCsvAndPng) {
   save_dataset(fx::synthetic_dataset(8, 200, 300, 53, 5), dir / "d");

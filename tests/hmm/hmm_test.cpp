@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 
 #include "fixtures.h"
 #include "hmm.h"
@@ -279,15 +280,21 @@ TEST(HmmTrain, RejectsBadOptions) {
   EXPECT_THROW(hmm::initial_left_right({seq({1, 2, 3, 4})}, opt), std::invalid_argument);
 }
 
+// The three-class model of 5 states per class that two tests below train on 20 synthetic trials per
+// class drawn with `seed`.
+model::OutcomeModel five_state_model(uint64_t seed) {
+  const Dataset train = fx::synthetic_dataset(20, 300, 500, seed);
+  hmm::ModelOptions opt;
+  opt.hmm.n_states = 5;
+  return hmm::train_outcome_model(fx::pointers(train), opt);
+}
+
 // The outcome model: one HMM per labelled class, priors from counts, features scaled to zero mean
 // and unit variance, sensor axes motion and vertical; trained on held-in data it classifies
 // held-out synthetic trials of well-separated classes all correctly.
 TEST(HmmOutcomeModel, TrainsAndClassifiesSyntheticClasses) {
-  const Dataset train = fx::synthetic_dataset(20, 300, 500, 21);
+  const auto m = five_state_model(21);
   const Dataset test = fx::synthetic_dataset(10, 300, 500, 22);
-  hmm::ModelOptions opt;
-  opt.hmm.n_states = 5;
-  const auto m = hmm::train_outcome_model(fx::pointers(train), opt);
   ASSERT_EQ(m.classes.size(), 3u);
   EXPECT_EQ(m.classes[0].name, "good");
   EXPECT_EQ(m.classes[2].name, "caught");
@@ -338,6 +345,110 @@ TEST(HmmOutcomeModel, MotionOnlyModelIgnoresAVerticalForceThatDiffersFromTrainin
   const auto b = hmm::classify(mm, hmm::features_of(shifted, mm.features));
   ASSERT_EQ(a.log_likelihood.size(), b.log_likelihood.size());
   for (size_t c = 0; c < a.log_likelihood.size(); ++c) EXPECT_EQ(a.log_likelihood[c], b.log_likelihood[c]);
+}
+
+// ---- a committee of models (hmm::vote) ----
+
+// A two-class model of F_motion alone with one state per class: class "good" emits N(good_mean, 1),
+// "missed" N(missed_mean, 1), equal priors. One sample x then has the closed-form posterior
+// P(good | x) = 1 / (1 + exp(((x - good_mean)^2 - (x - missed_mean)^2) / 2)).
+model::OutcomeModel one_state_model(double good_mean, double missed_mean, bool with_caught = false) {
+  model::OutcomeModel m;
+  m.features.axis[0] = model::kAxisMotion;
+  m.features.axis[1] = model::kAxisNone;
+  auto cls = [](const char* name, double mean) {
+    model::ClassHmm h;
+    h.name = name;
+    h.n_states = 1;
+    h.initial = {1.0};
+    h.transition = {1.0};
+    model::GaussianEmission e;
+    e.mean[0] = mean;
+    h.emission = {e};
+    return h;
+  };
+  m.classes = {cls("good", good_mean), cls("missed", missed_mean)};
+  if (with_caught) m.classes.push_back(cls("caught", 10.0));
+  for (auto& h : m.classes) h.log_prior = -std::log(static_cast<double>(m.classes.size()));
+  return m;
+}
+
+HapticSequence one_sample(double f_motion, Outcome label) {
+  HapticSequence t;
+  t.id = "one";
+  t.label = label;
+  HapticSample x{};
+  x.f_motion = f_motion;
+  t.samples = {x};
+  return t;
+}
+
+double posterior_good(double x, double good_mean, double missed_mean) {
+  return 1.0 / (1.0 + std::exp(((x - good_mean) * (x - good_mean) - (x - missed_mean) * (x - missed_mean)) / 2));
+}
+
+// Two models of three take the majority; the posterior sums are the closed form's.
+TEST(HmmVote, MajorityWinsWithClosedFormPosteriorSums) {
+  const auto a = one_state_model(0, 3), b = one_state_model(0, 2), c = one_state_model(3, 0);  // c reversed
+  const std::vector<const model::OutcomeModel*> committee = {&a, &b, &c};
+  const auto v = hmm::vote(committee, one_sample(0.5, Outcome::Good));
+  ASSERT_EQ(v.classes, (std::vector<std::string>{"good", "missed"}));
+  EXPECT_EQ(v.votes, (std::vector<int>{2, 1}));
+  EXPECT_EQ(v.samples, 1u);
+  EXPECT_EQ(v.predicted, 0);
+  const double pg = posterior_good(0.5, 0, 3) + posterior_good(0.5, 0, 2) + posterior_good(0.5, 3, 0);
+  EXPECT_NEAR(v.posterior_sum[0], pg, 1e-12);
+  EXPECT_NEAR(v.posterior_sum[1], 3.0 - pg, 1e-12);
+}
+
+// A tie goes to the larger posterior sum, not to the class named first: model a says good with
+// P = 0.55 (x = 0.3, means 0 and 1), model b says missed with P = 0.80 (means 2 and 0), so
+// good 0.55 + 0.20 < missed 0.45 + 0.80.
+TEST(HmmVote, TieGoesToTheLargerPosteriorSum) {
+  const auto a = one_state_model(0, 1), b = one_state_model(2, 0);
+  const auto v = hmm::vote({&a, &b}, one_sample(0.3, Outcome::Missed));
+  EXPECT_EQ(v.votes, (std::vector<int>{1, 1}));
+  EXPECT_NEAR(posterior_good(0.3, 0, 1), 0.5498, 1e-4);
+  EXPECT_NEAR(1 - posterior_good(0.3, 2, 0), 0.8022, 1e-4);
+  EXPECT_GT(v.posterior_sum[1], v.posterior_sum[0]);
+  EXPECT_EQ(v.predicted, 1);
+}
+
+// Classes are the union by name: a model that knows "caught" brings it in, the others give it
+// no vote, and a caught trial is scored; a label no model knows is skipped.
+TEST(HmmVote, ClassesAreTheUnionOfTheModels) {
+  const auto a = one_state_model(0, 3), b = one_state_model(0, 3), c = one_state_model(0, 3, true);
+  const std::vector<const model::OutcomeModel*> committee = {&a, &b, &c};
+  const HapticSequence caught = one_sample(10.0, Outcome::Caught), good = one_sample(0.0, Outcome::Good);
+  const auto v = hmm::vote(committee, caught);
+  ASSERT_EQ(v.classes, (std::vector<std::string>{"good", "missed", "caught"}));
+  EXPECT_EQ(v.votes, (std::vector<int>{0, 2, 1}));  // a and b can only say missed, the nearer mean
+  const auto ev = hmm::evaluate_vote(committee, {&caught, &good});
+  EXPECT_EQ(ev.total, 2);
+  EXPECT_EQ(ev.correct, 1);
+  EXPECT_EQ(ev.confusion[2][1], 1);
+  EXPECT_EQ(ev.confusion[0][0], 1);
+  const auto two = hmm::evaluate_vote({&a, &b}, {&caught, &good});
+  EXPECT_EQ(two.total, 1);
+  EXPECT_EQ(two.skipped, 1);
+}
+
+// A committee of one is the model itself: on trials drawn from known HMMs, whole and cut, the
+// same confusion matrix as evaluate() and the posterior of classify().
+TEST(HmmVote, CommitteeOfOneIsTheModel) {
+  const auto m = five_state_model(41);
+  const Dataset test = fx::synthetic_dataset(10, 300, 500, 42);
+  for (double cut : {std::numeric_limits<double>::infinity(), 0.05}) {
+    std::vector<hmm::Vote> votes;
+    const auto ev = hmm::evaluate(m, fx::pointers(test), cut);
+    const auto evv = hmm::evaluate_vote({&m}, fx::pointers(test), cut, &votes);
+    EXPECT_EQ(evv.classes, ev.classes);
+    EXPECT_EQ(evv.confusion, ev.confusion);
+    ASSERT_EQ(votes.size(), test.trials.size());
+    const auto c = hmm::classify(m, hmm::features_of(test.trials[0], m.features, cut));
+    EXPECT_EQ(votes[0].predicted, c.predicted);
+    for (size_t k = 0; k < c.posterior.size(); ++k) EXPECT_EQ(votes[0].posterior_sum[k], c.posterior[k]);
+  }
 }
 
 // Determinism: the same data trains the same bits.

@@ -37,7 +37,9 @@
 //     the same pool cut to one set's size (calibration j of k keeps the trials whose index is j
 //     mod k: more simulators, not more trials); and each single calibration's STC (over the
 //     trials of the people other than its own), beside the baseline classifier BC trained on the
-//     2-3 measured sequences each calibration was fitted to (paper VI-B.1). Prints the table and
+//     2-3 measured sequences each calibration was fitted to (paper VI-B.1); the vote of the
+//     single STCs of the people other than P (hmm::evaluate_vote) and, for comparison, their
+//     mixture (per class the mean likelihood of the raw forces). Prints the table and
 //     each simulator's early cue against the people's, writes DIR/pooled.json (plot:
 //     tools/plot/pooled_stc.py).
 //   bench_calib_pipeline timing [--gown ...] [--generations G --population N] [--threads T]
@@ -68,6 +70,7 @@
 #include "calibration.h"
 #include "dataset.h"
 #include "files.h"
+#include "hmm.h"
 #include "prediction.h"
 #include "sim_bridge.h"
 #include "stc.h"
@@ -657,7 +660,8 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     // its row, and the sums over all of them into `key` (rows) and `key`_accuracy_whole_and_cuts.
     auto per_calibration = [&](const char* key, const char* all_name,
                                const std::function<std::vector<HapticSequence>(const Source&)>& training,
-                               const std::function<std::string(const Source&)>& name) {
+                               const std::function<std::string(const Source&)>& name,
+                               std::vector<model::OutcomeModel>* keep = nullptr) {
       int sum[5] = {}, n_all = 0;
       Json rows = Json::array();
       for (const auto& src : sources) {
@@ -667,7 +671,9 @@ int run_pooled(const std::map<std::string, std::string>& a) {
         for (const auto* t : all)
           if (t->participant != src.participant) test.push_back(t);
         int right[5] = {};
-        count_right(train(tr, fs_.second_axis, name(src)), test, right);
+        model::OutcomeModel m = train(tr, fs_.second_axis, name(src));
+        count_right(m, test, right);
+        if (keep) keep->push_back(std::move(m));
         for (int c = 0; c < 5; ++c) sum[c] += right[c];
         n_all += static_cast<int>(test.size());
         print_row(name(src).c_str(), right, static_cast<int>(test.size()));
@@ -682,8 +688,9 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       jset.set(std::string(key) + "_accuracy_whole_and_cuts", pct(sum, n_all));
     };
     // Each calibration's own STC.
+    std::vector<model::OutcomeModel> singles;  // in the order of `sources`
     per_calibration("single", "alone, all of them", [](const Source& src) { return src.set.trials; },
-                    [](const Source& src) { return "alone: " + fs::path(src.file).stem().string(); });
+                    [](const Source& src) { return "alone: " + fs::path(src.file).stem().string(); }, &singles);
     // The baseline classifier (paper VI-B.1): the same HMMs trained on the 2-3 measured sequences
     // that each calibration was fitted to (the study holds no caught trial, so BC knows good and
     // missed only).
@@ -737,6 +744,59 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       std::snprintf(name, sizeof name, "pooled (%d to %d simulators)", fewest, most);
     print_row(name, pooled_right, n);
     print_row("pooled, cut to one set's size", equal_right, n);
+    // The same people's simulators as a committee of their own STCs rather than one STC of their
+    // pooled trials: the vote of the simulators' answers (hmm::evaluate_vote, what `dressguard
+    // classify --model A.dgm,B.dgm,...` does), and for comparison a mixture: per class, the mean
+    // of the simulators' likelihoods, each a density of the raw forces (the feature scaling's
+    // Jacobian put back, since every STC scales its own way).
+    {
+      int mix_right[5] = {}, vote_right[5] = {}, nm = 0;
+      for (const auto& p : people) {
+        std::vector<const HapticSequence*> test;
+        for (const auto* t : all)
+          if (t->participant == p && t->label && !t->samples.empty()) test.push_back(t);
+        std::vector<const model::OutcomeModel*> members;
+        for (std::size_t s = 0; s < sources.size(); ++s)
+          if (sources[s].participant != p) members.push_back(&singles[s]);
+        if (members.empty() || test.empty()) continue;
+        nm += static_cast<int>(test.size());
+        for (int c = 0; c < 5; ++c) {
+          const double cut = c == 0 ? std::numeric_limits<double>::infinity() : kCuts[c - 1];
+          vote_right[c] += hmm::evaluate_vote(members, test, cut).correct;
+          // class name -> per trial, the members' raw-force log-likelihoods
+          std::map<std::string, std::vector<std::vector<double>>> ll;
+          for (const auto* m : members) {
+            std::vector<hmm::TrialResult> per;
+            hmm::evaluate(*m, test, cut, &per);
+            double log_jacobian = 0;
+            for (int k = 0; k < model::kFeatures; ++k) log_jacobian += std::log(m->features.scale[k]);
+            for (std::size_t t = 0; t < test.size(); ++t)
+              for (std::size_t k = 0; k < m->classes.size(); ++k) {
+                auto& v = ll[m->classes[k].name];
+                v.resize(test.size());
+                v[t].push_back(per[t].result.log_likelihood[k] - static_cast<double>(per[t].samples) * log_jacobian);
+              }
+          }
+          for (std::size_t t = 0; t < test.size(); ++t) {
+            std::string best;
+            double best_ll = -std::numeric_limits<double>::infinity();
+            for (const auto& [name, v] : ll) {
+              if (v.size() <= t || v[t].empty()) continue;
+              const double top = *std::max_element(v[t].begin(), v[t].end());
+              double sum = 0;
+              for (double x : v[t]) sum += std::exp(x - top);
+              const double mix = top + std::log(sum / static_cast<double>(v[t].size()));
+              if (mix > best_ll) best_ll = mix, best = name;
+            }
+            mix_right[c] += best == outcome_name(*test[t]->label);
+          }
+        }
+      }
+      print_row("vote of the other people's STCs", vote_right, nm);
+      print_row("mixture of the other people's STCs", mix_right, nm);
+      jset.set("vote_accuracy_whole_and_cuts", pct(vote_right, nm));
+      jset.set("mixture_accuracy_whole_and_cuts", pct(mix_right, nm));
+    }
     double nn[4];  // the 1-NN compares curves cut at the same travel: scored at the cuts only
     for (int c = 0; c < 4; ++c) nn[c] = one_nn_accuracy(all, kCuts[c], fs_.nn);
     std::printf("  %-44s     -", "1-NN on the other people's measured curves");

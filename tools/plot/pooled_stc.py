@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """Accuracy against travel of the pooled STC (paper VII: HMMs trained on the simulators of
 several people, tested on a person none of them was calibrated on), beside each calibration's
-own STC, the baseline classifier on each calibration's 2-3 measured inputs, and the
-1-nearest-neighbour classifier on the other people's measured curves.
+own STC, the vote of those STCs (a committee), the baseline classifier on each calibration's 2-3
+measured inputs, and the 1-nearest-neighbour classifier on the other people's measured curves.
 
 usage: pooled_stc.py POOLED.json OUT.png
 POOLED.json is what `bench_calib_pipeline pooled` writes (DIR/pooled.json). One panel per force
@@ -49,6 +49,9 @@ def main(argv):
                 marker="s", ms=4, label="pooled, one set's size")
         ax.plot(xs, cuts_then_whole(s["pooled_accuracy_whole_and_cuts"]), color="tab:blue", lw=2.2, marker="o",
                 ms=5, label="pooled simulators")
+        if "vote_accuracy_whole_and_cuts" in s:
+            ax.plot(xs, cuts_then_whole(s["vote_accuracy_whole_and_cuts"]), color="tab:red", lw=2.2, marker="D",
+                    ms=5, label="vote of the simulators' STCs")
         ax.plot(CUTS, [100 * a for a in s["one_nn_accuracy_at_cuts"]], color="tab:green", lw=1.5, ls=":", marker="^",
                 ms=5, label="1-NN on other people's curves")
         ax.set_title(s["forces"], fontsize=10)
@@ -60,11 +63,11 @@ def main(argv):
         ax.grid(alpha=0.3)
     axes[0][0].set_ylabel("measured trials classified right [%]")
     handles, labels = axes[0][0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="lower center", ncol=len(labels), fontsize=8, frameon=False)
+    fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, frameon=False)
     n = len(d["sources"])
     fig.suptitle(f"STCs on people no simulator was calibrated on: {n} calibrations, {d['per_height']} trials per "
                  f"height each", fontsize=10)
-    fig.tight_layout(rect=(0, 0.07, 1, 1))
+    fig.tight_layout(rect=(0, 0.1, 1, 1))
     fig.savefig(argv[2], dpi=110)
     return 0
 
