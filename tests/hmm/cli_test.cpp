@@ -121,6 +121,17 @@ TEST_F(CliTest, CommitteeOfModelsVotes) {
   ASSERT_EQ(two_liars.code, 0) << two_liars.err;
   EXPECT_NE(two_liars.out.find("accuracy 0.3333 (6/18), a vote of 3 models"), std::string::npos) << two_liars.out;
   EXPECT_NE(two_liars.out.find("2/3"), std::string::npos) << two_liars.out;
+  // The sweep of a committee: the majority's accuracy at every distance (the liars' again).
+  const auto sw = run("classify --model " + m + "," + liar + "," + liar + " --data " + test + " --sweep 0.05:0.15:0.05 --sweep-out " +
+                      (dir / "sw").string() + " --no-plot");
+  ASSERT_EQ(sw.code, 0) << sw.err;
+  std::ifstream csv(dir / "sw.csv");
+  std::string line;
+  std::getline(csv, line);
+  for (const char* d : {"0.05", "0.1", "0.15"}) {
+    ASSERT_TRUE(std::getline(csv, line));
+    EXPECT_EQ(line, std::string(d) + ",0.333333,6,18");
+  }
 
   const auto missing = run("classify --model " + m + "," + (dir / "none.dgm").string() + " --data " + test);
   EXPECT_EQ(missing.code, 2);
