@@ -512,6 +512,42 @@ double good_minus_missed(const std::vector<const HapticSequence*>& trials, doubl
   return n[0] > 0 && n[1] > 0 ? sum[0] / n[0] - sum[1] / n[1] : std::numeric_limits<double>::quiet_NaN();
 }
 
+// How many of `test` a mixture of the `members` gets right, cut at `cut`: per class, the mean of
+// the members' likelihoods (over the members that have the class), each a density of the raw
+// forces: the feature scaling's Jacobian put back, since every STC scales its own way.
+int mixture_correct(const std::vector<const model::OutcomeModel*>& members,
+                    const std::vector<const HapticSequence*>& test, double cut) {
+  // class name -> per trial, the members' raw-force log-likelihoods
+  std::map<std::string, std::vector<std::vector<double>>> ll;
+  for (const auto* m : members) {
+    std::vector<hmm::TrialResult> per;
+    hmm::evaluate(*m, test, cut, &per);
+    double log_jacobian = 0;
+    for (int k = 0; k < model::kFeatures; ++k) log_jacobian += std::log(m->features.scale[k]);
+    for (std::size_t t = 0; t < test.size(); ++t)
+      for (std::size_t k = 0; k < m->classes.size(); ++k) {
+        auto& v = ll[m->classes[k].name];
+        v.resize(test.size());
+        v[t].push_back(per[t].result.log_likelihood[k] - static_cast<double>(per[t].samples) * log_jacobian);
+      }
+  }
+  int right = 0;
+  for (std::size_t t = 0; t < test.size(); ++t) {
+    std::string best;
+    double best_ll = -std::numeric_limits<double>::infinity();
+    for (const auto& [name, v] : ll) {
+      if (v[t].empty()) continue;
+      const double top = *std::max_element(v[t].begin(), v[t].end());
+      double sum = 0;
+      for (double x : v[t]) sum += std::exp(x - top);
+      const double mix = top + std::log(sum / static_cast<double>(v[t].size()));
+      if (mix > best_ll) best_ll = mix, best = name;
+    }
+    right += best == outcome_name(*test[t]->label);
+  }
+  return right;
+}
+
 int run_pooled(const std::map<std::string, std::string>& a) {
   const fs::path study = study_dir();
   if (study.empty()) {
@@ -746,9 +782,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     print_row("pooled, cut to one set's size", equal_right, n);
     // The same people's simulators as a committee of their own STCs rather than one STC of their
     // pooled trials: the vote of the simulators' answers (hmm::evaluate_vote, what `dressguard
-    // classify --model A.dgm,B.dgm,...` does), and for comparison a mixture: per class, the mean
-    // of the simulators' likelihoods, each a density of the raw forces (the feature scaling's
-    // Jacobian put back, since every STC scales its own way).
+    // classify --model A.dgm,B.dgm,...` does), and for comparison their mixture (mixture_correct).
     {
       int mix_right[5] = {}, vote_right[5] = {}, nm = 0;
       for (const auto& p : people) {
@@ -763,33 +797,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
         for (int c = 0; c < 5; ++c) {
           const double cut = c == 0 ? std::numeric_limits<double>::infinity() : kCuts[c - 1];
           vote_right[c] += hmm::evaluate_vote(members, test, cut).correct;
-          // class name -> per trial, the members' raw-force log-likelihoods
-          std::map<std::string, std::vector<std::vector<double>>> ll;
-          for (const auto* m : members) {
-            std::vector<hmm::TrialResult> per;
-            hmm::evaluate(*m, test, cut, &per);
-            double log_jacobian = 0;
-            for (int k = 0; k < model::kFeatures; ++k) log_jacobian += std::log(m->features.scale[k]);
-            for (std::size_t t = 0; t < test.size(); ++t)
-              for (std::size_t k = 0; k < m->classes.size(); ++k) {
-                auto& v = ll[m->classes[k].name];
-                v.resize(test.size());
-                v[t].push_back(per[t].result.log_likelihood[k] - static_cast<double>(per[t].samples) * log_jacobian);
-              }
-          }
-          for (std::size_t t = 0; t < test.size(); ++t) {
-            std::string best;
-            double best_ll = -std::numeric_limits<double>::infinity();
-            for (const auto& [name, v] : ll) {
-              if (v.size() <= t || v[t].empty()) continue;
-              const double top = *std::max_element(v[t].begin(), v[t].end());
-              double sum = 0;
-              for (double x : v[t]) sum += std::exp(x - top);
-              const double mix = top + std::log(sum / static_cast<double>(v[t].size()));
-              if (mix > best_ll) best_ll = mix, best = name;
-            }
-            mix_right[c] += best == outcome_name(*test[t]->label);
-          }
+          mix_right[c] += mixture_correct(members, test, cut);
         }
       }
       print_row("vote of the other people's STCs", vote_right, nm);
