@@ -27,6 +27,7 @@
 //     their missed ones at each cut (offline/sim/README.md, "The lateral force"). Seconds.
 //   bench_calib_pipeline pooled --calibrations A.json,B.json,... [--synth DIR] [--per-height N]
 //                               [--seed S] [--threads T] [--states K]
+//                               [--seed S1,S2,... --synth DIR1,DIR2,...]
 //     The pooled STC (paper VII: HMMs trained on the simulators of several people and tested on a
 //     person none of them was calibrated on) against each calibration's own STC and the 1-NN on
 //     the people's real trials. Each calibration synthesizes its set into DIR/<file's name>/, as
@@ -41,7 +42,8 @@
 //     single STCs of the people other than P (hmm::evaluate_vote) and, for comparison, their
 //     mixture (per class the mean likelihood of the raw forces). Prints the table and
 //     each simulator's early cue against the people's, writes DIR/pooled.json (plot:
-//     tools/plot/pooled_stc.py).
+//     tools/plot/pooled_stc.py). With several seeds, each seed's sets go in its own folder and each
+//     simulator trains on the union (N x seeds per height); the file is DIR1/pooled-S1-S2-....json.
 //   bench_calib_pipeline timing [--gown ...] [--generations G --population N] [--threads T]
 //                               [--arm-compliance ... --fist-shift ... --rim-shift ... --density ...]
 //     Wall time per simulation and of a G x N calibration of participant 4, with the final
@@ -566,10 +568,27 @@ int run_pooled(const std::map<std::string, std::string>& a) {
 
   SynthesisOptions so;
   so.per_height = std::stoi(get(a, "per-height", "40"));
-  so.seed = std::stoull(get(a, "seed", "1"));
   so.threads = std::stoi(get(a, "threads", "0"));
   const int states = std::stoi(get(a, "states", "10"));
-  const fs::path work = get(a, "synth", "pooled-stc");
+  // One synthesis per seed, each in its own folder: --seed 1,2 --synth A,B is A's sets (seed 1)
+  // and B's (seed 2), each simulator's trials the union of its sets.
+  auto split = [](const std::string& text) {
+    std::vector<std::string> parts;
+    std::stringstream in(text);
+    for (std::string x; std::getline(in, x, ',');)
+      if (!x.empty()) parts.push_back(x);
+    return parts;
+  };
+  std::vector<std::uint64_t> seeds;
+  for (const auto& s : split(get(a, "seed", "1"))) seeds.push_back(std::stoull(s));
+  std::vector<fs::path> works;
+  for (const auto& d : split(get(a, "synth", "pooled-stc"))) works.emplace_back(d);
+  if (seeds.empty() || works.size() != seeds.size()) {
+    std::fprintf(stderr, "pooled: --synth needs one folder per --seed (%zu seeds, %zu folders)\n", seeds.size(),
+                 works.size());
+    return 2;
+  }
+  const fs::path work = works.front();
 
   // Each calibration's synthesized set, its trials kept for the whole run.
   struct Source {
@@ -581,12 +600,24 @@ int run_pooled(const std::map<std::string, std::string>& a) {
   for (std::string f; std::getline(list, f, ',');) {
     if (f.empty()) continue;
     const Calibration cal = read_calibration(f);
-    const fs::path dir = work / fs::path(f).stem();
-    const auto t0 = std::chrono::steady_clock::now();
-    synthesize(cal, make_cloth_simulator(cal.gown).trial, so, dir, Comm::world());
-    std::printf("%s (participant %s): %d per height in %s, %.0f s\n", f.c_str(), cal.participant.c_str(), so.per_height,
-                dir.string().c_str(), seconds_since(t0));
-    sources.push_back({f, cal.participant, load_dataset(dir)});
+    Source src{f, cal.participant, {}};
+    for (std::size_t s = 0; s < seeds.size(); ++s) {
+      const fs::path dir = works[s] / fs::path(f).stem();
+      so.seed = seeds[s];
+      const auto t0 = std::chrono::steady_clock::now();
+      synthesize(cal, make_cloth_simulator(cal.gown).trial, so, dir, Comm::world());
+      std::printf("%s (participant %s): %d per height, seed %llu, in %s, %.0f s\n", f.c_str(), cal.participant.c_str(),
+                  so.per_height, static_cast<unsigned long long>(seeds[s]), dir.string().c_str(), seconds_since(t0));
+      // The s-th seed's trial i of a height is that height's trial s x per_height + i of the
+      // union, so that ids stay unique and the equal-size pool below splits the union evenly.
+      for (auto& t : load_dataset(dir).trials) {
+        const auto dash = t.id.rfind('-');
+        t.id = t.id.substr(0, dash + 1) +
+               std::to_string(static_cast<int>(s) * so.per_height + std::stoi(t.id.substr(dash + 1)));
+        src.set.trials.push_back(std::move(t));
+      }
+    }
+    sources.push_back(std::move(src));
   }
   const int k_all = static_cast<int>(sources.size());
 
@@ -619,8 +650,10 @@ int run_pooled(const std::map<std::string, std::string>& a) {
   };
 
   Json out = Json::object();
-  out.set("per_height", so.per_height);
-  out.set("seed", static_cast<double>(so.seed));
+  out.set("per_height", so.per_height * static_cast<int>(seeds.size()));
+  Json jseeds = Json::array();
+  for (auto sd : seeds) jseeds.push(static_cast<double>(sd));
+  out.set("seed", seeds.size() == 1 ? Json(static_cast<double>(seeds.front())) : jseeds);
   out.set("states", states);
   Json jsources = Json::array();
   for (const auto& src : sources) {
@@ -819,8 +852,13 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     jsets.push(jset);
   }
   out.set("force_sets", jsets);
-  write_file_atomic(work / "pooled.json", out.dump() + "\n");
-  std::printf("wrote %s\n", (work / "pooled.json").string().c_str());
+  // A union of seeds gets its own file beside the first seed's own.
+  std::string json_name = "pooled";
+  if (seeds.size() > 1)
+    for (auto sd : seeds) json_name += "-" + std::to_string(sd);
+  json_name += ".json";
+  write_file_atomic(work / json_name, out.dump() + "\n");
+  std::printf("wrote %s\n", (work / json_name).string().c_str());
   return 0;
 }
 }  // namespace
