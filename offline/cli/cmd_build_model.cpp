@@ -3,15 +3,21 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <iterator>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "args.h"
 #include "calibration.h"
 #include "commands.h"
 #include "dataset.h"
+#include "discrepancy.h"
 #include "files.h"
 #include "synthesis.h"
+#ifdef DRESSGUARD_HAVE_SIM
+#include "sim_bridge.h"
+#endif
 #ifdef DRESSGUARD_HAVE_HMM
 #include "stc.h"
 #endif
@@ -44,6 +50,12 @@ int run_build_model(int argc, char** argv) {
         "               than a zero force on every one of the calibration's sequences\n"
         "               (offline/calib/stc.h; pooled: on every sequence of every\n"
         "               calibration); with --data, both\n"
+        "  --discrepancy DATASET   with --calibration: add what each calibrated simulator gets\n"
+        "               wrong on its own sequences (found in DATASET, the measured data it was\n"
+        "               calibrated on) to every trial it synthesized, before training\n"
+        "               (offline/calib/discrepancy.h; Kennedy-O'Hagan's discrepancy term). Writes\n"
+        "               MODEL.dgm.discrepancy.csv. --forces auto then takes the paper's F_vertical:\n"
+        "               the correction removes the error that the rule above guards against\n"
         "  --per-height N --no-gown-noise --no-arm-noise --middle M --seed S --threads N --gown G\n"
         "               (synthesis; see dressguard synthesize --help)\n"
         "  --created T  creation time to record (default now, UTC); fixes the model's bytes\n"
@@ -51,7 +63,7 @@ int run_build_model(int argc, char** argv) {
     return 0;
   }
   args.allow_only({"help", "json", "no-gown-noise", "no-arm-noise", "calibration", "data", "out", "synth-dir",
-                   "states", "per-height", "seed", "gown", "threads", "forces", "middle", "created"});
+                   "states", "per-height", "seed", "gown", "threads", "forces", "middle", "created", "discrepancy"});
   const std::string out = args.require("out");
   if (args.has("calibration") == args.has("data")) throw UsageError("give exactly one of --calibration and --data");
   const int states = static_cast<int>(args.integer("states", 10));
@@ -59,8 +71,11 @@ int run_build_model(int argc, char** argv) {
   const std::string forces = args.get("forces").value_or("auto");
   if (forces != "auto" && forces != "both" && forces != "motion" && forces != "lateral")
     throw UsageError("--forces must be auto, both, lateral or motion");
+  if (args.has("discrepancy") && !args.has("calibration"))
+    throw UsageError("--discrepancy needs --calibration: it is a calibrated simulator's error on its own sequences");
   // The training sets: one per calibration (synthesized here) or the datasets given.
   std::vector<std::filesystem::path> sets;
+  std::vector<std::pair<std::string, Discrepancy>> discrepancies;  // per set (calibration file), with --discrepancy
   std::optional<std::vector<SequenceFit>> calibration_fits;
   bool lateral_fitted = false;
   if (args.has("calibration")) {
@@ -90,6 +105,21 @@ int run_build_model(int argc, char** argv) {
                      sets[i].string().c_str());
       run_synthesis(cals[i], args.get("gown").value_or(cals[i].gown), so, sets[i]);
     }
+    if (args.has("discrepancy") && Comm::world().is_root()) {  // training's input: one process's
+#ifndef DRESSGUARD_HAVE_SIM
+      throw UsageError("this dressguard was built without the cloth simulator (offline/sim); --discrepancy needs it");
+#else
+      const std::filesystem::path where = *args.get("discrepancy");
+      const Dataset measured = load_dataset(where);
+      for (std::size_t i = 0; i < cals.size(); ++i) {
+        // The synthesis's gown: the correction belongs to the simulator that made the trials.
+        const std::string gown = args.get("gown").value_or(cals[i].gown);
+        discrepancies.emplace_back(
+            files[i], discrepancy_of(cals[i], calibration_inputs(cals[i], measured, where / "manifest.csv"),
+                                     make_cloth_simulator(gown).trials));
+      }
+#endif
+    }
   } else {
     for (const auto& d : split_in_order(*args.get("data"))) sets.emplace_back(d);
     if (sets.empty()) throw UsageError("--data names no dataset");
@@ -100,13 +130,27 @@ int run_build_model(int argc, char** argv) {
 #else
   std::string data;  // the training sets' names, for the model's metadata and the summary
   for (const auto& d : sets) data += (data.empty() ? "" : ",") + d.string();
-  const Dataset ds = load_datasets(sets);
+  Dataset ds;
+  if (discrepancies.empty()) {
+    ds = load_datasets(sets);
+  } else {
+    for (std::size_t i = 0; i < sets.size(); ++i) {
+      Dataset one = load_dataset(sets[i]);
+      for (auto& t : one.trials) apply_discrepancy(discrepancies[i].second, t);
+      std::move(one.trials.begin(), one.trials.end(), std::back_inserter(ds.trials));
+    }
+    write_file_atomic(out + ".discrepancy.csv", discrepancy_csv(discrepancies));
+    data += " + discrepancy from " + *args.get("discrepancy");
+  }
   std::vector<const HapticSequence*> trials;
   for (const auto& t : ds.trials) trials.push_back(&t);
   StcAxes axes{model::kAxisVertical, "F_motion and F_vertical (training data given directly)"};
   if (forces == "both") axes = {model::kAxisVertical, "F_motion and F_vertical (--forces both)"};
   else if (forces == "lateral") axes = {model::kAxisLateral, "F_motion and F_lateral (--forces lateral)"};
   else if (forces == "motion") axes = {model::kAxisNone, "F_motion alone (--forces motion)"};
+  else if (!discrepancies.empty())
+    axes = {model::kAxisVertical, "F_motion and F_vertical (the paper's; --discrepancy corrects both on the "
+                                  "calibration's own sequences)"};
   else if (calibration_fits) axes = choose_stc_axes(*calibration_fits, lateral_fitted);
   StcOptions so;
   so.states = states;

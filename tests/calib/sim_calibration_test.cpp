@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "calibration.h"
+#include "discrepancy.h"
 #include "fake_sim.h"
 #include "prediction.h"
 #include "gown.h"
@@ -301,6 +302,57 @@ TEST(SimCalibration, Participant1sContrastCalibrationFitsTheirSequences) {
 // issue's 0.3: 0.4375 and 0.4216, bounded here by 0.45.
 TEST(SimCalibration, Participant4sSupportCalibrationFitsHisSequences) {
   expect_fits_own_sequences_to_the_bit("participant4-support.json", 0.45);
+}
+
+// The discrepancy term on a real calibration (discrepancy.h): participant 4's contrast file, his
+// two sequences. Added to the simulated curves it must bring them onto the measured ones,
+// except for what its 2 cm windows smooth away and the length term (eq. 4's w = 20 part, which
+// a force correction cannot move): the area part of L falls to the sensor's noise level, and the
+// early cue between the heights (what a classifier of cut sequences learns) becomes the
+// measured one.
+TEST(SimCalibration, DiscrepancyBringsParticipant4sSimulatorOntoHisSequences) {
+  const auto dir = study_dir();
+  if (dir.empty()) GTEST_SKIP() << "shared/data/kapusta2016-calibration-trials not present";
+  if (gown::measured_gown_path().empty()) GTEST_SKIP() << "shared/data/gown not present (calibrated on the measured gown)";
+  const Calibration cal =
+      read_calibration(std::filesystem::path(DRESSGUARD_SOURCE_DIR) / "models" / "participant4-contrast.json");
+  const auto inputs = calibration_inputs(cal, import_study(dir), dir);
+  ASSERT_EQ(inputs.size(), 2u);
+  ASSERT_EQ(inputs[0].height, ArmHeight::High);
+  ASSERT_EQ(inputs[1].height, ArmHeight::Low);
+  const auto sts = simulate_inputs(make_cloth_simulator(cal.gown).trials, cal.cloth, cal.offsets, inputs);
+  const Discrepancy d = measure_discrepancy(inputs, sts);
+  std::vector<HapticSequence> corrected;
+  for (std::size_t k = 0; k < inputs.size(); ++k) {
+    HapticSequence c = inputs[k];
+    c.samples = sts[k].samples;
+    apply_discrepancy(d, c);
+    corrected.push_back(c);
+    const double raw = area_objective(sts[k].samples, inputs[k].samples, 0.0);
+    const double fixed = area_objective(c.samples, inputs[k].samples, 0.0);
+    std::printf("  %s: area part of L %.4f -> %.4f with the discrepancy\n", inputs[k].id.c_str(), raw, fixed);
+    // Below the floor of the study's own repeats (two good trials of one person: 0.09; issue 4).
+    EXPECT_LT(fixed, 0.09) << inputs[k].id;
+    EXPECT_LT(fixed, 0.5 * raw) << inputs[k].id;
+  }
+  const double windows[3][2] = {{0.10, 0.15}, {0.15, 0.20}, {0.20, 0.30}};
+  for (const auto& w : windows) {
+    auto mean = [&](const HapticSequence& s) {
+      double sum = 0;
+      int n = 0;
+      for (const auto& x : s.samples)
+        if (x.travel >= w[0] && x.travel < w[1]) sum += x.f_motion, ++n;
+      return sum / n;
+    };
+    const double measured = mean(inputs[0]) - mean(inputs[1]);
+    const double simulated = mean(HapticSequence{"", "", ArmHeight::High, 0.1, {}, sts[0].samples}) -
+                             mean(HapticSequence{"", "", ArmHeight::Low, 0.1, {}, sts[1].samples});
+    const double fixed = mean(corrected[0]) - mean(corrected[1]);
+    std::printf("  high minus low F_motion over %.2f-%.2f m: measured %+.3f, simulated %+.3f, corrected %+.3f N\n",
+                w[0], w[1], measured, simulated, fixed);
+    // Half the faintest cue the pooled bench counts (0.02 N): the windows' smoothing is finer.
+    EXPECT_NEAR(fixed, measured, 0.01) << "over " << w[0] << "-" << w[1] << " m";
+  }
 }
 
 // One generation on participant 4's sequences (the paper's public code calibrated on the same

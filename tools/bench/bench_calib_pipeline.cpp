@@ -71,7 +71,9 @@
 
 #include "calibration.h"
 #include "dataset.h"
+#include "discrepancy.h"
 #include "files.h"
+#include "objective.h"
 #include "hmm.h"
 #include "prediction.h"
 #include "sim_bridge.h"
@@ -589,6 +591,12 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     return 2;
   }
   const fs::path work = works.front();
+  const std::string discrepancy_arg = get(a, "discrepancy", "off");
+  if (discrepancy_arg != "on" && discrepancy_arg != "off") {
+    std::fprintf(stderr, "pooled: --discrepancy takes on or off, not '%s'\n", discrepancy_arg.c_str());
+    return 2;
+  }
+  const bool discrepancy = discrepancy_arg == "on";
 
   // Each calibration's synthesized set, its trials kept for the whole run.
   struct Source {
@@ -616,6 +624,24 @@ int run_pooled(const std::map<std::string, std::string>& a) {
                std::to_string(static_cast<int>(s) * so.per_height + std::stoi(t.id.substr(dash + 1)));
         src.set.trials.push_back(std::move(t));
       }
+    }
+    // --discrepancy: what the simulator gets wrong on the person's own inputs, added to every
+    // synthesized trial (discrepancy.h). The inputs are simulated again and their objective
+    // checked against the file's, so that the correction is the calibration's own residual.
+    if (discrepancy) {
+      const std::vector<HapticSequence> inputs = calibration_inputs(cal, ds, study);
+      const auto simulated =
+          simulate_inputs(make_cloth_simulator(cal.gown).trials, cal.cloth, cal.offsets, inputs);
+      const auto objective_kind = parse_objective(cal.objective_kind);
+      std::printf("  discrepancy of %s:", fs::path(f).stem().string().c_str());
+      for (std::size_t i = 0; i < inputs.size(); ++i)
+        std::printf(" %s L %.3f (file %.3f)", inputs[i].id.c_str(),
+                    sequence_objective(objective_kind.value_or(ObjectiveKind::Area), simulated[i].samples,
+                                       inputs[i].samples),
+                    cal.fits[i].objective);
+      std::printf("\n");
+      const Discrepancy d = measure_discrepancy(inputs, simulated);
+      for (auto& t : src.set.trials) apply_discrepancy(d, t);
     }
     sources.push_back(std::move(src));
   }
@@ -856,6 +882,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
   std::string json_name = "pooled";
   if (seeds.size() > 1)
     for (auto sd : seeds) json_name += "-" + std::to_string(sd);
+  if (discrepancy) json_name += "-discrepancy";
   json_name += ".json";
   write_file_atomic(work / json_name, out.dump() + "\n");
   std::printf("wrote %s\n", (work / json_name).string().c_str());

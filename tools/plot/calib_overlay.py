@@ -36,6 +36,11 @@ Modes:
             `dressguard calibrate`'s progress lines (its stderr, kept in a file): the best L so far
             and each generation's best against the generation, and the best point's L per sequence
             where the lines name them. A resumed run's log may repeat a generation: the last wins.
+  discrepancy: calib_overlay.py discrepancy MODEL.dgm.discrepancy.csv --out discrepancy.png
+            `dressguard build-model --discrepancy`'s table: per calibration (one row of panels) and
+            force, what the calibrated simulator gets wrong on the person's own sequences, measured
+            minus simulated over travel, one line per arm height (offline/calib/discrepancy.h), with
+            the cuts of issue 4 dotted: what the correction adds to every synthesized trial.
 Reads only what dressguard writes (calibrate's curves file and progress lines; dataset folders).
 """
 import argparse
@@ -48,6 +53,20 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+
+
+CUTS = (0.15, 0.20, 0.25, 0.30)  # issue 4's cuts of the sequences [m]
+
+
+def cut_axes(ax, ylabel, up_to=1.0):
+    """Issue 4's cuts (dotted, up to `up_to`), the zero line and the travel axis of a force panel."""
+    for cut in CUTS:
+        if cut <= up_to:
+            ax.axvline(cut, color="gray", ls=":", lw=0.8)
+    ax.axhline(0, color="gray", lw=0.6)
+    ax.set_xlabel("travel [m]")
+    ax.set_ylabel(ylabel)
+    ax.grid(alpha=0.3)
 
 
 def read_curves(path):
@@ -116,13 +135,7 @@ def plot_classes(args):
         for row, pts in trials:
             pts = [p for p in pts if p[0] <= args.up_to]
             ax.plot([p[0] for p in pts], [p[idx] for p in pts], color=colors[row["label"]], lw=1.0, alpha=0.7)
-        for cut in (0.15, 0.20, 0.25, 0.30):
-            if cut <= args.up_to:
-                ax.axvline(cut, color="gray", ls=":", lw=0.8)
-        ax.axhline(0, color="gray", lw=0.6)
-        ax.set_xlabel("travel [m]")
-        ax.set_ylabel(name)
-        ax.grid(alpha=0.3)
+        cut_axes(ax, name, args.up_to)
     counts = {k: sum(1 for r, _ in trials if r["label"] == k) for k in colors}
     handles = [plt.Line2D([], [], color=c, label=f"{k} ({counts[k]} trials)") for k, c in colors.items() if counts[k]]
     axes[0].legend(handles=handles, fontsize=8, loc="lower left")
@@ -251,17 +264,35 @@ def plot_contrast(args):
                     ax.fill_between([a, b], [m - 2 * se] * 2, [m + 2 * se] * 2, color="gray", alpha=0.35, lw=0)
                 ax.plot([a, b], [m, m], color="tab:blue", lw=1.5)
                 ax.plot([a, b], [sim, sim], color="black", lw=1.5)
-            for cut in (0.15, 0.20, 0.25, 0.30):
-                ax.axvline(cut, color="gray", ls=":", lw=0.8)
-            ax.axhline(0, color="gray", lw=0.6)
+            cut_axes(ax, f"{name} difference [N]")
             ax.plot([], [], color="tab:blue", label="people (+-2 standard errors, grey)")
             ax.plot([], [], color="black", label="simulator")
             for colour, label in shade.values():
                 ax.fill_between([], [], [], color=colour, alpha=0.2, label=label)
             ax.set_title(f"{name}: high arm (good) minus {h} arm (missed)")
-            ax.set_xlabel("travel [m]")
-            ax.set_ylabel(f"{name} difference [N]")
-            ax.grid(alpha=0.3)
+            ax.legend(fontsize=7, loc="lower left")
+    fig.tight_layout()
+    fig.savefig(args.out, dpi=100)
+
+
+def plot_discrepancy(args):
+    rows = list(csv.DictReader(open(args.table, newline="")))
+    if not rows:
+        raise SystemExit(f"{args.table}: no rows (build-model --discrepancy writes one per grid point)")
+    cals = list(dict.fromkeys(r["calibration"] for r in rows))
+    colour = {"high": "tab:green", "middle": "tab:orange", "low": "tab:blue"}
+    forces = ("motion", "vertical", "lateral")
+    fig, axes = plt.subplots(len(cals), 3, figsize=(17, 3.4 * len(cals)), squeeze=False)
+    for i, cal in enumerate(cals):
+        for col, axis in enumerate(forces):
+            ax = axes[i][col]
+            for h in ("high", "middle", "low"):
+                mine = [r for r in rows if r["calibration"] == cal and r["height"] == h]
+                if mine:
+                    ax.plot([float(r["travel"]) for r in mine], [float(r["r_" + axis]) for r in mine],
+                            color=colour[h], lw=1.5, label=f"{h} arm")
+            cut_axes(ax, f"F_{axis} [N]")
+            ax.set_title(f"{os.path.basename(cal)}: F_{axis}, measured - simulated", fontsize=10)
             ax.legend(fontsize=7, loc="lower left")
     fig.tight_layout()
     fig.savefig(args.out, dpi=100)
@@ -337,8 +368,11 @@ def main():
     g = sub.add_parser("progress")
     g.add_argument("log")
     g.add_argument("--out", required=True)
+    z = sub.add_parser("discrepancy")
+    z.add_argument("table")
+    z.add_argument("--out", required=True)
     args = p.parse_args()
-    {"fit": plot_fit, "dataset": plot_dataset, "predict": plot_predict, "residual": plot_residual,
+    {"discrepancy": plot_discrepancy, "fit": plot_fit, "dataset": plot_dataset, "predict": plot_predict, "residual": plot_residual,
      "contrast": plot_contrast, "progress": plot_progress, "classes": plot_classes}[args.mode](args)
 
 
