@@ -30,13 +30,14 @@ bool window_mean(const std::vector<HapticSample>& samples, double lo, double hi,
 
 double last_travel(const std::vector<HapticSample>& s) { return s.empty() ? 0.0 : s.back().travel; }
 
-// r at x on one height's grid (non-empty).
-std::array<double, 3> on_grid(const std::vector<std::array<double, 3>>& r, const DiscrepancyOptions& o, double x) {
+// r at x on one height's grid (non-empty) that the curves covered up to `end`.
+std::array<double, 3> on_grid(const std::vector<std::array<double, 3>>& r, double end, const DiscrepancyOptions& o,
+                              double x) {
   if (x <= 0) return r.front();
   const double u = x / o.step;
   const auto last = static_cast<double>(r.size() - 1);
   if (u >= last) {
-    const double keep = std::max(0.0, 1.0 - (x - last * o.step) / o.fade);
+    const double keep = std::max(0.0, 1.0 - std::max(0.0, x - std::max(end, last * o.step)) / o.fade);
     std::array<double, 3> v = r.back();
     for (double& f : v) f *= keep;
     return v;
@@ -82,7 +83,9 @@ Discrepancy measure_discrepancy(const std::vector<HapticSequence>& inputs,
     auto& dst = d.by_height[h];
     if (count[h] == 0) {
       dst = r;
-    } else {  // a running mean over the inputs of this height, on the grid they share
+      d.end[h] = end;
+    } else {
+      d.end[h] = std::min(d.end[h], end);  // a running mean over the inputs of this height, on the grid they share
       dst.resize(std::min(dst.size(), r.size()));
       for (std::size_t j = 0; j < dst.size(); ++j)
         for (int k = 0; k < 3; ++k) dst[j][k] += (r[j][k] - dst[j][k]) / (count[h] + 1);
@@ -94,13 +97,13 @@ Discrepancy measure_discrepancy(const std::vector<HapticSequence>& inputs,
 
 std::array<double, 3> discrepancy_at(const Discrepancy& d, ArmHeight h, double x) {
   const auto& own = d.by_height[static_cast<int>(h)];
-  if (!own.empty()) return on_grid(own, d.options, x);
+  if (!own.empty()) return on_grid(own, d.end[static_cast<int>(h)], d.options, x);
   std::array<double, 3> sum{};
   int n = 0;
-  for (const auto& r : d.by_height) {
-    if (r.empty()) continue;
-    const auto v = on_grid(r, d.options, x);
-    for (int k = 0; k < 3; ++k) sum[k] += v[k];
+  for (int k = 0; k < 3; ++k) {
+    if (d.by_height[k].empty()) continue;
+    const auto v = on_grid(d.by_height[k], d.end[k], d.options, x);
+    for (int j = 0; j < 3; ++j) sum[j] += v[j];
     ++n;
   }
   if (n > 0)
@@ -117,8 +120,11 @@ void apply_discrepancy(const Discrepancy& d, HapticSequence& trial) {
   }
 }
 
-std::vector<HapticSequence> calibration_inputs(const Calibration& cal, const Dataset& measured,
-                                               const std::filesystem::path& where) {
+std::vector<HapticSequence> calibration_inputs(const Calibration& cal, const std::filesystem::path& cal_file,
+                                               const Dataset& measured, const std::filesystem::path& where) {
+  if (cal.fits.empty())
+    throw_input_error(cal_file, 0, "records no calibrated sequence ('sequences' is empty): nothing to measure a "
+                                   "discrepancy on");
   std::vector<HapticSequence> inputs;
   for (const auto& fit : cal.fits) {
     const auto it = std::find_if(measured.trials.begin(), measured.trials.end(),

@@ -39,6 +39,9 @@ struct Discrepancy {
   // Per ArmHeight: r_h at x = 0, step, 2 step, ... up to the travel both curves cover; empty when
   // the height had no input.
   std::array<std::vector<std::array<double, 3>>, 3> by_height;  // (motion, lateral, vertical) [N]
+  // Per ArmHeight, the travel both curves reached [m]: r_h keeps its last grid value up to it and
+  // fades only beyond (0: from the last grid point).
+  std::array<double, 3> end{};
 };
 
 // r_h of each input against its simulated curve (simulate_inputs: the calibrated cloth and
@@ -49,18 +52,18 @@ Discrepancy measure_discrepancy(const std::vector<HapticSequence>& inputs,
                                 const std::vector<SimulatedTrial>& simulated, const DiscrepancyOptions& o = {});
 
 // r_h at travel x for height h [N]: linear between grid points, the first value before 0, the
-// fade after the last. A height without its own input takes the mean of the heights that have
+// last one up to the height's end, the fade after it. A height without its own input takes the mean of the heights that have
 // one (the people's middle arm is a missed or a caught trial, between the two others).
 std::array<double, 3> discrepancy_at(const Discrepancy& d, ArmHeight h, double x);
 
 // Adds r_h(travel) to every sample of `trial` (h = trial.height).
 void apply_discrepancy(const Discrepancy& d, HapticSequence& trial);
 
-// The sequences calibration `cal` was fitted to (its fits' trial ids, in the file's order), from
-// the measured dataset `measured` read from `where`. Throws InputError naming `where` and the
-// first id it does not hold.
-std::vector<HapticSequence> calibration_inputs(const Calibration& cal, const Dataset& measured,
-                                               const std::filesystem::path& where);
+// The sequences calibration `cal` (read from `cal_file`) was fitted to (its fits' trial ids, in
+// the file's order), from the measured dataset `measured` read from `where`. Throws InputError
+// naming `cal_file` when it records no sequence, or `where` and the first id it does not hold.
+std::vector<HapticSequence> calibration_inputs(const Calibration& cal, const std::filesystem::path& cal_file,
+                                               const Dataset& measured, const std::filesystem::path& where);
 
 // The calibrated simulator's discrepancy: its inputs simulated with the calibration's cloth and
 // offsets (simulate_inputs, the very curves `calibrate` wrote), measured against them.

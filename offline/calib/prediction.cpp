@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "discrepancy.h"
 #include "files.h"
 
 namespace dressguard::calib {
@@ -86,6 +87,18 @@ std::pair<double, int> real_person_median(const Dataset& ds, const HapticSequenc
         other.participant != calibrated)
       l.push_back(sequence_objective(kind, other.samples, target.samples));
   return {median_of(l), static_cast<int>(l.size())};
+}
+
+void add_discrepancy(Prediction& p, const Discrepancy& d, const Dataset& ds, ObjectiveKind kind) {
+  for (auto& t : p.trials) {
+    const HapticSequence* measured = find_trial(ds, t.trial_id);
+    if (!measured) throw std::invalid_argument("add_discrepancy: the dataset holds no trial '" + t.trial_id + "'");
+    HapticSequence corrected{t.trial_id, t.participant, t.height, t.speed, std::nullopt, std::move(t.simulated)};
+    apply_discrepancy(d, corrected);
+    t.simulated = std::move(corrected.samples);
+    if (std::isfinite(t.objective)) t.objective = sequence_objective(kind, t.simulated, measured->samples);
+    t.vertical_sign = vertical_sign_agreement(t.simulated, measured->samples);
+  }
 }
 
 Prediction predict_others(const Calibration& cal, const Dataset& ds, const TrialSimulator& sim, int threads,

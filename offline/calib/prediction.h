@@ -82,6 +82,15 @@ Prediction predict_others(const Calibration& cal, const Dataset& ds, const Trial
 Prediction predict_others(const Calibration& cal, const Dataset& ds, const TrialSimulator& sim, int threads,
                           const Comm& comm, const std::function<void(const PredictionProgress&)>& progress = {});
 
+// The prediction of a simulator extended by a discrepancy term (discrepancy.h: what the
+// calibrated simulator gets wrong on its own person's sequences): `d` is added to every
+// simulated curve of `p`, and each trial's objective (the calibration's `kind`) and vertical
+// sign are scored again against its measured trial in `ds`. Whether that lowers L on *other*
+// people says how much of the error belongs to the simulator rather than to the person
+// (`dressguard predict --discrepancy`). Outcomes and ends stay the simulator's.
+struct Discrepancy;
+void add_discrepancy(Prediction& p, const Discrepancy& d, const Dataset& ds, ObjectiveKind kind);
+
 // The real-person yardstick of one target: L(other, target) for every labelled, non-caught trial
 // of the same height whose participant is neither the target's nor `calibrated`, with the
 // objective `kind`; their median (NaN when none) and count.

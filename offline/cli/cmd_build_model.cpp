@@ -115,7 +115,7 @@ int run_build_model(int argc, char** argv) {
         // The synthesis's gown: the correction belongs to the simulator that made the trials.
         const std::string gown = args.get("gown").value_or(cals[i].gown);
         discrepancies.emplace_back(
-            files[i], discrepancy_of(cals[i], calibration_inputs(cals[i], measured, where / "manifest.csv"),
+            files[i], discrepancy_of(cals[i], calibration_inputs(cals[i], files[i], measured, where / "manifest.csv"),
                                      make_cloth_simulator(gown).trials));
       }
 #endif

@@ -2,11 +2,13 @@
 // participants, beside the real-person yardstick (offline/calib/prediction.h).
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 
 #include "args.h"
 #include "calibration.h"
 #include "commands.h"
 #include "dataset.h"
+#include "discrepancy.h"
 #include "files.h"
 #include "prediction.h"
 #ifdef DRESSGUARD_HAVE_SIM
@@ -30,7 +32,7 @@ std::string number(double v) {
 }  // namespace
 
 int run_predict(int argc, char** argv) {
-  Args args(argc - 1, argv + 1, {"help", "json"});
+  Args args(argc - 1, argv + 1, {"help", "json", "discrepancy"});
   if (args.has("help")) {
     std::puts(
         "usage: dressguard predict --calibration CAL.json --data DATASET [--out PREFIX] [options]\n"
@@ -51,13 +53,17 @@ int run_predict(int argc, char** argv) {
         "  --out PREFIX   write PREFIX.csv (per trial), PREFIX.curves.csv, PREFIX.residual.csv and\n"
         "                 PREFIX.contrast.csv (for tools/plot/calib_overlay.py predict, residual and\n"
         "                 contrast)\n"
+        "  --discrepancy  add what the calibrated simulator gets wrong on its own person's\n"
+        "                 sequences (in DATASET too) to every simulated curve before scoring\n"
+        "                 (offline/calib/discrepancy.h): how much of the error is the simulator's\n"
+        "                 and not the person's\n"
         "  --window M     [m] travel window of the residual (default 0.05)\n"
         "  --gown G       override the calibration's gown (full, reduced, coarse)\n"
         "  --threads N    threads per process (default: all cores); under mpirun every rank runs a share\n"
         "  --json         machine-readable summary");
     return 0;
   }
-  args.allow_only({"help", "json", "calibration", "data", "out", "gown", "threads", "window"});
+  args.allow_only({"help", "json", "calibration", "data", "out", "gown", "threads", "window", "discrepancy"});
   const std::string cal_path = args.require("calibration");
   const std::string data = args.require("data");
   const int threads = static_cast<int>(args.integer("threads", 0));
@@ -78,12 +84,20 @@ int run_predict(int argc, char** argv) {
   if (comm.is_root())
     std::fprintf(stderr, "predict: the calibration of participant '%s' on %zu trials of other participants, gown %s\n",
                  cal.participant.c_str(), targets, gown.c_str());
-  const Prediction p =
-      predict_others(cal, ds, make_cloth_simulator(gown).trials, threads, comm, [](const PredictionProgress& pp) {
-        std::fprintf(stderr, "predict: %d/%d trials on this rank, elapsed %.0f s, ETA %.0f s\n", pp.done, pp.total,
-                     pp.elapsed_s, pp.eta_s);
-      });
+  const ClothSimulator sim = make_cloth_simulator(gown);
+  Prediction p = predict_others(cal, ds, sim.trials, threads, comm, [](const PredictionProgress& pp) {
+    std::fprintf(stderr, "predict: %d/%d trials on this rank, elapsed %.0f s, ETA %.0f s\n", pp.done, pp.total,
+                 pp.elapsed_s, pp.eta_s);
+  });
   if (!comm.is_root()) return 0;
+  if (args.has("discrepancy")) {
+    // The calibrating person's own sequences are in the same dataset.
+    const Discrepancy d =
+        discrepancy_of(cal, calibration_inputs(cal, cal_path, ds, std::filesystem::path(data) / "manifest.csv"), sim.trials);
+    add_discrepancy(p, d, ds, parse_objective(cal.objective_kind).value_or(ObjectiveKind::Area));
+    std::fprintf(stderr, "predict: every simulated curve corrected by participant '%s''s discrepancy\n",
+                 cal.participant.c_str());
+  }
   if (const auto prefix = args.get("out")) {
     write_file_atomic(*prefix + ".csv", prediction_csv(p));
     write_file_atomic(*prefix + ".curves.csv", prediction_curves_csv(p, ds));

@@ -173,6 +173,33 @@ if(STUDY)
      OR NOT EXISTS ${WORK}/pred.contrast.csv)
     message(FATAL_ERROR "predict on the study (${rc}):\n${out}\n${err}")
   endif()
+  # predict --discrepancy: the calibration's own error added to every simulated curve. A file
+  # without sequences has none to measure; c1.json (participant 4's two) on a dataset of his two
+  # trials and one of participant 5's: the one target scored again, its L not the plain one's.
+  expect_fail("predict --discrepancy without sequences" "cal4.json: records no calibrated sequence"
+              predict --calibration ${WORK}/cal4.json --data ${WORK}/study --discrepancy)
+  file(MAKE_DIRECTORY ${WORK}/study45)
+  file(WRITE ${WORK}/study45/manifest.csv "trial_id,participant,height,speed,label,file\n")
+  foreach(t s4-good-3 s4-miss-2 s5-good-1)
+    file(STRINGS ${WORK}/study/manifest.csv row REGEX "^${t},")
+    file(APPEND ${WORK}/study45/manifest.csv "${row}\n")
+    file(COPY ${WORK}/study/${t}.csv DESTINATION ${WORK}/study45)
+  endforeach()
+  foreach(mode plain discrepancy)
+    set(flag)
+    if(mode STREQUAL "discrepancy")
+      set(flag --discrepancy)
+    endif()
+    execute_process(COMMAND ${DG} predict --calibration ${WORK}/c1.json --data ${WORK}/study45 --threads 2 ${flag} --json
+                    RESULT_VARIABLE rc OUTPUT_VARIABLE out_${mode} ERROR_VARIABLE err)
+    string(REGEX MATCH "\"objective_median\": [0-9.e+-]+" l_${mode} "${out_${mode}}")
+    if(NOT rc EQUAL 0 OR NOT out_${mode} MATCHES "\"trials\": 1," OR l_${mode} STREQUAL "")
+      message(FATAL_ERROR "predict ${flag} on participant 5's good trial (${rc}):\n${out_${mode}}\n${err}")
+    endif()
+  endforeach()
+  if(NOT err MATCHES "corrected by participant '4''s discrepancy" OR l_plain STREQUAL l_discrepancy)
+    message(FATAL_ERROR "predict --discrepancy scored the plain simulator (${l_plain}, ${l_discrepancy}):\n${err}")
+  endif()
   # The residual table: a header and one row per 0.05 m window to the longest measured travel
   # (0.85 m: 17 windows) for each of the three heights.
   file(STRINGS ${WORK}/pred.residual.csv rows)

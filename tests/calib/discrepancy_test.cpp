@@ -65,9 +65,9 @@ TEST(Discrepancy, AddedToTheSimulatedCurveGivesTheMeasuredOne) {
   corrected.height = ArmHeight::Low;
   corrected.samples = sim.samples;
   apply_discrepancy(d, corrected);
-  // Up to the last grid point (within 1 cm of the curves' end); beyond it the fade begins.
-  const double last = 0.01 * static_cast<double>(d.by_height[static_cast<int>(ArmHeight::Low)].size() - 1);
-  for (std::size_t i = 0; i < sim.samples.size() && sim.samples[i].travel <= last; ++i) {
+  // To the end of both curves: the last grid point's value holds up to it.
+  EXPECT_EQ(d.end[static_cast<int>(ArmHeight::Low)], sim.samples.back().travel);
+  for (std::size_t i = 0; i < sim.samples.size(); ++i) {
     EXPECT_NEAR(corrected.samples[i].f_motion, measured.samples[i].f_motion, 1e-12);
     EXPECT_NEAR(corrected.samples[i].f_lateral, measured.samples[i].f_lateral, 1e-12);
     EXPECT_NEAR(corrected.samples[i].f_vertical, measured.samples[i].f_vertical, 1e-12);
@@ -84,6 +84,10 @@ TEST(Discrepancy, InterpolatesBetweenGridPointsAndFadesBeyondTheLast) {
   EXPECT_NEAR(at(0.02 + 0.025)[0], 1.5, 1e-12);  // half the fade: half the last value
   EXPECT_NEAR(at(0.02 + 0.05)[0], 0.0, 1e-12);   // the fade's end and beyond: nothing
   EXPECT_NEAR(at(0.5)[1], 0.0, 1e-12);
+  // Curves that went on to 0.03 m: the last value holds to there, the fade starts there.
+  d.end[0] = 0.03;
+  EXPECT_NEAR(at(0.028)[0], 3.0, 1e-12);
+  EXPECT_NEAR(at(0.03 + 0.025)[0], 1.5, 1e-12);
 }
 
 TEST(Discrepancy, AHeightWithoutItsOwnInputTakesTheMeanOfTheOthers) {
@@ -106,18 +110,24 @@ TEST(Discrepancy, BadInputNamesWhatIsWrong) {
   EXPECT_THROW(measure_discrepancy({}, {}, zero), std::invalid_argument);
   Calibration cal;
   cal.participant = "4";
+  try {
+    calibration_inputs(cal, "cal4.json", Dataset{}, "study/manifest.csv");
+    FAIL() << "no error for a calibration without sequences";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cal4.json: records no calibrated sequence"), std::string::npos) << e.what();
+  }
   cal.fits.push_back({"s4-good-3", ArmHeight::High, 0.1, 0.2, {}, {}, {}});
   Dataset ds;
   ds.trials.push_back(HapticSequence{"s4-miss-2", "4", ArmHeight::Low, 0.1, Outcome::Missed, {}});
   try {
-    calibration_inputs(cal, ds, "study/manifest.csv");
+    calibration_inputs(cal, "cal4.json", ds, "study/manifest.csv");
     FAIL() << "no error for an input the dataset does not hold";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("study/manifest.csv"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("'s4-good-3'"), std::string::npos) << e.what();
   }
   ds.trials.push_back(HapticSequence{"s4-good-3", "4", ArmHeight::High, 0.1, Outcome::Good, {}});
-  const auto inputs = calibration_inputs(cal, ds, "study/manifest.csv");
+  const auto inputs = calibration_inputs(cal, "cal4.json", ds, "study/manifest.csv");
   ASSERT_EQ(inputs.size(), 1u);
   EXPECT_EQ(inputs[0].id, "s4-good-3");
 }

@@ -10,6 +10,7 @@
 #include <mutex>
 
 #include "dataset.h"
+#include "discrepancy.h"
 #include "fake_sim.h"
 #include "files.h"
 #include "objective.h"
@@ -115,6 +116,48 @@ TEST(Prediction, ScoresEachTargetAgainstTheCalibratedPersonAndAThirdRealPerson) 
     EXPECT_EQ(s.trials, 3);
     EXPECT_GE(s.no_worse, 1);
   }
+}
+
+// The discrepancy term carried to other people (add_discrepancy, `predict --discrepancy`): every
+// measured trial is the stand-in's curve plus a constant c per force, so the calibrated person's
+// discrepancy is c at every grid point. A's twin is then predicted exactly once it is added
+// (L = 0, the sign everywhere); every other target is scored again against its own trial.
+TEST(Prediction, ADiscrepancyOfTheSimulatorCarriesToOtherPeople) {
+  Dataset ds = people({kA, kB, kTwinOfA});
+  const double c[3] = {-0.3, 0.1, 0.4};  // motion, lateral, vertical [N]
+  for (auto& t : ds.trials)
+    for (auto& x : t.samples) x.f_motion += c[0], x.f_lateral += c[1], x.f_vertical += c[2];
+  Calibration cal = calibration_of(kA);
+  for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low})
+    cal.fits.push_back({"p1-" + std::string(arm_height_name(h)), h, 0.1, 0.0, {}, {}, {}});
+  const auto inputs = calibration_inputs(cal, "cal1.json", ds, "people");
+  std::vector<SimulatedTrial> simulated;
+  for (const auto& in : inputs) simulated.push_back(testing::fake_simulate(cal.cloth, request_for(in, cal.offsets)));
+  const Discrepancy d = measure_discrepancy(inputs, simulated);
+  for (const auto& r : d.by_height) {
+    ASSERT_FALSE(r.empty());
+    for (const auto& v : r)
+      for (int k = 0; k < 3; ++k) ASSERT_NEAR(v[k], c[k], 1e-12);
+  }
+  Prediction p = predict_others(cal, ds, testing::fake_simulate, 1, Comm::world());
+  const Prediction raw = p;
+  add_discrepancy(p, d, ds, ObjectiveKind::Area);
+  ASSERT_EQ(p.trials.size(), 6u);
+  for (std::size_t i = 0; i < p.trials.size(); ++i) {
+    const auto& t = p.trials[i];
+    const HapticSequence& target = find(ds, t.trial_id);
+    EXPECT_EQ(t.objective, area_objective(t.simulated, target.samples)) << t.trial_id;
+    EXPECT_EQ(t.simulated_outcome, raw.trials[i].simulated_outcome);
+    EXPECT_EQ(t.simulated_end, raw.trials[i].simulated_end);
+    if (t.participant == "4") {
+      EXPECT_GT(raw.trials[i].objective, 0.1) << t.trial_id;  // c alone, before the term
+      EXPECT_NEAR(t.objective, 0.0, 1e-12) << t.trial_id;
+      if (!std::isnan(t.vertical_sign)) {
+        EXPECT_EQ(t.vertical_sign, 1.0) << t.trial_id;
+      }
+    }
+  }
+  EXPECT_THROW(add_discrepancy(p, d, people({kA}), ObjectiveKind::Area), std::invalid_argument);
 }
 
 // run_batch's promise: the same results on one thread and on two.

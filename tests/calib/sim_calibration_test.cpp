@@ -316,7 +316,7 @@ TEST(SimCalibration, DiscrepancyBringsParticipant4sSimulatorOntoHisSequences) {
   if (gown::measured_gown_path().empty()) GTEST_SKIP() << "shared/data/gown not present (calibrated on the measured gown)";
   const Calibration cal =
       read_calibration(std::filesystem::path(DRESSGUARD_SOURCE_DIR) / "models" / "participant4-contrast.json");
-  const auto inputs = calibration_inputs(cal, import_study(dir), dir);
+  const auto inputs = calibration_inputs(cal, "participant4-contrast.json", import_study(dir), dir);
   ASSERT_EQ(inputs.size(), 2u);
   ASSERT_EQ(inputs[0].height, ArmHeight::High);
   ASSERT_EQ(inputs[1].height, ArmHeight::Low);

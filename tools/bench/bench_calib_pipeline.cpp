@@ -629,7 +629,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     // synthesized trial (discrepancy.h). The inputs are simulated again and their objective
     // checked against the file's, so that the correction is the calibration's own residual.
     if (discrepancy) {
-      const std::vector<HapticSequence> inputs = calibration_inputs(cal, ds, study);
+      const std::vector<HapticSequence> inputs = calibration_inputs(cal, f, ds, study);
       const auto simulated =
           simulate_inputs(make_cloth_simulator(cal.gown).trials, cal.cloth, cal.offsets, inputs);
       const auto objective_kind = parse_objective(cal.objective_kind);
@@ -681,6 +681,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
   for (auto sd : seeds) jseeds.push(static_cast<double>(sd));
   out.set("seed", seeds.size() == 1 ? Json(static_cast<double>(seeds.front())) : jseeds);
   out.set("states", states);
+  out.set("discrepancy", discrepancy);
   Json jsources = Json::array();
   for (const auto& src : sources) {
     Json j = Json::object();

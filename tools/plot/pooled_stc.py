@@ -65,8 +65,9 @@ def main(argv):
     handles, labels = axes[0][0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, frameon=False)
     n = len(d["sources"])
+    term = ", each simulator's own error added (--discrepancy)" if d.get("discrepancy") else ""
     fig.suptitle(f"STCs on people no simulator was calibrated on: {n} calibrations, {d['per_height']} trials per "
-                 f"height each", fontsize=10)
+                 f"height each{term}", fontsize=10)
     fig.tight_layout(rect=(0, 0.1, 1, 1))
     fig.savefig(argv[2], dpi=110)
     return 0
