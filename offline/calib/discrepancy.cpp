@@ -127,13 +127,12 @@ std::vector<HapticSequence> calibration_inputs(const Calibration& cal, const std
                                    "discrepancy on");
   std::vector<HapticSequence> inputs;
   for (const auto& fit : cal.fits) {
-    const auto it = std::find_if(measured.trials.begin(), measured.trials.end(),
-                                 [&](const HapticSequence& t) { return t.id == fit.trial_id; });
-    if (it == measured.trials.end())
+    const HapticSequence* t = find_trial(measured, fit.trial_id);
+    if (!t)
       throw_input_error(where, 0,
                         "holds no trial '" + fit.trial_id + "', an input of participant " + cal.participant +
                             "'s calibration (give the dataset it was calibrated on)");
-    inputs.push_back(*it);
+    inputs.push_back(*t);
   }
   return inputs;
 }

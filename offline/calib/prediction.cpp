@@ -34,13 +34,6 @@ double median_of(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-// The dataset's trial with this id (ids are unique in a dataset), or null.
-const HapticSequence* find_trial(const Dataset& ds, const std::string& id) {
-  for (const auto& t : ds.trials)
-    if (t.id == id) return &t;
-  return nullptr;
-}
-
 bool predictable(const HapticSequence& t) { return t.label && *t.label != Outcome::Caught && !t.samples.empty(); }
 
 // The targets (indices) in groups of one height (one arm placement: the calibration's offset for

@@ -152,6 +152,12 @@ Dataset load_dataset(const fs::path& dir) {
   return ds;
 }
 
+const HapticSequence* find_trial(const Dataset& ds, const std::string& id) {
+  for (const auto& t : ds.trials)
+    if (t.id == id) return &t;
+  return nullptr;
+}
+
 Dataset load_datasets(const std::vector<fs::path>& dirs) {
   Dataset all;
   for (const auto& dir : dirs) {

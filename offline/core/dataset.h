@@ -27,6 +27,9 @@ std::string format_trial_csv(const std::vector<HapticSample>& samples);
 // Reads manifest.csv and every trial it names.
 Dataset load_dataset(const std::filesystem::path& dir);
 
+// The dataset's trial with this id (ids are unique within one dataset), or null.
+const HapticSequence* find_trial(const Dataset& ds, const std::string& id);
+
 // Several datasets read as one, their trials in the order given (a pooled training set: the
 // synthesized trials of several people's simulators). Trial ids may repeat from one dataset to
 // the next (every synthesized set names its trials sim-high-000, ...); within one they may not.
