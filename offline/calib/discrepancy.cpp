@@ -84,8 +84,8 @@ Discrepancy measure_discrepancy(const std::vector<HapticSequence>& inputs,
     if (count[h] == 0) {
       dst = r;
       d.end[h] = end;
-    } else {
-      d.end[h] = std::min(d.end[h], end);  // a running mean over the inputs of this height, on the grid they share
+    } else {  // a running mean over the inputs of this height, on the grid and travel they share
+      d.end[h] = std::min(d.end[h], end);
       dst.resize(std::min(dst.size(), r.size()));
       for (std::size_t j = 0; j < dst.size(); ++j)
         for (int k = 0; k < 3; ++k) dst[j][k] += (r[j][k] - dst[j][k]) / (count[h] + 1);

@@ -52,8 +52,9 @@ Discrepancy measure_discrepancy(const std::vector<HapticSequence>& inputs,
                                 const std::vector<SimulatedTrial>& simulated, const DiscrepancyOptions& o = {});
 
 // r_h at travel x for height h [N]: linear between grid points, the first value before 0, the
-// last one up to the height's end, the fade after it. A height without its own input takes the mean of the heights that have
-// one (the people's middle arm is a missed or a caught trial, between the two others).
+// last one up to the height's end, the fade after it. A height without its own input takes the
+// mean of the heights that have one (the people's middle arm is a missed or a caught trial,
+// between the two others).
 std::array<double, 3> discrepancy_at(const Discrepancy& d, ArmHeight h, double x);
 
 // Adds r_h(travel) to every sample of `trial` (h = trial.height).
