@@ -90,10 +90,13 @@ int run_classify(int argc, char** argv) {
         "  --sweep-out PREFIX      with --sweep: write PREFIX.csv and PREFIX.png (tools/plot/hmm_sweep.py)\n"
         "  --no-plot               with --sweep: write only the CSV\n"
         "  --participant P[,Q...]  only these participants' trials (leave-one-participant-out)\n"
+        "  --among C[,C...]        decide among these classes only, e.g. good,missed: the question a\n"
+        "                          classifier trained on the study's recordings (no caught trial) answers\n"
         "  --json                  print a machine-readable result");
     return 0;
   }
-  args.allow_only({"help", "json", "no-plot", "model", "data", "truncate-at", "sweep", "sweep-out", "participant"});
+  args.allow_only({"help", "json", "no-plot", "model", "data", "truncate-at", "sweep", "sweep-out", "participant",
+                    "among"});
   const std::string model_list = args.require("model"), data = args.require("data");
   const double truncate = args.number("truncate-at", std::numeric_limits<double>::infinity());
   if (!(truncate > 0)) throw UsageError("--truncate-at must be positive");
@@ -117,6 +120,12 @@ int run_classify(int argc, char** argv) {
     }
   }
   if (models.empty()) throw UsageError("--model needs at least one model file");
+  const hmm::ClassChoice among = split_in_order(args.get("among").value_or(""));
+  if (args.get("among") && among.empty()) throw UsageError("--among needs at least one class name");
+  for (size_t k = 0; k < models.size(); ++k)
+    for (const auto& name : among)
+      if (models[k].class_index(name) < 0)
+        throw UsageError("--among: '" + name + "' is not a class of " + model_paths[k]);
   std::vector<const model::OutcomeModel*> committee;
   for (const auto& m : models) committee.push_back(&m);
   // One model classifies as it always did (its log-likelihoods in the JSON); several vote.
@@ -128,7 +137,7 @@ int run_classify(int argc, char** argv) {
   if (trials.empty()) throw InputError(data + ": no trials" + (only.empty() ? "" : " of the given participants"));
   const bool json = args.has("json");
   auto evaluate_at = [&](double d) {
-    return single ? hmm::evaluate(*single, trials, d) : hmm::evaluate_vote(committee, trials, d);
+    return single ? hmm::evaluate(*single, trials, d, nullptr, among) : hmm::evaluate_vote(committee, trials, d, nullptr, among);
   };
 
   if (!sweep.empty()) {
@@ -172,7 +181,7 @@ int run_classify(int argc, char** argv) {
   if (!single) {
     // The committee: per trial the votes and the models' posterior sums.
     std::vector<hmm::Vote> per;
-    const auto ev = hmm::evaluate_vote(committee, trials, truncate, &per);
+    const auto ev = hmm::evaluate_vote(committee, trials, truncate, &per, among);
     if (json) {
       std::string rows, paths;
       for (size_t i = 0; i < per.size(); ++i) {
@@ -208,7 +217,7 @@ int run_classify(int argc, char** argv) {
     return 0;
   }
   std::vector<hmm::TrialResult> per;
-  const auto ev = hmm::evaluate(*single, trials, truncate, &per);
+  const auto ev = hmm::evaluate(*single, trials, truncate, &per, among);
   if (json) {
     std::string rows;
     for (const auto& r : per) {

@@ -570,18 +570,23 @@ model::OutcomeModel train_outcome_model(const std::vector<const HapticSequence*>
   return m;
 }
 
-Classification classify(const model::OutcomeModel& m, const FeatureSequence& seq) {
+Classification classify(const model::OutcomeModel& m, const FeatureSequence& seq, const ClassChoice& among) {
   Classification r;
+  const auto chosen = [&](size_t c) {
+    return among.empty() || std::find(among.begin(), among.end(), m.classes[c].name) != among.end();
+  };
   double best = kNegInf;
   for (size_t c = 0; c < m.classes.size(); ++c) {
     const double ll = forward_log_likelihood(m.classes[c], seq);
     r.log_likelihood.push_back(ll);
     const double score = ll + m.classes[c].log_prior;
-    if (score > best) best = score, r.predicted = static_cast<int>(c);
+    if (chosen(c) && score > best) best = score, r.predicted = static_cast<int>(c);
   }
+  if (r.predicted < 0)
+    throw std::invalid_argument("classify: none of the classes to decide among is a class of the model");
   double z = 0.0;
   for (size_t c = 0; c < m.classes.size(); ++c) {
-    r.posterior.push_back(std::exp(r.log_likelihood[c] + m.classes[c].log_prior - best));
+    r.posterior.push_back(chosen(c) ? std::exp(r.log_likelihood[c] + m.classes[c].log_prior - best) : 0.0);
     z += r.posterior.back();
   }
   for (double& p : r.posterior) p /= z;
@@ -589,7 +594,7 @@ Classification classify(const model::OutcomeModel& m, const FeatureSequence& seq
 }
 
 Evaluation evaluate(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials, double truncate_at,
-                    std::vector<TrialResult>* per_trial) {
+                    std::vector<TrialResult>* per_trial, const ClassChoice& among) {
   Evaluation ev;
   for (const auto& h : m.classes) ev.classes.push_back(h.name);
   const size_t k = m.classes.size();
@@ -604,7 +609,7 @@ Evaluation evaluate(const model::OutcomeModel& m, const std::vector<const Haptic
       ++ev.skipped;
       tr.truth = -1;
     } else {
-      tr.result = classify(m, seq);
+      tr.result = classify(m, seq, among);
       ev.confusion[tr.truth][tr.result.predicted]++;
       ev.total++;
       if (tr.result.predicted == tr.truth) ev.correct++;
@@ -632,7 +637,8 @@ int index_of(const std::vector<std::string>& names, const std::string& name) {
 
 }  // namespace
 
-Vote vote(const std::vector<const model::OutcomeModel*>& models, const HapticSequence& trial, double truncate_at) {
+Vote vote(const std::vector<const model::OutcomeModel*>& models, const HapticSequence& trial, double truncate_at,
+          const ClassChoice& among) {
   Vote v;
   v.classes = committee_classes(models);
   v.votes.assign(v.classes.size(), 0);
@@ -641,7 +647,7 @@ Vote vote(const std::vector<const model::OutcomeModel*>& models, const HapticSeq
     const FeatureSequence seq = features_of(trial, m->features, truncate_at);
     v.samples = seq.size();  // the cut is by travel, the same for every model
     if (seq.size() == 0) return v;
-    const Classification c = classify(*m, seq);
+    const Classification c = classify(*m, seq, among);
     for (size_t k = 0; k < m->classes.size(); ++k) v.posterior_sum[index_of(v.classes, m->classes[k].name)] += c.posterior[k];
     ++v.votes[index_of(v.classes, m->classes[c.predicted].name)];
   }
@@ -655,13 +661,13 @@ Vote vote(const std::vector<const model::OutcomeModel*>& models, const HapticSeq
 
 Evaluation evaluate_vote(const std::vector<const model::OutcomeModel*>& models,
                          const std::vector<const HapticSequence*>& trials, double truncate_at,
-                         std::vector<Vote>* per_trial) {
+                         std::vector<Vote>* per_trial, const ClassChoice& among) {
   Evaluation ev;
   ev.classes = committee_classes(models);
   ev.confusion.assign(ev.classes.size(), std::vector<int>(ev.classes.size(), 0));
   for (const auto* t : trials) {
     const int truth = t->label ? index_of(ev.classes, std::string(outcome_name(*t->label))) : -1;
-    Vote v = truth >= 0 ? vote(models, *t, truncate_at) : Vote{};
+    Vote v = truth >= 0 ? vote(models, *t, truncate_at, among) : Vote{};
     if (truth < 0 || v.predicted < 0) {
       ++ev.skipped;
     } else {

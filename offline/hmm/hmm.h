@@ -132,7 +132,15 @@ struct Classification {
   int predicted = -1;
   std::vector<double> log_likelihood, posterior;
 };
-Classification classify(const model::OutcomeModel& m, const FeatureSequence& seq);
+//
+// `among` (by name; empty: all of the model's classes) limits the decision to some classes: the
+// others keep their log-likelihood but get posterior 0 and are never predicted. Why: the study's
+// recordings hold good and missed trials only, so a classifier trained on them (the issue's
+// 1-nearest-neighbour baseline) can answer only "good or missed?"; asking an STC the same
+// question compares the two on one footing. The robot asks all three (a caught arm is the one
+// it must stop for), and so does every evaluation by default.
+using ClassChoice = std::vector<std::string>;
+Classification classify(const model::OutcomeModel& m, const FeatureSequence& seq, const ClassChoice& among = {});
 
 // Truth-by-prediction counts over a model's classes: confusion[truth][predicted].
 struct Evaluation {
@@ -150,11 +158,11 @@ struct TrialResult {
   Classification result;     // empty when skipped
 };
 
-// Classifies every trial (cut at truncate_at travel) and counts the confusion matrix over the
-// trials whose label is one of the model's classes.
+// Classifies every trial (cut at truncate_at travel, deciding `among` some classes as classify())
+// and counts the confusion matrix over the trials whose label is one of the model's classes.
 Evaluation evaluate(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials,
                     double truncate_at = std::numeric_limits<double>::infinity(),
-                    std::vector<TrialResult>* per_trial = nullptr);
+                    std::vector<TrialResult>* per_trial = nullptr, const ClassChoice& among = {});
 
 // ---- a committee of outcome models -----------------------------------------------------------
 
@@ -175,8 +183,9 @@ struct Vote {
   size_t samples = 0;                 // after the cut
   int predicted = -1;                 // index into classes; -1 when the cut leaves no sample
 };
+// With `among`, each model decides among those classes only (classify()).
 Vote vote(const std::vector<const model::OutcomeModel*>& models, const HapticSequence& trial,
-          double truncate_at = std::numeric_limits<double>::infinity());
+          double truncate_at = std::numeric_limits<double>::infinity(), const ClassChoice& among = {});
 
 // evaluate() for a committee: the confusion matrix over the union of the models' classes, every
 // labelled trial whose label one of the models knows. `per_trial` (may be null) gets every trial's
@@ -184,6 +193,6 @@ Vote vote(const std::vector<const model::OutcomeModel*>& models, const HapticSeq
 Evaluation evaluate_vote(const std::vector<const model::OutcomeModel*>& models,
                          const std::vector<const HapticSequence*>& trials,
                          double truncate_at = std::numeric_limits<double>::infinity(),
-                         std::vector<Vote>* per_trial = nullptr);
+                         std::vector<Vote>* per_trial = nullptr, const ClassChoice& among = {});
 
 }  // namespace dressguard::hmm

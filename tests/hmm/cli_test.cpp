@@ -136,6 +136,18 @@ TEST_F(CliTest, CommitteeOfModelsVotes) {
   const auto missing = run("classify --model " + m + "," + (dir / "none.dgm").string() + " --data " + test);
   EXPECT_EQ(missing.code, 2);
   EXPECT_NE(missing.err.find("none.dgm"), std::string::npos) << missing.err;
+
+  // Asked "good or missed?" (--among), the right committee still gets those 12 trials right and
+  // can no longer name the 6 caught ones; a class no model has is a usage error naming the file.
+  const auto among = run("classify --model " + m + "," + m + "," + liar + " --data " + test + " --among good,missed");
+  ASSERT_EQ(among.code, 0) << among.err;
+  EXPECT_NE(among.out.find("accuracy 0.6667 (12/18), a vote of 3 models"), std::string::npos) << among.out;
+  const auto single = run("classify --model " + m + " --data " + test + " --among good,missed --json");
+  ASSERT_EQ(single.code, 0) << single.err;
+  EXPECT_NEAR(json_field(single.out, "accuracy"), 12.0 / 18, 1e-12) << single.out;
+  const auto torn = run("classify --model " + m + "," + liar + " --data " + test + " --among good,torn");
+  EXPECT_EQ(torn.code, 2);
+  EXPECT_NE(torn.err.find("'torn' is not a class of " + m), std::string::npos) << torn.err;
 }
 
 // The sweep writes accuracy against travel as CSV (one row per distance) and a PNG.

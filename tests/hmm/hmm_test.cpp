@@ -433,6 +433,31 @@ TEST(HmmVote, ClassesAreTheUnionOfTheModels) {
   EXPECT_EQ(two.skipped, 1);
 }
 
+// Deciding among some classes: a trial at x = 8 is caught for a model with means good 0,
+// missed 3, caught 10 (the nearest mean, equal priors); asked "good or missed?" it is missed,
+// with the two-class posterior of the closed form and caught at exactly 0, its log-likelihood
+// still reported. A committee asked the same question gives caught no vote.
+TEST(HmmClassify, AmongLimitsTheDecisionToTheNamedClasses) {
+  const auto m = one_state_model(0, 3, true);
+  const HapticSequence t = one_sample(8.0, Outcome::Missed);
+  const auto seq = hmm::features_of(t, m.features);
+  const auto all = hmm::classify(m, seq);
+  EXPECT_EQ(m.classes[all.predicted].name, "caught");
+  const auto two = hmm::classify(m, seq, {"good", "missed"});
+  EXPECT_EQ(m.classes[two.predicted].name, "missed");
+  EXPECT_NEAR(two.posterior[0], posterior_good(8.0, 0, 3), 1e-12);
+  EXPECT_NEAR(two.posterior[1], 1 - posterior_good(8.0, 0, 3), 1e-12);
+  EXPECT_EQ(two.posterior[2], 0.0);
+  EXPECT_EQ(two.log_likelihood, all.log_likelihood);
+  const std::vector<const model::OutcomeModel*> committee = {&m, &m};
+  EXPECT_EQ(hmm::vote(committee, t).votes, (std::vector<int>{0, 0, 2}));
+  EXPECT_EQ(hmm::vote(committee, t, std::numeric_limits<double>::infinity(), {"good", "missed"}).votes,
+            (std::vector<int>{0, 2, 0}));
+  EXPECT_EQ(hmm::evaluate_vote(committee, {&t}).correct, 0);
+  EXPECT_EQ(hmm::evaluate_vote(committee, {&t}, std::numeric_limits<double>::infinity(), nullptr, {"good", "missed"}).correct, 1);
+  EXPECT_THROW(hmm::classify(m, seq, {"torn"}), std::invalid_argument);
+}
+
 // A committee of one is the model itself: on trials drawn from known HMMs, whole and cut, the
 // same confusion matrix as evaluate() and the posterior of classify().
 TEST(HmmVote, CommitteeOfOneIsTheModel) {

@@ -844,7 +844,10 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     // pooled trials: the vote of the simulators' answers (hmm::evaluate_vote, what `dressguard
     // classify --model A.dgm,B.dgm,...` does), and for comparison their mixture (mixture_correct).
     {
-      int mix_right[5] = {}, vote_right[5] = {}, nm = 0;
+      // The vote once more with each STC asked "good or missed?" (hmm::classify's `among`): the
+      // only question the 1-NN below, trained on recordings without a caught trial, can answer.
+      const hmm::ClassChoice good_or_missed{"good", "missed"};
+      int mix_right[5] = {}, vote_right[5] = {}, vote2_right[5] = {}, nm = 0;
       for (const auto& p : people) {
         std::vector<const HapticSequence*> test;
         for (const auto* t : all)
@@ -857,12 +860,15 @@ int run_pooled(const std::map<std::string, std::string>& a) {
         for (int c = 0; c < 5; ++c) {
           const double cut = c == 0 ? std::numeric_limits<double>::infinity() : kCuts[c - 1];
           vote_right[c] += hmm::evaluate_vote(members, test, cut).correct;
+          vote2_right[c] += hmm::evaluate_vote(members, test, cut, nullptr, good_or_missed).correct;
           mix_right[c] += mixture_correct(members, test, cut);
         }
       }
       print_row("vote of the other people's STCs", vote_right, nm);
+      print_row("vote, each asked good or missed only", vote2_right, nm);
       print_row("mixture of the other people's STCs", mix_right, nm);
       jset.set("vote_accuracy_whole_and_cuts", pct(vote_right, nm));
+      jset.set("vote_good_or_missed_accuracy_whole_and_cuts", pct(vote2_right, nm));
       jset.set("mixture_accuracy_whole_and_cuts", pct(mix_right, nm));
     }
     double nn[4];  // the 1-NN compares curves cut at the same travel: scored at the cuts only
