@@ -58,16 +58,23 @@ int run_build_model(int argc, char** argv) {
         "               the correction removes the error that the rule above guards against\n"
         "  --per-height N --no-gown-noise --no-arm-noise --middle M --seed S --threads N --gown G\n"
         "               (synthesis; see dressguard synthesize --help)\n"
+        "  --priors P   uniform (default: the paper's highest likelihood, and a caught arm's HMM\n"
+        "               as likely as the others before any force is read) | training: each\n"
+        "               class's share of the training trials (the Bayes decision for trials\n"
+        "               drawn like the synthesized ones: the protocol's three heights alike)\n"
         "  --created T  creation time to record (default now, UTC); fixes the model's bytes\n"
         "  --json       machine-readable summary");
     return 0;
   }
   args.allow_only({"help", "json", "no-gown-noise", "no-arm-noise", "calibration", "data", "out", "synth-dir",
-                   "states", "per-height", "seed", "gown", "threads", "forces", "middle", "created", "discrepancy"});
+                   "states", "per-height", "seed", "gown", "threads", "forces", "middle", "created", "discrepancy",
+                   "priors"});
   const std::string out = args.require("out");
   if (args.has("calibration") == args.has("data")) throw UsageError("give exactly one of --calibration and --data");
   const int states = static_cast<int>(args.integer("states", 10));
   if (states < 1 || states > 32) throw UsageError("--states must be in 1..32");
+  const std::string priors = args.get("priors").value_or("uniform");
+  if (priors != "uniform" && priors != "training") throw UsageError("--priors must be uniform or training");
   const std::string forces = args.get("forces").value_or("auto");
   if (forces != "auto" && forces != "both" && forces != "motion" && forces != "lateral")
     throw UsageError("--forces must be auto, both, lateral or motion");
@@ -154,8 +161,9 @@ int run_build_model(int argc, char** argv) {
   else if (calibration_fits) axes = choose_stc_axes(*calibration_fits, lateral_fitted);
   StcOptions so;
   so.states = states;
-  so.source = data + "; forces: " + axes.reason;
+  so.source = data + "; forces: " + axes.reason + (priors == "training" ? "; priors: the training shares" : "");
   so.second_axis = axes.second_axis;
+  so.uniform_priors = priors == "uniform";
   model::OutcomeModel m = build_outcome_model(trials, so);
   m.tool_version = "dressguard 0.1.0 build-model";
   m.created = args.get("created").value_or(utc_now());
@@ -163,8 +171,9 @@ int run_build_model(int argc, char** argv) {
   const double acc = accuracy(m, trials, std::numeric_limits<double>::infinity());
   if (args.has("json")) {
     std::printf("{\"model\": \"%s\", \"classes\": %zu, \"training_trials\": %zu, \"training_sets\": %zu, "
-                "\"training_accuracy\": %.4f, \"forces\": \"%s\"}\n",
-                out.c_str(), m.classes.size(), trials.size(), sets.size(), acc, stc_forces_name(axes.second_axis));
+                "\"training_accuracy\": %.4f, \"forces\": \"%s\", \"priors\": \"%s\"}\n",
+                out.c_str(), m.classes.size(), trials.size(), sets.size(), acc, stc_forces_name(axes.second_axis),
+                priors.c_str());
   } else {
     std::printf("wrote %s: %zu classes (", out.c_str(), m.classes.size());
     for (std::size_t i = 0; i < m.classes.size(); ++i) std::printf("%s%s", i ? ", " : "", m.classes[i].name.c_str());

@@ -528,6 +528,26 @@ model::FeatureConvention fit_feature_scaling(const std::vector<const HapticSeque
   return fc;
 }
 
+void set_log_priors(model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials, bool uniform) {
+  std::vector<double> count(m.classes.size(), 0.0);
+  for (const auto* t : trials)
+    if (t->label) {
+      const int c = m.class_index(outcome_name(*t->label));
+      if (c >= 0) count[c] += 1.0;
+    }
+  double total = 0.0;
+  for (double n : count) total += n;
+  for (size_t c = 0; c < m.classes.size(); ++c) {
+    if (!uniform && !(count[c] > 0))
+      throw std::invalid_argument("set_log_priors: no training trial of class '" + m.classes[c].name + "'");
+    m.classes[c].log_prior = uniform ? -std::log(static_cast<double>(m.classes.size())) : std::log(count[c] / total);
+  }
+  // Renormalise the priors in log space so that their exponentials sum to 1 to rounding.
+  double z = 0.0;
+  for (const auto& h : m.classes) z += std::exp(h.log_prior);
+  for (auto& h : m.classes) h.log_prior -= std::log(z);
+}
+
 model::OutcomeModel train_outcome_model(const std::vector<const HapticSequence*>& trials, const ModelOptions& opt,
                                         const std::function<void(const std::string&)>& progress) {
   std::vector<const HapticSequence*> labelled;
@@ -538,7 +558,6 @@ model::OutcomeModel train_outcome_model(const std::vector<const HapticSequence*>
   m.features = fit_feature_scaling(labelled, opt.features);
   m.source_dataset = opt.source_dataset;
   std::string summary;
-  std::vector<int> counts;
   for (int o = 0; o < kOutcomeCount; ++o) {
     std::vector<FeatureSequence> seqs;
     size_t samples = 0;
@@ -556,16 +575,9 @@ model::OutcomeModel train_outcome_model(const std::vector<const HapticSequence*>
                   r.log_likelihood, r.log_likelihood / static_cast<double>(samples));
     if (progress) progress(buf);
     summary += (summary.empty() ? "" : "; ") + std::string(buf);
-    counts.push_back(static_cast<int>(seqs.size()));
     m.classes.push_back(std::move(r.hmm));
   }
-  const double total = static_cast<double>(labelled.size());
-  for (size_t c = 0; c < m.classes.size(); ++c)
-    m.classes[c].log_prior = opt.uniform_priors ? -std::log(static_cast<double>(m.classes.size())) : std::log(counts[c] / total);
-  // Renormalise the priors in log space so that their exponentials sum to 1 to rounding.
-  double z = 0.0;
-  for (const auto& h : m.classes) z += std::exp(h.log_prior);
-  for (auto& h : m.classes) h.log_prior -= std::log(z);
+  set_log_priors(m, labelled, opt.uniform_priors);
   m.training_summary = summary;
   return m;
 }

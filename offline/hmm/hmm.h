@@ -120,6 +120,13 @@ struct ModelOptions {
   std::string source_dataset;   // written into the model's metadata
 };
 
+// The classes' log priors of m: equal (`uniform`, the paper's "highest likelihood"), or each
+// class's share of the labelled `trials` (the Bayes decision for data drawn like the training
+// set: a synthesized set has the study's three arm heights in equal numbers, so its shares are
+// the protocol's, not the measured trials'). Throws std::invalid_argument when a class has no
+// trial and `uniform` is false.
+void set_log_priors(model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials, bool uniform);
+
 // One HMM per outcome label present in `trials` (in Outcome order: good, missed, caught), trained
 // on the labelled trials; unlabelled trials are ignored. `progress` (may be empty) is told each
 // class's result. Throws std::invalid_argument when no trial is labelled.

@@ -38,6 +38,8 @@ expect_fail("synthesize with --per-height 1" "--per-height" synthesize --calibra
 expect_fail("synthesize with an unknown middle placement" "--middle" synthesize --calibration ${WORK}/bad.json --out ${WORK}/s --middle centre)
 expect_fail("build-model with both inputs" "exactly one" build-model --calibration ${WORK}/bad.json --data ${WORK} --out ${WORK}/m.dgm)
 expect_fail("build-model with unknown forces" "--forces" build-model --data ${WORK} --forces torque --out ${WORK}/m.dgm)
+expect_fail("build-model with unknown priors" "--priors must be uniform or training"
+            build-model --data ${WORK} --priors flat --out ${WORK}/m.dgm)
 expect_fail("build-model --discrepancy on a dataset" "--discrepancy needs --calibration"
             build-model --data ${WORK} --discrepancy ${WORK} --out ${WORK}/m.dgm)
 expect_fail("predict without --calibration" "--calibration" predict --data ${WORK})
@@ -261,6 +263,17 @@ if(STUDY)
     if(NOT rc EQUAL 0 OR NOT out MATCHES "\"forces\": \"motion,lateral\"" OR NOT rc2 EQUAL 0
        OR NOT shown MATCHES "feature 1 = \\([+-]f_lateral ")
       message(FATAL_ERROR "build-model --forces lateral (${rc}, ${rc2}):\n${out}\n${err}\n${shown}\n${err2}")
+    endif()
+    # --priors training: each class's share of the training trials (the study: 8 good, 14 missed),
+    # where the default gives each 1/2.
+    execute_process(COMMAND ${DG} build-model --data ${WORK}/study --out ${WORK}/mp.dgm --states 5 --priors training --json
+                    RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+    execute_process(COMMAND ${DG} model show ${WORK}/mp.dgm RESULT_VARIABLE rc2 OUTPUT_VARIABLE shown ERROR_VARIABLE err2)
+    execute_process(COMMAND ${DG} model show ${WORK}/m.dgm OUTPUT_VARIABLE shown_uniform)
+    if(NOT rc EQUAL 0 OR NOT out MATCHES "\"priors\": \"training\"" OR NOT rc2 EQUAL 0
+       OR NOT shown MATCHES "class 'good': 5 states, prior 0.3636" OR NOT shown MATCHES "class 'missed': 5 states, prior 0.6364"
+       OR NOT shown_uniform MATCHES "class 'good': 5 states, prior 0.5000")
+      message(FATAL_ERROR "build-model --priors training (${rc}, ${rc2}):\n${out}\n${err}\n${shown}\n${shown_uniform}")
     endif()
     # --created fixes the bytes: the same data twice give the same file (models/rebuild-default.sh).
     foreach(n 2 3)

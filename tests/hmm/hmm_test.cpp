@@ -458,6 +458,31 @@ TEST(HmmClassify, AmongLimitsTheDecisionToTheNamedClasses) {
   EXPECT_THROW(hmm::classify(m, seq, {"torn"}), std::invalid_argument);
 }
 
+// Priors: equal, or each class's share of the labelled training trials (2 good, 6 missed,
+// 0 caught: 1/4 and 3/4; unlabelled trials and labels the model lacks do not count); a class
+// without trials has no share to take.
+TEST(HmmOutcomeModel, PriorsAreEqualOrTheTrainingShares) {
+  auto m = one_state_model(0, 3);
+  std::vector<HapticSequence> ts;
+  for (int k = 0; k < 2; ++k) ts.push_back(one_sample(0, Outcome::Good));
+  for (int k = 0; k < 6; ++k) ts.push_back(one_sample(3, Outcome::Missed));
+  ts.push_back(one_sample(10, Outcome::Caught));
+  ts.push_back(one_sample(1, Outcome::Good));
+  ts.back().label.reset();
+  std::vector<const HapticSequence*> tr;
+  for (const auto& t : ts) tr.push_back(&t);
+  hmm::set_log_priors(m, tr, false);
+  EXPECT_NEAR(std::exp(m.classes[0].log_prior), 0.25, 1e-15);
+  EXPECT_NEAR(std::exp(m.classes[1].log_prior), 0.75, 1e-15);
+  hmm::set_log_priors(m, tr, true);
+  EXPECT_NEAR(std::exp(m.classes[0].log_prior), 0.5, 1e-15);
+  EXPECT_NEAR(std::exp(m.classes[1].log_prior), 0.5, 1e-15);
+  auto m3 = one_state_model(0, 3, true);
+  tr.pop_back();
+  tr.pop_back();  // no caught trial left
+  EXPECT_THROW(hmm::set_log_priors(m3, tr, false), std::invalid_argument);
+}
+
 // A committee of one is the model itself: on trials drawn from known HMMs, whole and cut, the
 // same confusion matrix as evaluate() and the posterior of classify().
 TEST(HmmVote, CommitteeOfOneIsTheModel) {
