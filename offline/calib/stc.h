@@ -51,11 +51,12 @@ const char* stc_forces_name(int second_axis);
 model::OutcomeModel build_outcome_model(const std::vector<const HapticSequence*>& trials, const StcOptions& o);
 
 // How many of the labelled `trials` the model gets right, with every trial cut after
-// `truncate_at` metres of travel (infinity: whole). A trial whose label is not a class of the
-// model counts as wrong (a model trained on simulated data without any "good" trial cannot be
-// right about a good trial); `counted` receives the number of labelled trials.
+// `truncate_at` metres of travel (infinity: whole), deciding `among` the named classes only
+// (empty: all; hmm::classify). A trial whose label is not a class of the model counts as wrong
+// (a model trained on simulated data without any "good" trial cannot be right about a good
+// trial); `counted` receives the number of labelled trials.
 int count_correct(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials,
-                  double truncate_at, int* counted = nullptr);
+                  double truncate_at, int* counted = nullptr, const std::vector<std::string>& among = {});
 
 // The same as a fraction of the labelled trials (0 when there are none).
 double accuracy(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials,

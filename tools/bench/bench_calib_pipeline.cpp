@@ -485,9 +485,10 @@ int run_timing(const std::map<std::string, std::string>& a) {
 
 
 // Correct classifications of a model over `test`, whole and at the four cuts (out[0] whole).
-void count_right(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& test, int out[5]) {
-  out[0] += count_correct(m, test, std::numeric_limits<double>::infinity());
-  for (int c = 0; c < 4; ++c) out[c + 1] += count_correct(m, test, kCuts[c]);
+void count_right(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& test, int out[5],
+                 const std::vector<std::string>& among = {}) {
+  out[0] += count_correct(m, test, std::numeric_limits<double>::infinity(), nullptr, among);
+  for (int c = 0; c < 4; ++c) out[c + 1] += count_correct(m, test, kCuts[c], nullptr, among);
 }
 
 // The index of a synthesized trial, from its id (synthesis_trial_id: "sim-high-007" -> 7).
@@ -787,6 +788,33 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     std::vector<model::OutcomeModel> singles;  // in the order of `sources`
     per_calibration("single", "alone, all of them", [](const Source& src) { return src.set.trials; },
                     [](const Source& src) { return "alone: " + fs::path(src.file).stem().string(); }, &singles);
+    // The same STCs with the committee's two choices of session 26 (below): priors the shares of
+    // their training sets, each asked "good or missed?".
+    {
+      int sum[5] = {}, n_all = 0;
+      Json rows = Json::array();
+      for (std::size_t s = 0; s < sources.size(); ++s) {
+        model::OutcomeModel m = singles[s];
+        std::vector<const HapticSequence*> tr, test;
+        for (const auto& t : sources[s].set.trials) tr.push_back(&t);
+        hmm::set_log_priors(m, tr, false);
+        for (const auto* t : all)
+          if (t->participant != sources[s].participant) test.push_back(t);
+        int right[5] = {};
+        count_right(m, test, right, {"good", "missed"});
+        for (int c = 0; c < 5; ++c) sum[c] += right[c];
+        n_all += static_cast<int>(test.size());
+        print_row(("good|missed, shares: " + fs::path(sources[s].file).stem().string()).c_str(), right,
+                  static_cast<int>(test.size()));
+        Json j = Json::object();
+        j.set("calibration", sources[s].file);
+        j.set("accuracy_whole_and_cuts", pct(right, static_cast<int>(test.size())));
+        rows.push(j);
+      }
+      print_row("good|missed, shares, all of them", sum, n_all);
+      jset.set("single_training_priors_good_or_missed", rows);
+      jset.set("single_training_priors_good_or_missed_accuracy_whole_and_cuts", pct(sum, n_all));
+    }
     // The baseline classifier (paper VI-B.1): the same HMMs trained on the 2-3 measured sequences
     // that each calibration was fitted to (the study holds no caught trial, so BC knows good and
     // missed only).
