@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Accuracy against travel of the pooled STC (paper VII: HMMs trained on the simulators of
 several people, tested on a person none of them was calibrated on), beside each calibration's
-own STC, the vote of those STCs (a committee), the baseline classifier on each calibration's 2-3
+own STC, the vote of those STCs (a committee; also with each STC's training shares as priors
+and asked "good or missed?", offline/calib/README.md session 26), the baseline classifier on each calibration's 2-3
 measured inputs, and the 1-nearest-neighbour classifier on the other people's measured curves.
 
 usage: pooled_stc.py POOLED.json OUT.png
@@ -52,6 +53,10 @@ def main(argv):
         if "vote_accuracy_whole_and_cuts" in s:
             ax.plot(xs, cuts_then_whole(s["vote_accuracy_whole_and_cuts"]), color="tab:red", lw=2.2, marker="D",
                     ms=5, label="vote of the simulators' STCs")
+        if "vote_training_priors_good_or_missed_accuracy_whole_and_cuts" in s:
+            ax.plot(xs, cuts_then_whole(s["vote_training_priors_good_or_missed_accuracy_whole_and_cuts"]),
+                    color="darkred", lw=2.2, ls="--", marker="D", mfc="white", ms=5,
+                    label="vote, training priors, good or missed")
         ax.plot(CUTS, [100 * a for a in s["one_nn_accuracy_at_cuts"]], color="tab:green", lw=1.5, ls=":", marker="^",
                 ms=5, label="1-NN on other people's curves")
         ax.set_title(s["forces"], fontsize=10)
