@@ -788,16 +788,22 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     std::vector<model::OutcomeModel> singles;  // in the order of `sources`
     per_calibration("single", "alone, all of them", [](const Source& src) { return src.set.trials; },
                     [](const Source& src) { return "alone: " + fs::path(src.file).stem().string(); }, &singles);
-    // The same STCs with the committee's two choices of session 26 (below): priors the shares of
-    // their training sets, each asked "good or missed?".
+    // The same STCs with priors the shares of their training sets (hmm::set_log_priors, build-model
+    // --priors training) instead of the paper's equal priors: where the forces barely differ yet
+    // (0.15 m), the prior decides. The rows below also ask each of them "good or missed?": the
+    // committee's two choices of session 26, whose vote further down uses the same models.
+    std::vector<model::OutcomeModel> shares = singles;
+    for (std::size_t s = 0; s < sources.size(); ++s) {
+      std::vector<const HapticSequence*> tr;
+      for (const auto& t : sources[s].set.trials) tr.push_back(&t);
+      hmm::set_log_priors(shares[s], tr, false);
+    }
     {
       int sum[5] = {}, n_all = 0;
       Json rows = Json::array();
       for (std::size_t s = 0; s < sources.size(); ++s) {
-        model::OutcomeModel m = singles[s];
-        std::vector<const HapticSequence*> tr, test;
-        for (const auto& t : sources[s].set.trials) tr.push_back(&t);
-        hmm::set_log_priors(m, tr, false);
+        const model::OutcomeModel& m = shares[s];
+        std::vector<const HapticSequence*> test;
         for (const auto* t : all)
           if (t->participant != sources[s].participant) test.push_back(t);
         int right[5] = {};
@@ -874,16 +880,8 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     {
       // The vote once more with each STC asked "good or missed?" (hmm::classify's `among`): the
       // only question the 1-NN below, trained on recordings without a caught trial, can answer.
-      // And both again with each STC's priors the shares of its training set (hmm::set_log_priors,
-      // build-model --priors training) instead of the paper's equal priors: where the forces
-      // barely differ yet (0.15 m), the prior decides.
+      // And both again with the training shares as priors (`shares`, above).
       const hmm::ClassChoice good_or_missed{"good", "missed"};
-      std::vector<model::OutcomeModel> shares = singles;
-      for (std::size_t s = 0; s < sources.size(); ++s) {
-        std::vector<const HapticSequence*> tr;
-        for (const auto& t : sources[s].set.trials) tr.push_back(&t);
-        hmm::set_log_priors(shares[s], tr, false);
-      }
       int mix_right[5] = {}, vote_right[5] = {}, vote2_right[5] = {}, share_right[5] = {}, share2_right[5] = {}, nm = 0;
       for (const auto& p : people) {
         std::vector<const HapticSequence*> test;
