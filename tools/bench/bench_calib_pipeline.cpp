@@ -41,7 +41,7 @@
 //     2-3 measured sequences each calibration was fitted to (paper VI-B.1); the vote of the
 //     single STCs of the people other than P (hmm::evaluate_vote) and, for comparison, their
 //     mixture (per class the mean likelihood of the raw forces). Prints the table and
-//     each simulator's early cue against the people's, writes DIR/pooled.json (plot:
+//     each simulator's early cue against the people's and its own person's, writes DIR/pooled.json (plot:
 //     tools/plot/pooled_stc.py). With several seeds, each seed's sets go in its own folder and each
 //     simulator trains on the union (N x seeds per height); the file is DIR1/pooled-S1-S2-....json.
 //   bench_calib_pipeline timing [--gown ...] [--generations G --population N] [--threads T]
@@ -603,13 +603,14 @@ int run_pooled(const std::map<std::string, std::string>& a) {
   struct Source {
     std::string file, participant;
     Dataset set;
+    std::vector<HapticSequence> inputs;  // the measured sequences the calibration was fitted to
   };
   std::vector<Source> sources;
   std::stringstream list(a.at("calibrations"));
   for (std::string f; std::getline(list, f, ',');) {
     if (f.empty()) continue;
     const Calibration cal = read_calibration(f);
-    Source src{f, cal.participant, {}};
+    Source src{f, cal.participant, {}, calibration_inputs(cal, f, ds, study)};
     for (std::size_t s = 0; s < seeds.size(); ++s) {
       const fs::path dir = works[s] / fs::path(f).stem();
       so.seed = seeds[s];
@@ -630,7 +631,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     // synthesized trial (discrepancy.h). The inputs are simulated again and their objective
     // checked against the file's, so that the correction is the calibration's own residual.
     if (discrepancy) {
-      const std::vector<HapticSequence> inputs = calibration_inputs(cal, f, ds, study);
+      const std::vector<HapticSequence>& inputs = src.inputs;
       const auto simulated =
           simulate_inputs(make_cloth_simulator(cal.gown).trials, cal.cloth, cal.offsets, inputs);
       const auto objective_kind = parse_objective(cal.objective_kind);
@@ -709,7 +710,9 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     std::printf("good minus missed, mean force [N] over 0.10-0.15 / 0.15-0.20 / 0.20-0.25 / 0.25-0.30 m of travel "
                 "(* the sign reversed against the people's, ~ under %.2f N where the people's is not):\n", kFaint);
     Json jcue = Json::array();
+    // One row: the 12 differences (force-major), printed and kept in the JSON.
     auto row = [&](const std::string& who, const std::vector<const HapticSequence*>& trials, const double* people) {
+      std::array<double, 12> cue{};
       Json j = Json::object();
       j.set("who", who);
       std::printf("  %-24s", who.c_str());
@@ -719,6 +722,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
         std::printf(" %s", forces[f].first);
         for (int w = 0; w < 4; ++w) {
           const double d = good_minus_missed(trials, windows[w][0], windows[w][1], forces[f].second);
+          cue[4 * f + w] = d;
           const double ref = people ? people[4 * f + w] : 0.0;
           const bool cue = people && std::isfinite(d) && std::abs(ref) >= kFaint;
           const bool wrong = cue && std::abs(d) >= kFaint && (d > 0) != (ref > 0);
@@ -734,16 +738,42 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       j.set("reversed", reversed);
       j.set("faint", faint);
       jcue.push(j);
+      return cue;
     };
-    double people[12];
-    for (int f = 0; f < 3; ++f)
-      for (int w = 0; w < 4; ++w) people[4 * f + w] = good_minus_missed(all, windows[w][0], windows[w][1], forces[f].second);
-    row("the people (measured)", all, nullptr);
+    const std::array<double, 12> people = row("the people (measured)", all, nullptr);
+    // Each simulator beside the person it was calibrated on: that person's own measured inputs
+    // (one per height). Whether a simulator's cue is wrong or its person's is unlike the others'
+    // decides what a longer search could change: it can bring the first to the second, no further.
+    // The distances below sum, per window, the simulators' |difference| from each reference.
+    std::array<double, 12> off_own{}, off_people{}, own_off_people{};
     for (const auto& src : sources) {
-      std::vector<const HapticSequence*> tr;
+      std::vector<const HapticSequence*> tr, own;
       for (const auto& t : src.set.trials) tr.push_back(&t);
-      row(fs::path(src.file).stem().string(), tr, people);
+      for (const auto& t : src.inputs) own.push_back(&t);
+      const auto sim = row(fs::path(src.file).stem().string(), tr, people.data());
+      const auto mine = row("  participant " + src.participant + "'s inputs", own, people.data());
+      for (int i = 0; i < 12; ++i) {
+        off_own[i] += std::abs(sim[i] - mine[i]) / k_all;
+        off_people[i] += std::abs(sim[i] - people[i]) / k_all;
+        own_off_people[i] += std::abs(mine[i] - people[i]) / k_all;
+      }
     }
+    auto distances = [&](const char* what, const std::array<double, 12>& v, const char* key) {
+      std::printf("  %-24s", what);
+      Json j = Json::object();
+      for (int f = 0; f < 3; ++f) {
+        Json jf = Json::array();
+        std::printf(" %s", forces[f].first);
+        for (int w = 0; w < 4; ++w) std::printf("  %4.2f ", v[4 * f + w]), jf.push(v[4 * f + w]);
+        j.set(forces[f].first, jf);
+      }
+      std::printf("\n");
+      out.set(key, j);
+    };
+    std::printf("mean |difference| [N] over the %d simulators, same windows:\n", k_all);
+    distances("simulator - its person", off_own, "early_cue_simulator_minus_own_person");
+    distances("simulator - the people", off_people, "early_cue_simulator_minus_people");
+    distances("its person - the people", own_off_people, "early_cue_own_person_minus_people");
     out.set("early_cue_good_minus_missed", jcue);
   }
   Json jsets = Json::array();
