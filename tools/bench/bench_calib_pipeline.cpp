@@ -28,6 +28,7 @@
 //   bench_calib_pipeline pooled --calibrations A.json,B.json,... [--synth DIR] [--per-height N]
 //                               [--seed S] [--threads T] [--states K]
 //                               [--seed S1,S2,... --synth DIR1,DIR2,...]
+//                               [--discrepancy on|off] [--arm-noise on|off] [--gown-noise on|off]
 //     The pooled STC (paper VII: HMMs trained on the simulators of several people and tested on a
 //     person none of them was calibrated on) against each calibration's own STC and the 1-NN on
 //     the people's real trials. Each calibration synthesizes its set into DIR/<file's name>/, as
@@ -592,12 +593,19 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     return 2;
   }
   const fs::path work = works.front();
-  const std::string discrepancy_arg = get(a, "discrepancy", "off");
-  if (discrepancy_arg != "on" && discrepancy_arg != "off") {
-    std::fprintf(stderr, "pooled: --discrepancy takes on or off, not '%s'\n", discrepancy_arg.c_str());
-    return 2;
+  // on|off switches; the noise models are the paper's ablations (V-A), both on by default.
+  std::map<std::string, bool> switches{{"discrepancy", false}, {"arm-noise", true}, {"gown-noise", true}};
+  for (auto& [name, value] : switches) {
+    const std::string v = get(a, name, value ? "on" : "off");
+    if (v != "on" && v != "off") {
+      std::fprintf(stderr, "pooled: --%s takes on or off, not '%s'\n", name.c_str(), v.c_str());
+      return 2;
+    }
+    value = v == "on";
   }
-  const bool discrepancy = discrepancy_arg == "on";
+  const bool discrepancy = switches.at("discrepancy");
+  so.arm_noise = switches.at("arm-noise");
+  so.gown_noise = switches.at("gown-noise");
 
   // Each calibration's synthesized set, its trials kept for the whole run.
   struct Source {
@@ -684,6 +692,8 @@ int run_pooled(const std::map<std::string, std::string>& a) {
   out.set("seed", seeds.size() == 1 ? Json(static_cast<double>(seeds.front())) : jseeds);
   out.set("states", states);
   out.set("discrepancy", discrepancy);
+  out.set("arm_noise", so.arm_noise);
+  out.set("gown_noise", so.gown_noise);
   Json jsources = Json::array();
   for (const auto& src : sources) {
     Json j = Json::object();
@@ -961,6 +971,8 @@ int run_pooled(const std::map<std::string, std::string>& a) {
   if (seeds.size() > 1)
     for (auto sd : seeds) json_name += "-" + std::to_string(sd);
   if (discrepancy) json_name += "-discrepancy";
+  if (!so.arm_noise) json_name += "-no-arm-noise";
+  if (!so.gown_noise) json_name += "-no-gown-noise";
   json_name += ".json";
   write_file_atomic(work / json_name, out.dump() + "\n");
   std::printf("wrote %s\n", (work / json_name).string().c_str());
