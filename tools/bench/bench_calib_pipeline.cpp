@@ -722,7 +722,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     Json jcue = Json::array();
     // One row: the 12 differences (force-major), printed and kept in the JSON.
     auto row = [&](const std::string& who, const std::vector<const HapticSequence*>& trials, const double* people) {
-      std::array<double, 12> cue{};
+      std::array<double, 12> diff{};
       Json j = Json::object();
       j.set("who", who);
       std::printf("  %-24s", who.c_str());
@@ -732,7 +732,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
         std::printf(" %s", forces[f].first);
         for (int w = 0; w < 4; ++w) {
           const double d = good_minus_missed(trials, windows[w][0], windows[w][1], forces[f].second);
-          cue[4 * f + w] = d;
+          diff[4 * f + w] = d;
           const double ref = people ? people[4 * f + w] : 0.0;
           const bool cue = people && std::isfinite(d) && std::abs(ref) >= kFaint;
           const bool wrong = cue && std::abs(d) >= kFaint && (d > 0) != (ref > 0);
@@ -748,13 +748,14 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       j.set("reversed", reversed);
       j.set("faint", faint);
       jcue.push(j);
-      return cue;
+      return diff;
     };
     const std::array<double, 12> people = row("the people (measured)", all, nullptr);
     // Each simulator beside the person it was calibrated on: that person's own measured inputs
     // (one per height). Whether a simulator's cue is wrong or its person's is unlike the others'
     // decides what a longer search could change: it can bring the first to the second, no further.
-    // The distances below sum, per window, the simulators' |difference| from each reference.
+    // The distances below are, per window, the mean over the simulators of |difference| from
+    // each reference.
     std::array<double, 12> off_own{}, off_people{}, own_off_people{};
     for (const auto& src : sources) {
       std::vector<const HapticSequence*> tr, own;
