@@ -55,6 +55,8 @@ def main(argv):
             sys.stderr.write(f"{path}: {e}\n")
             return 1
         term = "with the discrepancy term" if d.get("discrepancy") else "simulation alone"
+        if d.get("arm_noise") is False:
+            term += ", no arm-height noise"
         for ax, force in zip(row, FORCES):
             lo = min(min(p[force] + s[force]) for s, p in sims + [(people, people)])
             hi = max(max(p[force] + s[force]) for s, p in sims + [(people, people)])

@@ -71,6 +71,9 @@ def main(argv):
     fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, frameon=False)
     n = len(d["sources"])
     term = ", each simulator's own error added (--discrepancy)" if d.get("discrepancy") else ""
+    # The noise models are on unless the file says otherwise (files from before session 27 do not).
+    term += "".join(f", no {what} noise" for key, what in (("arm_noise", "arm-height"), ("gown_noise", "gown"))
+                    if d.get(key) is False)
     fig.suptitle(f"STCs on people no simulator was calibrated on: {n} calibrations, {d['per_height']} trials per "
                  f"height each{term}", fontsize=10)
     fig.tight_layout(rect=(0, 0.1, 1, 1))
