@@ -90,6 +90,14 @@ namespace {
 constexpr double kCuts[4] = {0.15, 0.20, 0.25, 0.30};
 constexpr double kOneNnReference[4] = {0.71, 0.83, 0.94, 1.00};
 
+// The classifiers take trials by pointer; the sets own them and outlive the pointers.
+std::vector<const HapticSequence*> pointers_to(const std::vector<HapticSequence>& trials) {
+  std::vector<const HapticSequence*> p;
+  p.reserve(trials.size());
+  for (const auto& t : trials) p.push_back(&t);
+  return p;
+}
+
 std::map<std::string, std::string> parse_args(int argc, char** argv, int first) {
   std::map<std::string, std::string> a;
   for (int i = first; i < argc; ++i) {
@@ -188,8 +196,7 @@ int run_baseline() {
     return 2;
   }
   const Dataset ds = import_study(study);
-  std::vector<const HapticSequence*> all;
-  for (const auto& t : ds.trials) all.push_back(&t);
+  const std::vector<const HapticSequence*> all = pointers_to(ds.trials);
   std::printf("1-NN on force curves, leave one participant out, %zu trials: right at 0.15 / 0.20 / 0.25 / 0.30 m\n",
               all.size());
   const NnForces sets[] = {{"F_motion", true, false, false},     {"F_vertical", false, true, false},
@@ -241,8 +248,7 @@ int run_eval(const std::map<std::string, std::string>& a) {
   for (int i = 0; i < kPersonParams; ++i) std::printf(", %s %s", kPersonParamInfo[i].name, person_words[i].c_str());
   std::printf("\n");
 
-  std::vector<const HapticSequence*> all;
-  for (const auto& t : ds.trials) all.push_back(&t);
+  const std::vector<const HapticSequence*> all = pointers_to(ds.trials);
   double nn[4];
   for (int c = 0; c < 4; ++c) nn[c] = one_nn_accuracy(all, kCuts[c]);
   std::printf("1-NN on force curves (leave one participant out): %.0f%% %.0f%% %.0f%% %.0f%% at 0.15/0.20/0.25/0.30 m "
@@ -323,9 +329,8 @@ int run_eval(const std::map<std::string, std::string>& a) {
     const fs::path synth = work / ("synth" + p);
     synthesize(cal, sim.trial, so, synth, Comm::world());
     const Dataset sd = load_dataset(synth);
-    std::vector<const HapticSequence*> strain, btrain, test;
-    for (const auto& t : sd.trials) strain.push_back(&t);
-    for (const auto& t : inputs) btrain.push_back(&t);
+    const std::vector<const HapticSequence*> strain = pointers_to(sd.trials), btrain = pointers_to(inputs);
+    std::vector<const HapticSequence*> test;
     for (const auto& t : ds.trials)
       if (t.participant != p) test.push_back(&t);
     // The STC with the forces its calibration supports (stc.h: choose_stc_axes, the default of
@@ -565,8 +570,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     return 2;
   }
   const Dataset ds = import_study(study);
-  std::vector<const HapticSequence*> all;
-  for (const auto& t : ds.trials) all.push_back(&t);
+  const std::vector<const HapticSequence*> all = pointers_to(ds.trials);
   std::set<std::string> people;
   for (const auto& t : ds.trials) people.insert(t.participant);
 
@@ -758,11 +762,8 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     // each reference.
     std::array<double, 12> off_own{}, off_people{}, own_off_people{};
     for (const auto& src : sources) {
-      std::vector<const HapticSequence*> tr, own;
-      for (const auto& t : src.set.trials) tr.push_back(&t);
-      for (const auto& t : src.inputs) own.push_back(&t);
-      const auto sim = row(fs::path(src.file).stem().string(), tr, people.data());
-      const auto mine = row("  participant " + src.participant + "'s inputs", own, people.data());
+      const auto sim = row(fs::path(src.file).stem().string(), pointers_to(src.set.trials), people.data());
+      const auto mine = row("  participant " + src.participant + "'s inputs", pointers_to(src.inputs), people.data());
       for (int i = 0; i < 12; ++i) {
         off_own[i] += std::abs(sim[i] - mine[i]) / k_all;
         off_people[i] += std::abs(sim[i] - people[i]) / k_all;
@@ -804,8 +805,8 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       Json rows = Json::array();
       for (const auto& src : sources) {
         const std::vector<HapticSequence> owned = training(src);
-        std::vector<const HapticSequence*> tr, test;
-        for (const auto& t : owned) tr.push_back(&t);
+        const std::vector<const HapticSequence*> tr = pointers_to(owned);
+        std::vector<const HapticSequence*> test;
         for (const auto* t : all)
           if (t->participant != src.participant) test.push_back(t);
         int right[5] = {};
@@ -834,11 +835,8 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     // (0.15 m), the prior decides. The rows below also ask each of them "good or missed?": the
     // committee's two choices of session 26, whose vote further down uses the same models.
     std::vector<model::OutcomeModel> shares = singles;
-    for (std::size_t s = 0; s < sources.size(); ++s) {
-      std::vector<const HapticSequence*> tr;
-      for (const auto& t : sources[s].set.trials) tr.push_back(&t);
-      hmm::set_log_priors(shares[s], tr, false);
-    }
+    for (std::size_t s = 0; s < sources.size(); ++s)
+      hmm::set_log_priors(shares[s], pointers_to(sources[s].set.trials), false);
     {
       int sum[5] = {}, n_all = 0;
       Json rows = Json::array();

@@ -55,8 +55,9 @@ def main(argv):
             sys.stderr.write(f"{path}: {e}\n")
             return 1
         term = "with the discrepancy term" if d.get("discrepancy") else "simulation alone"
-        if d.get("arm_noise") is False:
-            term += ", no arm-height noise"
+        # As pooled_stc.py: the noise models are on unless the file says otherwise.
+        term += "".join(f", no {what} noise" for key, what in (("arm_noise", "arm-height"), ("gown_noise", "gown"))
+                        if d.get(key) is False)
         for ax, force in zip(row, FORCES):
             lo = min(min(p[force] + s[force]) for s, p in sims + [(people, people)])
             hi = max(max(p[force] + s[force]) for s, p in sims + [(people, people)])
