@@ -19,9 +19,10 @@ std::string synthesis_trial_id(ArmHeight height, int index) {
 }
 
 const char* middle_arm_name(MiddleArm m) { return m == MiddleArm::CaughtEdge ? "caught-edge" : "nominal"; }
+const char* high_low_arm_name(HighLowArm a) { return a == HighLowArm::RepeatBand ? "repeat-band" : "paper"; }
 
 TrialRequest synthesis_request(const Calibration& cal, ArmHeight height, int index, const SynthesisOptions& o,
-                               double middle_base) {
+                               double middle_base, const ArmBand& band) {
   const std::uint64_t key = static_cast<std::uint64_t>(height) * 1000003ull + static_cast<std::uint64_t>(index);
   const std::uint64_t stream = mix_seed(o.seed, key);
   const double u = static_cast<double>(stream >> 11) * 0x1.0p-53;  // U[0, 1)
@@ -36,6 +37,10 @@ TrialRequest synthesis_request(const Calibration& cal, ArmHeight height, int ind
     // Middle: noise on the nominal height (or the simulator's edge), U[-6, 0] cm (the paper's
     // gravity compensation).
     r.arm_offset = middle_base + (o.arm_noise ? kArmNoiseMiddleLow * u : 0.0);
+  } else if (o.high_low == HighLowArm::RepeatBand) {
+    // High and low: calibrated offset + U[lower, upper], the repeat band.
+    r.arm_offset =
+        cal.offsets[static_cast<int>(height)] + (o.arm_noise ? band.lower + (band.upper - band.lower) * u : 0.0);
   } else {
     // High and low: calibrated offset + U[-1.5, 1.5] cm.
     r.arm_offset = cal.offsets[static_cast<int>(height)] + (o.arm_noise ? kArmNoiseHighLow * (2.0 * u - 1.0) : 0.0);
@@ -92,13 +97,55 @@ MiddleEdge locate_middle_edge(const Calibration& cal, const TrialSimulator& sim,
   return e;
 }
 
+ArmBand locate_repeat_band(const Calibration& cal, const TrialSimulator& sim, ArmHeight height, int threads,
+                           const Comm& comm, double step) {
+  if (height == ArmHeight::Middle)
+    throw std::invalid_argument("locate_repeat_band: the middle arm has no calibrated height to scan around");
+  const int k_max = static_cast<int>(std::lround(kArmNoiseHighLow / step));
+  if (!(step > 0) || k_max < 1)
+    throw std::invalid_argument("locate_repeat_band: step must be positive and at most 1.5 cm");
+  auto request = [&](double offset) {
+    TrialRequest q;
+    q.height = height;
+    q.arm_offset = cal.offsets[static_cast<int>(height)] + offset;
+    q.speed = 0.1;
+    q.max_travel = cal.rig_travel;
+    return q;
+  };
+  const char* name = height == ArmHeight::High ? "high" : "low";
+  // R: every rank simulates it (deterministic, so the same bits everywhere); one trial's time.
+  const SimulatedTrial reference = sim(cal.cloth, request(0.0));
+  if (!reference.finite || reference.samples.empty())
+    throw std::runtime_error(std::string("locate_repeat_band: the calibrated ") + name +
+                             " arm's trial did not stay finite");
+  ArmBand b;
+  b.at_calibrated = reference.outcome;
+  b.tolerance = reference.outcome == Outcome::Missed ? kRepeatDistanceMissed : kRepeatDistanceGood;
+  for (int k = -k_max; k <= k_max; ++k)
+    if (k != 0) b.offsets.push_back(k * step);
+  const int n = static_cast<int>(b.offsets.size());
+  b.distances = run_batch(n, 1, thread_count(threads), comm, [&](int t, double* r) {
+    const SimulatedTrial st = sim(cal.cloth, request(b.offsets[t]));
+    // A trial that blew up is as far from R as a trial can be (finite, so the band's file holds it).
+    r[0] = st.finite && !st.samples.empty() ? area_objective(st.samples, reference.samples) : 1e9;
+  });
+  b.trials = n + 1;
+  // offsets[k_max - 1] is -step, offsets[k_max] is +step: walk outwards from 0 on each side.
+  b.lower = 0.0;
+  for (int t = k_max - 1; t >= 0 && b.distances[t] <= b.tolerance; --t) b.lower = b.offsets[t];
+  b.upper = 0.0;
+  for (int t = k_max; t < n && b.distances[t] <= b.tolerance; ++t) b.upper = b.offsets[t];
+  return b;
+}
+
 namespace {
 
 // What the synthesized trials depend on, and only that: a calibration file rewritten with more
 // diagnostics (axis fits, provenance) still resumes its synthesis. Version 2 of the record
 // (2026-11-23); version 1 held the whole calibration file and is read through the same fields.
 std::string settings_record_of(const Json& calibration, const Json& per_height, const Json& gown_noise,
-                               const Json& arm_noise, const Json& seed, MiddleArm middle = MiddleArm::Nominal) {
+                               const Json& arm_noise, const Json& seed, MiddleArm middle = MiddleArm::Nominal,
+                               HighLowArm high_low = HighLowArm::Paper) {
   Json c = Json::object();
   for (const char* key : {"participant", "cloth", "arm_offsets", "gown", "rig_travel_m"})
     c.set(key, calibration.at(key));
@@ -111,12 +158,13 @@ std::string settings_record_of(const Json& calibration, const Json& per_height, 
   j.set("seed", seed);
   // Only when not the paper's: records written before the option existed still match.
   if (middle != MiddleArm::Nominal) j.set("middle", middle_arm_name(middle));
+  if (high_low != HighLowArm::Paper) j.set("high_low", high_low_arm_name(high_low));
   return j.dump() + "\n";
 }
 
 std::string settings_record(const Calibration& cal, const SynthesisOptions& o) {
   return settings_record_of(calibration_to_json(cal), Json(o.per_height), Json(o.gown_noise), Json(o.arm_noise),
-                            Json(std::to_string(o.seed)), o.middle);
+                            Json(std::to_string(o.seed)), o.middle, o.high_low);
 }
 
 // A folder's record in version 2, whichever version it was written in ("" when unreadable).
@@ -134,6 +182,39 @@ std::string stored_record(const fs::path& path) {
 }
 
 fs::path marker_path(const fs::path& out, const std::string& id) { return out / ".synth" / (id + ".done"); }
+
+// The repeat bands of a synthesis, kept beside its markers so that a resumed run does not scan
+// again (the settings record guarantees they belong to the same calibration and seed).
+Json band_to_json(const ArmBand& b) {
+  Json j = Json::object();
+  j.set("lower_m", b.lower);
+  j.set("upper_m", b.upper);
+  j.set("tolerance", b.tolerance);
+  j.set("at_calibrated", std::string(outcome_name(b.at_calibrated)));
+  Json offsets = Json::array(), distances = Json::array();
+  for (std::size_t k = 0; k < b.offsets.size(); ++k) {
+    offsets.push(b.offsets[k]);
+    distances.push(b.distances[k]);
+  }
+  j.set("offsets_m", offsets);
+  j.set("distances", distances);
+  j.set("trials", b.trials);
+  return j;
+}
+
+ArmBand band_from_json(const Json& j, const fs::path& file) {
+  ArmBand b;
+  b.lower = j.at("lower_m").number();
+  b.upper = j.at("upper_m").number();
+  b.tolerance = j.at("tolerance").number();
+  const auto at = parse_outcome(j.at("at_calibrated").string());
+  if (!at) throw_input_error(file, 0, "at_calibrated is not an outcome");
+  b.at_calibrated = *at;
+  for (const Json& v : j.at("offsets_m").items()) b.offsets.push_back(v.number());
+  for (const Json& v : j.at("distances").items()) b.distances.push_back(v.number());
+  b.trials = static_cast<int>(j.at("trials").number());
+  return b;
+}
 
 }  // namespace
 
@@ -159,6 +240,28 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
     edge = locate_middle_edge(cal, sim, options.threads, comm);
     middle_base = edge.offset;
   }
+  ArmBand high_band, low_band;
+  if (options.high_low == HighLowArm::RepeatBand && options.arm_noise) {
+    const fs::path band_path = out / ".synth" / "repeat-band.json";
+    if (fs::exists(band_path)) {
+      const Json j = Json::parse(read_file(band_path), band_path);
+      high_band = band_from_json(j.at("high"), band_path);
+      low_band = band_from_json(j.at("low"), band_path);
+    } else {
+      high_band = locate_repeat_band(cal, sim, ArmHeight::High, options.threads, comm);
+      low_band = locate_repeat_band(cal, sim, ArmHeight::Low, options.threads, comm);
+      comm.barrier();
+      if (comm.is_root()) {
+        Json j = Json::object();
+        j.set("high", band_to_json(high_band));
+        j.set("low", band_to_json(low_band));
+        write_file_atomic(band_path, j.dump() + "\n");
+      }
+    }
+    comm.barrier();
+  }
+  if (!options.arm_noise) high_band.lower = high_band.upper = low_band.lower = low_band.upper = 0.0;
+  auto band_of = [&](ArmHeight h) -> const ArmBand& { return h == ArmHeight::Low ? low_band : high_band; };
 
   const ArmHeight heights[3] = {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low};
   const int total = 3 * options.per_height;
@@ -183,7 +286,7 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
           }
         }
         if (!resumed) {
-          const SimulatedTrial st = sim(cal.cloth, synthesis_request(cal, h, index, options, middle_base));
+          const SimulatedTrial st = sim(cal.cloth, synthesis_request(cal, h, index, options, middle_base, band_of(h)));
           if (!st.finite || st.samples.empty())
             throw std::runtime_error("simulation of " + id + " did not stay finite; check the calibration");
           write_file_atomic(csv, format_trial_csv(st.samples));
@@ -209,6 +312,8 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
   SynthesisSummary s;
   s.trials = total;
   s.edge = edge;
+  s.high_band = high_band;
+  s.low_band = low_band;
   for (int t = 0; t < total; ++t) {
     s.per_label[static_cast<int>(res[2 * t])]++;
     s.resumed += res[2 * t + 1] > 0.5;
@@ -222,7 +327,7 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
       seq.id = synthesis_trial_id(h, index);
       seq.participant = "";
       seq.height = h;
-      seq.speed = synthesis_request(cal, h, index, options, middle_base).speed;
+      seq.speed = synthesis_request(cal, h, index, options, middle_base, band_of(h)).speed;
       seq.label = static_cast<Outcome>(static_cast<int>(res[2 * t]));
       seq.samples = read_trial_csv(out / (seq.id + ".csv"));
       ds.trials.push_back(std::move(seq));

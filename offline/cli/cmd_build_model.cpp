@@ -56,7 +56,7 @@ int run_build_model(int argc, char** argv) {
         "               (offline/calib/discrepancy.h; Kennedy-O'Hagan's discrepancy term). Writes\n"
         "               MODEL.dgm.discrepancy.csv. --forces auto then takes the paper's F_vertical:\n"
         "               the correction removes the error that the rule above guards against\n"
-        "  --per-height N --no-gown-noise --no-arm-noise --middle M --seed S --threads N --gown G\n"
+        "  --per-height N --no-gown-noise --no-arm-noise --middle M --high-low H --seed S --threads N --gown G\n"
         "               (synthesis; see dressguard synthesize --help)\n"
         "  --priors P   uniform (default: the paper's highest likelihood, and a caught arm's HMM\n"
         "               as likely as the others before any force is read) | training: each\n"
@@ -67,7 +67,7 @@ int run_build_model(int argc, char** argv) {
     return 0;
   }
   args.allow_only({"help", "json", "no-gown-noise", "no-arm-noise", "calibration", "data", "out", "synth-dir",
-                   "states", "per-height", "seed", "gown", "threads", "forces", "middle", "created", "discrepancy",
+                   "states", "per-height", "seed", "gown", "threads", "forces", "middle", "high-low", "created", "discrepancy",
                    "priors"});
   const std::string out = args.require("out");
   if (args.has("calibration") == args.has("data")) throw UsageError("give exactly one of --calibration and --data");

@@ -29,6 +29,10 @@ SynthesisOptions synthesis_options_from(const Args& args) {
   if (middle == "nominal") o.middle = MiddleArm::Nominal;
   else if (middle == "caught-edge") o.middle = MiddleArm::CaughtEdge;
   else throw UsageError("--middle must be nominal or caught-edge");
+  const std::string high_low = args.get("high-low").value_or("paper");
+  if (high_low == "paper") o.high_low = HighLowArm::Paper;
+  else if (high_low == "repeat-band") o.high_low = HighLowArm::RepeatBand;
+  else throw UsageError("--high-low must be paper or repeat-band");
   return o;
 }
 
@@ -42,6 +46,9 @@ SynthesisSummary run_synthesis(const Calibration& cal, const std::string& gown, 
   const Comm& comm = Comm::world();
   const TrialSimulator sim = make_cloth_simulator(gown).trial;
   int last = -1;
+  if (o.high_low == HighLowArm::RepeatBand && o.arm_noise && comm.is_root())
+    std::fprintf(stderr, "synthesize: scanning the high and low arms' heights for their repeat bands (26 trials, "
+                         "unless an earlier run kept them)\n");
   if (o.middle == MiddleArm::CaughtEdge && comm.is_root())
     std::fprintf(stderr, "synthesize: locating the simulator's good/caught edge for the middle arm (about 10 trials)\n");
   const SynthesisSummary s = synthesize(cal, sim, o, out, comm, [&](const SynthesisProgress& p) {
@@ -56,6 +63,13 @@ SynthesisSummary run_synthesis(const Calibration& cal, const std::string& gown, 
                  "synthesize: the middle arm's noise sat below %+.4f m from its nominal height (good at %+.4f m, "
                  "%s below; %d trials)\n",
                  s.edge.offset, s.edge.good_at, std::string(outcome_name(s.edge.below)).c_str(), s.edge.trials);
+  if (o.high_low == HighLowArm::RepeatBand && o.arm_noise && comm.is_root())
+    for (const ArmBand* b : {&s.high_band, &s.low_band})
+      std::fprintf(stderr,
+                   "synthesize: the %s arm's noise sat within [%+.4f, %+.4f] m of its calibrated height (its trial "
+                   "%s; eq. 3-5 distance <= %.3f)\n",
+                   b == &s.high_band ? "high" : "low", b->lower, b->upper,
+                   std::string(outcome_name(b->at_calibrated)).c_str(), b->tolerance);
   return s;
 #endif
 }
@@ -73,6 +87,9 @@ int run_synthesize(int argc, char** argv) {
         "  --middle M        nominal | caught-edge: where the middle arm's [-6, 0] cm noise sits: the\n"
         "                    nominal middle height (default, the paper) or the simulator's own edge\n"
         "                    between good and caught, found first by trisection (offline/calib/README.md)\n"
+        "  --high-low H      paper | repeat-band: the high and low arms' noise over the paper's +-1.5 cm\n"
+        "                    (default), or only where the noise-free trial stays within a measured repeat's\n"
+        "                    distance of the calibrated height's (eq. 3-5; found first on 26 trials)\n"
         "  --seed S          default 1; the dataset depends on the seed only, not on threads/ranks\n"
         "  --gown G          override the calibration's gown (full, reduced, coarse)\n"
         "  --threads N       threads per process (default: all cores)\n"
@@ -81,7 +98,7 @@ int run_synthesize(int argc, char** argv) {
     return 0;
   }
   args.allow_only({"help", "json", "no-gown-noise", "no-arm-noise", "calibration", "out", "per-height", "seed",
-                   "gown", "threads", "middle"});
+                   "gown", "threads", "middle", "high-low"});
   const std::string out = args.require("out");
   const SynthesisOptions o = synthesis_options_from(args);  // options first: a usage error needs no file
   const Calibration cal = read_calibration(args.require("calibration"));
@@ -90,9 +107,11 @@ int run_synthesize(int argc, char** argv) {
   if (Comm::world().is_root()) {
     if (args.has("json"))
       std::printf("{\"trials\": %d, \"resumed\": %d, \"good\": %d, \"missed\": %d, \"caught\": %d, "
-                  "\"middle\": \"%s\", \"middle_base_m\": %.6f, \"out\": \"%s\"}\n",
+                  "\"middle\": \"%s\", \"middle_base_m\": %.6f, \"high_low\": \"%s\", \"high_band_m\": [%.6f, %.6f], "
+                  "\"low_band_m\": [%.6f, %.6f], \"out\": \"%s\"}\n",
                   s.trials, s.resumed, s.per_label[0], s.per_label[1], s.per_label[2], middle_arm_name(o.middle),
-                  o.middle == MiddleArm::CaughtEdge ? s.edge.offset : 0.0, out.c_str());
+                  o.middle == MiddleArm::CaughtEdge ? s.edge.offset : 0.0, high_low_arm_name(o.high_low),
+                  s.high_band.lower, s.high_band.upper, s.low_band.lower, s.low_band.upper, out.c_str());
     else
       std::printf("synthesized %d trials (%d kept from an earlier run): %d good, %d missed, %d caught -> %s\n",
                   s.trials, s.resumed, s.per_label[0], s.per_label[1], s.per_label[2], out.c_str());

@@ -3,6 +3,7 @@
 // bounds files, input selection on the measured data, the calibration file.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 
@@ -824,6 +825,113 @@ TEST(Synthesis, MiddleArmAtTheSimulatorsCaughtEdge) {
   } catch (const std::runtime_error& err) {
     EXPECT_NE(std::string(err.what()).find("high arm (missed)"), std::string::npos) << err.what();
   }
+}
+
+// The repeat band (HighLowArm::RepeatBand) on a stand-in with a fist edge: its trials do not
+// depend on the arm's height except past an edge, 0.6 cm below the calibrated high arm and 1.1 cm
+// above the calibrated low one, where the rim catches and drags 1 N more from 0.15 m of travel on.
+// On the 0.25 cm grid the band must end at the last height before the edge (-0.5 cm at high,
+// +1.0 cm at low) and run to the paper's 1.5 cm on the other side, where every trial is the
+// calibrated one's (distance 0); a 1 N drag over half a metre is far beyond either repeat distance.
+namespace {
+SimulatedTrial fist_edge_simulate(const Calibration& cal, const ClothValues& c, const TrialRequest& r) {
+  TrialRequest flat = r;
+  const double calibrated = r.height == ArmHeight::Middle ? 0.0 : cal.offsets[static_cast<int>(r.height)];
+  flat.arm_offset = calibrated;
+  SimulatedTrial st = testing::fake_simulate(c, flat);
+  const double d = r.arm_offset - calibrated;
+  const bool caught_rim = (r.height == ArmHeight::High && d < -0.006) || (r.height == ArmHeight::Low && d > 0.011);
+  if (caught_rim)
+    for (auto& s : st.samples)
+      if (s.travel >= 0.15) s.f_motion -= 1.0;
+  return st;
+}
+}  // namespace
+
+TEST(Synthesis, RepeatBandEndsAtTheFistEdge) {
+  Calibration cal;
+  cal.offsets = {0.01, 0.0, -0.02};
+  std::atomic<int> runs{0};
+  const TrialSimulator sim = [&](const ClothValues& c, const TrialRequest& r) {
+    ++runs;
+    return fist_edge_simulate(cal, c, r);
+  };
+  const ArmBand high = locate_repeat_band(cal, sim, ArmHeight::High, 1, Comm::world());
+  EXPECT_DOUBLE_EQ(high.lower, -0.005);
+  EXPECT_DOUBLE_EQ(high.upper, 0.015);
+  EXPECT_EQ(high.at_calibrated, Outcome::Good);
+  EXPECT_EQ(high.tolerance, kRepeatDistanceGood);
+  EXPECT_EQ(high.trials, 13);
+  ASSERT_EQ(high.offsets.size(), 12u);
+  for (std::size_t k = 0; k < high.offsets.size(); ++k) {
+    if (high.offsets[k] >= -0.005) {
+      EXPECT_EQ(high.distances[k], 0.0) << high.offsets[k];
+    } else {
+      EXPECT_GT(high.distances[k], 2 * kRepeatDistanceMissed) << high.offsets[k];
+    }
+  }
+  // The scan's distance is eq. 3-5 between the offset's trial and the calibrated one's.
+  TrialRequest q;
+  q.height = ArmHeight::High;
+  q.speed = 0.1;
+  q.max_travel = cal.rig_travel;
+  q.arm_offset = cal.offsets[0];
+  const auto reference = fist_edge_simulate(cal, cal.cloth, q).samples;
+  q.arm_offset = cal.offsets[0] - 0.0075;
+  EXPECT_EQ(high.distances[3], area_objective(fist_edge_simulate(cal, cal.cloth, q).samples, reference));
+
+  const ArmBand low = locate_repeat_band(cal, sim, ArmHeight::Low, 3, Comm::world());
+  EXPECT_DOUBLE_EQ(low.lower, -0.015);
+  EXPECT_DOUBLE_EQ(low.upper, 0.01);
+  EXPECT_EQ(low.at_calibrated, Outcome::Missed);
+  EXPECT_EQ(low.tolerance, kRepeatDistanceMissed);
+  EXPECT_EQ(locate_repeat_band(cal, sim, ArmHeight::Low, 1, Comm::world()).distances, low.distances);  // threads
+  EXPECT_THROW(locate_repeat_band(cal, sim, ArmHeight::Middle, 1, Comm::world()), std::invalid_argument);
+
+  // The synthesis draws the high and low arms within their bands (both ends nearly reached by
+  // 100 draws), leaves the middle arm as the paper has it, and keeps the bands for a resumed run.
+  SynthesisOptions o;
+  o.high_low = HighLowArm::RepeatBand;
+  double lo[3] = {1, 1, 1}, hi[3] = {-1, -1, -1};
+  for (int i = 0; i < 100; ++i)
+    for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
+      const ArmBand& b = h == ArmHeight::Low ? low : high;
+      const double d = synthesis_request(cal, h, i, o, 0.0, b).arm_offset - cal.offsets[static_cast<int>(h)];
+      const int k = static_cast<int>(h);
+      lo[k] = std::min(lo[k], d);
+      hi[k] = std::max(hi[k], d);
+      if (h == ArmHeight::Middle) {
+        EXPECT_EQ(d, synthesis_request(cal, h, i, SynthesisOptions{}).arm_offset);
+      }
+    }
+  EXPECT_GE(lo[0], -0.005);
+  EXPECT_LT(lo[0], -0.004);
+  EXPECT_LE(hi[0], 0.015);
+  EXPECT_GT(hi[0], 0.014);
+  EXPECT_GE(lo[2], -0.015);
+  EXPECT_LT(lo[2], -0.014);
+  EXPECT_LE(hi[2], 0.01);
+  EXPECT_GT(hi[2], 0.009);
+
+  o.per_height = 4;
+  o.gown_noise = false;
+  const fs::path a = temp_dir("synth_band");
+  runs = 0;
+  const SynthesisSummary s = synthesize(cal, sim, o, a, Comm::world());
+  EXPECT_EQ(runs.load(), 2 * 13 + 3 * 4);
+  EXPECT_EQ(s.high_band.lower, high.lower);
+  EXPECT_EQ(s.low_band.upper, low.upper);
+  EXPECT_TRUE(fs::exists(a / ".synth" / "repeat-band.json"));
+  // Resumed: no trial and no scan again, the same bands (read back to the bit).
+  runs = 0;
+  const SynthesisSummary again = synthesize(cal, sim, o, a, Comm::world());
+  EXPECT_EQ(runs.load(), 0);
+  EXPECT_EQ(again.high_band.distances, s.high_band.distances);
+  EXPECT_EQ(again.low_band.lower, s.low_band.lower);
+  // A folder made with the band refuses the paper's placement.
+  o.high_low = HighLowArm::Paper;
+  EXPECT_THROW(synthesize(cal, sim, o, a, Comm::world()), InputError);
+  fs::remove_all(a);
 }
 
 TEST(Synthesis, DatasetIsIndependentOfThreadsAndResumes) {

@@ -36,6 +36,7 @@ file(WRITE ${WORK}/bad.json "{\"format\": \"dressguard-calibration 1\",\n\"parti
 expect_fail("synthesize with a bad calibration file" "bad.json" synthesize --calibration ${WORK}/bad.json --out ${WORK}/s)
 expect_fail("synthesize with --per-height 1" "--per-height" synthesize --calibration ${WORK}/bad.json --out ${WORK}/s --per-height 1)
 expect_fail("synthesize with an unknown middle placement" "--middle" synthesize --calibration ${WORK}/bad.json --out ${WORK}/s --middle centre)
+expect_fail("synthesize with an unknown high/low placement" "--high-low" synthesize --calibration ${WORK}/bad.json --out ${WORK}/s --high-low wide)
 expect_fail("build-model with both inputs" "exactly one" build-model --calibration ${WORK}/bad.json --data ${WORK} --out ${WORK}/m.dgm)
 expect_fail("build-model with unknown forces" "--forces" build-model --data ${WORK} --forces torque --out ${WORK}/m.dgm)
 expect_fail("build-model with unknown priors" "--priors must be uniform or training"

@@ -29,6 +29,7 @@
 //                               [--seed S] [--threads T] [--states K]
 //                               [--seed S1,S2,... --synth DIR1,DIR2,...]
 //                               [--discrepancy on|off] [--arm-noise on|off] [--gown-noise on|off]
+//                               [--high-low paper|repeat-band]
 //     The pooled STC (paper VII: HMMs trained on the simulators of several people and tested on a
 //     person none of them was calibrated on) against each calibration's own STC and the 1-NN on
 //     the people's real trials. Each calibration synthesizes its set into DIR/<file's name>/, as
@@ -610,6 +611,12 @@ int run_pooled(const std::map<std::string, std::string>& a) {
   const bool discrepancy = switches.at("discrepancy");
   so.arm_noise = switches.at("arm-noise");
   so.gown_noise = switches.at("gown-noise");
+  const std::string high_low = get(a, "high-low", "paper");
+  if (high_low != "paper" && high_low != "repeat-band") {
+    std::fprintf(stderr, "pooled: --high-low takes paper or repeat-band, not '%s'\n", high_low.c_str());
+    return 2;
+  }
+  so.high_low = high_low == "paper" ? HighLowArm::Paper : HighLowArm::RepeatBand;
 
   // Each calibration's synthesized set, its trials kept for the whole run.
   struct Source {
@@ -627,9 +634,14 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       const fs::path dir = works[s] / fs::path(f).stem();
       so.seed = seeds[s];
       const auto t0 = std::chrono::steady_clock::now();
-      synthesize(cal, make_cloth_simulator(cal.gown).trial, so, dir, Comm::world());
+      const SynthesisSummary sum = synthesize(cal, make_cloth_simulator(cal.gown).trial, so, dir, Comm::world());
       std::printf("%s (participant %s): %d per height, seed %llu, in %s, %.0f s\n", f.c_str(), cal.participant.c_str(),
                   so.per_height, static_cast<unsigned long long>(seeds[s]), dir.string().c_str(), seconds_since(t0));
+      if (so.high_low == HighLowArm::RepeatBand && so.arm_noise)
+        std::printf("  repeat bands: high [%+.2f, %+.2f] cm (%s), low [%+.2f, %+.2f] cm (%s)\n",
+                    100 * sum.high_band.lower, 100 * sum.high_band.upper,
+                    std::string(outcome_name(sum.high_band.at_calibrated)).c_str(), 100 * sum.low_band.lower,
+                    100 * sum.low_band.upper, std::string(outcome_name(sum.low_band.at_calibrated)).c_str());
       // The s-th seed's trial i of a height is that height's trial s x per_height + i of the
       // union, so that ids stay unique and the equal-size pool below splits the union evenly.
       for (auto& t : load_dataset(dir).trials) {
@@ -698,6 +710,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
   out.set("discrepancy", discrepancy);
   out.set("arm_noise", so.arm_noise);
   out.set("gown_noise", so.gown_noise);
+  out.set("high_low", high_low_arm_name(so.high_low));
   Json jsources = Json::array();
   for (const auto& src : sources) {
     Json j = Json::object();
@@ -972,6 +985,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
   if (discrepancy) json_name += "-discrepancy";
   if (!so.arm_noise) json_name += "-no-arm-noise";
   if (!so.gown_noise) json_name += "-no-gown-noise";
+  if (so.high_low != HighLowArm::Paper) json_name += std::string("-") + high_low_arm_name(so.high_low);
   json_name += ".json";
   write_file_atomic(work / json_name, out.dump() + "\n");
   std::printf("wrote %s\n", (work / json_name).string().c_str());
