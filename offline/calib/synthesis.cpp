@@ -213,6 +213,11 @@ ArmBand band_from_json(const Json& j, const fs::path& file) {
   for (const Json& v : j.at("offsets_m").items()) b.offsets.push_back(v.number());
   for (const Json& v : j.at("distances").items()) b.distances.push_back(v.number());
   b.trials = static_cast<int>(j.at("trials").number());
+  // A band is a span around the calibrated height within the paper's +-1.5 cm (locate_repeat_band
+  // never writes another); an edited or damaged file must not move the synthesized arms elsewhere.
+  if (!(b.lower <= 0.0 && b.upper >= 0.0 && b.lower >= -kArmNoiseHighLow - 1e-12 && b.upper <= kArmNoiseHighLow + 1e-12))
+    throw_input_error(file, 0, "a band must hold 0 and lie within +-" + std::to_string(kArmNoiseHighLow) +
+                                   " m (lower_m " + std::to_string(b.lower) + ", upper_m " + std::to_string(b.upper) + ")");
   return b;
 }
 

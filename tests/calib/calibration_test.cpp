@@ -928,6 +928,24 @@ TEST(Synthesis, RepeatBandEndsAtTheFistEdge) {
   EXPECT_EQ(runs.load(), 0);
   EXPECT_EQ(again.high_band.distances, s.high_band.distances);
   EXPECT_EQ(again.low_band.lower, s.low_band.lower);
+  // A damaged band file (a band that leaves out the calibrated height) is refused, naming the file.
+  const fs::path band_file = a / ".synth" / "repeat-band.json";
+  const std::string kept = read_file(band_file);
+  {
+    std::string bad = kept;
+    const auto at = bad.find("\"lower_m\"");
+    ASSERT_NE(at, std::string::npos);
+    bad.insert(bad.find(':', at) + 1, " 0.02,\"was\":");  // lower_m 0.02: above the calibrated height
+    write_file_atomic(band_file, bad);
+    try {
+      synthesize(cal, sim, o, a, Comm::world());
+      ADD_FAILURE() << "a band above the calibrated height was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("repeat-band.json"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("must hold 0"), std::string::npos) << e.what();
+    }
+    write_file_atomic(band_file, kept);
+  }
   // A folder made with the band refuses the paper's placement.
   o.high_low = HighLowArm::Paper;
   EXPECT_THROW(synthesize(cal, sim, o, a, Comm::world()), InputError);
