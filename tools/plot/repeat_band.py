@@ -38,7 +38,7 @@ def main():
     if len(sys.argv) != 3:
         raise SystemExit(__doc__)
     bands = load(sys.argv[1])
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), sharey=True)
+    fig, axes = plt.subplots(1, 2, figsize=(11, 5.6), sharey=True)
     cmap = plt.get_cmap("tab10")
     for ax, height in zip(axes, ["high", "low"]):
         ax.axvspan(-1.5, 1.5, color="0.93", zorder=0)
@@ -60,7 +60,7 @@ def main():
         ax.set_yscale("symlog", linthresh=0.1)
         ax.set_xlabel("arm offset from the calibrated height [cm]")
         ax.set_title(f"{height} arm")
-        ax.legend(fontsize=7, loc="upper center")
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2)
     axes[0].set_ylabel("eq. 3-5 distance to the calibrated height's trial")
     fig.suptitle("Which arm heights a calibrated simulator takes within a repeat's distance")
     fig.tight_layout()
