@@ -20,6 +20,11 @@ std::string synthesis_trial_id(ArmHeight height, int index) {
 
 const char* middle_arm_name(MiddleArm m) { return m == MiddleArm::CaughtEdge ? "caught-edge" : "nominal"; }
 const char* high_low_arm_name(HighLowArm a) { return a == HighLowArm::RepeatBand ? "repeat-band" : "paper"; }
+std::optional<HighLowArm> parse_high_low_arm(std::string_view s) {
+  for (HighLowArm a : {HighLowArm::Paper, HighLowArm::RepeatBand})
+    if (s == high_low_arm_name(a)) return a;
+  return std::nullopt;
+}
 
 TrialRequest synthesis_request(const Calibration& cal, ArmHeight height, int index, const SynthesisOptions& o,
                                double middle_base, const ArmBand& band) {

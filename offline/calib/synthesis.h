@@ -36,7 +36,9 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "calibration.h"
@@ -55,6 +57,7 @@ enum class HighLowArm {
   RepeatBand,  // calibrated offset + U over the repeat band within [-1.5, +1.5] cm (locate_repeat_band)
 };
 const char* high_low_arm_name(HighLowArm a);  // "paper", "repeat-band"
+std::optional<HighLowArm> parse_high_low_arm(std::string_view s);  // the inverse; nullopt otherwise
 
 struct SynthesisOptions {
   int per_height = 100;

@@ -29,10 +29,9 @@ SynthesisOptions synthesis_options_from(const Args& args) {
   if (middle == "nominal") o.middle = MiddleArm::Nominal;
   else if (middle == "caught-edge") o.middle = MiddleArm::CaughtEdge;
   else throw UsageError("--middle must be nominal or caught-edge");
-  const std::string high_low = args.get("high-low").value_or("paper");
-  if (high_low == "paper") o.high_low = HighLowArm::Paper;
-  else if (high_low == "repeat-band") o.high_low = HighLowArm::RepeatBand;
-  else throw UsageError("--high-low must be paper or repeat-band");
+  const auto high_low = parse_high_low_arm(args.get("high-low").value_or("paper"));
+  if (!high_low) throw UsageError("--high-low must be paper or repeat-band");
+  o.high_low = *high_low;
   return o;
 }
 

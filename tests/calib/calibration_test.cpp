@@ -887,6 +887,8 @@ TEST(Synthesis, RepeatBandEndsAtTheFistEdge) {
   EXPECT_EQ(low.tolerance, kRepeatDistanceMissed);
   EXPECT_EQ(locate_repeat_band(cal, sim, ArmHeight::Low, 1, Comm::world()).distances, low.distances);  // threads
   EXPECT_THROW(locate_repeat_band(cal, sim, ArmHeight::Middle, 1, Comm::world()), std::invalid_argument);
+  for (HighLowArm a : {HighLowArm::Paper, HighLowArm::RepeatBand}) EXPECT_EQ(parse_high_low_arm(high_low_arm_name(a)), a);
+  EXPECT_FALSE(parse_high_low_arm("band"));
 
   // The synthesis draws the high and low arms within their bands (both ends nearly reached by
   // 100 draws), leaves the middle arm as the paper has it, and keeps the bands for a resumed run.

@@ -8,6 +8,7 @@
 
 #include "dataset.h"
 #include "objective.h"
+#include "synthesis.h"
 
 namespace dressguard::calib {
 namespace {
@@ -132,6 +133,10 @@ TEST(Objective, YardstickOnMeasuredRepeats) {
   EXPECT_NEAR(area_objective(trial(ds, "s1-good-1").samples, trial(ds, "s1-good-3").samples, 5.0), 0.09, 0.005);
   EXPECT_NEAR(missed, 0.22, 0.005);
   EXPECT_NEAR(0.5 * (mid_a + mid_b), 0.26, 0.005);
+  // The repeat band of the synthesis (synthesis.h) uses these two figures as constants: they must
+  // be what the study's repeats give, to their printed three digits.
+  EXPECT_NEAR(good, kRepeatDistanceGood, 0.0005);
+  EXPECT_NEAR(missed, kRepeatDistanceMissed, 0.0005);
   // Symmetry between repeats: swapping the roles moves L by less than 0.001 (dx choice).
   EXPECT_NEAR(L("s1-good-3", "s1-good-1"), good, 1e-3);
   EXPECT_NEAR(L("s1-miss-4", "s1-miss-1"), missed, 1e-3);

@@ -611,12 +611,13 @@ int run_pooled(const std::map<std::string, std::string>& a) {
   const bool discrepancy = switches.at("discrepancy");
   so.arm_noise = switches.at("arm-noise");
   so.gown_noise = switches.at("gown-noise");
-  const std::string high_low = get(a, "high-low", "paper");
-  if (high_low != "paper" && high_low != "repeat-band") {
-    std::fprintf(stderr, "pooled: --high-low takes paper or repeat-band, not '%s'\n", high_low.c_str());
+  const std::string high_low_arg = get(a, "high-low", "paper");
+  const auto high_low = parse_high_low_arm(high_low_arg);
+  if (!high_low) {
+    std::fprintf(stderr, "pooled: --high-low takes paper or repeat-band, not '%s'\n", high_low_arg.c_str());
     return 2;
   }
-  so.high_low = high_low == "paper" ? HighLowArm::Paper : HighLowArm::RepeatBand;
+  so.high_low = *high_low;
 
   // Each calibration's synthesized set, its trials kept for the whole run.
   struct Source {
