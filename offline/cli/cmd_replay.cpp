@@ -1,5 +1,8 @@
 // dressguard replay: the predictor daemon's own code (predictor/core) run over a candump log.
+#include <algorithm>
 #include <cstdio>
+#include <filesystem>
+#include <map>
 #include <memory>
 
 #include "args.h"
@@ -14,13 +17,18 @@ namespace dressguard::cli {
 namespace {
 
 const char* kHelp =
-    "usage: dressguard replay --model MODEL.dgm --log FILE.log [--config FILE] [--set KEY=VALUE] [--json]\n"
+    "usage: dressguard replay --model MODEL.dgm (--log FILE.log | --logs DIR) [--config FILE] [--set KEY=VALUE] [--json]\n"
     "  Runs the predictor daemon's code (E2E checks, forward filter, stop policy, deadlines) on a\n"
     "  candump log without a bus and prints whether and when it would stop the robot, and why.\n"
     "  --model MODEL.dgm  outcome model; a model that does not load is reported (exit 2) unless\n"
     "                     --allow-model-error is given, which replays as the daemon would run\n"
     "                     without a model (every trial refused)\n"
     "  --log FILE.log     candump -l log (as written by candump or `dressguard export-candump`)\n"
+    "  --logs DIR         every *.log in DIR, in name order, and a table of the stops per outcome:\n"
+    "                     a name ending in -good.log, -missed.log or -caught.log (as export-candump\n"
+    "                     --data names them) is that outcome, any other is 'unlabelled'. What a\n"
+    "                     stop policy costs (good and missed pulls stopped) against what it buys\n"
+    "                     (caught pulls stopped, and how long before their own end)\n"
     "  --config FILE      the daemon's config file (its predictor keys; others are ignored)\n"
     "  --set KEY=VALUE    override one predictor key, e.g. --set stop_threshold=0.95\n"
     "  --tick-ms N        the daemon's timer period (default 1)\n"
@@ -37,6 +45,40 @@ std::string json_escape(const std::string& s) {
   return o;
 }
 
+std::vector<protocol::LoggedFrame> load_log(const std::string& path) {
+  try {
+    return protocol::parse_candump_log(read_file(path), path);
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::runtime_error& e) {
+    throw InputError(e.what());
+  }
+}
+
+// The outcome a log's file name carries ("<id>-<label>.log", export-candump --data's naming).
+std::string label_of(const std::filesystem::path& log) {
+  const std::string stem = log.stem().string();
+  for (const char* l : {"good", "missed", "caught"}) {
+    const std::string tail = std::string("-") + l;
+    if (stem.size() > tail.size() && stem.compare(stem.size() - tail.size(), tail.size(), tail) == 0) return l;
+  }
+  return "unlabelled";
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// One outcome's row of the --logs table. A stop's lead is the time from the deciding sample to
+// the trial's last sample (for a caught trial: how long before its own end, the rig's 10 N stop).
+struct StopTally {
+  int logs = 0, trials = 0, caught_stops = 0, other_stops = 0;
+  std::vector<double> travel, lead;
+};
+
 }  // namespace
 
 int run_replay(int argc, char** argv) {
@@ -45,9 +87,9 @@ int run_replay(int argc, char** argv) {
     std::puts(kHelp);
     return 0;
   }
-  args.allow_only({"help", "json", "model", "log", "config", "set", "tick-ms", "allow-model-error"});
+  args.allow_only({"help", "json", "model", "log", "logs", "config", "set", "tick-ms", "allow-model-error"});
   const std::string model_path = args.require("model");
-  const std::string log_path = args.require("log");
+  if (args.has("log") == args.has("logs")) throw UsageError("give exactly one of --log FILE.log or --logs DIR");
   std::string cfg_text;
   std::string cfg_name = "--set";
   if (auto c = args.get("config")) {
@@ -73,24 +115,100 @@ int run_replay(int argc, char** argv) {
     if (!args.has("allow-model-error")) throw InputError(e.what());
     model_error = e.what();
   }
-  std::vector<protocol::LoggedFrame> frames;
-  try {
-    frames = protocol::parse_candump_log(read_file(log_path), log_path);
-  } catch (const InputError&) {
-    throw;
-  } catch (const std::runtime_error& e) {
-    throw InputError(e.what());
-  }
-  predictor::ReplayResult r;
-  try {
-    r = predictor::replay_frames(m.get(), cfg, frames, tick_ms * 1'000'000);
-  } catch (const model::ModelError& e) {
-    throw InputError(model_path + ": " + e.what());
-  }
+  auto replay = [&](const std::vector<protocol::LoggedFrame>& frames) {
+    try {
+      return predictor::replay_frames(m.get(), cfg, frames, tick_ms * 1'000'000);
+    } catch (const model::ModelError& e) {
+      throw InputError(model_path + ": " + e.what());
+    }
+  };
   std::vector<std::string> names;
   if (m)
     for (const auto& c : m->classes) names.push_back(c.name);
   while (names.size() < 3) names.push_back("class" + std::to_string(names.size()));
+
+  if (auto dir = args.get("logs")) {
+    namespace fs = std::filesystem;
+    if (!fs::is_directory(*dir)) throw InputError(*dir + ": not a folder of candump logs");
+    std::vector<fs::path> logs;
+    for (const auto& e : fs::directory_iterator(*dir))
+      if (e.path().extension() == ".log") logs.push_back(e.path());
+    if (logs.empty()) throw InputError(*dir + ": no *.log file in it");
+    std::sort(logs.begin(), logs.end());
+    std::map<std::string, StopTally> tally;
+    std::string json_logs;
+    for (const auto& log : logs) {
+      const auto frames = load_log(log.string());
+      const auto r = replay(frames);
+      std::map<uint16_t, uint16_t> trial_samples;  // by trial id, from its TrialEnd frame
+      for (const auto& lf : frames)
+        if (protocol::TrialEnd e; protocol::decode(lf.frame, e)) trial_samples[e.trial_id] = e.samples;
+      const std::string label = label_of(log);
+      auto& row = tally[label];
+      ++row.logs;
+      std::string line = log.filename().string() + " (" + label + "):";
+      for (const auto& t : r.trials) {
+        ++row.trials;
+        // The samples the trial went on for after the deciding one (its TrialEnd's count; without
+        // one, the log's last sample).
+        const auto end = trial_samples.find(t.trial);
+        const double n = end != trial_samples.end() ? end->second : t.samples;
+        const double lead = std::max(0.0, n - 1 - static_cast<double>(t.stop_sample)) * cfg.sample_period_s;
+        char buf[256];
+        if (t.stopped && t.reason == protocol::StopReason::Caught) {
+          ++row.caught_stops;
+          row.travel.push_back(t.travel);
+          row.lead.push_back(lead);
+          std::snprintf(buf, sizeof buf, " trial %u STOP (caught) at %.3f m, %.2f s before its end;", t.trial, t.travel, lead);
+        } else if (t.stopped) {
+          ++row.other_stops;
+          std::snprintf(buf, sizeof buf, " trial %u STOP (%s) at %.3f m;", t.trial, protocol::stop_reason_name(t.reason), t.travel);
+        } else {
+          std::snprintf(buf, sizeof buf, " trial %u no stop (max P(caught) %.3f);", t.trial, t.max_p_caught);
+        }
+        line += buf;
+        char jb[512];
+        std::snprintf(jb, sizeof jb,
+                      "%s{\"file\": \"%s\", \"label\": \"%s\", \"trial_id\": %u, \"stopped\": %s, \"reason\": \"%s\", "
+                      "\"travel\": %.4f, \"lead\": %.2f, \"max_p_caught\": %.6f}",
+                      json_logs.empty() ? "" : ", ", json_escape(log.filename().string()).c_str(), label.c_str(), t.trial,
+                      t.stopped ? "true" : "false", t.stopped ? protocol::stop_reason_name(t.reason) : "none",
+                      t.stopped ? t.travel : 0.0, t.stopped ? lead : 0.0, t.max_p_caught);
+        json_logs += jb;
+      }
+      if (!args.has("json")) std::printf("%s\n", line.c_str());
+    }
+    if (args.has("json")) {
+      std::string s = "{\"trials\": [" + json_logs + "], \"outcomes\": {";
+      bool first = true;
+      for (const auto& [label, row] : tally) {
+        char buf[512];
+        std::snprintf(buf, sizeof buf,
+                      "%s\"%s\": {\"logs\": %d, \"trials\": %d, \"caught_stops\": %d, \"other_stops\": %d, "
+                      "\"median_stop_travel\": %.4f, \"median_lead\": %.2f}",
+                      first ? "" : ", ", label.c_str(), row.logs, row.trials, row.caught_stops, row.other_stops,
+                      median(row.travel), median(row.lead));
+        s += buf;
+        first = false;
+      }
+      std::printf("%s}}\n", s.c_str());
+      return 0;
+    }
+    std::printf("\n%-11s %6s %14s %12s %21s %20s\n", "outcome", "trials", "caught stops", "other stops",
+                "median stop travel", "median lead [s]");
+    for (const auto& [label, row] : tally) {
+      std::printf("%-11s %6d %8d (%3.0f%%) %12d", label.c_str(), row.trials, row.caught_stops,
+                  row.trials ? 100.0 * row.caught_stops / row.trials : 0.0, row.other_stops);
+      if (row.caught_stops)
+        std::printf(" %19.3f m %20.2f\n", median(row.travel), median(row.lead));
+      else
+        std::printf(" %21s %20s\n", "-", "-");
+    }
+    return 0;
+  }
+
+  const std::string log_path = *args.get("log");
+  const predictor::ReplayResult r = replay(load_log(log_path));
 
   // The first trial that stopped (or the first trial) is the headline.
   const predictor::ReplayTrial* head = nullptr;

@@ -235,6 +235,42 @@ TEST(ReplayCli, JsonReportsTheStop) {
   EXPECT_FALSE(fs::exists("/tmp/dg_never.log"));
 }
 
+TEST(ReplayCli, LogsFolderTalliesTheStopsPerOutcome) {
+  // The same logs and model as ReplayLogs above, replayed by `replay --logs`: its table must say
+  // what the per-log test asserts (every caught trial stopped by the caught rule ahead of its
+  // end, no good or missed one), and the fault logs, whose names carry no outcome, are
+  // 'unlabelled'.
+  int rc = 0;
+  const std::string out = run(std::string(DG_CLI) + " replay --model " + DG_TEST_MODEL + " --logs " + kLogs.string() + " --json", rc);
+  ASSERT_EQ(rc, 0) << out;
+  const auto row = [&](const std::string& label) {
+    const auto at = out.find("\"" + label + "\": {\"logs\"");
+    return at == std::string::npos ? std::string() : out.substr(at, out.find('}', at) - at);
+  };
+  EXPECT_NE(row("caught").find("\"trials\": 3, \"caught_stops\": 3, \"other_stops\": 0"), std::string::npos) << out;
+  EXPECT_NE(row("good").find("\"trials\": 3, \"caught_stops\": 0, \"other_stops\": 0"), std::string::npos) << out;
+  EXPECT_NE(row("missed").find("\"trials\": 3, \"caught_stops\": 0, \"other_stops\": 0"), std::string::npos) << out;
+  EXPECT_NE(row("unlabelled").find("\"logs\": 4, \"trials\": 4"), std::string::npos) << out;
+  // A caught stop comes before the trial's own end: a positive lead (samples x 10 ms).
+  const std::string caught = row("caught");
+  const auto lead_at = caught.find("\"median_lead\": ");
+  ASSERT_NE(lead_at, std::string::npos) << out;
+  EXPECT_GT(std::stod(caught.substr(lead_at + 15)), 0.0) << out;
+  // A folder without logs, and one that does not exist, are named; --log and --logs exclude each other.
+  const fs::path empty = fs::temp_directory_path() / ("dg_replay_nologs_" + std::to_string(::getpid()));
+  fs::create_directories(empty);
+  const std::string bad = run(std::string(DG_CLI) + " replay --model " + DG_TEST_MODEL + " --logs " + empty.string() + " 2>&1", rc);
+  EXPECT_EQ(WEXITSTATUS(rc), 2);
+  EXPECT_NE(bad.find(empty.string() + ": no *.log file"), std::string::npos) << bad;
+  fs::remove_all(empty);
+  const std::string bad2 = run(std::string(DG_CLI) + " replay --model " + DG_TEST_MODEL + " --logs /nonexistent-dir 2>&1", rc);
+  EXPECT_EQ(WEXITSTATUS(rc), 2);
+  EXPECT_NE(bad2.find("/nonexistent-dir"), std::string::npos) << bad2;
+  const std::string both = run(std::string(DG_CLI) + " replay --model " + DG_TEST_MODEL + " --logs x --log y.log 2>&1", rc);
+  EXPECT_NE(WEXITSTATUS(rc), 0);
+  EXPECT_NE(both.find("exactly one of --log"), std::string::npos) << both;
+}
+
 TEST(ReplayMeasured, StudyTrialsHitTheHardLimitWhereTheRigStopped) {
   const char* sd = std::getenv("DRESSGUARD_SHARED_DIR");
   const fs::path study = fs::path(sd ? sd : DRESSGUARD_SHARED_DIR) / "data/kapusta2016-calibration-trials";
