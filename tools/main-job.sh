@@ -45,7 +45,8 @@ mkdir -p "$model"
 "$dg" model show "$model/stc.dgm" | head -8
 if [ -f "$out/measured/manifest.csv" ]; then
   # The measured trials against the model just trained and against the shipped default model
-  # (models/default.dgm: participant 4's calibrated simulator, 100 reduced-gown trials per height).
+  # (models/default.dgm: seven people's calibrated simulators, 40 reduced-gown trials per height
+  # each; their own measured trials are in its training, through the discrepancy term).
   for m in "$model/stc.dgm" models/default.dgm; do
     name=$(basename "$m" .dgm)
     echo "main-job: the measured trials classified by $m"
@@ -68,12 +69,12 @@ fi
 echo "main-job: synthesized data, model and evaluation in $model"
 
 # Robot side (predictor/): simulated trials as CAN traffic, and what the predictor would do on
-# each. The shipped model (models/default.dgm) was trained on participant 4's calibrated
-# simulator, so its trials come from that simulator (`simulate --calibration`): the high arm
-# (good), the low arm (missed), and the high arm 2 cm lower, inside that simulator's caught band
-# (1-4 cm below its high arm on the measured gown; offline/sim/README.md). The default-parameter
-# trials above go to the model just trained on the same simulator (stc.dgm), when it has a
-# caught class.
+# each. The shipped model (models/default.dgm) was trained on seven people's calibrated
+# simulators; these trials come from one of them, participant 4's (`simulate --calibration`): the
+# high arm (good), the low arm (missed), and the middle arm 8 cm up, below that simulator's
+# good/caught edge (11.0 cm above the nominal middle; models/README.md), where the forearm is
+# caught. The default-parameter trials above go to the model just trained on the same simulator
+# (stc.dgm), when it has a caught class.
 robot="$out/robot"
 mkdir -p "$robot"
 replay() {  # replay MODEL CSV NAME
@@ -89,11 +90,19 @@ else
   echo "main-job: $model/stc.dgm has no caught class (its few trials held none), so the predictor could not stop on it: no replay"
 fi
 if [ -f models/default.dgm ]; then
-  cal=models/participant4-simulator.json
-  for spec in "high 0 high" "low 0 low" "high -0.02 high-2cm"; do
+  cal=models/participant4-contrast.json
+  for spec in "high 0 high" "low 0 low" "middle 0.08 middle+8cm"; do
     set -- $spec
     "$dg" simulate --calibration "$cal" --height "$1" --arm-offset "$2" --frames 0 --out "$robot/p4-$3.csv" >/dev/null
     replay models/default.dgm "$robot/p4-$3.csv" "participant4-$3 ($(sed -n 's/.*"label": "\([a-z]*\)".*/\1/p' "$robot/p4-$3.json"))"
   done
+fi
+if [ -f models/default.dgm ] && [ -f "$out/measured/manifest.csv" ]; then
+  # The study's 22 real pulls as the bus would carry them, through the predictor with the shipped
+  # model: none of them was caught, so every caught stop here is a pull the robot would have
+  # ended for nothing (models/README.md, "The stop rule on the real pulls").
+  "$dg" export-candump --data "$out/measured" --out "$robot/measured" >/dev/null
+  echo "main-job: the stop rule of models/default.dgm on the measured pulls (none was caught)"
+  "$dg" replay --model models/default.dgm --logs "$robot/measured" | sed -n '/^outcome/,$p'
 fi
 echo "main-job: candump logs and replays in $robot"
