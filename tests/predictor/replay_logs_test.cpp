@@ -307,4 +307,44 @@ TEST(ReplayMeasured, StudyTrialsHitTheHardLimitWhereTheRigStopped) {
   fs::remove_all(tmp);
 }
 
+TEST(ReplayMeasured, ShippedModelStopsAtMostFourGoodAndFourMissedRealPulls) {
+  // None of the study's 22 pulls was caught, so every caught stop on them ends a pull for nothing.
+  // The shipped model (models/README.md, "The stop rule on the real pulls") stops 4 of the 8 good
+  // and 4 of the 14 missed ones with its own policy; session 10's stopped 7 and 8. The bounds are
+  // those figures: a model or a predictor change that stops more real pulls fails here.
+  const char* sd = std::getenv("DRESSGUARD_SHARED_DIR");
+  const fs::path study = fs::path(sd ? sd : DRESSGUARD_SHARED_DIR) / "data/kapusta2016-calibration-trials";
+  if (!fs::exists(study)) GTEST_SKIP() << "shared/data not present: the measured pulls are not there to replay";
+  const fs::path def = fs::path(DRESSGUARD_SOURCE_DIR) / "models/default.dgm";
+  const fs::path tmp = fs::temp_directory_path() / ("dg_shipped_" + std::to_string(::getpid()));
+  int rc = 0;
+  run(std::string(DG_CLI) + " import --study " + study.string() + " --out " + (tmp / "ds").string() + " >/dev/null", rc);
+  ASSERT_EQ(rc, 0);
+  run(std::string(DG_CLI) + " export-candump --data " + (tmp / "ds").string() + " --out " + (tmp / "logs").string() + " >/dev/null", rc);
+  ASSERT_EQ(rc, 0);
+  const auto m = model::read_model(def);
+  PredictorConfig cfg;  // the model's own stop policy
+  int good = 0, missed = 0, good_stops = 0, missed_stops = 0;
+  for (const auto& e : fs::directory_iterator(tmp / "logs")) {
+    const auto r = replay_frames(&m, cfg, load(e.path()));
+    ASSERT_EQ(r.trials.size(), 1u);
+    const bool caught_stop = r.trials[0].stopped && r.trials[0].reason == protocol::StopReason::Caught;
+    const std::string name = e.path().filename().string();
+    if (ends_with(name, "-good.log")) {
+      ++good;
+      good_stops += caught_stop;
+    } else if (ends_with(name, "-missed.log")) {
+      ++missed;
+      missed_stops += caught_stop;
+    }
+  }
+  fs::remove_all(tmp);
+  EXPECT_EQ(good, 8);
+  EXPECT_EQ(missed, 14);
+  EXPECT_LE(good_stops, 4);
+  EXPECT_LE(missed_stops, 4);
+  std::printf("  shipped model: caught stops on %d of %d good and %d of %d missed measured pulls\n", good_stops, good,
+              missed_stops, missed);
+}
+
 }  // namespace
