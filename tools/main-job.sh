@@ -104,5 +104,7 @@ if [ -f models/default.dgm ] && [ -f "$out/measured/manifest.csv" ]; then
   "$dg" export-candump --data "$out/measured" --out "$robot/measured" >/dev/null
   echo "main-job: the stop rule of models/default.dgm on the measured pulls (none was caught)"
   "$dg" replay --model models/default.dgm --logs "$robot/measured" | sed -n '/^outcome/,$p'
+  "$dg" replay --model models/default.dgm --logs "$robot/measured" --json > "$robot/measured-stops.json"
+  /usr/bin/python3 tools/plot/stop_rule.py "$robot/stop-rule.png" "models/default.dgm=$robot/measured-stops.json"
 fi
 echo "main-job: candump logs and replays in $robot"
