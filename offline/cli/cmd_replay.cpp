@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 
@@ -79,6 +80,89 @@ struct StopTally {
   std::vector<double> travel, lead;
 };
 
+// --logs DIR: every log of the folder through `replay`, one line each, then the stops per outcome.
+int replay_folder(const std::string& dir,
+                  const std::function<predictor::ReplayResult(const std::vector<protocol::LoggedFrame>&)>& replay,
+                  double sample_period_s, bool json) {
+  namespace fs = std::filesystem;
+  if (!fs::is_directory(dir)) throw InputError(dir + ": not a folder of candump logs");
+  std::vector<fs::path> logs;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().extension() == ".log") logs.push_back(e.path());
+  if (logs.empty()) throw InputError(dir + ": no *.log file in it");
+  std::sort(logs.begin(), logs.end());
+  std::map<std::string, StopTally> tally;
+  std::string json_logs;
+  for (const auto& log : logs) {
+    const auto frames = load_log(log.string());
+    const auto r = replay(frames);
+    std::map<uint16_t, uint16_t> trial_samples;  // by trial id, from its TrialEnd frame
+    for (const auto& lf : frames)
+      if (protocol::TrialEnd e; protocol::decode(lf.frame, e)) trial_samples[e.trial_id] = e.samples;
+    const std::string label = label_of(log);
+    auto& row = tally[label];
+    ++row.logs;
+    std::string line = log.filename().string() + " (" + label + "):";
+    for (const auto& t : r.trials) {
+      ++row.trials;
+      // The samples the trial went on for after the deciding one (its TrialEnd's count; without
+      // one, the log's last sample).
+      const auto end = trial_samples.find(t.trial);
+      const double n = end != trial_samples.end() ? end->second : t.samples;
+      const double lead = std::max(0.0, n - 1 - static_cast<double>(t.stop_sample)) * sample_period_s;
+      char buf[256];
+      if (t.stopped && t.reason == protocol::StopReason::Caught) {
+        ++row.caught_stops;
+        row.travel.push_back(t.travel);
+        row.lead.push_back(lead);
+        std::snprintf(buf, sizeof buf, " trial %u STOP (caught) at %.3f m, %.2f s before its end;", t.trial, t.travel, lead);
+      } else if (t.stopped) {
+        ++row.other_stops;
+        std::snprintf(buf, sizeof buf, " trial %u STOP (%s) at %.3f m;", t.trial, protocol::stop_reason_name(t.reason), t.travel);
+      } else {
+        std::snprintf(buf, sizeof buf, " trial %u no stop (max P(caught) %.3f);", t.trial, t.max_p_caught);
+      }
+      line += buf;
+      char jb[256];
+      std::snprintf(jb, sizeof jb,
+                    "\"trial_id\": %u, \"stopped\": %s, \"reason\": \"%s\", \"travel\": %.4f, \"lead\": %.2f, "
+                    "\"max_p_caught\": %.6f}",
+                    t.trial, t.stopped ? "true" : "false", t.stopped ? protocol::stop_reason_name(t.reason) : "none",
+                    t.stopped ? t.travel : 0.0, t.stopped ? lead : 0.0, t.max_p_caught);
+      json_logs += std::string(json_logs.empty() ? "" : ", ") + "{\"file\": \"" + json_escape(log.filename().string()) +
+                   "\", \"label\": \"" + label + "\", " + jb;
+    }
+    if (!json) std::printf("%s\n", line.c_str());
+  }
+  if (json) {
+    std::string s = "{\"trials\": [" + json_logs + "], \"outcomes\": {";
+    bool first = true;
+    for (const auto& [label, row] : tally) {
+      char buf[512];
+      std::snprintf(buf, sizeof buf,
+                    "%s\"%s\": {\"logs\": %d, \"trials\": %d, \"caught_stops\": %d, \"other_stops\": %d, "
+                    "\"median_stop_travel\": %.4f, \"median_lead\": %.2f}",
+                    first ? "" : ", ", label.c_str(), row.logs, row.trials, row.caught_stops, row.other_stops,
+                    median(row.travel), median(row.lead));
+      s += buf;
+      first = false;
+    }
+    std::printf("%s}}\n", s.c_str());
+    return 0;
+  }
+  std::printf("\n%-11s %6s %14s %12s %21s %20s\n", "outcome", "trials", "caught stops", "other stops",
+              "median stop travel", "median lead [s]");
+  for (const auto& [label, row] : tally) {
+    std::printf("%-11s %6d %8d (%3.0f%%) %12d", label.c_str(), row.trials, row.caught_stops,
+                row.trials ? 100.0 * row.caught_stops / row.trials : 0.0, row.other_stops);
+    if (row.caught_stops)
+      std::printf(" %19.3f m %20.2f\n", median(row.travel), median(row.lead));
+    else
+      std::printf(" %21s %20s\n", "-", "-");
+  }
+  return 0;
+}
+
 }  // namespace
 
 int run_replay(int argc, char** argv) {
@@ -127,85 +211,7 @@ int run_replay(int argc, char** argv) {
     for (const auto& c : m->classes) names.push_back(c.name);
   while (names.size() < 3) names.push_back("class" + std::to_string(names.size()));
 
-  if (auto dir = args.get("logs")) {
-    namespace fs = std::filesystem;
-    if (!fs::is_directory(*dir)) throw InputError(*dir + ": not a folder of candump logs");
-    std::vector<fs::path> logs;
-    for (const auto& e : fs::directory_iterator(*dir))
-      if (e.path().extension() == ".log") logs.push_back(e.path());
-    if (logs.empty()) throw InputError(*dir + ": no *.log file in it");
-    std::sort(logs.begin(), logs.end());
-    std::map<std::string, StopTally> tally;
-    std::string json_logs;
-    for (const auto& log : logs) {
-      const auto frames = load_log(log.string());
-      const auto r = replay(frames);
-      std::map<uint16_t, uint16_t> trial_samples;  // by trial id, from its TrialEnd frame
-      for (const auto& lf : frames)
-        if (protocol::TrialEnd e; protocol::decode(lf.frame, e)) trial_samples[e.trial_id] = e.samples;
-      const std::string label = label_of(log);
-      auto& row = tally[label];
-      ++row.logs;
-      std::string line = log.filename().string() + " (" + label + "):";
-      for (const auto& t : r.trials) {
-        ++row.trials;
-        // The samples the trial went on for after the deciding one (its TrialEnd's count; without
-        // one, the log's last sample).
-        const auto end = trial_samples.find(t.trial);
-        const double n = end != trial_samples.end() ? end->second : t.samples;
-        const double lead = std::max(0.0, n - 1 - static_cast<double>(t.stop_sample)) * cfg.sample_period_s;
-        char buf[256];
-        if (t.stopped && t.reason == protocol::StopReason::Caught) {
-          ++row.caught_stops;
-          row.travel.push_back(t.travel);
-          row.lead.push_back(lead);
-          std::snprintf(buf, sizeof buf, " trial %u STOP (caught) at %.3f m, %.2f s before its end;", t.trial, t.travel, lead);
-        } else if (t.stopped) {
-          ++row.other_stops;
-          std::snprintf(buf, sizeof buf, " trial %u STOP (%s) at %.3f m;", t.trial, protocol::stop_reason_name(t.reason), t.travel);
-        } else {
-          std::snprintf(buf, sizeof buf, " trial %u no stop (max P(caught) %.3f);", t.trial, t.max_p_caught);
-        }
-        line += buf;
-        char jb[512];
-        std::snprintf(jb, sizeof jb,
-                      "%s{\"file\": \"%s\", \"label\": \"%s\", \"trial_id\": %u, \"stopped\": %s, \"reason\": \"%s\", "
-                      "\"travel\": %.4f, \"lead\": %.2f, \"max_p_caught\": %.6f}",
-                      json_logs.empty() ? "" : ", ", json_escape(log.filename().string()).c_str(), label.c_str(), t.trial,
-                      t.stopped ? "true" : "false", t.stopped ? protocol::stop_reason_name(t.reason) : "none",
-                      t.stopped ? t.travel : 0.0, t.stopped ? lead : 0.0, t.max_p_caught);
-        json_logs += jb;
-      }
-      if (!args.has("json")) std::printf("%s\n", line.c_str());
-    }
-    if (args.has("json")) {
-      std::string s = "{\"trials\": [" + json_logs + "], \"outcomes\": {";
-      bool first = true;
-      for (const auto& [label, row] : tally) {
-        char buf[512];
-        std::snprintf(buf, sizeof buf,
-                      "%s\"%s\": {\"logs\": %d, \"trials\": %d, \"caught_stops\": %d, \"other_stops\": %d, "
-                      "\"median_stop_travel\": %.4f, \"median_lead\": %.2f}",
-                      first ? "" : ", ", label.c_str(), row.logs, row.trials, row.caught_stops, row.other_stops,
-                      median(row.travel), median(row.lead));
-        s += buf;
-        first = false;
-      }
-      std::printf("%s}}\n", s.c_str());
-      return 0;
-    }
-    std::printf("\n%-11s %6s %14s %12s %21s %20s\n", "outcome", "trials", "caught stops", "other stops",
-                "median stop travel", "median lead [s]");
-    for (const auto& [label, row] : tally) {
-      std::printf("%-11s %6d %8d (%3.0f%%) %12d", label.c_str(), row.trials, row.caught_stops,
-                  row.trials ? 100.0 * row.caught_stops / row.trials : 0.0, row.other_stops);
-      if (row.caught_stops)
-        std::printf(" %19.3f m %20.2f\n", median(row.travel), median(row.lead));
-      else
-        std::printf(" %21s %20s\n", "-", "-");
-    }
-    return 0;
-  }
+  if (auto dir = args.get("logs")) return replay_folder(*dir, replay, cfg.sample_period_s, args.has("json"));
 
   const std::string log_path = *args.get("log");
   const predictor::ReplayResult r = replay(load_log(log_path));
