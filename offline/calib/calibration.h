@@ -126,6 +126,11 @@ struct SimulatedTrial {
   std::vector<HapticSample> samples;
   Outcome outcome = Outcome::Missed;  // the automatic label of paper V-A
   bool finite = true;                 // false: the simulation blew up (ranked worst)
+  // The label's evidence (sim::TrialResult): how far the lower half of the sleeve opening ended
+  // behind the elbow centre (forearm side) and past it [m], 0 for a missed trial; NaN when the
+  // simulator does not say (a test's stand-in).
+  double d_behind = std::numeric_limits<double>::quiet_NaN();
+  double d_ahead = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Must be deterministic and callable from several threads at once.

@@ -79,6 +79,8 @@ SimulatedTrial simulated(sim::TrialResult&& res) {
   out.samples = std::move(res.seq.samples);
   out.outcome = res.outcome;
   out.finite = res.finite;
+  out.d_behind = res.d_behind;
+  out.d_ahead = res.d_ahead;
   return out;
 }
 

@@ -3,7 +3,9 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <limits>
 #include <mutex>
 
 #include "files.h"
@@ -188,6 +190,53 @@ std::string stored_record(const fs::path& path) {
 
 fs::path marker_path(const fs::path& out, const std::string& id) { return out / ".synth" / (id + ".done"); }
 
+// A finished trial's marker: its label, then the label's evidence (d_behind d_ahead, exact).
+// Markers of earlier versions hold the label alone; their evidence reads as NaN (unknown).
+std::string marker_text(const SimulatedTrial& st) {
+  char buf[128];
+  std::snprintf(buf, sizeof buf, "%s\n%.17g %.17g\n", std::string(outcome_name(st.outcome)).c_str(), st.d_behind,
+                st.d_ahead);
+  return buf;
+}
+struct Marker {
+  Outcome label = Outcome::Missed;
+  double d_behind = std::numeric_limits<double>::quiet_NaN(), d_ahead = std::numeric_limits<double>::quiet_NaN();
+};
+std::optional<Marker> read_marker(const fs::path& file) {
+  const std::string text = read_file(file);
+  const std::size_t eol = text.find('\n');
+  const auto label = parse_outcome(text.substr(0, eol));
+  if (!label) return std::nullopt;
+  Marker m;
+  m.label = *label;
+  if (eol != std::string::npos) {
+    double b = 0, a = 0;
+    if (std::sscanf(text.c_str() + eol + 1, "%lf %lf", &b, &a) == 2) m.d_behind = b, m.d_ahead = a;
+  }
+  return m;
+}
+
+// labels.csv: one row per trial, what decided its label (paper V-A): the arm's offset from its
+// height's nominal, the travel at the end, and the opening's lower half behind and past the
+// elbow centre. An unknown value (a marker from before this file existed) is an empty field.
+std::string labels_csv(const std::vector<HapticSequence>& trials, const std::vector<double>& arm_offsets,
+                       const std::vector<double>& d_behind, const std::vector<double>& d_ahead) {
+  std::string out = "trial_id,height,speed,arm_offset_m,label,travel_m,d_behind_m,d_ahead_m\n";
+  auto num = [](double v) {
+    if (std::isnan(v)) return std::string();
+    char b[32];
+    std::snprintf(b, sizeof b, "%.6f", v);
+    return std::string(b);
+  };
+  for (std::size_t t = 0; t < trials.size(); ++t) {
+    const HapticSequence& q = trials[t];
+    out += q.id + "," + std::string(arm_height_name(q.height)) + "," + num(q.speed) + "," + num(arm_offsets[t]) + "," +
+           std::string(outcome_name(*q.label)) + "," + num(q.samples.empty() ? 0.0 : q.samples.back().travel) + "," +
+           num(d_behind[t]) + "," + num(d_ahead[t]) + "\n";
+  }
+  return out;
+}
+
 // The repeat bands of a synthesis, kept beside its markers so that a resumed run does not scan
 // again (the settings record guarantees they belong to the same calibration and seed).
 Json band_to_json(const ArmBand& b) {
@@ -278,9 +327,10 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
   std::atomic<int> done{0}, skipped{0};
   std::mutex progress_mutex;
   const int mine = (total - comm.rank() + comm.size() - 1) / comm.size();
-  // Result block per trial: label code, resumed flag.
+  // Result block per trial: label code, resumed flag, d_behind, d_ahead.
+  constexpr int kBlock = 4;
   const std::vector<double> res =
-      run_batch(total, 2, thread_count(options.threads), comm, [&](int t, double* r) {
+      run_batch(total, kBlock, thread_count(options.threads), comm, [&](int t, double* r) {
         const ArmHeight h = heights[t / options.per_height];
         const int index = t % options.per_height;
         const std::string id = synthesis_trial_id(h, index);
@@ -288,10 +338,10 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
         const fs::path marker = marker_path(out, id);
         bool resumed = false;
         if (fs::exists(marker) && fs::exists(csv)) {
-          const std::string text = read_file(marker);
-          const auto label = parse_outcome(text.substr(0, text.find('\n')));
-          if (label) {
-            r[0] = static_cast<double>(*label);
+          if (const auto m = read_marker(marker)) {
+            r[0] = static_cast<double>(m->label);
+            r[2] = m->d_behind;
+            r[3] = m->d_ahead;
             resumed = true;
           }
         }
@@ -300,8 +350,10 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
           if (!st.finite || st.samples.empty())
             throw std::runtime_error("simulation of " + id + " did not stay finite; check the calibration");
           write_file_atomic(csv, format_trial_csv(st.samples));
-          write_file_atomic(marker, std::string(outcome_name(st.outcome)) + "\n");
+          write_file_atomic(marker, marker_text(st));
           r[0] = static_cast<double>(st.outcome);
+          r[2] = st.d_behind;
+          r[3] = st.d_ahead;
         }
         r[1] = resumed ? 1.0 : 0.0;
         const int d = ++done;
@@ -325,24 +377,30 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
   s.high_band = high_band;
   s.low_band = low_band;
   for (int t = 0; t < total; ++t) {
-    s.per_label[static_cast<int>(res[2 * t])]++;
-    s.resumed += res[2 * t + 1] > 0.5;
+    s.per_label[static_cast<int>(res[kBlock * t])]++;
+    s.resumed += res[kBlock * t + 1] > 0.5;
   }
   if (comm.is_root()) {
     Dataset ds;
+    std::vector<double> arm_offsets, d_behind, d_ahead;
     for (int t = 0; t < total; ++t) {
       HapticSequence seq;
       const ArmHeight h = heights[t / options.per_height];
       const int index = t % options.per_height;
+      const TrialRequest request = synthesis_request(cal, h, index, options, middle_base, band_of(h));
       seq.id = synthesis_trial_id(h, index);
       seq.participant = "";
       seq.height = h;
-      seq.speed = synthesis_request(cal, h, index, options, middle_base, band_of(h)).speed;
-      seq.label = static_cast<Outcome>(static_cast<int>(res[2 * t]));
+      seq.speed = request.speed;
+      seq.label = static_cast<Outcome>(static_cast<int>(res[kBlock * t]));
       seq.samples = read_trial_csv(out / (seq.id + ".csv"));
       ds.trials.push_back(std::move(seq));
+      arm_offsets.push_back(request.arm_offset);
+      d_behind.push_back(res[kBlock * t + 2]);
+      d_ahead.push_back(res[kBlock * t + 3]);
     }
     save_dataset(ds, out);
+    write_file_atomic(out / "labels.csv", labels_csv(ds.trials, arm_offsets, d_behind, d_ahead));
   }
   comm.barrier();
   s.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

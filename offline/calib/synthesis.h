@@ -30,7 +30,9 @@
 // paper's 0.85 m when unknown) or at 10 N. Labels come from the simulator (paper V-A rule). Every trial's randomness derives from
 // (seed, height, index) alone, so the dataset is the same whatever the thread or rank count.
 // Resumable: each finished trial is written at once (CSV, then a small ".done" marker holding its
-// label, both atomically); a rerun skips trials whose marker and CSV exist.
+// label and the label's evidence, both atomically); a rerun skips trials whose marker and CSV exist.
+// Beside the manifest, labels.csv lists per trial the arm offset, the travel at the end and that
+// evidence (SimulatedTrial::d_behind, d_ahead): which trials sit near the label rule's 7 cm.
 #pragma once
 
 #include <cstdint>

@@ -169,7 +169,7 @@ int run_simulate(int argc, char** argv) {
   std::snprintf(b, sizeof b,
                 "{\"label\": \"%s\", \"height\": \"%s\", \"arm_offset\": %.6g, \"speed\": %.6g, \"seed\": %llu, "
                 "\"noise\": %s, \"gown\": \"%s\", \"friction\": \"%s\", \"travel\": %.6f, \"d_max\": %.6f, "
-                "\"stopped_by_force\": %s, \"contact_travel\": %.6f, \"samples\": %zu, \"f_motion\": %.6f, "
+                "\"d_behind\": %.6f, \"d_ahead\": %.6f, \"stopped_by_force\": %s, \"contact_travel\": %.6f, \"samples\": %zu, \"f_motion\": %.6f, "
                 "\"f_lateral\": %.6f, \"f_vertical\": %.6f, \"weight\": %.6f, \"support_load\": %.6f, \"area_ratio\": %.6f, "
                 "\"settle_s\": %.4f, \"settle_speed\": %.6f, \"settled\": %s, "
                 "\"bending_rigidity\": %.6g, \"bending_length\": %.6g, "
@@ -179,7 +179,7 @@ int run_simulate(int argc, char** argv) {
                 "\"out\": \"%s\", \"params\": %s}",
                 std::string(outcome_name(r.outcome)).c_str(), hs.c_str(), r.arm_offset, spec.speed,
                 static_cast<unsigned long long>(spec.seed), spec.gown_noise ? "true" : "false", gs.c_str(), fr.c_str(),
-                r.travel, r.d_max, r.stopped_by_force ? "true" : "false", r.contact_travel, r.seq.samples.size(),
+                r.travel, r.d_max, r.d_behind, r.d_ahead, r.stopped_by_force ? "true" : "false", r.contact_travel, r.seq.samples.size(),
                 last.f_motion, last.f_lateral, last.f_vertical, r.weight, r.support_load, r.area_ratio, r.settle_time,
                 r.settle_speed, r.settled ? "true" : "false", rigidity, sim::bending_length(rigidity, params.areal_density),
                 r.opening.depth, r.opening.height, r.opening.width, r.opening.centre_y, r.opening.perimeter_ratio,

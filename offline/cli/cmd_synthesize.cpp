@@ -93,6 +93,9 @@ int run_synthesize(int argc, char** argv) {
         "  --gown G          override the calibration's gown (full, reduced, coarse)\n"
         "  --threads N       threads per process (default: all cores)\n"
         "  --json            machine-readable summary\n"
+        "  Writes DATASET/labels.csv beside the manifest: each trial's arm offset, travel at the end\n"
+        "  and the label's evidence (paper V-A: how far the sleeve opening's lower half ended behind\n"
+        "  and past the elbow centre; good within 7 cm on either side).\n"
         "  Resumable: trials already in DATASET (from the same settings) are kept.");
     return 0;
   }

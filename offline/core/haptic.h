@@ -25,6 +25,9 @@ struct HapticSample {
 // The three outcomes of the task (paper section V-A).
 enum class Outcome { Good = 0, Missed = 1, Caught = 2 };
 inline constexpr int kOutcomeCount = 3;
+// Paper V-A's label rule for a pull that stopped before the end of travel: good when no vertex of
+// the sleeve opening's lower half ended farther than this from the elbow centre along the pull [m].
+inline constexpr double kGoodLabelDistance = 0.07;
 
 // The three controlled arm heights of the study; the real arm deviates from them.
 enum class ArmHeight { High = 0, Middle = 1, Low = 2 };

@@ -53,7 +53,7 @@ Frame make_frame(const GownState& s, double t, double travel) {
 
 Outcome label_outcome(bool full_travel, double d_max) {
   if (full_travel) return Outcome::Missed;
-  return d_max <= 0.07 ? Outcome::Good : Outcome::Caught;
+  return d_max <= kGoodLabelDistance ? Outcome::Good : Outcome::Caught;
 }
 
 namespace {
@@ -368,10 +368,15 @@ TrialResult finish_pull(const GownModel& m, Pulling& p, const TrialSpec& spec, c
   const int n = static_cast<int>(s.x.size());
   r.travel = Profile{spec.acceleration, spec.speed, spec.max_travel}.travel(p.t);
   r.self_pairs_dropped = s.pairs_dropped;
-  r.d_max = 0;
+  r.d_max = r.d_behind = r.d_ahead = 0;
   if (!p.full) {
     // The elbow where the (compliant) arm has it now.
-    for (int v : at_rest.lower) r.d_max = std::max(r.d_max, std::abs(s.x[v].x - (m.elbow.x + s.arm_shift.x)));
+    for (int v : at_rest.lower) {
+      const double dx = s.x[v].x - (m.elbow.x + s.arm_shift.x);
+      r.d_max = std::max(r.d_max, std::abs(dx));
+      r.d_behind = std::max(r.d_behind, -dx);
+      r.d_ahead = std::max(r.d_ahead, dx);
+    }
   }
   r.outcome = label_outcome(p.full, r.d_max);
   r.seq.label = r.outcome;

@@ -223,6 +223,10 @@ struct TrialResult {
   HapticSequence seq;               // samples from the start of the pull; label set
   Outcome outcome = Outcome::Missed;
   double d_max = 0;                 // [m] paper V-A label distance (NaN-free; 0 when missed)
+  // d_max's two sides, 0 when missed: the most a lower-half vertex of the opening lags behind the
+  // elbow centre (on the forearm's side, x below it) and the most one has gone past it (x above;
+  // the pull runs along +x). d_max = max(d_behind, d_ahead): the paper's distance has no sign.
+  double d_behind = 0, d_ahead = 0;  // [m]
   bool stopped_by_force = false;
   double travel = 0;                // [m] gripper travel at the stop
   double contact_t = -1;            // [s] first sample with cloth-arm contact (-1: none)

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include <unistd.h>
 
@@ -952,6 +953,78 @@ TEST(Synthesis, RepeatBandEndsAtTheFistEdge) {
   o.high_low = HighLowArm::Paper;
   EXPECT_THROW(synthesize(cal, sim, o, a, Comm::world()), InputError);
   fs::remove_all(a);
+}
+
+// labels.csv says what decided each label (paper V-A): a missed trial ran the rig's whole
+// travel; a stopped one is good when the lower half of the opening ended within 7 cm of the
+// elbow centre on either side, caught otherwise. A trial resumed from a marker written before the
+// evidence was kept (its label alone) has empty evidence fields and keeps its label.
+TEST(Synthesis, LabelsCsvRecordsWhatDecidedEachLabel) {
+  Calibration cal;
+  SynthesisOptions o;
+  o.per_height = 6;
+  o.threads = 2;
+  o.middle = MiddleArm::CaughtEdge;  // the middle arms just below the stand-in's edge: caught and missed
+  const fs::path dir = temp_dir("synth_labels");
+  const double middle_base = synthesize(cal, testing::fake_simulate, o, dir, Comm::world()).edge.offset;
+  auto rows_of = [&] {
+    std::vector<std::vector<std::string>> rows;
+    std::istringstream in(read_file(dir / "labels.csv"));
+    std::string line;
+    std::getline(in, line);
+    EXPECT_EQ(line, "trial_id,height,speed,arm_offset_m,label,travel_m,d_behind_m,d_ahead_m");
+    while (std::getline(in, line)) {
+      std::vector<std::string> f;
+      std::size_t a = 0;
+      for (std::size_t b; (b = line.find(',', a)) != std::string::npos; a = b + 1) f.push_back(line.substr(a, b - a));
+      f.push_back(line.substr(a));
+      EXPECT_EQ(f.size(), 8u) << line;
+      rows.push_back(f);
+    }
+    return rows;
+  };
+  const Dataset ds = load_dataset(dir);
+  auto rows = rows_of();
+  ASSERT_EQ(rows.size(), ds.trials.size());
+  int counted[kOutcomeCount] = {};
+  for (std::size_t t = 0; t < rows.size(); ++t) {
+    const auto& r = rows[t];
+    const HapticSequence& q = ds.trials[t];
+    EXPECT_EQ(r[0], q.id);
+    EXPECT_EQ(r[4], outcome_name(*q.label)) << q.id;
+    const TrialRequest req = synthesis_request(cal, q.height, static_cast<int>(t % o.per_height), o, middle_base);
+    EXPECT_NEAR(std::stod(r[3]), req.arm_offset, 1e-6) << q.id;
+    const double travel = std::stod(r[5]), d = std::max(std::stod(r[6]), std::stod(r[7]));
+    EXPECT_NEAR(travel, q.samples.back().travel, 1e-6) << q.id;
+    if (*q.label == Outcome::Missed) {
+      EXPECT_NEAR(travel, cal.rig_travel, 1e-6) << q.id;
+    } else {
+      EXPECT_LT(travel, cal.rig_travel - 1e-3) << q.id;
+    }
+    if (*q.label == Outcome::Good) {
+      EXPECT_LE(d, 0.07) << q.id;
+    }
+    if (*q.label == Outcome::Caught) {
+      EXPECT_GT(d, 0.07) << q.id;
+    }
+    ++counted[static_cast<int>(*q.label)];
+  }
+  // The stand-in gives all three outcomes here, so each branch above was checked.
+  for (int c = 0; c < kOutcomeCount; ++c) EXPECT_GT(counted[c], 0) << outcome_name(static_cast<Outcome>(c));
+  // A marker from before the evidence: the label alone. The rerun keeps its label, and its
+  // evidence is unknown, not zero.
+  const std::string id = synthesis_trial_id(ArmHeight::High, 2);  // a stopped trial (good)
+  ASSERT_EQ(*ds.trials[2].label, Outcome::Good);
+  write_file_atomic(dir / ".synth" / (id + ".done"), "good\n");
+  EXPECT_EQ(synthesize(cal, testing::fake_simulate, o, dir, Comm::world()).resumed, 3 * o.per_height);
+  rows = rows_of();
+  ASSERT_EQ(rows.size(), ds.trials.size());
+  EXPECT_EQ(rows[2][0], id);
+  EXPECT_EQ(rows[2][4], "good");
+  EXPECT_EQ(rows[2][6], "");
+  EXPECT_EQ(rows[2][7], "");
+  EXPECT_NE(rows[3][6], "");
+  fs::remove_all(dir);
 }
 
 TEST(Synthesis, DatasetIsIndependentOfThreadsAndResumes) {

@@ -44,10 +44,14 @@ inline SimulatedTrial fake_simulate(const ClothValues& c, const TrialRequest& r)
     out.samples.push_back({t, x, -drag, lateral, vert});
     if (drag >= 10.0 || std::abs(vert) >= 10.0) {
       out.outcome = arm > -0.05 ? Outcome::Good : Outcome::Caught;
+      // The label's evidence as the simulator gives it: a caught sleeve stays on the forearm.
+      out.d_behind = arm > -0.05 ? 0.03 : 0.12;
+      out.d_ahead = 0.0;
       break;
     }
     if (x >= r.max_travel) {
       out.outcome = Outcome::Missed;
+      out.d_behind = out.d_ahead = 0.0;
       break;
     }
   }

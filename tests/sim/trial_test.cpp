@@ -210,8 +210,14 @@ TEST(SimTrial, ThreeOutcomesFromArmHeightAlone) {
   std::vector<Outcome> seen;
   for (size_t k = 0; k < offsets.size(); ++k) {
     const TrialResult& r = results[k];
-    std::printf("arm offset %+.2f m: %-7s travel %.3f m, d_max %.3f m\n", offsets[k], std::string(outcome_name(r.outcome)).c_str(), r.travel,
-                r.d_max);
+    std::printf("arm offset %+.2f m: %-7s travel %.3f m, d_max %.3f m (behind the elbow %.3f, past it %.3f)\n", offsets[k],
+                std::string(outcome_name(r.outcome)).c_str(), r.travel, r.d_max, r.d_behind, r.d_ahead);
+    // The label's two sides make up its unsigned distance; a missed trial has neither.
+    EXPECT_EQ(r.d_max, std::max(r.d_behind, r.d_ahead)) << offsets[k];
+    if (r.outcome == Outcome::Missed) {
+      EXPECT_EQ(r.d_behind, 0.0);
+      EXPECT_EQ(r.d_ahead, 0.0);
+    }
     if (seen.empty() || seen.back() != r.outcome) seen.push_back(r.outcome);
   }
   const std::vector<Outcome> want = {Outcome::Good, Outcome::Caught, Outcome::Missed};
