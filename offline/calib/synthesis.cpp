@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <limits>
 #include <mutex>
+#include <sstream>
 
 #include "files.h"
 
@@ -276,6 +277,41 @@ ArmBand band_from_json(const Json& j, const fs::path& file) {
 }
 
 }  // namespace
+
+std::vector<std::string> ambiguous_labels(const fs::path& set, double margin) {
+  const fs::path file = set / "labels.csv";
+  if (!fs::exists(file))
+    throw_input_error(file, 0, "not found: the set was synthesized before labels.csv existed; synthesize it again");
+  std::istringstream in(read_file(file));
+  std::string line;
+  std::getline(in, line);
+  const std::string header = "trial_id,height,speed,arm_offset_m,label,travel_m,d_behind_m,d_ahead_m";
+  if (line != header) throw_input_error(file, 1, "the header is not '" + header + "'");
+  std::vector<std::string> out;
+  for (long n = 2; std::getline(in, line); ++n) {
+    if (line.empty()) continue;
+    std::vector<std::string> f;
+    std::size_t a = 0;
+    for (std::size_t b; (b = line.find(',', a)) != std::string::npos; a = b + 1) f.push_back(line.substr(a, b - a));
+    f.push_back(line.substr(a));
+    if (f.size() != 8) throw_input_error(file, n, "expected 8 fields, found " + std::to_string(f.size()));
+    const auto label = parse_outcome(f[4]);
+    if (!label) throw_input_error(file, n, "'" + f[4] + "' is not an outcome");
+    if (*label == Outcome::Missed) continue;  // ran the whole travel: the 7 cm does not apply
+    if (f[6].empty() || f[7].empty())
+      throw_input_error(file, n, "trial " + f[0] + " stopped early but has no label evidence (its marker predates "
+                                 "labels.csv): remove .synth/" + f[0] + ".done and synthesize again");
+    double behind = 0, ahead = 0;
+    try {
+      behind = std::stod(f[6]);
+      ahead = std::stod(f[7]);
+    } catch (const std::exception&) {
+      throw_input_error(file, n, "d_behind_m or d_ahead_m of trial " + f[0] + " is not a number");
+    }
+    if (std::abs(std::max(behind, ahead) - kGoodLabelDistance) < margin) out.push_back(f[0]);
+  }
+  return out;
+}
 
 SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, const SynthesisOptions& options,
                             const fs::path& out, const Comm& comm,

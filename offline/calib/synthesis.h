@@ -142,6 +142,17 @@ struct SynthesisSummary {
   double elapsed_s = 0;
 };
 
+// The trials of a synthesized set whose label the rule's 7 cm decides by less than `margin` [m]
+// (build-model --label-margin): those that stopped before the end of travel with
+// |max(d_behind, d_ahead) - kGoodLabelDistance| < margin, from the set's labels.csv, in file
+// order. Why: where a simulator's sleeve rim ends wrapped around the elbow, its lower half lies
+// about 7 cm from the elbow centre, and the label of each trial is decided by a millimetre that
+// the noise models move at random (participant 0's simulator: 38 of its 40 high-arm trials within
+// 5 mm of the rule, 18 of them labelled caught; offline/calib/README.md, session 31).
+// Throws InputError naming the file and line when labels.csv is missing or malformed, or when a
+// stopped trial has no evidence (a set synthesized before labels.csv existed: synthesize again).
+std::vector<std::string> ambiguous_labels(const std::filesystem::path& set, double margin);
+
 // Simulates the missing trials into `out` (a dataset folder) and writes its manifest. Every rank
 // of `comm` calls it; trials are spread over ranks (index % size) and threads; rank 0 writes
 // the manifest after all ranks have finished. Returns the same summary on every rank.

@@ -58,6 +58,10 @@ int run_build_model(int argc, char** argv) {
         "               the correction removes the error that the rule above guards against\n"
         "  --per-height N --no-gown-noise --no-arm-noise --middle M --high-low H --seed S --threads N --gown G\n"
         "               (synthesis; see dressguard synthesize --help)\n"
+        "  --label-margin M   leave out of training every synthesized trial whose label the rule's\n"
+        "               7 cm decides by less than M metres (a stopped trial with max(d_behind,\n"
+        "               d_ahead) within M of 7 cm, from each set's labels.csv): a label that the\n"
+        "               noise models flip at random teaches a class the other's forces. Default 0\n"
         "  --priors P   uniform (default: the paper's highest likelihood, and a caught arm's HMM\n"
         "               as likely as the others before any force is read) | training: each\n"
         "               class's share of the training trials (the Bayes decision for trials\n"
@@ -67,7 +71,7 @@ int run_build_model(int argc, char** argv) {
     return 0;
   }
   args.allow_only({"help", "json", "no-gown-noise", "no-arm-noise", "calibration", "data", "out", "synth-dir",
-                   "states", "per-height", "seed", "gown", "threads", "forces", "middle", "high-low", "created", "discrepancy",
+                   "states", "per-height", "seed", "gown", "threads", "forces", "middle", "high-low", "created", "discrepancy", "label-margin",
                    "priors"});
   const std::string out = args.require("out");
   if (args.has("calibration") == args.has("data")) throw UsageError("give exactly one of --calibration and --data");
@@ -78,6 +82,9 @@ int run_build_model(int argc, char** argv) {
   const std::string forces = args.get("forces").value_or("auto");
   if (forces != "auto" && forces != "both" && forces != "motion" && forces != "lateral")
     throw UsageError("--forces must be auto, both, lateral or motion");
+  const double label_margin = args.number("label-margin", 0.0);
+  if (!(label_margin >= 0.0 && label_margin < kGoodLabelDistance))
+    throw UsageError("--label-margin must be in [0, 0.07) metres");
   if (args.has("discrepancy") && !args.has("calibration"))
     throw UsageError("--discrepancy needs --calibration: it is a calibrated simulator's error on its own sequences");
   // The training sets: one per calibration (synthesized here) or the datasets given.
@@ -138,16 +145,30 @@ int run_build_model(int argc, char** argv) {
   std::string data;  // the training sets' names, for the model's metadata and the summary
   for (const auto& d : sets) data += (data.empty() ? "" : ",") + d.string();
   Dataset ds;
-  if (discrepancies.empty()) {
-    ds = load_datasets(sets);
-  } else {
-    for (std::size_t i = 0; i < sets.size(); ++i) {
-      Dataset one = load_dataset(sets[i]);
-      for (auto& t : one.trials) apply_discrepancy(discrepancies[i].second, t);
-      std::move(one.trials.begin(), one.trials.end(), std::back_inserter(ds.trials));
+  int left_out = 0;
+  for (std::size_t i = 0; i < sets.size(); ++i) {
+    Dataset one = load_dataset(sets[i]);
+    if (label_margin > 0) {
+      const std::vector<std::string> drop = ambiguous_labels(sets[i], label_margin);
+      const auto n = one.trials.size();
+      std::erase_if(one.trials, [&](const HapticSequence& t) {
+        return std::find(drop.begin(), drop.end(), t.id) != drop.end();
+      });
+      left_out += static_cast<int>(n - one.trials.size());
     }
+    if (!discrepancies.empty())
+      for (auto& t : one.trials) apply_discrepancy(discrepancies[i].second, t);
+    std::move(one.trials.begin(), one.trials.end(), std::back_inserter(ds.trials));
+  }
+  if (!discrepancies.empty()) {
     write_file_atomic(out + ".discrepancy.csv", discrepancy_csv(discrepancies));
     data += " + discrepancy from " + *args.get("discrepancy");
+  }
+  if (label_margin > 0) {
+    char note[160];
+    std::snprintf(note, sizeof note, "; %d trials left out, their label within %.4g m of the rule's 7 cm", left_out,
+                  label_margin);
+    data += note;
   }
   std::vector<const HapticSequence*> trials;
   for (const auto& t : ds.trials) trials.push_back(&t);
@@ -171,9 +192,10 @@ int run_build_model(int argc, char** argv) {
   const double acc = accuracy(m, trials, std::numeric_limits<double>::infinity());
   if (args.has("json")) {
     std::printf("{\"model\": \"%s\", \"classes\": %zu, \"training_trials\": %zu, \"training_sets\": %zu, "
-                "\"training_accuracy\": %.4f, \"forces\": \"%s\", \"priors\": \"%s\"}\n",
+                "\"training_accuracy\": %.4f, \"forces\": \"%s\", \"priors\": \"%s\", \"label_margin\": %.6g, "
+                "\"left_out\": %d}\n",
                 out.c_str(), m.classes.size(), trials.size(), sets.size(), acc, stc_forces_name(axes.second_axis),
-                priors.c_str());
+                priors.c_str(), label_margin, left_out);
   } else {
     std::printf("wrote %s: %zu classes (", out.c_str(), m.classes.size());
     for (std::size_t i = 0; i < m.classes.size(); ++i) std::printf("%s%s", i ? ", " : "", m.classes[i].name.c_str());

@@ -1024,6 +1024,24 @@ TEST(Synthesis, LabelsCsvRecordsWhatDecidedEachLabel) {
   EXPECT_EQ(rows[2][6], "");
   EXPECT_EQ(rows[2][7], "");
   EXPECT_NE(rows[3][6], "");
+  // build-model --label-margin reads this evidence: the stand-in's stopped trials end 3 cm
+  // (good) and 12 cm (caught) from the elbow, so a margin of 4.5 cm takes the good ones alone
+  // and 1 cm none; a stopped trial without evidence is named by file and line.
+  EXPECT_THROW(ambiguous_labels(dir, 0.01), InputError);
+  try {
+    ambiguous_labels(dir, 0.01);
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("labels.csv:4: trial " + id), std::string::npos) << e.what();
+  }
+  fs::remove(dir / ".synth" / (id + ".done"));
+  synthesize(cal, testing::fake_simulate, o, dir, Comm::world());
+  EXPECT_TRUE(ambiguous_labels(dir, 0.01).empty());
+  std::vector<std::string> good;
+  for (const auto& t : load_dataset(dir).trials)
+    if (*t.label == Outcome::Good) good.push_back(t.id);
+  EXPECT_FALSE(good.empty());
+  EXPECT_EQ(ambiguous_labels(dir, 0.045), good);
+  EXPECT_THROW(ambiguous_labels(temp_dir("synth_none"), 0.01), InputError);
   fs::remove_all(dir);
 }
 

@@ -107,6 +107,32 @@ if(HMM)
   if(NOT rc EQUAL 0 OR NOT shown1 STREQUAL shown2)
     message(FATAL_ERROR "build-model --data A,B against the pooled build (${rc}):\n${shown1}\n---\n${shown2}\n${err}")
   endif()
+  # --label-margin leaves out the trials whose label evidence (labels.csv) sits within the margin
+  # of the rule's 7 cm; the rest train the model. Any margin below 7 cm is accepted; a set
+  # without labels.csv is named.
+  execute_process(COMMAND ${DG} build-model --data ${WORK}/sB --label-margin 0.069 --out ${WORK}/margin.dgm
+                          --states 3 --forces motion --json
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  string(REGEX MATCH "\"training_trials\": ([0-9]+)" _ "${out}")
+  set(kept "${CMAKE_MATCH_1}")
+  string(REGEX MATCH "\"left_out\": ([0-9]+)" _ "${out}")
+  set(dropped "${CMAKE_MATCH_1}")
+  file(STRINGS ${WORK}/sB/labels.csv stopped REGEX ",(good|caught),")
+  list(LENGTH stopped n_stopped)
+  if(NOT rc EQUAL 0 OR kept STREQUAL "" OR dropped STREQUAL "")
+    message(FATAL_ERROR "build-model --label-margin (${rc}):\n${out}\n${err}")
+  endif()
+  math(EXPR total "${kept} + ${dropped}")
+  if(NOT total EQUAL 6 OR dropped GREATER n_stopped)
+    message(FATAL_ERROR "build-model --label-margin: ${kept} kept + ${dropped} left out of 6 trials, ${n_stopped} stopped:\n${out}")
+  endif()
+  expect_fail("build-model with a label margin of 7 cm" "--label-margin must be in"
+              build-model --data ${WORK}/sB --label-margin 0.07 --out ${WORK}/m.dgm)
+  file(REMOVE_RECURSE ${WORK}/sB-old)
+  file(COPY ${WORK}/sB/ DESTINATION ${WORK}/sB-old)
+  file(REMOVE ${WORK}/sB-old/labels.csv)  # a set synthesized before labels.csv existed
+  expect_fail("build-model --label-margin on a set without labels.csv" "sB-old/labels.csv: not found"
+              build-model --data ${WORK}/pooled.dgm.synth/cal4,${WORK}/sB-old --label-margin 0.01 --out ${WORK}/m.dgm)
   # train pools alike, and names a missing set's manifest.
   execute_process(COMMAND ${DG} train --data ${WORK}/pooled.dgm.synth/cal4,${WORK}/sB --out ${WORK}/t.dgm --states 3 --json
                   RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
