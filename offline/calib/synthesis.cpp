@@ -281,7 +281,9 @@ ArmBand band_from_json(const Json& j, const fs::path& file) {
 std::vector<std::string> ambiguous_labels(const fs::path& set, double margin) {
   const fs::path file = set / "labels.csv";
   if (!fs::exists(file))
-    throw_input_error(file, 0, "not found: the set was synthesized before labels.csv existed; synthesize it again");
+    throw_input_error(file, 0,
+                      "not found: --label-margin needs a set that `synthesize` wrote with its label evidence (this "
+                      "one is measured, or older than labels.csv: synthesize it again)");
   std::istringstream in(read_file(file));
   std::string line;
   std::getline(in, line);
