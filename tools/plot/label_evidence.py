@@ -82,7 +82,7 @@ def main(argv):
         ax.tick_params(labelsize=7)
     for ax in list(axes.flat)[len(sets):]:
         ax.axis("off")
-    fig.suptitle("label evidence of the synthesized trials that stopped early (grey: good by the 7 cm rule)", fontsize=10)
+    fig.suptitle("synthesized trials that stopped early\n(grey: good by the 7 cm rule)", fontsize=9)
     fig.tight_layout()
     fig.savefig(out, dpi=110)
     print(f"wrote {out}")
