@@ -126,6 +126,18 @@ if(HMM)
   if(NOT total EQUAL 6 OR dropped GREATER n_stopped)
     message(FATAL_ERROR "build-model --label-margin: ${kept} kept + ${dropped} left out of 6 trials, ${n_stopped} stopped:\n${out}")
   endif()
+  # The same evidence as a picture (tools/plot/label_evidence.py), and its error for a set without it.
+  get_filename_component(plots ${PLOT} DIRECTORY)
+  execute_process(COMMAND /usr/bin/python3 ${plots}/label_evidence.py ${WORK}/evidence.png --margin 0.005 sB=${WORK}/sB
+                  RESULT_VARIABLE rc ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/evidence.png)
+    message(FATAL_ERROR "label_evidence.py on a synthesized set (${rc}): ${err}")
+  endif()
+  execute_process(COMMAND /usr/bin/python3 ${plots}/label_evidence.py ${WORK}/none.png none=${WORK}/missing
+                  RESULT_VARIABLE rc ERROR_VARIABLE err)
+  if(rc EQUAL 0 OR NOT err MATCHES "missing/labels.csv")
+    message(FATAL_ERROR "label_evidence.py on a folder without labels.csv (${rc}): ${err}")
+  endif()
   expect_fail("build-model with a label margin of 7 cm" "--label-margin must be in"
               build-model --data ${WORK}/sB --label-margin 0.07 --out ${WORK}/m.dgm)
   file(REMOVE_RECURSE ${WORK}/sB-old)
