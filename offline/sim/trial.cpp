@@ -373,10 +373,10 @@ TrialResult finish_pull(const GownModel& m, Pulling& p, const TrialSpec& spec, c
     // The elbow where the (compliant) arm has it now.
     for (int v : at_rest.lower) {
       const double dx = s.x[v].x - (m.elbow.x + s.arm_shift.x);
-      r.d_max = std::max(r.d_max, std::abs(dx));
       r.d_behind = std::max(r.d_behind, -dx);
       r.d_ahead = std::max(r.d_ahead, dx);
     }
+    r.d_max = std::max(r.d_behind, r.d_ahead);  // the paper's unsigned distance
   }
   r.outcome = label_outcome(p.full, r.d_max);
   r.seq.label = r.outcome;
