@@ -108,5 +108,9 @@ if [ -f models/default.dgm ] && [ -f "$out/measured/manifest.csv" ]; then
   "$dg" replay --model models/default.dgm --logs "$robot/measured" | sed -n '/^outcome/,$p'
   "$dg" replay --model models/default.dgm --logs "$robot/measured" --json > "$robot/measured-stops.json"
   /usr/bin/python3 tools/plot/stop_rule.py "$robot/stop-rule.png" "models/default.dgm=$robot/measured-stops.json"
+  # What each stop threshold would cost at the study's mix of pulls (the deployer's choice).
+  echo "main-job: pulls stopped for nothing per 100 of the study's protocol, by stop threshold"
+  /usr/bin/python3 tools/plot/stop_threshold_curve.py "$robot/stop-threshold-curve.png" --dressguard "$dg" \
+    --model models/default.dgm --logs "$robot/measured" --json "$robot/stop-threshold-curve.json"
 fi
 echo "main-job: candump logs and replays in $robot"

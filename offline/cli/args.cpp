@@ -27,12 +27,12 @@ Args::Args(int argc, char** argv, std::set<std::string> flags) {
     if (a.rfind("--", 0) == 0 && a.size() > 2) {
       std::string name = a.substr(2);
       if (auto eq = name.find('='); eq != std::string::npos) {
-        values_[name.substr(0, eq)] = name.substr(eq + 1);
+        values_[name.substr(0, eq)].push_back(name.substr(eq + 1));
       } else if (flags.count(name)) {
         flags_set_.insert(name);
       } else {
         if (i + 1 >= argc) throw UsageError("option --" + name + " needs a value");
-        values_[name] = argv[++i];
+        values_[name].push_back(argv[++i]);
       }
     } else {
       positional_.push_back(a);
@@ -45,7 +45,16 @@ bool Args::has(const std::string& name) const { return flags_set_.count(name) ||
 std::optional<std::string> Args::get(const std::string& name) const {
   auto it = values_.find(name);
   if (it == values_.end()) return std::nullopt;
-  return it->second;
+  if (it->second.size() > 1) {
+    throw UsageError("option --" + name + " given " + std::to_string(it->second.size()) + " times ('" +
+                     it->second.front() + "', '" + it->second.back() + "'): give it once");
+  }
+  return it->second.front();
+}
+
+std::vector<std::string> Args::all(const std::string& name) const {
+  auto it = values_.find(name);
+  return it == values_.end() ? std::vector<std::string>{} : it->second;
 }
 
 std::string Args::require(const std::string& name) const {

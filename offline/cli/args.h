@@ -30,7 +30,11 @@ class Args {
   Args(int argc, char** argv, std::set<std::string> flags);
 
   bool has(const std::string& name) const;
+  // The option's value. An option given twice is a UsageError naming it: the second value would
+  // otherwise replace the first without a word. Options meant to repeat are read with all().
   std::optional<std::string> get(const std::string& name) const;
+  // Every value of a repeatable option, in the order given (e.g. replay's --set KEY=VALUE).
+  std::vector<std::string> all(const std::string& name) const;
   std::string require(const std::string& name) const;  // UsageError when absent
   double number(const std::string& name, double fallback) const;  // UsageError when not a number
   long integer(const std::string& name, long fallback) const;
@@ -39,7 +43,7 @@ class Args {
   void allow_only(const std::set<std::string>& known) const;
 
  private:
-  std::map<std::string, std::string> values_;
+  std::map<std::string, std::vector<std::string>> values_;
   std::set<std::string> flags_set_;
   std::vector<std::string> positional_;
 };

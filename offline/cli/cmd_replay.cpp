@@ -31,7 +31,8 @@ const char* kHelp =
     "                     stop policy costs (good and missed pulls stopped) against what it buys\n"
     "                     (caught pulls stopped, and how long before their own end)\n"
     "  --config FILE      the daemon's config file (its predictor keys; others are ignored)\n"
-    "  --set KEY=VALUE    override one predictor key, e.g. --set stop_threshold=0.95\n"
+    "  --set KEY=VALUE    override one predictor key, after --config's; repeat it for several,\n"
+    "                     e.g. --set stop_threshold=0.99 --set stop_consecutive=10\n"
     "  --tick-ms N        the daemon's timer period (default 1)\n"
     "  --json             {stopped, stop_time, travel, reason, posteriors at the stop, ...}\n"
     "  Times are logical: stop_time = the deciding sample's index x the sample period; travel is\n"
@@ -180,7 +181,7 @@ int run_replay(int argc, char** argv) {
     cfg_text = read_file(*c);
     cfg_name = *c;
   }
-  if (auto s = args.get("set")) cfg_text += "\n" + *s + "\n";
+  for (const auto& s : args.all("set")) cfg_text += "\n" + s + "\n";
   predictor::PredictorConfig cfg;
   try {
     std::vector<predictor::ConfigEntry> others;  // the daemon's own keys: not replay's business

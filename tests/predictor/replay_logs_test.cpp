@@ -271,6 +271,27 @@ TEST(ReplayCli, LogsFolderTalliesTheStopsPerOutcome) {
   EXPECT_NE(both.find("exactly one of --log"), std::string::npos) << both;
 }
 
+TEST(ReplayCli, EverySetOverridesItsKey) {
+  // Two --set options both apply. A threshold of 0.01 alone (with the model's 5 samples) stops
+  // every trial, since P(caught) starts near 1/3. 100000 consecutive samples, longer than any
+  // trial, stops none. If only the last --set counted, as before session 32, every trial would
+  // stop here.
+  int rc = 0;
+  const std::string base = std::string(DG_CLI) + " replay --model " + DG_TEST_MODEL + " --logs " + kLogs.string();
+  const std::string lone = run(base + " --set stop_threshold=0.01 --json", rc);
+  ASSERT_EQ(rc, 0) << lone;
+  EXPECT_NE(lone.find("\"good\": {\"logs\": 3, \"trials\": 3, \"caught_stops\": 3"), std::string::npos) << lone;
+  const std::string two = run(base + " --set stop_consecutive=100000 --set stop_threshold=0.01 --json", rc);
+  ASSERT_EQ(rc, 0) << two;
+  // (The fault logs still stop, for their faults: no caught stop is what the two keys decide.)
+  EXPECT_EQ(two.find("\"reason\": \"caught\""), std::string::npos) << two;
+  // Any other option given twice is refused, naming it and both values, not silently replaced.
+  const std::string twice = run(base + " --model other.dgm 2>&1", rc);
+  EXPECT_EQ(WEXITSTATUS(rc), 2);
+  EXPECT_NE(twice.find("option --model given 2 times"), std::string::npos) << twice;
+  EXPECT_NE(twice.find("'other.dgm'"), std::string::npos) << twice;
+}
+
 // The study's measured trials as candump logs in tmp/logs (`import`, then `export-candump --data`
 // with `export_options`); "" when shared/data is not here. Logs are generated at test time, never
 // committed (the data is not redistributable).

@@ -1,0 +1,157 @@
+#!/usr/bin/python3
+"""The stop rule's operating curve: what each stop threshold costs and buys at the study's mix.
+
+The predictor stops the robot when P(caught) stays above `stop_threshold` for `stop_consecutive`
+samples. The threshold is the deployer's choice. This tool replays the same candump logs
+through the predictor's own code (`dressguard replay --logs DIR --set ... --json`) at each
+threshold. It weights each outcome's stop rate by that outcome's share of the study's protocol:
+360 pulls, 120 good at the high arm, 120 missed at the low arm, and 91 caught and 29 missed at
+the middle arm (shared/data README). It reports, per 100 pulls:
+  - stopped for nothing: good, low-arm missed and middle-arm missed pulls that were stopped;
+  - catches stopped: the caught rate times 91 of 360.
+A log's outcome is the end of its name (-good.log, -missed.log, -caught.log, as `export-candump`
+names them). A missed log is a middle-arm miss when its name holds "middlemiss" (the study's
+trial ids, e.g. s2-middlemiss-7-missed.log) and a low-arm miss otherwise. Logs of other names are
+left out. From a --caught-logs folder only the caught logs count: the study recorded no caught
+pull, so the caught ones are synthetic, and their folder's other trials are no measured mix.
+Without caught logs the catches column is empty; an outcome without logs counts as never
+stopped and is flagged.
+
+usage: stop_threshold_curve.py OUT.png --model MODEL.dgm --logs DIR [--logs DIR ...]
+           [--caught-logs DIR ...] [--dressguard BIN] [--consecutive N] [--thresholds T,T,...]
+           [--json OUT.json]
+models/README.md, "The stop rule on the real pulls".
+"""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+
+# The study's protocol (shared/data README): pulls of each kind out of 360.
+PROTOCOL = {"good": 120, "low missed": 120, "middle missed": 29, "caught": 91}
+TOTAL = sum(PROTOCOL.values())
+DEFAULT_THRESHOLDS = "0.5,0.7,0.8,0.9,0.95,0.99,0.999,0.9999"
+
+
+def kind_of(file, label):
+    if label == "missed":
+        return "middle missed" if "middlemiss" in file else "low missed"
+    return label if label in ("good", "caught") else None
+
+
+def replay(args, logs, threshold):
+    cmd = [args.dressguard, "replay", "--model", args.model, "--logs", logs, "--set",
+           f"stop_threshold={threshold}", "--set", f"stop_consecutive={args.consecutive}", "--json"]
+    run = subprocess.run(cmd, capture_output=True, text=True)
+    if run.returncode != 0:
+        sys.exit(f"stop_threshold_curve.py: {' '.join(cmd)} failed ({run.returncode}): "
+                 f"{run.stderr.strip() or run.stdout.strip()}")
+    return json.loads(run.stdout)["trials"]
+
+
+def point(args, threshold):
+    """Stops and trials per kind at one threshold, over every --logs folder."""
+    tally = {k: [0, 0] for k in PROTOCOL}
+    leads = []  # seconds between each caught stop of a caught pull and that pull's own end
+    folders = [(d, False) for d in args.logs] + [(d, True) for d in args.caught_logs]
+    for logs, caught_only in folders:
+        for t in replay(args, logs, threshold):
+            k = kind_of(t["file"], t["label"])
+            if k is None or (caught_only and k != "caught"):
+                continue
+            tally[k][1] += 1
+            stopped = bool(t["stopped"]) and t["reason"] == "caught"
+            tally[k][0] += stopped
+            if stopped and k == "caught" and t.get("lead") is not None:
+                leads.append(t["lead"])
+    rate = {k: (s / n if n else None) for k, (s, n) in tally.items()}
+    nothing = sum(100.0 * PROTOCOL[k] / TOTAL * (rate[k] or 0.0)
+                  for k in ("good", "low missed", "middle missed"))
+    catches = None if rate["caught"] is None else 100.0 * PROTOCOL["caught"] / TOTAL * rate["caught"]
+    return {"threshold": threshold, "stops": tally, "stopped_for_nothing_per_100": nothing,
+            "catches_stopped_per_100": catches,
+            "median_lead_s": statistics.median(leads) if leads else None}
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("out")
+    p.add_argument("--model", required=True)
+    p.add_argument("--logs", action="append", required=True)
+    p.add_argument("--caught-logs", action="append", default=[])
+    p.add_argument("--dressguard", default=os.path.join(os.path.dirname(__file__), "..", "..", "build",
+                                                       "release", "offline", "cli", "dressguard"))
+    p.add_argument("--consecutive", type=int, default=5)
+    p.add_argument("--thresholds", default=DEFAULT_THRESHOLDS)
+    p.add_argument("--json", dest="json_out")
+    args = p.parse_args()
+    for path, what in [(args.model, "model"), (args.dressguard, "dressguard binary")]:
+        if not os.path.isfile(path):
+            sys.exit(f"stop_threshold_curve.py: {path}: no such {what}")
+    try:
+        thresholds = [float(t) for t in args.thresholds.split(",")]
+    except ValueError:
+        sys.exit(f"stop_threshold_curve.py: --thresholds '{args.thresholds}' is not a comma-separated list of numbers")
+    if not thresholds or any(not 0.0 < t < 1.0 for t in thresholds) or args.consecutive < 1:
+        sys.exit("stop_threshold_curve.py: every threshold must lie in (0, 1) and --consecutive be at least 1")
+
+    points = [point(args, t) for t in sorted(thresholds)]
+    counts = points[0]["stops"]
+    missing = [k for k in PROTOCOL if counts[k][1] == 0]
+    print(f"{'threshold':>10}  {'good':>7} {'low miss':>8} {'mid miss':>8} {'caught':>7}   "
+          f"stopped for nothing / 100   catches stopped / 100 (of {100 * PROTOCOL['caught'] / TOTAL:.0f})"
+          f"   median lead [s]")
+    for q in points:
+        s = q["stops"]
+        cell = lambda k: f"{s[k][0]}/{s[k][1]}" if s[k][1] else "-"
+        catches = "-" if q["catches_stopped_per_100"] is None else f"{q['catches_stopped_per_100']:.1f}"
+        lead = "-" if q["median_lead_s"] is None else f"{q['median_lead_s']:.2f}"
+        print(f"{q['threshold']:>10g}  {cell('good'):>7} {cell('low missed'):>8} {cell('middle missed'):>8} "
+              f"{cell('caught'):>7}   {q['stopped_for_nothing_per_100']:>25.1f}   {catches:>21}   {lead:>16}")
+    if missing:
+        print(f"no logs of: {', '.join(missing)} (counted as never stopped)")
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.8))
+    xs = [q["stopped_for_nothing_per_100"] for q in points]
+    if counts["caught"][1]:
+        ys = [q["catches_stopped_per_100"] for q in points]
+        ax.plot(xs, ys, "o-", color="tab:red")
+        ax.axhline(100 * PROTOCOL["caught"] / TOTAL, color="grey", ls=":", lw=1)
+        ax.set_ylabel(f"catches stopped per 100 pulls (of {100 * PROTOCOL['caught'] / TOTAL:.1f})")
+    else:
+        ys = [0.0] * len(points)
+        ax.plot(xs, ys, "o", color="tab:red")
+        ax.set_ylabel("catches stopped per 100 pulls (no caught logs)")
+    # Thresholds that land on the same point share one label.
+    labels = {}
+    for q, x, y in zip(points, xs, ys):
+        lead = "" if q["median_lead_s"] is None else f" ({q['median_lead_s']:.2f} s)"
+        labels.setdefault((x, y), []).append(f"{q['threshold']:g}{lead}")
+    for i, ((x, y), names) in enumerate(sorted(labels.items())):
+        ax.annotate("\n".join(names), (x, y), textcoords="offset points", xytext=(4, -14 - 10 * (len(names) - 1)
+                    if i % 2 else 8), fontsize=7)
+    ax.set_ylim(0, 100 * PROTOCOL["caught"] / TOTAL * 1.08)
+    ax.set_xlabel("pulls stopped for nothing per 100 (good, low and middle misses)")
+    ax.set_title(f"stop rule: P(caught) > threshold for {args.consecutive} samples\n"
+                 f"{os.path.basename(args.model)}, weighted by the study's protocol (360 pulls)", fontsize=10)
+    ax.set_xlim(left=0)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(args.out, dpi=120)
+    print(f"wrote {args.out}")
+    if args.json_out:
+        with open(args.json_out + ".tmp", "w") as fh:
+            json.dump({"model": args.model, "consecutive": args.consecutive, "protocol": PROTOCOL,
+                       "points": points}, fh, indent=1)
+        os.replace(args.json_out + ".tmp", args.json_out)
+
+
+if __name__ == "__main__":
+    main()
