@@ -104,7 +104,7 @@ def main():
 
     points = [point(args, t) for t in sorted(thresholds)]
     counts = points[0]["stops"]
-    missing = [k for k in PROTOCOL if counts[k][1] == 0]
+    missing = [k for k in ("good", "low missed", "middle missed") if counts[k][1] == 0]
     print(f"{'threshold':>10}  {'good':>7} {'low miss':>8} {'mid miss':>8} {'caught':>7}   "
           f"stopped for nothing / 100   catches stopped / 100 (of {100 * PROTOCOL['caught'] / TOTAL:.0f})"
           f"   median lead [s]")
@@ -117,6 +117,8 @@ def main():
               f"{cell('caught'):>7}   {q['stopped_for_nothing_per_100']:>25.1f}   {catches:>21}   {lead:>16}")
     if missing:
         print(f"no logs of: {', '.join(missing)} (counted as never stopped)")
+    if counts["caught"][1] == 0:
+        print("no caught logs: no catches column (the study recorded no caught pull; --caught-logs adds synthetic ones)")
 
     fig, ax = plt.subplots(figsize=(6.4, 4.8))
     xs = [q["stopped_for_nothing_per_100"] for q in points]
