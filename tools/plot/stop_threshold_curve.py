@@ -7,7 +7,8 @@ through the predictor's own code (`dressguard replay --logs DIR --set ... --json
 threshold. It weights each outcome's stop rate by that outcome's share of the study's protocol:
 360 pulls, 120 good at the high arm, 120 missed at the low arm, and 91 caught and 29 missed at
 the middle arm (shared/data README). It reports, per 100 pulls:
-  - stopped for nothing: good, low-arm missed and middle-arm missed pulls that were stopped;
+  - stopped for nothing: good, low-arm missed and middle-arm missed pulls stopped for "caught"
+    (stops for a fault or the hard limit are the rig's, not the threshold's, and are not counted);
   - catches stopped: the caught rate times 91 of 360.
 A log's outcome is the end of its name (-good.log, -missed.log, -caught.log, as `export-candump`
 names them). A missed log is a middle-arm miss when its name holds "middlemiss" (the study's
