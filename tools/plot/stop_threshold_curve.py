@@ -138,8 +138,10 @@ def main():
         lead = "" if q["median_lead_s"] is None else f" ({q['median_lead_s']:.2f} s)"
         labels.setdefault((x, y), []).append(f"{q['threshold']:g}{lead}")
     for i, ((x, y), names) in enumerate(sorted(labels.items())):
-        ax.annotate("\n".join(names), (x, y), textcoords="offset points", xytext=(4, -14 - 10 * (len(names) - 1)
-                    if i % 2 else 8), fontsize=7)
+        # Neighbouring points' labels alternate above and below the curve; a label below grows
+        # downwards by one line per threshold it holds.
+        below = -14 - 10 * (len(names) - 1)
+        ax.annotate("\n".join(names), (x, y), textcoords="offset points", xytext=(4, below if i % 2 else 8), fontsize=7)
     ax.set_ylim(0, 100 * PROTOCOL["caught"] / TOTAL * 1.08)
     ax.set_xlabel("pulls stopped for nothing per 100 (good, low and middle misses)")
     ax.set_title(f"stop rule: P(caught) > threshold for {args.consecutive} samples\n"
