@@ -184,6 +184,7 @@ def main():
     check(m is not None, "the VM booted Debian's kernel: " + (m.group(1) + " " + m.group(2).strip() if m else "no"))
     check("DG-VM: done" in console, "the in-VM script ran to its end")
     check("DG-VM: insmod" not in console, "can, can-raw, can-dev, vcan loaded")
+    check("daemon not listening" not in console, "every scenario's daemon was listening before the play")
     sec = sections(console)
     for name in ("clean", "hardlimit", "gap", "nomodel", "latency"):
         m = re.search(rf"DG-VM: \[[\d.]+\] scenario {name} daemon_exit (\d+)", console)
