@@ -13,14 +13,14 @@ ip link set vcan0 txqueuelen 1000 2>/dev/null
 ip link set up vcan0 || ip2 link set up vcan0
 say "vcan0 $(cat /sys/class/net/vcan0/operstate)"
 
-# Waits until the daemon's log says "listening on": its CAN sockets are open from then on, so no
+# wait_listening LOG SCENARIO: waits until the daemon's LOG says "listening on": its CAN sockets are open from then on, so no
 # frame played after it is lost. A fixed pause is not enough: an ASan build under emulation on a
 # busy host took more than the 0.5 s this once waited, and missed the first trial's start.
 wait_listening() {
   i=0
   while ! grep -q "listening on" "$1" 2>/dev/null; do
     i=$((i + 1))
-    if [ $i -gt 600 ]; then say "daemon not listening after 60 s"; return; fi
+    if [ $i -gt 600 ]; then say "scenario $2: daemon not listening after 60 s"; return; fi
     sleep 0.1
   done
 }
@@ -35,7 +35,7 @@ scenario() {
   dressguard-predictor --interface vcan0 --set sensor_timeout_ms=200 $dargs --latency-report > /tmp/$name.log 2>&1 &
   dpid=$!
   sleep 0.5   # candump (started above) is up by then
-  wait_listening /tmp/$name.log
+  wait_listening /tmp/$name.log $name
   say "scenario $name start"
   play_$name
   sleep 0.3
