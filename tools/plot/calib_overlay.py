@@ -330,7 +330,7 @@ def plot_progress(args):
     names = sorted({n for k in g for n in gens[k][2]})
     for n in names:
         pts = [(k, gens[k][2][n]) for k in g if n in gens[k][2]]
-        ax.plot([p[0] for p in pts], [p[1] for p in pts], "--.", lw=1.2, drawstyle="steps-post", label=f"best so far: {n}")
+        ax.plot([p[0] for p in pts], [p[1] for p in pts], "--.", lw=1.2, drawstyle="steps-post", label=f"{n}, of the best so far")
     ax.set_yscale("log")
     ax.set_xlabel("generation")
     ax.set_ylabel("L (paper eq. 3-5)")
