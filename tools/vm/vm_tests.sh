@@ -14,8 +14,9 @@ ip link set up vcan0 || ip2 link set up vcan0
 say "vcan0 $(cat /sys/class/net/vcan0/operstate)"
 
 # wait_listening LOG SCENARIO: waits until the daemon's LOG says "listening on": its CAN sockets
-# are open from then on, so no frame played after it is lost. A fixed pause is not enough: an ASan build under emulation on a
-# busy host took more than the 0.5 s this once waited, and missed the first trial's start.
+# are open from then on, so no frame played after it is lost. A fixed pause is not enough: an
+# ASan build under emulation on a busy host took more than the 0.5 s this once waited, and
+# missed the first trial's start.
 wait_listening() {
   i=0
   while ! grep -q "listening on" "$1" 2>/dev/null; do
