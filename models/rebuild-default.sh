@@ -1,7 +1,7 @@
 #!/bin/sh
 # Rebuilds models/default.dgm, the default model: the simulation-trained classifier of seven
-# people's calibrated simulators (the committee of offline/calib/README.md, sessions 25-30), and
-# records its SHA-256 in models/default.dgm.sha256, which tests/models checks.
+# people's calibrated simulators (the committee of offline/calib/MEASUREMENTS.md, sessions
+# 25-30), and records its SHA-256 in models/default.dgm.sha256, which tests/models checks.
 #
 # What it trains on: each calibration synthesizes 40 trials per arm height (seed 1, both noise
 # models, the reduced measured gown); the high and low arms' noise stays inside each simulator's

@@ -41,7 +41,8 @@ model="$out/model"
 mkdir -p "$model"
 "$dg" synthesize --calibration models/default-simulator.json --out "$model/synth" \
   --per-height "${MAIN_JOB_PER_HEIGHT:-4}" --gown "${MAIN_JOB_GOWN:-reduced}" --seed 1
-# What decided each synthesized label (the 7 cm rule of paper V-A; offline/calib/README.md, session 31).
+# What decided each synthesized label (the 7 cm rule of paper V-A;
+# offline/calib/MEASUREMENTS.md, session 31).
 /usr/bin/python3 tools/plot/label_evidence.py "$model/label-evidence.png" "default simulator=$model/synth"
 "$dg" train --data "$model/synth" --out "$model/stc.dgm"
 "$dg" model show "$model/stc.dgm" | head -8

@@ -63,12 +63,12 @@ void set_person_value(ClothValues& c, int i, double v) {
 
 Bounds default_bounds() {
   Bounds b;
-  // The start is the plausibility grid's best point against participant 4 (offline/sim/README.md:
-  // the best of stretch {0.2, 0.6} x friction {0.2, 0.35, 0.5} at bend 0.7, with the fixed arm and
-  // with the compliant one), not the simulator's defaults: from it, 6 x 10 candidates at sigma0
-  // 0.1 calibrated participants 2, 4, 5, 7 to L 2.50, 1.11, 1.15, 2.26 where the defaults' start
-  // (stretch 0.8, bend 0.5, friction 0.5) at sigma0 0.3 gave 3.35, 1.86, 1.52, 3.45 (README.md,
-  // session 7).
+  // The start is the plausibility grid's best point against participant 4
+  // (offline/sim/MEASUREMENTS.md: the best of stretch {0.2, 0.6} x friction {0.2, 0.35, 0.5} at
+  // bend 0.7, with the fixed arm and with the compliant one), not the simulator's defaults: from
+  // it, 6 x 10 candidates at sigma0 0.1 calibrated participants 2, 4, 5, 7 to L 2.50, 1.11, 1.15,
+  // 2.26 where the defaults' start (stretch 0.8, bend 0.5, friction 0.5) at sigma0 0.3 gave 3.35,
+  // 1.86, 1.52, 3.45 (MEASUREMENTS.md, session 7).
   b.cloth[0] = {0.0, 1.0, 0.2};   // stretch
   b.cloth[1] = {0.0, 1.0, 0.5};   // shear
   b.cloth[2] = {0.0, 1.0, 0.7};   // bend

@@ -313,7 +313,7 @@ double contrast_term(const std::vector<HapticSequence>& inputs, const std::vecto
 // force over the travel both cover [N m]. w = 0 because eq. 4's length penalty is already
 // charged on the other two axes. The paper leaves F_lateral out (its rig's pull and its arm lie
 // in one vertical plane), but the study's people did not: every good trial pulls the gripper
-// sideways by 0.05-0.15 N from 0.1 m on and every missed one does not (offline/sim/README.md,
+// sideways by 0.05-0.15 N from 0.1 m on and every missed one does not (offline/sim/MEASUREMENTS.md,
 // "The lateral force"), and only this term lets a search place the arm sideways
 // (kArmLateral). 0 when the weight is 0; a simulation that did not finish scores infinity.
 double lateral_term(const std::vector<HapticSequence>& inputs, const std::vector<SimulatedTrial>& simulated,

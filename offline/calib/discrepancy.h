@@ -2,8 +2,8 @@
 // Kennedy and O'Hagan (2001, "Bayesian calibration of computer models", eq. 5), measured = simulator
 // + discrepancy + noise. After calibration the simulator's error on the person's own sequences
 // is not noise: it has a shape over travel that repeats in every trial of that arm height (the
-// sleeve resting on the fist early, then lagging the measured ramp; offline/sim/README.md, "What
-// the simulation gets wrong"). That shape is measured here from the same 2-3 sequences the
+// sleeve resting on the fist early, then lagging the measured ramp; offline/sim/MEASUREMENTS.md,
+// "What the simulation gets wrong"). That shape is measured here from the same 2-3 sequences the
 // calibration was fitted to, and can be added to the simulator's synthesized trials, so that a
 // classifier trained on them (the STC) learns the outcomes' differences as the sensor shows
 // them rather than as the simulator makes them.

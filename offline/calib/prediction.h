@@ -128,7 +128,7 @@ inline constexpr double kResidualFloor = 0.1;  // [N]
 // The forces the residual and the contrast look at, by index: [0] F_motion, [1] F_vertical (the
 // paper's two) and [2] F_lateral (positive toward the person: sim/trial.h). F_lateral since
 // 2026-11-25: the people's good and missed trials differ in it from 0.15 m of travel on
-// (offline/sim/README.md, "The lateral force").
+// (offline/sim/MEASUREMENTS.md, "The lateral force").
 inline constexpr int kForces = 3;
 const char* force_name(int axis);    // "F_motion", "F_vertical", "F_lateral"
 const char* force_column(int axis);  // "motion", "vertical", "lateral" (the CSV columns' suffixes)

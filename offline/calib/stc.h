@@ -24,18 +24,18 @@ struct StcOptions {
 // Which forces an STC should model, from its calibration. The paper's HMMs are bivariate
 // (F_motion, F_vertical), but a force the simulator gets wrong (our sleeve-pulling gown hangs on
 // the arm and lifts the gripper where the measured vertical force stays near 0;
-// offline/calib/README.md) teaches the classifier a difference between simulation and reality
-// instead of one between outcomes. So a second force is modelled only where the calibrated
-// simulator predicts it better than a zero force does on every one of the calibration's own
-// sequences (AxisFit::error < AxisFit::zero, calibration.h). Every sequence, not their sum: each
-// outcome's HMM learns mostly from one arm height, so a force wrong at one height is wrong in that
-// class (participant 4's paper-budget calibration: right at the low arm, wrong at the high one,
-// better in sum; its bivariate STC scored 15-20 % at 0.20-0.25 m of travel, F_motion alone 45 %;
-// offline/calib/README.md, session 15).
+// offline/calib/MEASUREMENTS.md, session 5) teaches the classifier a difference between
+// simulation and reality instead of one between outcomes. So a second force is modelled only where
+// the calibrated simulator predicts it better than a zero force does on every one of the
+// calibration's own sequences (AxisFit::error < AxisFit::zero, calibration.h). Every sequence, not
+// their sum: each outcome's HMM learns mostly from one arm height, so a force wrong at one height
+// is wrong in that class (participant 4's paper-budget calibration: right at the low arm, wrong at
+// the high one, better in sum; its bivariate STC scored 15-20 % at 0.20-0.25 m of travel, F_motion
+// alone 45 %; offline/calib/MEASUREMENTS.md, session 15).
 // In order:
 //  1. F_lateral when the calibration fitted it (`lateral_fitted`: calibrate --lateral-weight) and
 //     it passes: the people's good and missed trials differ in it from 0.1 m of travel on, where
-//     they barely differ in the other two (offline/sim/README.md, "The lateral force");
+//     they barely differ in the other two (offline/sim/MEASUREMENTS.md, "The lateral force");
 //  2. F_vertical when it passes (the paper's pair);
 //  3. F_motion alone.
 // Both forces when the fits were not measured (a calibration file written before 2026-11-23).

@@ -13,9 +13,9 @@
 // Why the second: the study's middle arm catches in 91 of 120 trials (data README), and the
 // paper's noise there is meant "to increase the chance of generating both caught and missed
 // outcomes"; but the simulator's sleeve opening hangs higher than the real one (its lowest rim
-// point 4 cm above the fist's top at the nominal middle, offline/calib/README.md), so every
-// calibrated simulator so far misses at the nominal middle and catches only 1-5 cm below the high
-// arm. Its own edge is the height where its catching begins; U[-6, 0] cm below it gives both
+// point 4 cm above the fist's top at the nominal middle, offline/calib/MEASUREMENTS.md,
+// session 10), so every calibrated simulator so far misses at the nominal middle and catches
+// only 1-5 cm below the high arm. Its own edge is the height where its catching begins; U[-6, 0] cm below it gives both
 // outcomes in the study's proportion when the caught band is 4-5 cm tall.
 // Where the high and low arms' noise may go (SynthesisOptions::high_low): the paper's +-1.5 cm
 // around the calibrated height, or only the part of it where the simulated trial stays within one
@@ -23,16 +23,17 @@
 // near the fist the simulated drag is far more sensitive to the arm's height than the people's
 // (participant 4's calibrated high arm drags -0.15 N at 0.20-0.25 m of travel, and -1.10 N 0.75 cm
 // lower, where the rim catches on the fist; the study's eight good trials, of seven people, spread
-// by 0.06 N there: offline/calib/README.md, session 27). The paper's noise then teaches the good
-// class a variation that no person shows. The band keeps the noise to heights whose trial differs
-// from the calibrated one no more than two measured repeats of one person's trial differ.
+// by 0.06 N there: offline/calib/MEASUREMENTS.md, session 27). The paper's noise then teaches
+// the good class a variation that no person shows. The band keeps the noise to heights whose trial
+// differs from the calibrated one no more than two measured repeats of one person's trial differ.
 // The pull ends at the calibration's rig travel (the participant's measured end of travel; the
-// paper's 0.85 m when unknown) or at 10 N. Labels come from the simulator (paper V-A rule). Every trial's randomness derives from
-// (seed, height, index) alone, so the dataset is the same whatever the thread or rank count.
-// Resumable: each finished trial is written at once (CSV, then a small ".done" marker holding its
-// label and the label's evidence, both atomically); a rerun skips trials whose marker and CSV exist.
-// Beside the manifest, labels.csv lists per trial the arm offset, the travel at the end and that
-// evidence (SimulatedTrial::d_behind, d_ahead): which trials sit near the label rule's 7 cm.
+// paper's 0.85 m when unknown) or at 10 N. Labels come from the simulator (paper V-A rule). Every
+// trial's randomness derives from (seed, height, index) alone, so the dataset is the same whatever
+// the thread or rank count. Resumable: each finished trial is written at once (CSV, then a small
+// ".done" marker holding its label and the label's evidence, both atomically); a rerun skips trials
+// whose marker and CSV exist. Beside the manifest, labels.csv lists per trial the arm offset, the
+// travel at the end and that evidence (SimulatedTrial::d_behind, d_ahead): which trials sit near
+// the label rule's 7 cm.
 #pragma once
 
 #include <cstdint>
@@ -148,7 +149,7 @@ struct SynthesisSummary {
 // order. Why: where a simulator's sleeve rim ends wrapped around the elbow, its lower half lies
 // about 7 cm from the elbow centre, and the label of each trial is decided by a millimetre that
 // the noise models move at random (participant 0's simulator: 38 of its 40 high-arm trials within
-// 5 mm of the rule, 18 of them labelled caught; offline/calib/README.md, session 31).
+// 5 mm of the rule, 18 of them labelled caught; offline/calib/MEASUREMENTS.md, session 31).
 // Throws InputError naming the file and line when labels.csv is missing or malformed, or when a
 // stopped trial has no evidence (a set synthesized before labels.csv existed: synthesize again).
 std::vector<std::string> ambiguous_labels(const std::filesystem::path& set, double margin);

@@ -66,22 +66,24 @@ int run_calibrate(int argc, char** argv) {
         "                      default), hold it there (the default) or shift it by M metres\n"
         "  --hem W,R           the gown's cuff: bending R x stiffer within W metres of the sleeve\n"
         "                      opening (held, not fitted; recorded in CAL.json, so synthesis uses\n"
-        "                      it too; offline/sim/README.md, \"How stiff the gown is\"). Default none\n"
+        "                      it too; offline/sim/MEASUREMENTS.md, \"How stiff the gown is\").\n"
+        "                      Default none\n"
         "  --density fit|fixed|D   the gown's areal density [kg/m^2]: fit it too (one more parameter,\n"
         "                      in [0.04, 0.25] by default), hold it at the paper's 0.145 (the default)\n"
         "                      or at D; recorded in CAL.json, so synthesis uses it too\n"
-        "                      (offline/sim/README.md, \"The gown's weight\")\n"
+        "                      (offline/sim/MEASUREMENTS.md, \"The gown's weight\")\n"
         "  --arm-lateral fit|fixed|M   the person's arm sideways of the gripper's line (+y, away\n"
         "                      from the body): fit it (one more parameter, in [-0.05, 0.05] m by\n"
         "                      default; --lateral-weight lets the lateral force judge it), hold it\n"
         "                      under the jaws (the paper's, the default) or at M metres\n"
-        "                      (offline/sim/README.md, \"The lateral force\")\n"
+        "                      (offline/sim/MEASUREMENTS.md, \"The lateral force\")\n"
         "  --fist-lateral fit|fixed|M   the fist alone sideways, the elbow fixed (the forearm turned\n"
         "                      about the elbow); as --arm-lateral\n"
         "  --support-depth fit|fixed|M   a support under the gown that carries part of its body\n"
-        "                      (a 15 cm capsule under the arm; offline/sim/README.md, \"What holds the\n"
-        "                      gown on the person's side\"): fit how far below the grasp its axis is\n"
-        "                      (one more parameter, in [0.6, 1.0] m by default), none (the paper's,\n"
+        "                      (a 15 cm capsule under the arm; offline/sim/MEASUREMENTS.md,\n"
+        "                      \"What holds the gown on the person's side\"): fit how far below\n"
+        "                      the grasp its axis is (one more parameter, in [0.6, 1.0] m by\n"
+        "                      default), none (the paper's,\n"
         "                      the default) or at M metres (0: none)\n"
         "  --support-lateral fit|fixed|M   the support sideways (negative: toward the person; in\n"
         "                      [-0.2, 0.05] m by default when fitted); only with a support\n"
@@ -275,7 +277,7 @@ int run_calibrate(int argc, char** argv) {
                     r.lateral / o.lateral_weight, o.lateral_weight, r.lateral);
       for (int i = 0; i < kClothParams; ++i) {
         std::printf("  %-13s %.4f", kClothParamNames[i], cloth_value(r.cloth, i));
-        // What bend means as a fabric (light woven fabrics: 1.5-3 cm; offline/sim/README.md).
+        // What bend means as a fabric (light woven fabrics: 1.5-3 cm; offline/sim/MEASUREMENTS.md).
         if (std::string(kClothParamNames[i]) == "bend" && sim.bending_length)
           std::printf("  (bending length %.1f cm on this gown)",
                       100 * sim.bending_length(cloth_value(r.cloth, i), r.cloth.areal_density));

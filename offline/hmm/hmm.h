@@ -174,7 +174,7 @@ Evaluation evaluate(const model::OutcomeModel& m, const std::vector<const Haptic
 // ---- a committee of outcome models -----------------------------------------------------------
 
 // The vote of several outcome models on one trial: a committee of simulation-trained classifiers,
-// one per person's simulator (offline/calib/README.md, session 22). Each model classifies the
+// one per person's simulator (offline/calib/MEASUREMENTS.md, session 22). Each model classifies the
 // trial, cut at `truncate_at`, in its own features (classify()); the class that most models pick
 // wins, a tie goes to the larger sum of the models' posteriors for the tied classes, and then to
 // the class named first. Classes are matched by name; `classes` is their union in the order the

@@ -14,7 +14,7 @@
 // person's side (-y): at the end of 21 of the study's 22 trials, when the sleeve lies on the
 // forearm and reaches toward the upper arm, the measured F_lateral is positive (+0.05 to +0.83
 // N), and there the simulated gown pulls the gripper toward the upper arm (-y) at every arm
-// height (offline/sim/README.md, "The lateral force"). Before 2026-11-25 f_lateral was +F.y.
+// height (offline/sim/MEASUREMENTS.md, "The lateral force"). Before 2026-11-25 f_lateral was +F.y.
 //
 // Time (paper IV-A, V-A; Macklin et al. 2019 "small steps"): 300 Hz output steps, each split into
 // `substeps` (20) XPBD substeps that each integrate and solve every constraint once; collision
@@ -46,9 +46,9 @@ namespace dressguard::sim {
 //            the default k = 0.7 17.2 cm (thin card). The solver delivers these within 10 % up
 //            to k = 0.8 at the gown meshes' edge lengths (the cantilever test). The default keeps
 //            the held sleeve opening round enough for the high arm to enter it (at 0.35-0.5 it
-//            sags into a slit or an ellipse whose lower rim the fist catches; offline/sim/README.md,
-//            "How stiff the gown is"): a model parameter that calibration fits per person, stiffer
-//            than the fabric it stands for.
+//            sags into a slit or an ellipse whose lower rim the fist catches;
+//            offline/sim/MEASUREMENTS.md, "How stiff the gown is"): a model parameter that
+//            calibration fits per person, stiffer than the fabric it stands for.
 // friction: Coulomb coefficient cloth-arm, [0, 2]; self_friction: cloth-cloth, [0, 2].
 // damping [1/s]: velocity decay rate (v *= exp(-damping h) per substep) during the pull and the
 // perturbation, fixed by default; 2/s costs the pulled gown only m * 2/s * 0.1 m/s = 0.05 N of
@@ -71,7 +71,7 @@ namespace dressguard::sim {
 // on the sleeve opening's plane of symmetry (its centre is within 1 mm of y = 0), so that the
 // gown's pull on the gripper has no lateral part until the cloth reaches the upper arm. The
 // people did not hold their arms there: all 8 good trials of the study pull the gripper sideways
-// by 0.05-0.15 N from 0.15 m of travel, and the 14 missed ones do not (offline/sim/README.md,
+// by 0.05-0.15 N from 0.15 m of travel, and the 14 missed ones do not (offline/sim/MEASUREMENTS.md,
 // "The lateral force"). A fist beside the opening's centre does that: inside the opening it
 // pushes the rim toward its own side; below it, it deflects the sleeve toward the other side.
 // Calibration may fit both per person with the lateral force in its objective.
@@ -82,16 +82,17 @@ namespace dressguard::sim {
 // softened in compression (SceneOptions::compression_softening stands for single fabric buckling
 // below the mesh's scale; stitched layers do not, and a softened cuff shrank its rim by 9-22 %).
 // 0 and 1, the defaults, are the paper's uniform cloth. A hem holds an opening of soft fabric
-// open the way a stiff `bend` holds the whole gown (offline/sim/README.md, "How stiff the gown is").
+// open the way a stiff `bend` holds the whole gown (offline/sim/MEASUREMENTS.md, "How stiff the
+// gown is").
 // support_depth [m], support_lateral [m]: something under the gown that carries part of its body,
-// as the people's small late lateral force says something does in the study (offline/sim/README.md,
-// "What holds the gown on the person's side"): a horizontal capsule of radius kSupportRadius along
-// x, from kSupportBehind behind the grasp point to kSupportAhead ahead of it (the paper's elbow),
-// its axis support_depth below the grasp point and support_lateral along y (negative: toward the
-// person). It stays where it is whatever the arm's height or place, and comes up from
-// kSupportDrop below its place over the first kSupportRiseSteps output steps of settling, so that
-// the hanging gown comes to lie on it rather than starting inside it. Its contact has the arm's
-// friction. support_depth 0, the default and the paper's, is no support.
+// as the people's small late lateral force says something does in the study
+// (offline/sim/MEASUREMENTS.md, "What holds the gown on the person's side"): a horizontal capsule
+// of radius kSupportRadius along x, from kSupportBehind behind the grasp point to kSupportAhead
+// ahead of it (the paper's elbow), its axis support_depth below the grasp point and support_lateral
+// along y (negative: toward the person). It stays where it is whatever the arm's height or place,
+// and comes up from kSupportDrop below its place over the first kSupportRiseSteps output steps of
+// settling, so that the hanging gown comes to lie on it rather than starting inside it. Its contact
+// has the arm's friction. support_depth 0, the default and the paper's, is no support.
 struct ClothParams {
   double stretch = 0.8;
   double shear = 0.5;
@@ -131,7 +132,8 @@ inline constexpr double kMaxHemWidth = 0.2, kMaxHemBendRatio = 1e4;
 //              substep, and once per output step the friction impulse (bounded by mu times the
 //              step's normal impulse) changes only the velocity; the tangential slip already made
 //              by gravity and internal constraints stays, so friction is underestimated (the
-//              paper's claim, tested). No cloth-cloth friction (stock PhysX has none, paper IV-A.3).
+//              paper's claim, tested). No cloth-cloth friction (stock PhysX has none, paper
+//              IV-A.3).
 //  Improved:   the paper's fix: the friction correction is applied to the positions (and so to
 //              the velocities) in every substep that resolves the contact; self-friction likewise.
 //  Constraint: static friction as a positional stick constraint holding each contact at its anchor
@@ -207,8 +209,8 @@ struct Frame {
 // outcome before any force does. Heights are world z relative to the grasp point (the jaws);
 // the arm's axis lies at y = 0. The fist passes under a rim whose lowest point is above its top
 // (rim_low_above_fist > r_fist), meets the rim with its face when that point lies between its top
-// and its underside, and can enter when it is lower (offline/sim/README.md, "Where the opening
-// must hang"). Zero when the mesh has no opening.
+// and its underside, and can enter when it is lower (offline/sim/MEASUREMENTS.md, "Where the
+// opening must hang"). Zero when the mesh has no opening.
 struct OpeningShape {
   double depth = 0;               // [m] the lowest rim vertex below the grasp point
   double height = 0;              // [m] the loop's vertical extent
@@ -339,8 +341,8 @@ enum class GownResolution { Full = 0, Reduced = 1, Coarse = 2 };
 Scene make_default_scene(GownResolution res = GownResolution::Reduced, bool parametric = false);
 
 // One trial: grasp, gravity, settling (with the optional perturbation during output steps
-// 180-330, i.e. 0.5 s) until the gown is at rest, then the pull until max_travel or the force limit. Deterministic: the
-// same inputs give the same bits (single thread, no fast-math).
+// 180-330, i.e. 0.5 s) until the gown is at rest, then the pull until max_travel or the force
+// limit. Deterministic: the same inputs give the same bits (single thread, no fast-math).
 TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const TrialSpec& spec);
 
 // Several trials with one cloth, the same bits as simulate_trial() on each, in the order of

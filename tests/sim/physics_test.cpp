@@ -297,7 +297,7 @@ TEST(SimPhysics, StripRidesOnAMovingArmByFriction) {
 // The simulated droop must give the c that bending_length(bending_rigidity(bend, f)) declares,
 // within 5 %, at the reduced gown's edge length (2.8 cm) over the calibrated range of bend.
 // Finer meshes saturate (small-steps XPBD caps a constraint's stiffness near m / h^2 per
-// substep: at 5 mm edges c stops growing near 6.7 cm; offline/sim/README.md, "How stiff the
+// substep: at 5 mm edges c stops growing near 6.7 cm; offline/sim/MEASUREMENTS.md, "How stiff the
 // gown is"); the last check shows that cap, so this test would see it move.
 namespace {
 

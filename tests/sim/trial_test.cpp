@@ -232,7 +232,7 @@ TEST(SimTrial, ThreeOutcomesFromArmHeightAlone) {
 // its low-arm trial's final drag must be within 50% of the measured one (the issue's
 // tolerances). The low-arm trial runs to 0.72 m, where the rig stopped miss/2
 // (rig_end_of_travel, as calibration does), so both drags are read at the same travel.
-// Measured on this grid (dg_sim_fit, offline/sim/README.md): friction 0.35 / stretch 0.2 wins
+// Measured on this grid (dg_sim_fit, offline/sim/MEASUREMENTS.md): friction 0.35 / stretch 0.2 wins
 // (L 4.33 + 0.69; stop 0.559 m against 0.607, drag -2.58 N against -3.99). What the test does not
 // hide: at friction 0.2 the objective would pick stretch 0.2 (L 3.54 + 0.88), whose drag is
 // -2.16 N, 54% short: the good trial's term dominates the sum and prefers less friction than

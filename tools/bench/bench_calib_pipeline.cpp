@@ -24,7 +24,7 @@
 //   bench_calib_pipeline baseline
 //     The 1-NN baseline alone, on each force and on sets of them (F_motion, F_vertical,
 //     F_lateral; both of the paper's; all three): which force tells the people's good trials from
-//     their missed ones at each cut (offline/sim/README.md, "The lateral force"). Seconds.
+//     their missed ones at each cut (offline/sim/MEASUREMENTS.md, "The lateral force"). Seconds.
 //   bench_calib_pipeline pooled --calibrations A.json,B.json,... [--synth DIR] [--per-height N]
 //                               [--seed S] [--threads T] [--states K]
 //                               [--seed S1,S2,... --synth DIR1,DIR2,...]

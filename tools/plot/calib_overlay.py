@@ -31,7 +31,7 @@ Modes:
             Every labelled trial of a dataset (`dressguard import`'s study, or a synthesized one)
             over travel, one colour per outcome, for F_motion, F_vertical and F_lateral, with the
             cuts of issue 4 dotted: where the outcomes part (the people's part first in
-            F_lateral; offline/sim/README.md, "The lateral force").
+            F_lateral; offline/sim/MEASUREMENTS.md, "The lateral force").
   progress: calib_overlay.py progress CALIBRATE.log --out progress.png
             `dressguard calibrate`'s progress lines (its stderr, kept in a file): the best L so far
             and each generation's best against the generation, and the best point's L per sequence

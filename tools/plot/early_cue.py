@@ -4,7 +4,7 @@
 against the measured inputs of the person it was calibrated on. A point on the diagonal is a
 simulator that teaches its person's cue; the grey band is the people's own (all 22 trials), the
 cue a classifier of other people needs. One row per file (e.g. the bench run with and without the
-discrepancy term), one panel per force. offline/calib/README.md, session 27.
+discrepancy term), one panel per force. offline/calib/MEASUREMENTS.md, session 27.
 
 usage: early_cue.py POOLED.json [POOLED2.json ...] OUT.png
 POOLED.json is what `bench_calib_pipeline pooled` writes.

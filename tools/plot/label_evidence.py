@@ -4,7 +4,7 @@ of travel, how far the sleeve opening's lower half ended behind the elbow centre
 and past it, from the labels.csv that `dressguard synthesize` writes beside its manifest. The
 rule takes the larger of the two: good at 7 cm or less (the shaded square), else caught. A
 simulator whose trials sit on the square's edge has labels that the noise models decide.
-offline/calib/README.md, session 31.
+offline/calib/MEASUREMENTS.md, session 31.
 
 usage: label_evidence.py OUT.png [--margin M] NAME=SET_DIR [NAME=SET_DIR ...]
   --margin M   also draw the band build-model --label-margin M leaves out (metres)

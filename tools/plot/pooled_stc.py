@@ -2,8 +2,9 @@
 """Accuracy against travel of the pooled STC (paper VII: HMMs trained on the simulators of
 several people, tested on a person none of them was calibrated on), beside each calibration's
 own STC, the vote of those STCs (a committee; also with each STC's training shares as priors
-and asked "good or missed?", offline/calib/README.md session 26), the baseline classifier on each calibration's 2-3
-measured inputs, and the 1-nearest-neighbour classifier on the other people's measured curves.
+and asked "good or missed?", offline/calib/MEASUREMENTS.md, session 26), the baseline classifier
+on each calibration's 2-3 measured inputs, and the 1-nearest-neighbour classifier on the other
+people's measured curves.
 
 usage: pooled_stc.py POOLED.json OUT.png
 POOLED.json is what `bench_calib_pipeline pooled` writes (DIR/pooled.json). One panel per force

@@ -5,7 +5,7 @@ and the low arm, the eq. 3-5 distance (w = 20) between the noise-free trial at e
 the calibrated height and the calibrated height's own trial, one line per simulator; the dashed
 line is the study's repeat distance of the calibrated trial's outcome (two measured repeats of one
 person's trial), the shaded span the paper's +-1.5 cm noise. The band a synthesis draws from is
-the part around 0 below the dashed line (thick). offline/calib/README.md, session 29.
+the part around 0 below the dashed line (thick). offline/calib/MEASUREMENTS.md, session 29.
 
 usage: repeat_band.py SYNTH_DIR OUT.png
 SYNTH_DIR holds one synthesis folder per simulator (as `bench_calib_pipeline pooled --synth`
