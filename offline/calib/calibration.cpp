@@ -234,6 +234,28 @@ double rig_travel_of(const std::vector<HapticSequence>& inputs) {
 
 // ---- checkpoint ---------------------------------------------------------------------------------
 
+std::string_view combine_name(SequenceCombine c) { return c == SequenceCombine::Worst ? "worst" : "sum"; }
+
+std::optional<SequenceCombine> parse_combine(std::string_view s) {
+  if (s == "sum") return SequenceCombine::Sum;
+  if (s == "worst") return SequenceCombine::Worst;
+  return std::nullopt;
+}
+
+double combined_objective(const double* terms, int K, int T, SequenceCombine c) {
+  double sum = 0.0, worst = -std::numeric_limits<double>::infinity();
+  for (int k = 0; k < K; ++k) {
+    if (!std::isfinite(terms[k])) return std::numeric_limits<double>::infinity();
+    sum += terms[k];
+    worst = std::max(worst, terms[k]);
+  }
+  // Sum: the same additions in the same order as before the option existed (shipped files keep
+  // their bits).
+  double f = c == SequenceCombine::Worst ? worst + kWorstRho * sum : sum;
+  for (int k = K; k < T; ++k) f += terms[k];
+  return std::isfinite(f) ? f : std::numeric_limits<double>::infinity();
+}
+
 namespace {
 
 constexpr const char* kCheckpointMagic = "dressguard-calibration-checkpoint";
@@ -252,6 +274,7 @@ std::string fingerprint(const std::vector<HapticSequence>& inputs, const Paramet
     << ";sigma0=" << hexd(o.sigma0) << ";objective=" << objective_name(o.objective);
   if (o.contrast_weight > 0) f << ";contrast=" << hexd(o.contrast_weight);  // (older checkpoints resume)
   if (o.lateral_weight > 0) f << ";lateral=" << hexd(o.lateral_weight);     // likewise
+  if (o.combine != SequenceCombine::Sum) f << ";combine=" << combine_name(o.combine);  // likewise
   f << ";names=";
   for (const auto& n : space.names()) f << n << ',';
   f << ";bounds=";
@@ -454,8 +477,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   // The search itself is unchanged: the start does not enter CMA-ES's update.
   const Eigen::VectorXd start = space.initial_unit();
   const std::vector<double> start_fits = evaluate({start});
-  double start_f = 0.0;
-  for (int k = 0; k < T; ++k) start_f += start_fits[static_cast<std::size_t>(k)];  // the generations' order
+  const double start_f = combined_objective(start_fits.data(), K, T, options.combine);
 
   int done_here = 0;
   while (!es.stopped()) {
@@ -465,7 +487,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
     const std::vector<double> per = evaluate(xs);
     std::vector<double> f(static_cast<std::size_t>(lambda), 0.0);
     for (int c = 0; c < lambda; ++c)
-      for (int k = 0; k < T; ++k) f[c] += per[static_cast<std::size_t>(c) * T + k];  // fixed order: same bits
+      f[c] = combined_objective(per.data() + static_cast<std::size_t>(c) * T, K, T, options.combine);
     const double best_before = es.best_f();
     const int arg = static_cast<int>(std::min_element(f.begin(), f.end()) - f.begin());
     es.tell(f);
@@ -595,6 +617,7 @@ Json calibration_to_json(const Calibration& c) {
   j.set("arm_offsets", off);
   j.set("objective_kind", c.objective_kind);
   j.set("objective", c.objective);
+  if (c.combine != "sum") j.set("combine", c.combine);  // (files of the paper's sum keep their text)
   // Only with a contrast term (files without one keep their text).
   if (c.contrast_weight > 0) {
     j.set("contrast_weight", c.contrast_weight);
@@ -664,6 +687,11 @@ Calibration calibration_from_json(const Json& j, const std::filesystem::path& so
     }
     c.objective_kind = j.at("objective_kind").string();
     c.objective = j.at("objective").number();
+    if (j.has("combine")) {
+      c.combine = j.at("combine").string();
+      if (!parse_combine(c.combine))
+        throw std::runtime_error("combine must be \"sum\" or \"worst\", not \"" + c.combine + "\"");
+    }
     if (j.has("contrast_weight")) {
       c.contrast_weight = j.at("contrast_weight").number();
       c.contrast = j.at("contrast").number();

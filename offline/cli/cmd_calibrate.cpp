@@ -46,6 +46,9 @@ int run_calibrate(int argc, char** argv) {
         "                      about 0.1 from initial values known to fit, e.g. another calibration's)\n"
         "  --seed S            input selection and CMA-ES (default 1); same seed, same result\n"
         "  --objective area|position-weighted   (default area: paper eq. 3-5)\n"
+        "  --combine sum|worst   how the sequences' L combine: sum (the paper, the default) or\n"
+        "                      worst (max_k L_k + 0.1 sum_k L_k: the worst-fitted sequence first,\n"
+        "                      as issue 4 judges each one; offline/calib/calibration.h)\n"
         "  --contrast-weight K   add K times the heights' contrast to the objective: how the high\n"
         "                      sequence's forces differ from the lower one's over the first 0.30 m,\n"
         "                      simulated against measured (offline/calib/objective.h, contrast_error;\n"
@@ -99,8 +102,8 @@ int run_calibrate(int argc, char** argv) {
   args.allow_only({"help", "json", "no-arm-offset", "data", "participant", "profile", "bounds", "start", "seed", "out",
                    "checkpoint", "objective", "gown", "threads", "generations", "population",
                    "stop-after-generations", "arm-compliance", "fist-shift", "rim-shift", "sigma0", "hem",
-                   "density", "contrast-weight", "lateral-weight", "arm-lateral", "fist-lateral", "support-depth",
-                   "support-lateral"});
+                   "density", "contrast-weight", "lateral-weight", "combine", "arm-lateral", "fist-lateral",
+                   "support-depth", "support-lateral"});
   const std::string data = args.require("data");
   const std::string participant = args.require("participant");
   const std::string out = args.require("out");
@@ -122,6 +125,9 @@ int run_calibrate(int argc, char** argv) {
   const auto kind = parse_objective(args.get("objective").value_or("area"));
   if (!kind) throw UsageError("--objective must be area or position-weighted");
   o.objective = *kind;
+  const auto combine = parse_combine(args.get("combine").value_or("sum"));
+  if (!combine) throw UsageError("--combine must be sum or worst, not '" + *args.get("combine") + "'");
+  o.combine = *combine;
   if (const auto cw = args.get("contrast-weight")) {
     o.contrast_weight = args.number("contrast-weight", 0);
     if (!(o.contrast_weight >= 0 && o.contrast_weight <= 1000))
@@ -225,6 +231,7 @@ int run_calibrate(int argc, char** argv) {
   cal.lateral_weight = o.lateral_weight;
   cal.lateral = r.lateral;
   cal.objective_kind = std::string(objective_name(o.objective));
+  cal.combine = std::string(combine_name(o.combine));
   cal.gown = gown;
   cal.rig_travel = rig_travel_of(inputs);
   Json prov = Json::object();
@@ -264,6 +271,12 @@ int run_calibrate(int argc, char** argv) {
       std::printf("participant %s: L = %.4f after %d generations (%ld evaluations, %s; the start's L %.4f)\n",
                   participant.c_str(), r.objective, r.generations_done, r.evaluations, minutes(r.elapsed_s).c_str(),
                   r.start_objective);
+      if (o.combine == SequenceCombine::Worst) {
+        double sum = 0;
+        for (const auto& f : cal.fits) sum += f.objective;
+        std::printf("  L combines the sequences as worst (max + %g x sum); their sum, the paper's L: %.4f\n",
+                    kWorstRho, sum);
+      }
       for (const auto& f : cal.fits)
         std::printf("  %-18s %-6s L = %.4f; over the common travel F_motion %.3f (zero force %.3f), F_vertical %.3f "
                     "(zero force %.3f), F_lateral %.3f (zero force %.3f) N m\n", f.trial_id.c_str(),
