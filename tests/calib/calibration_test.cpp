@@ -6,6 +6,7 @@
 #include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 
 #include <unistd.h>
@@ -69,6 +70,22 @@ CalibrationOptions quick(int gens, int threads) {
   o.seed = 11;
   o.threads = threads;
   return o;
+}
+
+// Runs `o` for `stop` generations with its checkpoint in `dir`, checks that the checkpoint refuses
+// the same run with one setting changed (`change`), then resumes it to the end and returns the
+// result, which must have the bits of an uninterrupted run.
+CalibrationResult stop_refuse_resume(const std::vector<HapticSequence>& inputs, const ParameterSpace& space,
+                                     CalibrationOptions o, const fs::path& dir, int stop,
+                                     const std::function<void(CalibrationOptions&)>& change) {
+  o.checkpoint = dir / "run.ckpt";
+  o.stop_after_generations = stop;
+  EXPECT_FALSE(calibrate(inputs, space, testing::fake_simulate, o, Comm::world()).complete);
+  CalibrationOptions other = o;
+  change(other);
+  EXPECT_THROW(calibrate(inputs, space, testing::fake_simulate, other, Comm::world()), InputError);
+  o.stop_after_generations = 0;
+  return calibrate(inputs, space, testing::fake_simulate, o, Comm::world());
 }
 
 // A start that fits exactly (the stand-in's own parameters, no offsets to fit) is kept by a
@@ -199,15 +216,8 @@ TEST(Calibration, LateralTermJoinsTheObjective) {
   EXPECT_EQ(lateral_term(inputs, {blown, best[1]}, 3), std::numeric_limits<double>::infinity());
 
   const fs::path dir = temp_dir("lateral");
-  auto part = o;
-  part.checkpoint = dir / "run.ckpt";
-  part.stop_after_generations = 3;
-  EXPECT_FALSE(calibrate(inputs, space, testing::fake_simulate, part, Comm::world()).complete);
-  auto other = part;
-  other.lateral_weight = 4;
-  EXPECT_THROW(calibrate(inputs, space, testing::fake_simulate, other, Comm::world()), InputError);
-  part.stop_after_generations = 0;
-  const auto resumed = calibrate(inputs, space, testing::fake_simulate, part, Comm::world());
+  const auto resumed =
+      stop_refuse_resume(inputs, space, o, dir, 3, [](CalibrationOptions& other) { other.lateral_weight = 4; });
   EXPECT_EQ(resumed.objective, r.objective);
   EXPECT_EQ(resumed.lateral, r.lateral);
   EXPECT_TRUE(resumed.best_unit == r.best_unit);
@@ -301,15 +311,8 @@ TEST(Calibration, WorstCombineFitsTheWorstSequenceBetter) {
   EXPECT_LT(worst_of(rw), 0.95 * worst_of(rs));
 
   const fs::path dir = temp_dir("combine");
-  auto part = o;
-  part.checkpoint = dir / "run.ckpt";
-  part.stop_after_generations = 15;
-  EXPECT_FALSE(calibrate(inputs, space, testing::fake_simulate, part, Comm::world()).complete);
-  auto other = part;
-  other.combine = SequenceCombine::Sum;
-  EXPECT_THROW(calibrate(inputs, space, testing::fake_simulate, other, Comm::world()), InputError);
-  part.stop_after_generations = 0;
-  const auto resumed = calibrate(inputs, space, testing::fake_simulate, part, Comm::world());
+  const auto resumed = stop_refuse_resume(inputs, space, o, dir, 15,
+                                          [](CalibrationOptions& other) { other.combine = SequenceCombine::Sum; });
   EXPECT_EQ(resumed.objective, rw.objective);
   EXPECT_TRUE(resumed.best_unit == rw.best_unit);
 
