@@ -232,7 +232,7 @@ double rig_travel_of(const std::vector<HapticSequence>& inputs) {
   return travel > 0 ? travel : 0.85;
 }
 
-// ---- checkpoint ---------------------------------------------------------------------------------
+// ---- one candidate's objective ------------------------------------------------------------------
 
 std::string_view combine_name(SequenceCombine c) { return c == SequenceCombine::Worst ? "worst" : "sum"; }
 
@@ -255,6 +255,8 @@ double combined_objective(const double* terms, int K, int T, SequenceCombine c) 
   for (int k = K; k < T; ++k) f += terms[k];
   return std::isfinite(f) ? f : std::numeric_limits<double>::infinity();
 }
+
+// ---- checkpoint ---------------------------------------------------------------------------------
 
 namespace {
 
