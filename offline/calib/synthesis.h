@@ -15,8 +15,8 @@
 // outcomes"; but the simulator's sleeve opening hangs higher than the real one (its lowest rim
 // point 4 cm above the fist's top at the nominal middle, offline/calib/MEASUREMENTS.md,
 // session 10), so every calibrated simulator so far misses at the nominal middle and catches
-// only 1-5 cm below the high arm. Its own edge is the height where its catching begins; U[-6, 0] cm below it gives both
-// outcomes in the study's proportion when the caught band is 4-5 cm tall.
+// only 1-5 cm below the high arm. Its own edge is the height where its catching begins; U[-6, 0]
+// cm below it gives both outcomes in the study's proportion when the caught band is 4-5 cm tall.
 // Where the high and low arms' noise may go (SynthesisOptions::high_low): the paper's +-1.5 cm
 // around the calibrated height, or only the part of it where the simulated trial stays within one
 // measured repeat's distance of the calibrated height's trial (locate_repeat_band). Why the second:

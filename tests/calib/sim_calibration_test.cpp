@@ -170,8 +170,8 @@ TEST(SimCalibration, MiddleEdgeOfParticipant4sSimulator) {
 // w = 20); 0.75 cm lower it still goes in but drags -1.10 N at 0.20-0.25 m of travel against the
 // calibrated -0.15 N (offline/calib/MEASUREMENTS.md, session 27). Both are further from the
 // calibrated trial than two measured repeats of one person's good trial (0.108), so the band stops
-// above -0.75 cm. Upwards the distance grows too (0.17 at +0.75 cm, 0.73 at +1.5 cm; session 29): the
-// simulated good trial is more sensitive to the arm's height than a person's repeats in both
+// above -0.75 cm. Upwards the distance grows too (0.17 at +0.75 cm, 0.73 at +1.5 cm; session
+// 29): the simulated good trial is more sensitive to the arm's height than a person's repeats in both
 // directions, and more so towards the fist. A coarse scan (0.75 cm: four trials beside the
 // calibrated one) is enough to see it; the synthesis scans at 0.25 cm.
 TEST(SimCalibration, RepeatBandOfParticipant4sHighArmStopsAboveTheFist) {
