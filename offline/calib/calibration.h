@@ -282,7 +282,7 @@ struct GenerationProgress {
   double generation_best = 0;
   double elapsed_s = 0;     // this process
   double eta_s = 0;         // estimated remaining, from this process's pace
-  bool resumed = false;
+  bool resumed = false;     // this process continued from a checkpoint
 };
 
 // How well the calibrated simulator predicts one force axis of one input: eq. 3 with w = 0 (the

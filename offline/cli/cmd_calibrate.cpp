@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <ctime>
+#include <filesystem>
 
 #include "args.h"
 #include "calibration.h"
@@ -185,7 +186,12 @@ int run_calibrate(int argc, char** argv) {
     for (std::size_t k = 0; k < inputs.size(); ++k) std::fprintf(stderr, "%s%s", k ? ", " : "", inputs[k].id.c_str());
     std::fprintf(stderr, "), %d parameters, %d x %d, %d rank(s) x %d thread(s), gown %s\n", space.dimension(),
                  o.generations, o.population, comm.size(), thread_count(o.threads), gown.c_str());
+    // Said before the first generation (minutes away at the paper's budget): whether this run
+    // starts afresh or continues a stopped one. A checkpoint of another command is refused then.
+    std::fprintf(stderr, "calibrate: checkpoint %s (%s)\n", o.checkpoint.c_str(),
+                 std::filesystem::exists(o.checkpoint) ? "exists: resuming it" : "new: written each generation");
   }
+  bool first_line = true;
   const CalibrationResult r = calibrate(inputs, space, sim.trials, o, comm, [&](const GenerationProgress& p) {
     std::string per;  // the best point's L per sequence
     for (std::size_t k = 0; k < p.best_fits.size() && k < inputs.size(); ++k) {
@@ -203,9 +209,13 @@ int run_calibrate(int argc, char** argv) {
       std::snprintf(buf, sizeof buf, ", lateral %.3f", p.best_lateral);
       per += buf;
     }
-    std::fprintf(stderr, "generation %d/%d  best L %.4f (%s)  (this generation %.4f)  elapsed %s  ETA %s\n",
+    // The first line of a resumed process says where it took over (each line follows one generation).
+    char resumed[64] = "";
+    if (p.resumed && first_line) std::snprintf(resumed, sizeof resumed, "  (resumed after generation %d)", p.generation - 1);
+    first_line = false;
+    std::fprintf(stderr, "generation %d/%d  best L %.4f (%s)  (this generation %.4f)  elapsed %s  ETA %s%s\n",
                  p.generation, p.generations, p.best, per.c_str(), p.generation_best, minutes(p.elapsed_s).c_str(),
-                 minutes(p.eta_s).c_str());
+                 minutes(p.eta_s).c_str(), resumed);
   });
   if (!r.complete) {
     if (comm.is_root()) {

@@ -205,6 +205,36 @@ if(STUDY)
      OR NOT EXISTS ${WORK}/c1-fit.png)
     message(FATAL_ERROR "calib_overlay.py fit on calibrate's curves (${rc}, header '${header}'): ${err}")
   endif()
+  # Stopped after its first generation and run again (coarse gown, 2 x 4, ~30 s for the three
+  # runs): the start names the checkpoint and whether it resumes it, the resumed process says
+  # where it took over, the checkpoint is gone at the end, and the file's objective has every
+  # digit of an uninterrupted run's (the resume is exact; calib_driver_test checks the bits).
+  set(again calibrate --data ${WORK}/study --participant 4 --gown coarse --generations 2 --population 4
+            --threads 2 --seed 3)
+  execute_process(COMMAND ${DG} ${again} --out ${WORK}/r.json --stop-after-generations 1
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR EXISTS ${WORK}/r.json OR NOT EXISTS ${WORK}/r.json.ckpt
+     OR NOT out MATCHES "stopped after 1 generations; run the same command again to resume from [^\n]*/r\\.json\\.ckpt"
+     OR NOT err MATCHES "calibrate: checkpoint [^\n]*/r\\.json\\.ckpt \\(new: written each generation\\)\n"
+     OR err MATCHES "resumed after")
+    message(FATAL_ERROR "calibrate stopped after one generation (${rc}):\n${out}\n${err}")
+  endif()
+  execute_process(COMMAND ${DG} ${again} --out ${WORK}/r.json RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/r.json OR EXISTS ${WORK}/r.json.ckpt
+     OR NOT err MATCHES "calibrate: checkpoint [^\n]*/r\\.json\\.ckpt \\(exists: resuming it\\)\n"
+     OR NOT err MATCHES "\ngeneration 2/2  best L [^\n]*  \\(resumed after generation 1\\)\n"
+     OR err MATCHES "generation 1/2")
+    message(FATAL_ERROR "calibrate resumed (${rc}):\n${out}\n${err}")
+  endif()
+  execute_process(COMMAND ${DG} ${again} --out ${WORK}/w.json RESULT_VARIABLE rc ERROR_VARIABLE err)
+  file(READ ${WORK}/r.json resumed_file)
+  file(READ ${WORK}/w.json whole_file)
+  string(REGEX MATCH "\n  \"objective\": [^,]+," resumed_objective "${resumed_file}")
+  string(REGEX MATCH "\n  \"objective\": [^,]+," whole_objective "${whole_file}")
+  if(NOT rc EQUAL 0 OR resumed_objective STREQUAL "" OR NOT resumed_objective STREQUAL whole_objective
+     OR err MATCHES "resumed after")
+    message(FATAL_ERROR "resumed against uninterrupted calibration: '${resumed_objective}' and '${whole_objective}' (${rc}):\n${err}")
+  endif()
   # predict: participant 4's calibration on the other six participants' 20 trials (coarse gown, ~40 s).
   execute_process(COMMAND ${DG} predict --calibration ${WORK}/cal4.json --data ${WORK}/study --out ${WORK}/pred --json
                   RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
