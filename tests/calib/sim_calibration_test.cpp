@@ -279,8 +279,8 @@ TEST(SimCalibration, Participant4sPaperBudgetCalibrationFitsHisSequences) {
 
 // Participant 4 with the worst sequence first (calibrate --combine worst, 12 x 32, sigma0 0.03,
 // seed 2, from participant4-paper-budget.json; session 36): good 0.2337, missed 0.2341. The worse
-// sequence is below the paper-budget file's (0.256) and 0.004 above the paper's simulator's worse
-// one (0.22 / 0.23); the sum 0.468 is below the file's 0.471. Bounded here by 0.235.
+// sequence is below the paper-budget file's (0.256); each is above the paper's simulator's (0.22,
+// 0.23) by 0.014 and 0.004; the sum 0.468 is below the file's 0.471. Bounded here by 0.235.
 TEST(SimCalibration, Participant4sWorstFirstCalibrationFitsHisSequences) {
   expect_fits_own_sequences_to_the_bit("participant4-worst.json", 0.235);
 }
