@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
+#include <optional>
 
 #include "args.h"
 #include "calibration.h"
@@ -164,15 +165,28 @@ int run_calibrate(int argc, char** argv) {
     space.hem_bend_ratio = r;
   }
   space.bounds = args.get("bounds") ? read_bounds(*args.get("bounds")) : default_bounds();
+  std::optional<Calibration> start_cal;
   if (const auto start = args.get("start")) {
     try {
-      start_from(space.bounds, read_calibration(*start));
+      start_cal = read_calibration(*start);
+      start_from(space.bounds, *start_cal);
     } catch (const std::invalid_argument& e) {
       throw UsageError("--start " + *start + ": " + e.what());
     }
   }
   const Dataset ds = load_dataset(data);
   const std::vector<HapticSequence> inputs = select_inputs(ds, participant, o.seed);
+  // The seed picks the sequences (IV-B.1: one per height at random). Continuing a calibration of
+  // the same person with another seed fits other trials than the file was fitted to, its offsets
+  // included: legitimate, but rarely what was meant, so it is said before the hours of search.
+  if (start_cal && start_cal->participant == participant) {
+    std::string was, now;
+    for (const SequenceFit& f : start_cal->fits) was += (was.empty() ? "" : ", ") + f.trial_id;
+    for (const HapticSequence& s : inputs) now += (now.empty() ? "" : ", ") + s.id;
+    if (was != now)
+      std::fprintf(stderr, "calibrate: note: --start %s was fitted to %s; seed %llu selects %s\n",
+                   args.get("start")->c_str(), was.c_str(), static_cast<unsigned long long>(o.seed), now.c_str());
+  }
   if (!args.has("no-arm-offset"))
     for (const auto& s : inputs) space.offset_heights.push_back(s.height);
 

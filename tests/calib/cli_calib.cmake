@@ -219,6 +219,18 @@ if(STUDY)
      OR err MATCHES "resumed after")
     message(FATAL_ERROR "calibrate stopped after one generation (${rc}):\n${out}\n${err}")
   endif()
+  # Another person's command pointed at that checkpoint is refused before anything is simulated,
+  # and the checkpoint survives (the resume below reads it). Its --start file is participant 1's,
+  # fitted to s1-good-3 and s1-miss-1, and its seed selects another good trial: said first.
+  execute_process(COMMAND ${DG} calibrate --data ${WORK}/study --participant 1 --out ${WORK}/p1.json --gown coarse
+                          --start ${CMAKE_CURRENT_LIST_DIR}/../../models/participant1-worst.json --seed 3
+                          --checkpoint ${WORK}/r.json.ckpt
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(rc EQUAL 0 OR EXISTS ${WORK}/p1.json OR NOT EXISTS ${WORK}/r.json.ckpt
+     OR NOT err MATCHES "calibrate: note: --start [^\n]*participant1-worst\\.json was fitted to s1-good-3, s1-miss-1; seed 3 selects s1-good-1, s1-miss-1\n"
+     OR NOT err MATCHES "r\\.json\\.ckpt:2: checkpoint belongs to a different calibration")
+    message(FATAL_ERROR "calibrate with another calibration's checkpoint (${rc}):\n${out}\n${err}")
+  endif()
   execute_process(COMMAND ${DG} ${again} --out ${WORK}/r.json RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/r.json OR EXISTS ${WORK}/r.json.ckpt
      OR NOT err MATCHES "calibrate: checkpoint [^\n]*/r\\.json\\.ckpt \\(exists: resuming it\\)\n"
