@@ -176,17 +176,6 @@ int run_calibrate(int argc, char** argv) {
   }
   const Dataset ds = load_dataset(data);
   const std::vector<HapticSequence> inputs = select_inputs(ds, participant, o.seed);
-  // The seed picks the sequences (IV-B.1: one per height at random). Continuing a calibration of
-  // the same person with another seed fits other trials than the file was fitted to, its offsets
-  // included: legitimate, but rarely what was meant, so it is said before the hours of search.
-  if (start_cal && start_cal->participant == participant) {
-    std::string was, now;
-    for (const SequenceFit& f : start_cal->fits) was += (was.empty() ? "" : ", ") + f.trial_id;
-    for (const HapticSequence& s : inputs) now += (now.empty() ? "" : ", ") + s.id;
-    if (was != now)
-      std::fprintf(stderr, "calibrate: note: --start %s was fitted to %s; seed %llu selects %s\n",
-                   args.get("start")->c_str(), was.c_str(), static_cast<unsigned long long>(o.seed), now.c_str());
-  }
   if (!args.has("no-arm-offset"))
     for (const auto& s : inputs) space.offset_heights.push_back(s.height);
 
@@ -196,14 +185,25 @@ int run_calibrate(int argc, char** argv) {
   const Comm& comm = Comm::world();
   const ClothSimulator sim = make_cloth_simulator(gown);
   if (comm.is_root()) {
-    std::fprintf(stderr, "calibrate: participant %s, %zu sequences (", participant.c_str(), inputs.size());
-    for (std::size_t k = 0; k < inputs.size(); ++k) std::fprintf(stderr, "%s%s", k ? ", " : "", inputs[k].id.c_str());
-    std::fprintf(stderr, "), %d parameters, %d x %d, %d rank(s) x %d thread(s), gown %s\n", space.dimension(),
+    std::string ids;  // the selected sequences, "s4-good-3, s4-miss-2"
+    for (const HapticSequence& s : inputs) ids += (ids.empty() ? "" : ", ") + s.id;
+    std::fprintf(stderr, "calibrate: participant %s, %zu sequences (%s), %d parameters, %d x %d, %d rank(s) x %d "
+                 "thread(s), gown %s\n", participant.c_str(), inputs.size(), ids.c_str(), space.dimension(),
                  o.generations, o.population, comm.size(), thread_count(o.threads), gown.c_str());
     // Said before the first generation (minutes away at the paper's budget): whether this run
     // starts afresh or continues a stopped one. A checkpoint of another command is refused then.
     std::fprintf(stderr, "calibrate: checkpoint %s (%s)\n", o.checkpoint.c_str(),
                  std::filesystem::exists(o.checkpoint) ? "exists: resuming it" : "new: written each generation");
+    // The seed picks the sequences (IV-B.1: one per height at random). Continuing a calibration of
+    // the same person with another seed fits other trials than the file was fitted to, its offsets
+    // included: legitimate, but rarely what was meant, so it is said before the hours of search.
+    if (start_cal && start_cal->participant == participant) {
+      std::string was;
+      for (const SequenceFit& f : start_cal->fits) was += (was.empty() ? "" : ", ") + f.trial_id;
+      if (was != ids)
+        std::fprintf(stderr, "calibrate: note: --start %s was fitted to %s; seed %llu selects %s\n",
+                     args.get("start")->c_str(), was.c_str(), static_cast<unsigned long long>(o.seed), ids.c_str());
+    }
   }
   bool first_line = true;
   const CalibrationResult r = calibrate(inputs, space, sim.trials, o, comm, [&](const GenerationProgress& p) {
