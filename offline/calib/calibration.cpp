@@ -202,6 +202,30 @@ std::vector<HapticSequence> select_inputs(const Dataset& ds, const std::string& 
   return out;
 }
 
+std::vector<HapticSequence> inputs_by_id(const Dataset& ds, const std::string& participant,
+                                         const std::vector<std::string>& ids) {
+  if (ids.empty()) throw InputError("no trial named: give one to three trial ids, one per arm height");
+  std::array<const HapticSequence*, 3> by_height{};  // the chosen trial of each ArmHeight
+  for (const std::string& id : ids) {
+    const auto t = std::find_if(ds.trials.begin(), ds.trials.end(), [&](const auto& s) { return s.id == id; });
+    if (t == ds.trials.end()) throw InputError("trial '" + id + "' is not in the dataset");
+    if (t->participant != participant)
+      throw InputError("trial '" + id + "' is participant " + t->participant + "'s, not " + participant + "'s");
+    if (!t->label) throw InputError("trial '" + id + "' has no outcome label");
+    if (*t->label == Outcome::Caught)
+      throw InputError("trial '" + id + "' is caught; calibration fits good and missed trials only (IV-B.1)");
+    const HapticSequence*& slot = by_height[static_cast<int>(t->height)];
+    if (slot)
+      throw InputError("trials '" + slot->id + "' and '" + id + "' are both at the " +
+                       std::string(arm_height_name(t->height)) + " arm; give one per height (IV-B.1)");
+    slot = &*t;
+  }
+  std::vector<HapticSequence> out;
+  for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low})
+    if (by_height[static_cast<int>(h)]) out.push_back(*by_height[static_cast<int>(h)]);
+  return out;
+}
+
 TrialRequest request_for(const HapticSequence& input, const std::array<double, 3>& offsets) {
   TrialRequest r;
   r.height = input.height;

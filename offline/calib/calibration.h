@@ -228,6 +228,14 @@ bool set_person_param(ParameterSpace& space, int i, const std::string& word);
 // Throws InputError when the participant has none.
 std::vector<HapticSequence> select_inputs(const Dataset& ds, const std::string& participant, std::uint64_t seed);
 
+// The measured sequences named by `ids` instead (`calibrate --inputs`): what a user gives to
+// fit chosen trials, e.g. to continue a calibration on the trials it was fitted to under another
+// CMA-ES seed. The same rules as the seeded choice: each a labelled good or missed trial of
+// `participant`, at most one per arm height; returned in the seeded choice's order (high, middle,
+// low). Throws InputError naming the trial and the rule it breaks.
+std::vector<HapticSequence> inputs_by_id(const Dataset& ds, const std::string& participant,
+                                         const std::vector<std::string>& ids);
+
 // ---- the driver ---------------------------------------------------------------------------------
 
 // How the input sequences' objectives combine into the one number CMA-ES minimises.

@@ -47,6 +47,8 @@ int run_calibrate(int argc, char** argv) {
         "  --sigma0 S          CMA-ES's initial step in the unit box (default 0.3: a global search;\n"
         "                      about 0.1 from initial values known to fit, e.g. another calibration's)\n"
         "  --seed S            input selection and CMA-ES (default 1); same seed, same result\n"
+        "  --inputs ID,ID[,ID] fit these trials of P (one per height, good or missed) instead of\n"
+        "                      the seed's choice; the seed then drives CMA-ES alone\n"
         "  --objective area|position-weighted   (default area: paper eq. 3-5)\n"
         "  --combine sum|worst   how the sequences' L combine: sum (the paper, the default) or\n"
         "                      worst (max_k L_k + 0.1 sum_k L_k: the worst-fitted sequence first,\n"
@@ -104,7 +106,7 @@ int run_calibrate(int argc, char** argv) {
                    "checkpoint", "objective", "gown", "threads", "generations", "population",
                    "stop-after-generations", "arm-compliance", "fist-shift", "rim-shift", "sigma0", "hem",
                    "density", "contrast-weight", "lateral-weight", "combine", "arm-lateral", "fist-lateral",
-                   "support-depth", "support-lateral"});
+                   "support-depth", "support-lateral", "inputs"});
   const std::string data = args.require("data");
   const std::string participant = args.require("participant");
   const std::string out = args.require("out");
@@ -175,7 +177,22 @@ int run_calibrate(int argc, char** argv) {
     }
   }
   const Dataset ds = load_dataset(data);
-  const std::vector<HapticSequence> inputs = select_inputs(ds, participant, o.seed);
+  std::vector<std::string> chosen;  // --inputs, split at commas
+  if (const auto list = args.get("inputs")) {
+    std::size_t from = 0;
+    for (std::size_t comma; (comma = list->find(',', from)) != std::string::npos; from = comma + 1)
+      chosen.push_back(list->substr(from, comma - from));
+    chosen.push_back(list->substr(from));
+    for (const std::string& id : chosen)
+      if (id.empty()) throw UsageError("--inputs must be trial ids separated by commas, not '" + *list + "'");
+  }
+  std::vector<HapticSequence> inputs;
+  try {
+    inputs = chosen.empty() ? select_inputs(ds, participant, o.seed) : inputs_by_id(ds, participant, chosen);
+  } catch (const InputError& e) {
+    if (chosen.empty()) throw;
+    throw UsageError("--inputs: " + std::string(e.what()) + " (" + data + "/manifest.csv)");
+  }
   if (!args.has("no-arm-offset"))
     for (const auto& s : inputs) space.offset_heights.push_back(s.height);
 
@@ -194,15 +211,24 @@ int run_calibrate(int argc, char** argv) {
     // starts afresh or continues a stopped one. A checkpoint of another command is refused then.
     std::fprintf(stderr, "calibrate: checkpoint %s (%s)\n", o.checkpoint.c_str(),
                  std::filesystem::exists(o.checkpoint) ? "exists: resuming it" : "new: written each generation");
-    // The seed picks the sequences (IV-B.1: one per height at random). Continuing a calibration of
-    // the same person with another seed fits other trials than the file was fitted to, its offsets
-    // included: legitimate, but rarely what was meant, so it is said before the hours of search.
+    // The seed picks the sequences (IV-B.1: one per height at random) unless --inputs names them.
+    // Continuing a calibration of the same person on other trials than the file was fitted to (its
+    // offsets included) is legitimate but rarely what was meant: said before the hours of search,
+    // with the --inputs value that would fit the file's own trials.
     if (start_cal && start_cal->participant == participant) {
       std::string was;
-      for (const SequenceFit& f : start_cal->fits) was += (was.empty() ? "" : ", ") + f.trial_id;
-      if (was != ids)
-        std::fprintf(stderr, "calibrate: note: --start %s was fitted to %s; seed %llu selects %s\n",
-                     args.get("start")->c_str(), was.c_str(), static_cast<unsigned long long>(o.seed), ids.c_str());
+      std::string flag;  // the same as --inputs' value, "s4-good-3,s4-miss-2"
+      for (const SequenceFit& f : start_cal->fits) {
+        was += (was.empty() ? "" : ", ") + f.trial_id;
+        flag += (flag.empty() ? "" : ",") + f.trial_id;
+      }
+      if (was != ids && chosen.empty())
+        std::fprintf(stderr, "calibrate: note: --start %s was fitted to %s; seed %llu selects %s (--inputs %s "
+                     "fits those)\n", args.get("start")->c_str(), was.c_str(),
+                     static_cast<unsigned long long>(o.seed), ids.c_str(), flag.c_str());
+      else if (was != ids)
+        std::fprintf(stderr, "calibrate: note: --start %s was fitted to %s; --inputs names %s\n",
+                     args.get("start")->c_str(), was.c_str(), ids.c_str());
     }
   }
   bool first_line = true;
@@ -262,6 +288,7 @@ int run_calibrate(int argc, char** argv) {
   prov.set("created", utc_now());
   prov.set("dataset", data);
   prov.set("seed", std::to_string(o.seed));
+  prov.set("inputs", chosen.empty() ? "chosen by the seed (IV-B.1)" : "named by --inputs");
   prov.set("profile", profile);
   prov.set("generations", r.generations_done);
   prov.set("population", o.population);

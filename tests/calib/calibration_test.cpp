@@ -623,6 +623,48 @@ TEST(Calibration, InputSelectionOnMeasuredData) {
   EXPECT_THROW(select_inputs(ds, "42", 1), InputError);
 }
 
+// calibrate --inputs: the named trials in the seeded choice's order (high, middle, low), and each
+// of IV-B.1's rules refused with the trial's name, on a dataset small enough to read.
+TEST(Calibration, InputsByIdFollowTheSelectionRules) {
+  Dataset ds;
+  const auto add = [&](std::string id, std::string who, ArmHeight h, std::optional<Outcome> label) {
+    HapticSequence t;
+    t.id = std::move(id);
+    t.participant = std::move(who);
+    t.height = h;
+    t.label = label;
+    ds.trials.push_back(t);
+  };
+  add("s1-good-1", "1", ArmHeight::High, Outcome::Good);
+  add("s1-good-3", "1", ArmHeight::High, Outcome::Good);
+  add("s1-miss-1", "1", ArmHeight::Low, Outcome::Missed);
+  add("s1-caught-1", "1", ArmHeight::Middle, Outcome::Caught);
+  add("s1-unknown", "1", ArmHeight::Middle, std::nullopt);
+  add("s2-miss-1", "2", ArmHeight::Low, Outcome::Missed);
+
+  const auto in = inputs_by_id(ds, "1", {"s1-miss-1", "s1-good-3"});  // given low first
+  ASSERT_EQ(in.size(), 2u);
+  EXPECT_EQ(in[0].id, "s1-good-3");
+  EXPECT_EQ(in[1].id, "s1-miss-1");
+  ASSERT_EQ(inputs_by_id(ds, "1", {"s1-good-1"}).size(), 1u);
+
+  const auto refused = [&](const std::vector<std::string>& ids) {
+    try {
+      inputs_by_id(ds, "1", ids);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(refused({}).find("no trial named"), std::string::npos);
+  EXPECT_NE(refused({"s1-good-9"}).find("trial 's1-good-9' is not in the dataset"), std::string::npos);
+  EXPECT_NE(refused({"s2-miss-1"}).find("trial 's2-miss-1' is participant 2's, not 1's"), std::string::npos);
+  EXPECT_NE(refused({"s1-caught-1"}).find("trial 's1-caught-1' is caught"), std::string::npos);
+  EXPECT_NE(refused({"s1-unknown"}).find("trial 's1-unknown' has no outcome label"), std::string::npos);
+  EXPECT_NE(refused({"s1-good-1", "s1-good-3"}).find("trials 's1-good-1' and 's1-good-3' are both at the high arm"),
+            std::string::npos);
+}
+
 TEST(Calibration, CalibrationFileRoundTripAndErrors) {
   Calibration c;
   c.participant = "4";

@@ -168,6 +168,13 @@ if(STUDY)
   expect_fail("calibrate with a bad bounds file" "bounds.txt:2: unknown parameter 'stiffness'"
               calibrate --data ${WORK}/study --participant 4 --out ${WORK}/c.json --bounds ${WORK}/bounds.txt)
   expect_fail("calibrate an absent participant" "participant '42'" calibrate --data ${WORK}/study --participant 42 --out ${WORK}/c.json)
+  expect_fail("calibrate --inputs with another person's trial"
+              "--inputs: trial 's1-miss-1' is participant 1's, not 4's (${WORK}/study/manifest.csv)"
+              calibrate --data ${WORK}/study --participant 4 --out ${WORK}/c.json --inputs s4-good-3,s1-miss-1)
+  expect_fail("calibrate --inputs with two trials at one height" "--inputs: trials 's1-good-1' and 's1-good-3' are both at the high arm"
+              calibrate --data ${WORK}/study --participant 1 --out ${WORK}/c.json --inputs s1-good-1,s1-good-3)
+  expect_fail("calibrate --inputs ending in a comma" "--inputs must be trial ids separated by commas, not 's4-good-3,'"
+              calibrate --data ${WORK}/study --participant 4 --out ${WORK}/c.json --inputs s4-good-3,)
   # One generation of 4 on the coarse gown (~10 s), the density and the arm's side fitted too, the
   # heights' contrast and the lateral force in the objective: the calibration file (its searched
   # parameters end with the density and the arm's side; both terms' weights and values; each
@@ -227,9 +234,20 @@ if(STUDY)
                           --checkpoint ${WORK}/r.json.ckpt
                   RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(rc EQUAL 0 OR EXISTS ${WORK}/p1.json OR NOT EXISTS ${WORK}/r.json.ckpt
-     OR NOT err MATCHES "calibrate: note: --start [^\n]*participant1-worst\\.json was fitted to s1-good-3, s1-miss-1; seed 3 selects s1-good-1, s1-miss-1\n"
+     OR NOT err MATCHES "calibrate: note: --start [^\n]*participant1-worst\\.json was fitted to s1-good-3, s1-miss-1; seed 3 selects s1-good-1, s1-miss-1 \\(--inputs s1-good-3,s1-miss-1 fits those\\)\n"
      OR NOT err MATCHES "r\\.json\\.ckpt:2: checkpoint belongs to a different calibration")
     message(FATAL_ERROR "calibrate with another calibration's checkpoint (${rc}):\n${out}\n${err}")
+  endif()
+  # The same with the file's own trials named (--inputs, in either order): seed 3 no longer
+  # chooses them, so the header lists them in height order and nothing needs saying.
+  execute_process(COMMAND ${DG} calibrate --data ${WORK}/study --participant 1 --out ${WORK}/p1.json --gown coarse
+                          --start ${CMAKE_CURRENT_LIST_DIR}/../../models/participant1-worst.json --seed 3
+                          --inputs s1-miss-1,s1-good-3 --checkpoint ${WORK}/r.json.ckpt
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(rc EQUAL 0 OR EXISTS ${WORK}/p1.json OR NOT EXISTS ${WORK}/r.json.ckpt OR err MATCHES "note:"
+     OR NOT err MATCHES "calibrate: participant 1, 2 sequences \\(s1-good-3, s1-miss-1\\)"
+     OR NOT err MATCHES "r\\.json\\.ckpt:2: checkpoint belongs to a different calibration")
+    message(FATAL_ERROR "calibrate --inputs with another calibration's checkpoint (${rc}):\n${out}\n${err}")
   endif()
   execute_process(COMMAND ${DG} ${again} --out ${WORK}/r.json RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/r.json OR EXISTS ${WORK}/r.json.ckpt
