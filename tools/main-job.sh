@@ -69,6 +69,9 @@ if [ -f "$out/measured/manifest.csv" ]; then
   /usr/bin/python3 tools/plot/calib_overlay.py predict "$model/predict-p4" --out "$model/predict-p4.png"
   /usr/bin/python3 tools/plot/calib_overlay.py residual "$model/predict-p4" --out "$model/residual-p4.png"
 fi
+# Issue 4's standing: each participant's best shipped calibration on its own sequences (L per
+# sequence against the 0.3 goal, the study's repeat floor and the paper's simulator).
+/usr/bin/python3 tools/plot/calib_overlay.py standing models/participant*.json --out "$model/calibrations-standing.png"
 echo "main-job: synthesized data, model and evaluation in $model"
 
 # Robot side (predictor/): simulated trials as CAN traffic, and what the predictor would do on

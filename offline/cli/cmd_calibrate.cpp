@@ -177,21 +177,18 @@ int run_calibrate(int argc, char** argv) {
     }
   }
   const Dataset ds = load_dataset(data);
-  std::vector<std::string> chosen;  // --inputs, split at commas
-  if (const auto list = args.get("inputs")) {
-    std::size_t from = 0;
-    for (std::size_t comma; (comma = list->find(',', from)) != std::string::npos; from = comma + 1)
-      chosen.push_back(list->substr(from, comma - from));
-    chosen.push_back(list->substr(from));
-    for (const std::string& id : chosen)
-      if (id.empty()) throw UsageError("--inputs must be trial ids separated by commas, not '" + *list + "'");
-  }
+  const std::vector<std::string> chosen = split_in_order(args.get("inputs").value_or(""));
+  if (args.get("inputs") && chosen.empty()) throw UsageError("--inputs must name one to three trial ids, not '" +
+                                                              *args.get("inputs") + "'");
   std::vector<HapticSequence> inputs;
-  try {
-    inputs = chosen.empty() ? select_inputs(ds, participant, o.seed) : inputs_by_id(ds, participant, chosen);
-  } catch (const InputError& e) {
-    if (chosen.empty()) throw;
-    throw UsageError("--inputs: " + std::string(e.what()) + " (" + data + "/manifest.csv)");
+  if (chosen.empty()) {
+    inputs = select_inputs(ds, participant, o.seed);
+  } else {
+    try {
+      inputs = inputs_by_id(ds, participant, chosen);
+    } catch (const InputError& e) {
+      throw UsageError("--inputs: " + std::string(e.what()) + " (" + data + "/manifest.csv)");
+    }
   }
   if (!args.has("no-arm-offset"))
     for (const auto& s : inputs) space.offset_heights.push_back(s.height);

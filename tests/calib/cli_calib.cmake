@@ -33,6 +33,26 @@ expect_fail("calibrate with the support beyond the gown" "--support-depth must b
 expect_fail("calibrate with the arm beside the opening" "--arm-lateral must be fit, fixed or a value (arm_lateral must be within +-0.1 m" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --arm-lateral 0.15)
 expect_fail("calibrate with a weightless gown" "areal_density must be within 0.01 and 1 kg/m" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --density 0)
 expect_fail("calibrate on a missing dataset" "manifest.csv" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json)
+
+# The shipped calibrations' standing on their own sequences as a picture (no study needed: the
+# files hold their objectives): per participant the file whose worse sequence is lower, and the
+# goal said only where every sequence is within it.
+set(M ${CMAKE_CURRENT_LIST_DIR}/../../models)
+execute_process(COMMAND /usr/bin/python3 ${PLOT} standing ${M}/participant4-paper-budget.json
+                        ${M}/participant4-worst.json ${M}/participant1-worst.json --out ${WORK}/standing.png
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/standing.png
+   OR NOT out MATCHES "participant 1: participant1-worst\\.json: s1-good-3 0\\.2540, s1-miss-1 0\\.3004\n"
+   OR NOT out MATCHES "participant 4: participant4-worst\\.json: s4-good-3 0\\.2337, s4-miss-2 0\\.2341  \\(each <= 0\\.3\\)\n")
+  message(FATAL_ERROR "calib_overlay.py standing (${rc}):\n${out}\n${err}")
+endif()
+file(WRITE ${WORK}/nofits.json "{\"participant\": \"4\"}")
+execute_process(COMMAND /usr/bin/python3 ${PLOT} standing ${WORK}/nofits.json --out ${WORK}/none.png
+                RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(rc EQUAL 0 OR EXISTS ${WORK}/none.png OR NOT err MATCHES "nofits\\.json: no 'sequences'")
+  message(FATAL_ERROR "calib_overlay.py standing on a file without sequences (${rc}): ${err}")
+endif()
+
 file(WRITE ${WORK}/bad.json "{\"format\": \"dressguard-calibration 1\",\n\"participant\": 4,\n}")
 expect_fail("synthesize with a bad calibration file" "bad.json" synthesize --calibration ${WORK}/bad.json --out ${WORK}/s)
 expect_fail("synthesize with --per-height 1" "--per-height" synthesize --calibration ${WORK}/bad.json --out ${WORK}/s --per-height 1)
@@ -173,8 +193,8 @@ if(STUDY)
               calibrate --data ${WORK}/study --participant 4 --out ${WORK}/c.json --inputs s4-good-3,s1-miss-1)
   expect_fail("calibrate --inputs with two trials at one height" "--inputs: trials 's1-good-1' and 's1-good-3' are both at the high arm"
               calibrate --data ${WORK}/study --participant 1 --out ${WORK}/c.json --inputs s1-good-1,s1-good-3)
-  expect_fail("calibrate --inputs ending in a comma" "--inputs must be trial ids separated by commas, not 's4-good-3,'"
-              calibrate --data ${WORK}/study --participant 4 --out ${WORK}/c.json --inputs s4-good-3,)
+  expect_fail("calibrate --inputs naming no trial" "--inputs must name one to three trial ids, not ','"
+              calibrate --data ${WORK}/study --participant 4 --out ${WORK}/c.json --inputs ,)
   # One generation of 4 on the coarse gown (~10 s), the density and the arm's side fitted too, the
   # heights' contrast and the lateral force in the objective: the calibration file (its searched
   # parameters end with the density and the arm's side; both terms' weights and values; each
