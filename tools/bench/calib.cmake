@@ -1,4 +1,5 @@
-# calib area (offline/calib): CMA-ES against pagmo2's, and the calibration pipeline benchmark.
+# calib area (offline/calib): CMA-ES against pagmo2's, the calibration pipeline benchmark, and the
+# objective's landscape around a calibration.
 find_package(Pagmo QUIET)
 if(Pagmo_FOUND)
   add_executable(bench_calib_cmaes ${CMAKE_CURRENT_LIST_DIR}/bench_calib_cmaes.cpp)
@@ -9,4 +10,6 @@ endif()
 if(TARGET dg_sim AND TARGET dg_hmm)
   add_executable(bench_calib_pipeline ${CMAKE_CURRENT_LIST_DIR}/bench_calib_pipeline.cpp)
   target_link_libraries(bench_calib_pipeline PRIVATE dg_calib)
+  add_executable(bench_calib_landscape ${CMAKE_CURRENT_LIST_DIR}/bench_calib_landscape.cpp)
+  target_link_libraries(bench_calib_landscape PRIVATE dg_calib)
 endif()

@@ -1,0 +1,33 @@
+# tools/bench/bench_calib_landscape: the objective around a shipped calibration. Its baseline
+# (the file's point simulated again) must reproduce the recorded L of each sequence to the bit,
+# and the scale's row must name each sequence and the combined L; bad options exit 2 by name.
+# -DDG=<dressguard> -DBENCH=<bench_calib_landscape> -DWORK=<dir> -DSTUDY=<study dir or empty>
+# -DCAL=<models/participant4-worst.json>
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK})
+execute_process(COMMAND ${BENCH} --calibration ${CAL} RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "need --calibration CAL.json and --data DATASET")
+  message(FATAL_ERROR "bench_calib_landscape without --data (${rc}): ${err}")
+endif()
+execute_process(COMMAND ${BENCH} --calibration ${CAL} --data ${WORK} --scales 0.01,2 RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "each scale must be in \\(0, 1\\]")
+  message(FATAL_ERROR "bench_calib_landscape with a scale of 2 (${rc}): ${err}")
+endif()
+if(NOT STUDY)
+  message("SKIP: shared/data/kapusta2016-calibration-trials not present; the landscape needs the study")
+  return()
+endif()
+execute_process(COMMAND ${DG} import --study ${STUDY} --out ${WORK}/study RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "dressguard import (${rc})")
+endif()
+# One point at 1 % of each box (three simulations of two sequences, about a minute on one core).
+execute_process(COMMAND ${BENCH} --calibration ${CAL} --data ${WORK}/study --scales 0.01 --samples 1 --threads 2
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0
+   OR NOT out MATCHES "s4-good-3          L 0\\.2337 \\(recorded 0\\.2337, the same bits\\)"
+   OR NOT out MATCHES "s4-miss-2          L 0\\.2341 \\(recorded 0\\.2341, the same bits\\)"
+   OR NOT out MATCHES "\n0\\.01      s4-miss-2 +[0-9.]+ +[0-9.]+ +[0-9.]+ +[0-9.]+   [01] of 1\n"
+   OR NOT out MATCHES "\n0\\.01      combined +[0-9.]+ +[0-9.]+ +[0-9.]+ +0\\.0000   [01] of 1 below the file's 0\\.2809\n")
+  message(FATAL_ERROR "bench_calib_landscape on participant 4 (${rc}):\n${out}\n${err}")
+endif()
