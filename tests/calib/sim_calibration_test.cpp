@@ -245,7 +245,9 @@ void expect_fits_own_sequences_to_the_bit(const std::string& file, double at_mos
       std::filesystem::path(::testing::TempDir()) / ("dg_own_" + std::filesystem::path(file).stem().string());
   std::filesystem::remove_all(data);
   save_dataset(import_study(dir), data);
-  const auto inputs = select_inputs(load_dataset(data), cal.participant, 1);
+  std::vector<std::string> ids;  // the trials the file was fitted to (calibrate's seed or --inputs)
+  for (const SequenceFit& f : cal.fits) ids.push_back(f.trial_id);
+  const auto inputs = inputs_by_id(load_dataset(data), cal.participant, ids);
   std::filesystem::remove_all(data);
   ASSERT_EQ(inputs.size(), cal.fits.size());
   const std::vector<SimulatedTrial> sts = simulate_inputs(make_cloth_simulator(cal.gown).trials, cal.cloth, cal.offsets, inputs);
@@ -316,6 +318,14 @@ TEST(SimCalibration, Participant1sPaperBudgetCalibrationFitsTheirSequences) {
 // 0.0004 above the 0.3, bounded here by 0.301. The recorded objective is max + 0.1 sum.
 TEST(SimCalibration, Participant1sWorstFirstCalibrationFitsTheirSequences) {
   expect_fits_own_sequences_to_the_bit("participant1-worst.json", 0.301);
+}
+
+// Participant 1, a second worst-first round (10 x 32, sigma0 0.03, seed 1, from
+// participant1-worst.json; session 37): good 0.2764, missed 0.2984, both within the 0.3.
+// The combined objective moved by 0.0001 (0.3559 to 0.3558): the missed sequence crossed 0.3 at
+// the good one's cost (0.254 to 0.276). Bounded here by 0.2985.
+TEST(SimCalibration, Participant1sSecondWorstFirstRoundFitsTheirSequences) {
+  expect_fits_own_sequences_to_the_bit("participant1-worst2.json", 0.2985);
 }
 
 // Participant 0, three sequences (8 x 24 from their session-11 values; session 18). Far from the
