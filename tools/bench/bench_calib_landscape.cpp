@@ -18,6 +18,7 @@
 #include <array>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <random>
 #include <stdexcept>
@@ -100,8 +101,11 @@ int run(int argc, char** argv) {
   std::vector<double> scales;
   for (std::size_t from = 0; from <= scales_arg.size();) {
     const std::size_t comma = std::min(scales_arg.find(',', from), scales_arg.size());
-    scales.push_back(std::stod(scales_arg.substr(from, comma - from)));
-    if (!(scales.back() > 0 && scales.back() <= 1)) throw std::runtime_error("each scale must be in (0, 1]");
+    const std::string word = scales_arg.substr(from, comma - from);
+    char* end = nullptr;
+    scales.push_back(std::strtod(word.c_str(), &end));
+    if (word.empty() || *end != '\0' || !(scales.back() > 0 && scales.back() <= 1))
+      throw std::runtime_error("each scale must be in (0, 1], not '" + word + "' (--scales " + scales_arg + ")");
     from = comma + 1;
   }
 
