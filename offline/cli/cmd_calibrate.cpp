@@ -223,7 +223,7 @@ int run_calibrate(int argc, char** argv) {
         std::fprintf(stderr, "calibrate: note: --start %s was fitted to %s; seed %llu selects %s (--inputs %s "
                      "fits those)\n", args.get("start")->c_str(), was.c_str(),
                      static_cast<unsigned long long>(o.seed), ids.c_str(), flag.c_str());
-      else if (was != ids)
+      if (was != ids && !chosen.empty())
         std::fprintf(stderr, "calibrate: note: --start %s was fitted to %s; --inputs names %s\n",
                      args.get("start")->c_str(), was.c_str(), ids.c_str());
     }
