@@ -269,6 +269,15 @@ if(STUDY)
      OR NOT err MATCHES "r\\.json\\.ckpt:2: checkpoint belongs to a different calibration")
     message(FATAL_ERROR "calibrate --inputs with another calibration's checkpoint (${rc}):\n${out}\n${err}")
   endif()
+  # Other trials named than the file's: said, without a seed to blame.
+  execute_process(COMMAND ${DG} calibrate --data ${WORK}/study --participant 1 --out ${WORK}/p1.json --gown coarse
+                          --start ${CMAKE_CURRENT_LIST_DIR}/../../models/participant1-worst.json
+                          --inputs s1-good-1,s1-miss-1 --checkpoint ${WORK}/r.json.ckpt
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(rc EQUAL 0 OR EXISTS ${WORK}/p1.json OR NOT EXISTS ${WORK}/r.json.ckpt
+     OR NOT err MATCHES "calibrate: note: --start [^\n]*participant1-worst\\.json was fitted to s1-good-3, s1-miss-1; --inputs names s1-good-1, s1-miss-1\n")
+    message(FATAL_ERROR "calibrate --inputs naming other trials than --start's (${rc}):\n${out}\n${err}")
+  endif()
   execute_process(COMMAND ${DG} ${again} --out ${WORK}/r.json RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/r.json OR EXISTS ${WORK}/r.json.ckpt
      OR NOT err MATCHES "calibrate: checkpoint [^\n]*/r\\.json\\.ckpt \\(exists: resuming it\\)\n"
