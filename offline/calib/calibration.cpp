@@ -169,6 +169,48 @@ std::vector<std::string> ParameterSpace::names() const {
   return n;
 }
 
+std::vector<ParamBound> ParameterSpace::boxes() const {
+  std::vector<ParamBound> out;
+  for (const std::string& n : names()) out.push_back(box_of(bounds, *find_param(n)));
+  return out;
+}
+
+std::optional<ParamRef> find_param(std::string_view name) {
+  for (int i = 0; i < kClothParams; ++i)
+    if (name == kClothParamNames[i]) return ParamRef{ParamRef::Kind::Cloth, i};
+  for (int i = 0; i < kPersonParams; ++i)
+    if (name == kPersonParamInfo[i].name) return ParamRef{ParamRef::Kind::Person, i};
+  for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low})
+    if (name == "arm_offset_" + std::string(arm_height_name(h))) return ParamRef{ParamRef::Kind::Offset, static_cast<int>(h)};
+  return std::nullopt;
+}
+
+double param_value(const ParamRef& p, const ClothValues& c, const std::array<double, 3>& offsets) {
+  switch (p.kind) {
+    case ParamRef::Kind::Cloth: return cloth_value(c, p.index);
+    case ParamRef::Kind::Person: return person_value(c, p.index);
+    case ParamRef::Kind::Offset: return offsets[p.index];
+  }
+  return 0.0;
+}
+
+void set_param_value(const ParamRef& p, ClothValues& c, std::array<double, 3>& offsets, double v) {
+  switch (p.kind) {
+    case ParamRef::Kind::Cloth: set_cloth_value(c, p.index, v); break;
+    case ParamRef::Kind::Person: set_person_value(c, p.index, v); break;
+    case ParamRef::Kind::Offset: offsets[p.index] = v; break;
+  }
+}
+
+const ParamBound& box_of(const Bounds& b, const ParamRef& p) {
+  switch (p.kind) {
+    case ParamRef::Kind::Cloth: return b.cloth[p.index];
+    case ParamRef::Kind::Person: return b.person[p.index];
+    case ParamRef::Kind::Offset: break;
+  }
+  return b.arm_offset;  // the heights share one box
+}
+
 bool set_person_param(ParameterSpace& space, int i, const std::string& word) {
   if (word == "fit") {
     space.person[i].fit = true;

@@ -214,7 +214,23 @@ struct ParameterSpace {
   ClothValues cloth(const Eigen::VectorXd& unit) const;
   std::array<double, 3> offsets(const Eigen::VectorXd& unit) const;  // [m] by ArmHeight, 0 if not optimised
   std::vector<std::string> names() const;  // "stretch", ..., "arm_offset_high", ..., "arm_compliance", ...
+  // The box of each parameter of names(), in that order: the unit box's ends in metres, N/m... A
+  // calibration file records them (provenance "boxes"), so that a later tool knows the search's
+  // box when a bounds file set it.
+  std::vector<ParamBound> boxes() const;
 };
+
+// One parameter of a search by its ParameterSpace::names() spelling: where it lives in a
+// calibration's (cloth, offsets) and which box of a Bounds is its own. What a tool that reads
+// a calibration file's provenance needs to move a searched parameter (bench_calib_landscape).
+struct ParamRef {
+  enum class Kind { Cloth, Person, Offset } kind;
+  int index;  // into kClothParamNames, kPersonParamInfo, or ArmHeight
+};
+std::optional<ParamRef> find_param(std::string_view name);  // nullopt: not a parameter's name
+double param_value(const ParamRef& p, const ClothValues& c, const std::array<double, 3>& offsets);
+void set_param_value(const ParamRef& p, ClothValues& c, std::array<double, 3>& offsets, double v);
+const ParamBound& box_of(const Bounds& b, const ParamRef& p);
 
 // Person parameter i of `space` from a command line's word: "fit" (search bounds.person[i]),
 // "fixed" (kPersonParamInfo[i].paper), or a value held during the search. False when the word is

@@ -299,6 +299,14 @@ int run_calibrate(int argc, char** argv) {
   Json names = Json::array();
   for (const auto& n : space.names()) names.push(n);
   prov.set("parameters", names);
+  Json boxes = Json::array();  // each searched parameter's [lower, upper], in "parameters" order
+  for (const ParamBound& b : space.boxes()) {
+    Json box = Json::array();
+    box.push(b.lower);
+    box.push(b.upper);
+    boxes.push(box);
+  }
+  prov.set("boxes", boxes);
   Json unit = Json::array();
   for (long i = 0; i < r.best_unit.size(); ++i) unit.push(r.best_unit[i]);
   prov.set("best_unit_vector", unit);

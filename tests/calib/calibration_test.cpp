@@ -550,6 +550,49 @@ TEST(Calibration, BoundsFileParsesAndNamesBadLines) {
   fs::remove_all(dir);
 }
 
+// Each searched parameter's box in names() order (what a calibration file records), a bounds
+// file's box where it set one, and every name leads back to the value the unit vector gave it.
+TEST(Calibration, SearchedParametersKnowTheirBoxesAndValues) {
+  const fs::path dir = temp_dir("boxes");
+  write_file_atomic(dir / "b.txt", "friction 0.1 1.5\narm_offset -0.03 0.03\nfist_shift 0 0.12\n");
+  ParameterSpace s;
+  s.bounds = read_bounds(dir / "b.txt");
+  s.offset_heights = {ArmHeight::High, ArmHeight::Low};
+  ASSERT_TRUE(set_person_param(s, kArmCompliance, "fit"));
+  ASSERT_TRUE(set_person_param(s, kFistShift, "fit"));
+  const std::vector<std::string> names = s.names();
+  const std::vector<ParamBound> boxes = s.boxes();
+  ASSERT_EQ(static_cast<int>(boxes.size()), s.dimension());
+  EXPECT_EQ(boxes[3].lower, 0.1);  // friction, from the file
+  EXPECT_EQ(boxes[3].upper, 1.5);
+  EXPECT_EQ(boxes[0].upper, default_bounds().cloth[0].upper);  // stretch, the default
+  EXPECT_EQ(names[kClothParams + 1], "arm_offset_low");
+  EXPECT_EQ(boxes[kClothParams + 1].lower, -0.03);  // the heights share the file's offset box
+  EXPECT_EQ(names[kClothParams + 3], "fist_shift");
+  EXPECT_EQ(boxes[kClothParams + 3].upper, 0.12);
+  // A point of the unit box: each name reads back its value, and writing it rebuilds the point.
+  Eigen::VectorXd u(s.dimension());
+  for (int k = 0; k < s.dimension(); ++k) u[k] = 0.1 + 0.8 * k / s.dimension();
+  const ClothValues c = s.cloth(u);
+  const std::array<double, 3> off = s.offsets(u);
+  ClothValues c2;
+  std::array<double, 3> off2{};
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    const std::optional<ParamRef> ref = find_param(names[k]);
+    ASSERT_TRUE(ref) << names[k];
+    const double v = param_value(*ref, c, off);
+    EXPECT_DOUBLE_EQ(v, boxes[k].lower + u[static_cast<long>(k)] * (boxes[k].upper - boxes[k].lower)) << names[k];
+    set_param_value(*ref, c2, off2, v);
+  }
+  for (int i = 0; i < kClothParams; ++i) EXPECT_EQ(cloth_value(c2, i), cloth_value(c, i));
+  EXPECT_EQ(c2.arm_compliance, c.arm_compliance);
+  EXPECT_EQ(c2.fist_shift, c.fist_shift);
+  EXPECT_EQ(off2, off);
+  EXPECT_EQ(off2[static_cast<int>(ArmHeight::Middle)], 0.0);  // not searched
+  for (const char* unknown : {"arm_offset", "stiffness", "arm_offset_side", ""}) EXPECT_FALSE(find_param(unknown)) << unknown;
+  fs::remove_all(dir);
+}
+
 // calibrate --start: a calibration's values become the next search's start, each calibrated
 // height's offset its own (a bounds file holds one for all), inside the bounds or refused by name.
 TEST(Calibration, StartFromACalibration) {

@@ -209,6 +209,7 @@ if(STUDY)
   endif()
   if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/c1.json OR NOT EXISTS ${WORK}/c1.json.curves.csv
      OR NOT c1 MATCHES "\"parameters\": \\[[^]]*\"arm_offset_low\", \"areal_density\", \"arm_lateral\"\\]"
+     OR NOT c1 MATCHES "\\[0\\.04[0-9]*, 0\\.25\\],\n +\\[-0\\.05[0-9]*, 0\\.05[0-9]*\\]\n +\\]"
      OR NOT c1 MATCHES "\"contrast_weight\": 5,\n  \"contrast\": [0-9.e-]+,\n  \"lateral_weight\": 3,\n  \"lateral\": [0-9]"
      OR NOT c1 MATCHES "\"lateral_error\": [0-9.e-]+,\n      \"lateral_zero\": [0-9]"
      OR NOT out MATCHES "\n  areal_density +0\\.[0-9]+\n  arm_lateral +-?0\\.[0-9]+\n"

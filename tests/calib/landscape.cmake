@@ -25,9 +25,31 @@ endif()
 execute_process(COMMAND ${BENCH} --calibration ${CAL} --data ${WORK}/study --scales 0.01 --samples 1 --threads 2
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT rc EQUAL 0
+   OR NOT out MATCHES "note: the file records no boxes \\(written before session 40\\): the steps use the default boxes"
+   OR NOT out MATCHES "\n  friction +[0-9.]+ in \\[0, 2\\]\n"
    OR NOT out MATCHES "s4-good-3          L 0\\.2337 \\(recorded 0\\.2337, the same bits\\)"
    OR NOT out MATCHES "s4-miss-2          L 0\\.2341 \\(recorded 0\\.2341, the same bits\\)"
    OR NOT out MATCHES "\n0\\.01      s4-miss-2 +[0-9.]+ +[0-9.]+ +[0-9.]+ +[0-9.]+   [01] of 1\n"
    OR NOT out MATCHES "\n0\\.01      combined +[0-9.]+ +[0-9.]+ +[0-9.]+ +0\\.0000   [01] of 1 below the file's 0\\.2809\n")
   message(FATAL_ERROR "bench_calib_landscape on participant 4 (${rc}):\n${out}\n${err}")
+endif()
+# A calibration with its own boxes (a bounds file; one generation of 4 on the coarse gown, about
+# 20 s): the bench steps within the recorded boxes, not the defaults, and still reproduces the
+# file's point to the bit.
+file(WRITE ${WORK}/bounds.txt "friction 0.1 1.5\narm_offset -0.03 0.03\n")
+execute_process(COMMAND ${DG} calibrate --data ${WORK}/study --participant 4 --out ${WORK}/c.json --gown coarse
+                        --generations 1 --population 4 --threads 2 --seed 1 --bounds ${WORK}/bounds.txt
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "calibrate with a bounds file (${rc}):\n${out}\n${err}")
+endif()
+execute_process(COMMAND ${BENCH} --calibration ${WORK}/c.json --data ${WORK}/study --scales 0.01 --samples 1
+                        --threads 2
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR out MATCHES "records no boxes"
+   OR NOT out MATCHES "\n  friction +[0-9.]+ in \\[0\\.1, 1\\.5\\]\n"
+   OR NOT out MATCHES "\n  arm_offset_high +-?[0-9.e-]+ in \\[-0\\.03, 0\\.03\\]\n"
+   OR NOT out MATCHES "\n  stretch +[0-9.e-]+ in \\[0, 1\\]\n"
+   OR NOT out MATCHES "s4-miss-2 +L [0-9.]+ \\(recorded [0-9.]+, the same bits\\)")
+  message(FATAL_ERROR "bench_calib_landscape on a calibration with its own boxes (${rc}):\n${out}\n${err}")
 endif()

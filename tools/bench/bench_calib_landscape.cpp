@@ -7,7 +7,8 @@
 // The file's point is simulated again on the sequences it was fitted to (the baseline of the run:
 // it must give the recorded L of each sequence, to the bit). Then, for each scale s, `samples`
 // points around it: every parameter the calibration searched (its provenance names them) moved by
-// s times its box's width (default_bounds) times a standard normal draw, clamped to the box.
+// s times its box's width (the file's recorded box, else default_bounds) times a standard normal
+// draw, clamped to the box.
 // The draws are the same at every scale (common random numbers), so the scales differ in the step
 // alone. Prints, per scale and sequence, the min / median / max of L, how many points keep every
 // sequence at L <= 0.3 (issue 4), and the combined objective (the file's --combine) against the
@@ -20,6 +21,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -39,40 +41,38 @@ namespace {
 // One searched parameter: where it lives in (cloth, offsets) and its box.
 struct Searched {
   std::string name;
-  enum class Kind { Cloth, Person, Offset } kind;
-  int index;  // kClothParamNames, kPersonParamInfo or ArmHeight
+  ParamRef ref;
   ParamBound box;
 };
 
-std::vector<Searched> searched_parameters(const Calibration& cal) {
-  const Bounds b = default_bounds();
-  std::vector<Searched> out;
+// The searched parameters the file's provenance names, each with the box the search worked in:
+// the provenance's "boxes" where the file records them (calibrate, since session 40), else the
+// default box (the files before it; a bounds file's boxes were not recorded then, said below).
+std::vector<Searched> searched_parameters(const Calibration& cal, bool& default_boxes) {
   if (!cal.provenance.has("parameters")) throw std::runtime_error("the calibration file names no searched parameters");
-  for (const Json& j : cal.provenance.at("parameters").items()) {
-    const std::string& n = j.string();
-    bool found = false;
-    for (int i = 0; i < kClothParams && !found; ++i)
-      if (n == kClothParamNames[i]) out.push_back({n, Searched::Kind::Cloth, i, b.cloth[i]}), found = true;
-    for (int i = 0; i < kPersonParams && !found; ++i)
-      if (n == kPersonParamInfo[i].name) out.push_back({n, Searched::Kind::Person, i, b.person[i]}), found = true;
-    for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low})
-      if (!found && n == "arm_offset_" + std::string(arm_height_name(h)))
-        out.push_back({n, Searched::Kind::Offset, static_cast<int>(h), b.arm_offset}), found = true;
-    if (!found) throw std::runtime_error("unknown searched parameter '" + n + "' in the calibration file");
+  const std::vector<Json>& names = cal.provenance.at("parameters").items();
+  default_boxes = !cal.provenance.has("boxes");
+  if (!default_boxes && cal.provenance.at("boxes").items().size() != names.size())
+    throw std::runtime_error("the calibration file's provenance has " +
+                             std::to_string(cal.provenance.at("boxes").items().size()) + " boxes for " +
+                             std::to_string(names.size()) + " parameters");
+  const Bounds defaults = default_bounds();
+  std::vector<Searched> out;
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    const std::string& n = names[k].string();
+    const std::optional<ParamRef> ref = find_param(n);
+    if (!ref) throw std::runtime_error("unknown searched parameter '" + n + "' in the calibration file");
+    ParamBound box = box_of(defaults, *ref);
+    if (!default_boxes) {
+      const std::vector<Json>& ends = cal.provenance.at("boxes").items()[k].items();
+      if (ends.size() != 2 || !(ends[0].number() < ends[1].number()))
+        throw std::runtime_error("the calibration file's box of " + n + " is not [lower, upper] with lower < upper");
+      box.lower = ends[0].number();
+      box.upper = ends[1].number();
+    }
+    out.push_back({n, *ref, box});
   }
   return out;
-}
-
-double value_of(const Searched& p, const ClothValues& c, const std::array<double, 3>& off) {
-  if (p.kind == Searched::Kind::Cloth) return cloth_value(c, p.index);
-  if (p.kind == Searched::Kind::Person) return person_value(c, p.index);
-  return off[p.index];
-}
-
-void set_value(const Searched& p, ClothValues& c, std::array<double, 3>& off, double v) {
-  if (p.kind == Searched::Kind::Cloth) set_cloth_value(c, p.index, v);
-  else if (p.kind == Searched::Kind::Person) set_person_value(c, p.index, v);
-  else off[p.index] = v;
 }
 
 double median(std::vector<double> v) {
@@ -113,9 +113,12 @@ int run(int argc, char** argv) {
   std::vector<std::string> ids;
   for (const SequenceFit& f : cal.fits) ids.push_back(f.trial_id);
   const std::vector<HapticSequence> inputs = inputs_by_id(load_dataset(data), cal.participant, ids);
-  const std::vector<Searched> params = searched_parameters(cal);
+  bool default_boxes = false;
+  const std::vector<Searched> params = searched_parameters(cal, default_boxes);
   const auto combine = parse_combine(cal.combine);
   if (!combine) throw std::runtime_error("unknown combine '" + cal.combine + "' in the calibration file");
+  if (default_boxes)
+    std::printf("note: the file records no boxes (written before session 40): the steps use the default boxes\n");
   if (cal.contrast_weight > 0 || cal.lateral_weight > 0)
     std::printf("note: the file's contrast / lateral terms are left out of the combined L below\n");
   const ClothSimulator sim = make_cloth_simulator(cal.gown);
@@ -134,6 +137,9 @@ int run(int argc, char** argv) {
   std::printf("bench_calib_landscape: participant %s, %d sequences, %d searched parameters, %d scale(s) x %d "
               "points, %d thread(s), gown %s\n", cal.participant.c_str(), K, P, S, samples, thread_count(threads),
               cal.gown.c_str());
+  for (const Searched& p : params)
+    std::printf("  %-16s %10.6g in [%g, %g]\n", p.name.c_str(), param_value(p.ref, cal.cloth, cal.offsets),
+                p.box.lower, p.box.upper);
   const auto t0 = std::chrono::steady_clock::now();
   const std::vector<double> L = run_batch(tasks, K, threads, Comm::world(), [&](int t, double* out) {
     ClothValues c = cal.cloth;
@@ -142,10 +148,10 @@ int run(int argc, char** argv) {
       const int s = (t - 1) / samples, i = (t - 1) % samples;
       for (int p = 0; p < P; ++p) {
         const ParamBound& box = params[p].box;
-        const double v0 = value_of(params[p], cal.cloth, cal.offsets);
+        const double v0 = param_value(params[p].ref, cal.cloth, cal.offsets);
         const double lo = std::min(box.lower, v0), hi = std::max(box.upper, v0);
         const double v = v0 + scales[s] * (box.upper - box.lower) * z[static_cast<std::size_t>(i) * P + p];
-        set_value(params[p], c, off, std::clamp(v, lo, hi));
+        set_param_value(params[p].ref, c, off, std::clamp(v, lo, hi));
       }
     }
     const std::vector<SimulatedTrial> sts = simulate_inputs(sim.trials, c, off, inputs);
