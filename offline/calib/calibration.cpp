@@ -9,6 +9,7 @@
 #include <limits>
 #include <map>
 #include <sstream>
+#include <utility>
 
 #include "cmaes.h"
 #include "files.h"
@@ -106,22 +107,21 @@ Bounds read_bounds(const std::filesystem::path& path) {
     if (row >> extra) throw_input_error(path, n, "unexpected '" + extra + "' after the bounds of " + name);
     if (pb.initial < pb.lower || pb.initial > pb.upper)
       throw_input_error(path, n, "initial value of " + name + " is outside its bounds");
-    ParamBound* target = nullptr;
-    for (int i = 0; i < kClothParams; ++i)
-      if (name == kClothParamNames[i]) target = &b.cloth[i];
-    if (name == "arm_offset") target = &b.arm_offset;
-    for (int i = 0; i < kPersonParams; ++i)
-      if (name == kPersonParamInfo[i].name) {
-        if (pb.lower < kPersonParamInfo[i].lowest || pb.upper > kPersonParamInfo[i].highest)
-          throw_input_error(path, n, name + " " + kPersonParamInfo[i].range);
-        target = &b.person[i];
-      }
-    if (!target) {
+    // The heights share one box, spelt "arm_offset" here (find_param knows only each height's).
+    const std::optional<ParamRef> ref =
+        name == "arm_offset" ? std::optional<ParamRef>(ParamRef{ParamRef::Kind::Offset, 0}) : find_param(name);
+    if (ref && ref->kind == ParamRef::Kind::Offset && name != "arm_offset")
+      throw_input_error(path, n, "the heights' offsets share one box: name it arm_offset, not " + name);
+    if (!ref) {
       std::string known = "stretch, shear, bend, friction, self_friction, arm_offset";
       for (const PersonParamInfo& info : kPersonParamInfo) known += std::string(", ") + info.name;
       throw_input_error(path, n, "unknown parameter '" + name + "' (expected " + known + ")");
     }
-    *target = pb;
+    if (ref->kind == ParamRef::Kind::Person) {
+      const PersonParamInfo& info = kPersonParamInfo[ref->index];
+      if (pb.lower < info.lowest || pb.upper > info.highest) throw_input_error(path, n, name + " " + info.range);
+    }
+    box_of(b, *ref) = pb;
   }
   return b;
 }
@@ -209,6 +209,10 @@ const ParamBound& box_of(const Bounds& b, const ParamRef& p) {
     case ParamRef::Kind::Offset: break;
   }
   return b.arm_offset;  // the heights share one box
+}
+
+ParamBound& box_of(Bounds& b, const ParamRef& p) {
+  return const_cast<ParamBound&>(box_of(std::as_const(b), p));  // one switch for both
 }
 
 bool set_person_param(ParameterSpace& space, int i, const std::string& word) {

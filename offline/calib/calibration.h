@@ -231,6 +231,7 @@ std::optional<ParamRef> find_param(std::string_view name);  // nullopt: not a pa
 double param_value(const ParamRef& p, const ClothValues& c, const std::array<double, 3>& offsets);
 void set_param_value(const ParamRef& p, ClothValues& c, std::array<double, 3>& offsets, double v);
 const ParamBound& box_of(const Bounds& b, const ParamRef& p);
+ParamBound& box_of(Bounds& b, const ParamRef& p);  // read_bounds fills a box through it
 
 // Person parameter i of `space` from a command line's word: "fit" (search bounds.person[i]),
 // "fixed" (kPersonParamInfo[i].paper), or a value held during the search. False when the word is

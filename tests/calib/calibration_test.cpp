@@ -528,6 +528,7 @@ TEST(Calibration, BoundsFileParsesAndNamesBadLines) {
   EXPECT_EQ(b.cloth[3].lower, 0.1);
   EXPECT_EQ(b.cloth[3].upper, 1.5);
   EXPECT_EQ(b.cloth[3].initial, 0.6);
+  EXPECT_EQ(b.arm_offset.lower, -0.03);
   EXPECT_EQ(b.arm_offset.initial, 0.0);           // midpoint when not given
   EXPECT_EQ(b.cloth[0].upper, default_bounds().cloth[0].upper);  // untouched default
   auto error_of = [&](const std::string& text) {
@@ -547,6 +548,9 @@ TEST(Calibration, BoundsFileParsesAndNamesBadLines) {
             std::string::npos);
   EXPECT_NE(error_of("stretch 0 1\nfist_shift 0 0.3\n").find("bad.txt:2: fist_shift must be within"), std::string::npos);
   EXPECT_NE(error_of("rim_shift -0.05 0.03\n").find("bad.txt:1: rim_shift must be within"), std::string::npos);
+  // One box for every height's offset: a height's own name would look accepted and be ignored.
+  EXPECT_NE(error_of("stretch 0 1\narm_offset_low -0.02 0.02\n").find("bad.txt:2: the heights' offsets share one box"),
+            std::string::npos);
   fs::remove_all(dir);
 }
 
