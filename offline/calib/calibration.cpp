@@ -107,11 +107,13 @@ Bounds read_bounds(const std::filesystem::path& path) {
     if (row >> extra) throw_input_error(path, n, "unexpected '" + extra + "' after the bounds of " + name);
     if (pb.initial < pb.lower || pb.initial > pb.upper)
       throw_input_error(path, n, "initial value of " + name + " is outside its bounds");
-    // The heights share one box, spelt "arm_offset" here (find_param knows only each height's).
-    const std::optional<ParamRef> ref =
-        name == "arm_offset" ? std::optional<ParamRef>(ParamRef{ParamRef::Kind::Offset, 0}) : find_param(name);
-    if (ref && ref->kind == ParamRef::Kind::Offset && name != "arm_offset")
-      throw_input_error(path, n, "the heights' offsets share one box: name it arm_offset, not " + name);
+    // The heights share one box, named "arm_offset" here; find_param knows each height's name.
+    std::optional<ParamRef> ref = ParamRef{ParamRef::Kind::Offset, 0};
+    if (name != "arm_offset") {
+      ref = find_param(name);
+      if (ref && ref->kind == ParamRef::Kind::Offset)
+        throw_input_error(path, n, "the heights' offsets share one box: name it arm_offset, not " + name);
+    }
     if (!ref) {
       std::string known = "stretch, shear, bend, friction, self_friction, arm_offset";
       for (const PersonParamInfo& info : kPersonParamInfo) known += std::string(", ") + info.name;
