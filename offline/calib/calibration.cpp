@@ -123,6 +123,10 @@ Bounds read_bounds(const std::filesystem::path& path) {
       const PersonParamInfo& info = kPersonParamInfo[ref->index];
       if (pb.lower < info.lowest || pb.upper > info.highest) throw_input_error(path, n, name + " " + info.range);
     }
+    if (ref->kind == ParamRef::Kind::Cloth) {
+      const ClothParamLimits& lim = kClothParamLimits[ref->index];
+      if (pb.lower < lim.lowest || pb.upper > lim.highest) throw_input_error(path, n, name + " " + lim.range);
+    }
     box_of(b, *ref) = pb;
   }
   return b;

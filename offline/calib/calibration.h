@@ -75,6 +75,21 @@ inline bool hem_in_range(double width, double ratio) {
 }
 inline constexpr std::array<const char*, kClothParams> kClothParamNames = {"stretch", "shear", "bend", "friction",
                                                                            "self_friction"};
+// The simulator's limits of each cloth value (sim/trial.h and sim/params.cpp check the same): the
+// stiffnesses are positions on their compliance scales, which the simulator clamps to [0, 1], so a
+// box beyond would search a flat objective; a friction coefficient is not negative. read_bounds
+// refuses a box past them.
+struct ClothParamLimits {
+  double lowest, highest;
+  const char* range;
+};
+inline constexpr std::array<ClothParamLimits, kClothParams> kClothParamLimits = {{
+    {0.0, 1.0, "must be within [0, 1] (a position on its compliance scale; the simulator clamps beyond)"},
+    {0.0, 1.0, "must be within [0, 1] (a position on its compliance scale; the simulator clamps beyond)"},
+    {0.0, 1.0, "must be within [0, 1] (a position on its compliance scale; the simulator clamps beyond)"},
+    {0.0, std::numeric_limits<double>::infinity(), "cannot be negative"},
+    {0.0, std::numeric_limits<double>::infinity(), "cannot be negative"},
+}};
 double cloth_value(const ClothValues& c, int i);
 void set_cloth_value(ClothValues& c, int i, double v);
 

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <string>
+#include <utility>
 
 #include "files.h"
 #include "model.h"
@@ -61,6 +63,11 @@ ClothParams parse_params(const std::string& text, const std::filesystem::path& f
       *f = v;
     }
   }
+  for (const auto& [name, k] : {std::pair{"stretch", p.stretch}, {"shear", p.shear}, {"bend", p.bend}})
+    if (!(k >= kStiffnessLowest && k <= kStiffnessHighest))
+      throw_input_error(file, 0, std::string(name) + " must be within [0, 1] (a position on its compliance scale, sim/trial.h)");
+  if (p.friction < 0) throw_input_error(file, 0, "friction must not be negative");
+  if (p.self_friction < 0) throw_input_error(file, 0, "self_friction must not be negative");
   if (p.areal_density <= 0) throw_input_error(file, 0, "areal_density must be positive");
   if (p.arm_compliance < 0) throw_input_error(file, 0, "arm_compliance must be 0 (a fixed arm) or positive");
   if (!(std::abs(p.fist_shift) <= kMaxFistShift))

@@ -124,6 +124,10 @@ inline constexpr double kMaxSupportDepth = 1.5, kMaxSupportLateral = 0.3;
 inline constexpr double kMaxFistShift = 0.2;
 // |arm_lateral| beyond this puts the fist (radius 5 cm) beside a 16 cm opening, not in front of it.
 inline constexpr double kMaxArmLateral = 0.1;  // and |fist_lateral|
+// stretch, shear and bend are positions on their compliance scales, [0, 1] (compliance_of() clamps
+// beyond, so a value outside would silently act as its end); friction and self_friction are
+// coefficients, not negative.
+inline constexpr double kStiffnessLowest = 0.0, kStiffnessHighest = 1.0;
 // A cuff's limits: width [m] and how much stiffer than the fabric it may be.
 inline constexpr double kMaxHemWidth = 0.2, kMaxHemBendRatio = 1e4;
 

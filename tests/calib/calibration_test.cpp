@@ -548,6 +548,14 @@ TEST(Calibration, BoundsFileParsesAndNamesBadLines) {
             std::string::npos);
   EXPECT_NE(error_of("stretch 0 1\nfist_shift 0 0.3\n").find("bad.txt:2: fist_shift must be within"), std::string::npos);
   EXPECT_NE(error_of("rim_shift -0.05 0.03\n").find("bad.txt:1: rim_shift must be within"), std::string::npos);
+  // A stiffness box past the simulator's compliance scale would search a flat objective (the
+  // simulator clamps to [0, 1]); a friction coefficient below 0 has no meaning.
+  EXPECT_NE(error_of("shear 0 1\nstretch -0.5 1 0.01\n").find("bad.txt:2: stretch must be within [0, 1]"),
+            std::string::npos);
+  EXPECT_NE(error_of("bend 0.2 1.2\n").find("bad.txt:1: bend must be within [0, 1]"), std::string::npos);
+  EXPECT_NE(error_of("self_friction -0.1 2\n").find("bad.txt:1: self_friction cannot be negative"),
+            std::string::npos);
+  EXPECT_EQ(error_of("friction 0 5 0.5\n"), "");  // a coefficient has no upper limit
   // One box for every height's offset: a height's own name would look accepted and be ignored.
   EXPECT_NE(error_of("stretch 0 1\narm_offset_low -0.02 0.02\n").find("bad.txt:2: the heights' offsets share one box"),
             std::string::npos);

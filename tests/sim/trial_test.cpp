@@ -172,6 +172,13 @@ TEST(SimParams, ParseFormats) {
   EXPECT_THROW(parse_params("support_depth 1.6\n", "p.txt"), InputError);  // beyond kMaxSupportDepth
   EXPECT_THROW(parse_params("support_depth -0.1\n", "p.txt"), InputError);
   EXPECT_THROW(parse_params("support_lateral 0.4\n", "p.txt"), InputError);  // beyond kMaxSupportLateral
+  // A stiffness is a position on its compliance scale: beyond [0, 1] compliance_of() would clamp it
+  // and the file's value would not be the one simulated.
+  EXPECT_EQ(parse_params("stretch 0\nshear 1\nbend 0\n", "x").shear, 1.0);
+  EXPECT_THROW(parse_params("stretch -0.1\n", "p.txt"), InputError);
+  EXPECT_THROW(parse_params("bend 1.2\n", "p.txt"), InputError);
+  EXPECT_THROW(parse_params("friction -0.2\n", "p.txt"), InputError);
+  EXPECT_THROW(parse_params("self_friction -0.2\n", "p.txt"), InputError);
   try {
     parse_params("friction 0.3\nbend x\n", "p.txt");
     FAIL();
