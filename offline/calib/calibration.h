@@ -83,13 +83,12 @@ struct ClothParamLimits {
   double lowest, highest;
   const char* range;
 };
-inline constexpr std::array<ClothParamLimits, kClothParams> kClothParamLimits = {{
-    {0.0, 1.0, "must be within [0, 1] (a position on its compliance scale; the simulator clamps beyond)"},
-    {0.0, 1.0, "must be within [0, 1] (a position on its compliance scale; the simulator clamps beyond)"},
-    {0.0, 1.0, "must be within [0, 1] (a position on its compliance scale; the simulator clamps beyond)"},
-    {0.0, std::numeric_limits<double>::infinity(), "cannot be negative"},
-    {0.0, std::numeric_limits<double>::infinity(), "cannot be negative"},
-}};
+inline constexpr ClothParamLimits kStiffnessLimits = {
+    0.0, 1.0, "must be within [0, 1] (a position on its compliance scale; the simulator clamps beyond)"};
+inline constexpr ClothParamLimits kFrictionLimits = {0.0, std::numeric_limits<double>::infinity(),
+                                                     "cannot be negative"};
+inline constexpr std::array<ClothParamLimits, kClothParams> kClothParamLimits = {
+    kStiffnessLimits, kStiffnessLimits, kStiffnessLimits, kFrictionLimits, kFrictionLimits};
 double cloth_value(const ClothValues& c, int i);
 void set_cloth_value(ClothValues& c, int i, double v);
 
