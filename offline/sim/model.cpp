@@ -261,7 +261,7 @@ Scene make_scene(const ClothMesh& mesh, const SceneOptions& opt) {
 }
 
 double compliance_of(double k, double alpha_soft, double alpha_stiff) {
-  k = std::clamp(k, 0.0, 1.0);
+  k = std::clamp(k, kStiffnessLowest, kStiffnessHighest);  // params.cpp refuses a file beyond them
   return std::exp(std::log(alpha_soft) + k * (std::log(alpha_stiff) - std::log(alpha_soft)));
 }
 
