@@ -692,4 +692,24 @@ Evaluation evaluate_vote(const std::vector<const model::OutcomeModel*>& models,
   return ev;
 }
 
+AccuracyInterval wilson_interval(int right, int n, double z) {
+  if (n <= 0 || right < 0 || right > n) throw std::invalid_argument("wilson_interval: need 0 <= right <= n, n > 0");
+  const double k = right, N = n, z2 = z * z;
+  const double centre = (k + z2 / 2) / (N + z2);
+  const double half = z * std::sqrt(k * (N - k) / N + z2 / 4) / (N + z2);
+  return {std::max(0.0, centre - half), std::min(1.0, centre + half)};
+}
+
+double mcnemar_exact_p(int only_first, int only_second) {
+  if (only_first < 0 || only_second < 0) throw std::invalid_argument("mcnemar_exact_p: counts cannot be negative");
+  const int n = only_first + only_second, m = std::min(only_first, only_second);
+  if (n == 0) return 1.0;
+  // sum_{i<=m} C(n, i) / 2^n in logs (lgamma), so that n in the thousands neither overflows nor
+  // underflows term by term.
+  double tail = 0;
+  for (int i = 0; i <= m; ++i)
+    tail += std::exp(std::lgamma(n + 1.0) - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0) - n * std::log(2.0));
+  return std::min(1.0, 2 * tail);
+}
+
 }  // namespace dressguard::hmm

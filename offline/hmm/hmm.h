@@ -202,4 +202,32 @@ Evaluation evaluate_vote(const std::vector<const model::OutcomeModel*>& models,
                          double truncate_at = std::numeric_limits<double>::infinity(),
                          std::vector<Vote>* per_trial = nullptr, const ClassChoice& among = {});
 
+// ---- two classifiers on the same trials ------------------------------------------------------
+
+// How sure a measured accuracy is: the Wilson score interval (Wilson 1927) of `right` out of `n`
+// trials at the normal quantile z (1.96: 95 %),
+//
+//   centre = (k + z^2 / 2) / (n + z^2),   half = z sqrt(k (n - k) / n + z^2 / 4) / (n + z^2),
+//
+// which stays inside [0, 1] and keeps its coverage near 0 % and 100 %, where the textbook
+// p +- z sqrt(p (1 - p) / n) does not (Brown, Cai and DasGupta 2001). The study's 22 trials give
+// 16 of 22 (73 %) an interval of [52, 87] %: a few trials either way are inside it.
+struct AccuracyInterval {
+  double lower = 0, upper = 1;
+};
+AccuracyInterval wilson_interval(int right, int n, double z = 1.959963984540054);
+
+// Whether two classifiers scored on the same trials differ: McNemar's test in its exact form
+// (McNemar 1947; Dietterich 1998 for classifiers). Only the trials on which exactly one of them
+// is right count: `only_first` of them the first got right, `only_second` the second. If both
+// were equally good, each such trial would go either way with probability 1/2, so with
+// n = b + c discordant trials and m = min(b, c) the two-sided p-value is
+//
+//   p = min(1, 2 sum_{i=0}^{m} C(n, i) / 2^n),
+//
+// and 1 when n = 0. Why not two accuracies side by side: the trials both classifiers get right
+// or both get wrong say nothing about which is better, and on 22 trials a difference of two
+// trials is as likely as not (b = 2, c = 4: p = 0.69).
+double mcnemar_exact_p(int only_first, int only_second);
+
 }  // namespace dressguard::hmm

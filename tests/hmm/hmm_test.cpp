@@ -2,9 +2,11 @@
 // computed by enumeration or closed form, and "sample from known parameters, retrain, recover".
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <stdexcept>
 
 #include "fixtures.h"
 #include "hmm.h"
@@ -511,4 +513,56 @@ TEST(HmmTrain, Deterministic) {
   const auto b = hmm::train(data, opt);
   EXPECT_EQ(a.log_likelihood, b.log_likelihood);
   EXPECT_EQ(a.hmm.transition, b.hmm.transition);
+}
+
+// ---- two classifiers on the same trials -------------------------------------------------------
+
+// The exact McNemar p-value against sums worked by hand: only the discordant trials count, each a
+// fair coin under the null hypothesis (hmm.h).
+TEST(HmmCompare, McNemarExactMatchesTheBinomialTail) {
+  EXPECT_DOUBLE_EQ(hmm::mcnemar_exact_p(0, 0), 1.0);                // nothing to tell them apart
+  EXPECT_DOUBLE_EQ(hmm::mcnemar_exact_p(3, 3), 1.0);                // 2 x (42/64) capped at 1
+  EXPECT_NEAR(hmm::mcnemar_exact_p(0, 5), 2.0 / 32, 1e-15);         // 2 x C(5,0) / 2^5
+  EXPECT_NEAR(hmm::mcnemar_exact_p(1, 6), 2.0 * 8 / 128, 1e-15);    // 2 x (1 + 7) / 2^7
+  EXPECT_NEAR(hmm::mcnemar_exact_p(2, 4), 2.0 * 22 / 64, 1e-15);    // 2 x (1 + 6 + 15) / 2^6
+  EXPECT_DOUBLE_EQ(hmm::mcnemar_exact_p(6, 1), hmm::mcnemar_exact_p(1, 6));  // two-sided: symmetric
+  // Against the same tail summed in integers, every split of n = 20.
+  for (int b = 0; b <= 20; ++b) {
+    long long tail = 0, c_ni = 1;  // C(20, i), built up term by term
+    for (int i = 0; i <= std::min(b, 20 - b); ++i) {
+      tail += c_ni;
+      c_ni = c_ni * (20 - i) / (i + 1);
+    }
+    EXPECT_NEAR(hmm::mcnemar_exact_p(b, 20 - b), std::min(1.0, 2.0 * tail / 1048576.0), 1e-12) << "b = " << b;
+  }
+  // Thousands of discordant trials neither overflow nor underflow to 0 (logs, hmm.cpp).
+  EXPECT_GT(hmm::mcnemar_exact_p(0, 1000), 0.0);
+  EXPECT_LT(hmm::mcnemar_exact_p(0, 1000), 1e-300);
+  EXPECT_DOUBLE_EQ(hmm::mcnemar_exact_p(500, 500), 1.0);
+  EXPECT_THROW(hmm::mcnemar_exact_p(-1, 2), std::invalid_argument);
+}
+
+// The Wilson interval's closed forms at the ends (k = 0: [0, z^2 / (n + z^2)]) and a value worked
+// by hand for the study's size (16 of 22, hmm.h); mirrored for n - k.
+TEST(HmmCompare, WilsonIntervalClosedForms) {
+  const double z = 1.959963984540054, z2 = z * z;
+  const hmm::AccuracyInterval none = hmm::wilson_interval(0, 10);
+  EXPECT_DOUBLE_EQ(none.lower, 0.0);
+  EXPECT_NEAR(none.upper, z2 / (10 + z2), 1e-15);
+  const hmm::AccuracyInterval all = hmm::wilson_interval(10, 10);
+  EXPECT_NEAR(all.lower, 10 / (10 + z2), 1e-15);
+  EXPECT_DOUBLE_EQ(all.upper, 1.0);
+  const hmm::AccuracyInterval i16 = hmm::wilson_interval(16, 22);
+  EXPECT_NEAR(i16.lower, 0.5185, 1e-4);
+  EXPECT_NEAR(i16.upper, 0.8685, 1e-4);
+  const hmm::AccuracyInterval i6 = hmm::wilson_interval(6, 22);
+  EXPECT_NEAR(i6.lower, 1 - i16.upper, 1e-12);
+  EXPECT_NEAR(i6.upper, 1 - i16.lower, 1e-12);
+  // The textbook interval would leave [0, 1] here; Wilson's does not, and it holds the estimate.
+  const hmm::AccuracyInterval i1 = hmm::wilson_interval(1, 22);
+  EXPECT_GT(i1.lower, 0.0);
+  EXPECT_LT(i1.lower, 1.0 / 22);
+  EXPECT_GT(i1.upper, 1.0 / 22);
+  EXPECT_THROW(hmm::wilson_interval(3, 2), std::invalid_argument);
+  EXPECT_THROW(hmm::wilson_interval(0, 0), std::invalid_argument);
 }

@@ -42,7 +42,10 @@
 //     trials of the people other than its own), beside the baseline classifier BC trained on the
 //     2-3 measured sequences each calibration was fitted to (paper VI-B.1); the vote of the
 //     single STCs of the people other than P (hmm::evaluate_vote) and, for comparison, their
-//     mixture (per class the mean likelihood of the raw forces). Prints the table and
+//     mixture (per class the mean likelihood of the raw forces). The vote and the 1-NN are then
+//     compared trial by trial at each cut: how many trials only one of them gets right, McNemar's
+//     exact p of that split and each accuracy's 95 % Wilson interval (hmm.h), because 22 trials
+//     leave a few trials' difference inside the noise. Prints the table and
 //     each simulator's early cue against the people's and its own person's, writes DIR/pooled.json (plot:
 //     tools/plot/pooled_stc.py). With several seeds, each seed's sets go in its own folder and each
 //     simulator trains on the union (N x seeds per height); the file is DIR1/pooled-S1-S2-....json.
@@ -165,9 +168,10 @@ std::vector<double> curve_features(const HapticSequence& t, double cut, const Nn
   return f;
 }
 
-// Leave-one-participant-out 1-NN (Euclidean on curve_features): the accuracy over all trials.
-double one_nn_accuracy(const std::vector<const HapticSequence*>& all, double cut, const NnForces& use = kPaperForces) {
-  int right = 0;
+// Leave-one-participant-out 1-NN (Euclidean on curve_features): per trial of `all`, in its order,
+// whether the nearest trial of another participant has its label.
+std::vector<char> one_nn_right(const std::vector<const HapticSequence*>& all, double cut, const NnForces& use) {
+  std::vector<char> right;
   for (const auto* q : all) {
     const auto fq = curve_features(*q, cut, use);
     double best = std::numeric_limits<double>::infinity();
@@ -179,9 +183,14 @@ double one_nn_accuracy(const std::vector<const HapticSequence*>& all, double cut
       for (std::size_t i = 0; i < fq.size(); ++i) d += (fq[i] - fr[i]) * (fq[i] - fr[i]);
       if (d < best) best = d, nn = r;
     }
-    right += nn && nn->label == q->label;
+    right.push_back(nn && nn->label == q->label);
   }
-  return static_cast<double>(right) / all.size();
+  return right;
+}
+// Its accuracy over all trials.
+double one_nn_accuracy(const std::vector<const HapticSequence*>& all, double cut, const NnForces& use = kPaperForces) {
+  const std::vector<char> right = one_nn_right(all, cut, use);
+  return static_cast<double>(std::count(right.begin(), right.end(), 1)) / all.size();
 }
 
 // A model's accuracy on `test`, whole and at the four cuts: out[0] whole, out[1..4] kCuts.
@@ -809,6 +818,9 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     std::printf("%s\n", fs_.name);
     Json jset = Json::object();
     jset.set("forces", std::string(fs_.name));
+    // Per trial, whether the plain vote (below) got it right, whole and at each cut: paired with
+    // the 1-NN's answers at the end.
+    std::array<std::map<const HapticSequence*, bool>, 5> vote_right_of;
     // One classifier per calibration, each on the trials of everyone but the calibration's person:
     // its row, and the sums over all of them into `key` (rows) and `key`_accuracy_whole_and_cuts.
     auto per_calibration = [&](const char* key, const char* all_name,
@@ -947,7 +959,11 @@ int run_pooled(const std::map<std::string, std::string>& a) {
         nm += static_cast<int>(test.size());
         for (int c = 0; c < 5; ++c) {
           const double cut = c == 0 ? std::numeric_limits<double>::infinity() : kCuts[c - 1];
-          vote_right[c] += hmm::evaluate_vote(members, test, cut).correct;
+          std::vector<hmm::Vote> votes;
+          vote_right[c] += hmm::evaluate_vote(members, test, cut, &votes).correct;
+          for (std::size_t i = 0; i < test.size(); ++i)
+            vote_right_of[c][test[i]] = votes[i].predicted >= 0 && test[i]->label &&
+                                        votes[i].classes[votes[i].predicted] == outcome_name(*test[i]->label);
           vote2_right[c] += hmm::evaluate_vote(members, test, cut, nullptr, good_or_missed).correct;
           share_right[c] += hmm::evaluate_vote(share_members, test, cut).correct;
           share2_right[c] += hmm::evaluate_vote(share_members, test, cut, nullptr, good_or_missed).correct;
@@ -966,10 +982,63 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       jset.set("mixture_accuracy_whole_and_cuts", pct(mix_right, nm));
     }
     double nn[4];  // the 1-NN compares curves cut at the same travel: scored at the cuts only
-    for (int c = 0; c < 4; ++c) nn[c] = one_nn_accuracy(all, kCuts[c], fs_.nn);
+    std::vector<char> nn_right[4];
+    for (int c = 0; c < 4; ++c) {
+      nn_right[c] = one_nn_right(all, kCuts[c], fs_.nn);
+      nn[c] = static_cast<double>(std::count(nn_right[c].begin(), nn_right[c].end(), 1)) / all.size();
+    }
     std::printf("  %-44s     -", "1-NN on the other people's measured curves");
     for (double v : nn) std::printf(" %4.0f%%", 100.0 * v);
     std::printf("   (%zu trials)\n", all.size());
+    // The vote (the paper's decision rule) against the 1-NN trial by trial (hmm.h: the Wilson
+    // interval of each accuracy, McNemar's exact test of the difference): b trials only the vote
+    // gets right, c only the 1-NN.
+    Json jpaired = Json::array();
+    std::printf("  %-44s     -", "vote vs 1-NN, paired: only vote / only 1-NN");
+    std::array<int, 4> b{}, cc{}, paired_n{}, vote_k{}, nn_k{};
+    for (int c = 0; c < 4; ++c) {
+      for (std::size_t i = 0; i < all.size(); ++i) {
+        const auto it = vote_right_of[c + 1].find(all[i]);
+        if (it == vote_right_of[c + 1].end()) continue;  // not among the vote's trials
+        ++paired_n[c];
+        vote_k[c] += it->second;
+        nn_k[c] += nn_right[c][i];
+        b[c] += it->second && !nn_right[c][i];
+        cc[c] += !it->second && nn_right[c][i];
+      }
+      std::printf("   %d/%d", b[c], cc[c]);
+    }
+    std::printf("\n  %-44s     -", "  McNemar's exact p (two-sided)");
+    for (int c = 0; c < 4; ++c) std::printf(" %5.2f", hmm::mcnemar_exact_p(b[c], cc[c]));
+    auto interval_json = [](const hmm::AccuracyInterval& iv) {
+      Json j = Json::array();
+      j.push(iv.lower);
+      j.push(iv.upper);
+      return j;
+    };
+    std::array<hmm::AccuracyInterval, 4> vote_iv, nn_iv;
+    for (int c = 0; c < 4; ++c)
+      vote_iv[c] = hmm::wilson_interval(vote_k[c], std::max(paired_n[c], 1)),
+      nn_iv[c] = hmm::wilson_interval(nn_k[c], std::max(paired_n[c], 1));
+    std::printf("\n  %-44s     -", "  95 % Wilson interval, vote");
+    for (const auto& iv : vote_iv) std::printf(" %2.0f-%2.0f", 100 * iv.lower, 100 * iv.upper);
+    std::printf("\n  %-44s     -", "  95 % Wilson interval, 1-NN");
+    for (int c = 0; c < 4; ++c) {
+      std::printf(" %2.0f-%2.0f", 100 * nn_iv[c].lower, 100 * nn_iv[c].upper);
+      Json j = Json::object();
+      j.set("cut", kCuts[c]);
+      j.set("trials", paired_n[c]);
+      j.set("vote_right", vote_k[c]);
+      j.set("one_nn_right", nn_k[c]);
+      j.set("only_vote_right", b[c]);
+      j.set("only_one_nn_right", cc[c]);
+      j.set("mcnemar_exact_p", hmm::mcnemar_exact_p(b[c], cc[c]));
+      j.set("vote_interval", interval_json(vote_iv[c]));
+      j.set("one_nn_interval", interval_json(nn_iv[c]));
+      jpaired.push(j);
+    }
+    std::printf("\n");
+    jset.set("vote_against_one_nn_at_cuts", jpaired);
     jset.set("per_participant", jper);
     jset.set("pooled_accuracy_whole_and_cuts", pct(pooled_right, n));
     jset.set("pooled_equal_size_accuracy_whole_and_cuts", pct(equal_right, n));

@@ -8,7 +8,9 @@ people's measured curves.
 
 usage: pooled_stc.py POOLED.json OUT.png
 POOLED.json is what `bench_calib_pipeline pooled` writes (DIR/pooled.json). One panel per force
-set; "whole" is drawn at the right end, after the cuts.
+set; "whole" is drawn at the right end, after the cuts. Where the file pairs the vote with the
+1-NN (since session 43), each cut shows both accuracies' 95 % intervals and, at the bottom, the
+trials only the vote / only the 1-NN got right with McNemar's exact p.
 """
 import json
 import sys
@@ -60,6 +62,19 @@ def main(argv):
                     label="vote, training priors, good or missed")
         ax.plot(CUTS, [100 * a for a in s["one_nn_accuracy_at_cuts"]], color="tab:green", lw=1.5, ls=":", marker="^",
                 ms=5, label="1-NN on other people's curves")
+        # The vote against the 1-NN trial by trial (files since session 43): each accuracy's 95 %
+        # Wilson interval, drawn just left (vote) and right (1-NN) of the cut, and McNemar's exact
+        # p of the trials only one of them gets right.
+        for pair in s.get("vote_against_one_nn_at_cuts", []):
+            x = pair["cut"]
+            for dx, key, right, colour in ((-0.004, "vote_interval", "vote_right", "tab:red"),
+                                           (0.004, "one_nn_interval", "one_nn_right", "tab:green")):
+                lo, hi = (100 * v for v in pair[key])
+                mid = 100 * pair[right] / pair["trials"]
+                ax.errorbar([x + dx], [mid], yerr=[[mid - lo], [hi - mid]], color=colour, lw=1, capsize=2,
+                            fmt="none")
+            ax.annotate(f"{pair['only_vote_right']}/{pair['only_one_nn_right']}\np {pair['mcnemar_exact_p']:.2f}",
+                        (x, 3), ha="center", fontsize=7, color="0.3")
         ax.set_title(s["forces"], fontsize=10)
         ax.set_xticks(xs)
         ax.set_xticklabels([f"{c:.2f}" for c in CUTS] + ["whole"])
