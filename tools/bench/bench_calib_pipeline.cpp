@@ -996,13 +996,17 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     Json jpaired = Json::array();
     std::printf("  %-44s     -", "vote vs 1-NN, paired: only vote / only 1-NN");
     std::array<int, 4> b{}, cc{}, paired_n{}, vote_k{}, nn_k{};
+    std::array<Json, 4> vote_ids, nn_ids;  // which trials each got right: pairs another run's vote
     for (int c = 0; c < 4; ++c) {
+      vote_ids[c] = Json::array(), nn_ids[c] = Json::array();
       for (std::size_t i = 0; i < all.size(); ++i) {
         const auto it = vote_right_of[c + 1].find(all[i]);
         if (it == vote_right_of[c + 1].end()) continue;  // not among the vote's trials
         ++paired_n[c];
         vote_k[c] += it->second;
         nn_k[c] += nn_right[c][i];
+        if (it->second) vote_ids[c].push(all[i]->id);
+        if (nn_right[c][i]) nn_ids[c].push(all[i]->id);
         b[c] += it->second && !nn_right[c][i];
         cc[c] += !it->second && nn_right[c][i];
       }
@@ -1035,6 +1039,8 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       j.set("mcnemar_exact_p", hmm::mcnemar_exact_p(b[c], cc[c]));
       j.set("vote_interval", interval_json(vote_iv[c]));
       j.set("one_nn_interval", interval_json(nn_iv[c]));
+      j.set("vote_right_trials", vote_ids[c]);
+      j.set("one_nn_right_trials", nn_ids[c]);
       jpaired.push(j);
     }
     std::printf("\n");
