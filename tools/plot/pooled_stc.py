@@ -85,6 +85,9 @@ def main(argv):
     axes[0][0].set_ylabel("measured trials classified right [%]")
     handles, labels = axes[0][0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, frameon=False)
+    if any("vote_against_one_nn_at_cuts" in s for s in sets):
+        fig.text(0.01, 0.01, "bars: 95 % Wilson intervals of the vote (left) and the 1-NN (right); numbers at the "
+                 "bottom: trials only the vote / only the 1-NN got right, McNemar's exact p", fontsize=7, color="0.3")
     n = len(d["sources"])
     term = ", each simulator's own error added (--discrepancy)" if d.get("discrepancy") else ""
     # The noise models are on unless the file says otherwise (files from before session 27 do not).
