@@ -65,11 +65,20 @@ std::filesystem::path find_plot_script() {
   return {};
 }
 
-// The accuracy line and the confusion matrix.
+// The accuracy line (with its 95 % Wilson interval: on the study's 22 trials a few trials either
+// way are noise, hmm.h) and the confusion matrix.
 void print_summary(const hmm::Evaluation& ev, size_t models) {
-  std::printf("\naccuracy %.4f (%d/%d)%s%s\n", ev.accuracy(), ev.correct, ev.total,
+  std::string interval;
+  if (ev.total > 0) {
+    const hmm::AccuracyInterval iv = hmm::wilson_interval(ev.correct, ev.total);
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "; 95 %% interval %.2f-%.2f", iv.lower, iv.upper);
+    interval = buf;
+  }
+  std::printf("\naccuracy %.4f (%d/%d)%s%s%s\n", ev.accuracy(), ev.correct, ev.total,
               models > 1 ? (", a vote of " + std::to_string(models) + " models").c_str() : "",
-              ev.skipped ? (", " + std::to_string(ev.skipped) + " trials skipped (unlabelled, label not in the model, or empty)").c_str() : "");
+              ev.skipped ? (", " + std::to_string(ev.skipped) + " trials skipped (unlabelled, label not in the model, or empty)").c_str() : "",
+              interval.c_str());
   std::printf("%s", hmm::confusion_text(ev).c_str());
 }
 

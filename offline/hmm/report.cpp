@@ -104,7 +104,12 @@ std::string evaluation_json(const Evaluation& ev) {
     o << (r ? ", " : "")
       << json_array(ev.confusion[r].begin(), ev.confusion[r].end(), [](int v) { return std::to_string(v); });
   o << "], \"correct\": " << ev.correct << ", \"total\": " << ev.total << ", \"skipped\": " << ev.skipped
-    << ", \"accuracy\": " << json_number(ev.accuracy()) << "}";
+    << ", \"accuracy\": " << json_number(ev.accuracy());
+  if (ev.total > 0) {  // how sure that accuracy is on this many trials (hmm.h, wilson_interval)
+    const AccuracyInterval iv = wilson_interval(ev.correct, ev.total);
+    o << ", \"accuracy_interval\": [" << json_number(iv.lower) << ", " << json_number(iv.upper) << "]";
+  }
+  o << "}";
   return o.str();
 }
 

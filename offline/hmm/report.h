@@ -18,7 +18,9 @@ std::string json_number(double v);
 std::string model_json(const model::OutcomeModel& m);
 // The confusion matrix as aligned text, rows = truth, columns = predicted.
 std::string confusion_text(const Evaluation& ev);
-// {"classes": [...], "confusion": [[...]], "correct": n, "total": n, "skipped": n, "accuracy": x}
+// {"classes": [...], "confusion": [[...]], "correct": n, "total": n, "skipped": n, "accuracy": x,
+//  "accuracy_interval": [lower, upper]} (the 95 % Wilson interval, wilson_interval; left out when
+// no trial was scored)
 std::string evaluation_json(const Evaluation& ev);
 
 }  // namespace dressguard::hmm

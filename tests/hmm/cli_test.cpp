@@ -83,6 +83,9 @@ TEST_F(CliTest, TrainClassifyShowOnSyntheticData) {
   const auto text = run("classify --model " + (dir / "m.dgm").string() + " --data " + (dir / "test").string());
   ASSERT_EQ(text.code, 0);
   EXPECT_NE(text.out.find("accuracy 1.0000 (18/18)"), std::string::npos) << text.out;
+  // 18 of 18 is not certainty: the Wilson interval's lower end is 18 / (18 + 1.96^2) = 0.824.
+  EXPECT_NE(text.out.find("; 95 % interval 0.82-1.00"), std::string::npos) << text.out;
+  EXPECT_NE(cl.out.find("\"accuracy_interval\": [0.824"), std::string::npos) << cl.out;
   EXPECT_NE(text.out.find("truth \\ pred"), std::string::npos);
   // Cut at 2 cm (20 samples) every trial is still classified, with fewer samples.
   const auto cut = run("classify --model " + (dir / "m.dgm").string() + " --data " + (dir / "test").string() +
