@@ -82,6 +82,47 @@ void print_summary(const hmm::Evaluation& ev, size_t models) {
   std::printf("%s", hmm::confusion_text(ev).c_str());
 }
 
+// Per trial of `trials`: 1 when the model (one) or the committee (several, voting) names its label
+// at the cut, 0 when it names another class, -1 when the trial is not scored (unlabelled, a label
+// no model has, or empty after the cut) -- the same rules as hmm::evaluate and evaluate_vote.
+std::vector<int> right_per_trial(const std::vector<const model::OutcomeModel*>& models,
+                                 const std::vector<const HapticSequence*>& trials, double cut,
+                                 const hmm::ClassChoice& among) {
+  std::vector<int> right;
+  if (models.size() == 1) {
+    std::vector<hmm::TrialResult> per;
+    hmm::evaluate(*models[0], trials, cut, &per, among);
+    for (const auto& r : per) right.push_back(r.truth < 0 || r.result.predicted < 0 ? -1 : r.truth == r.result.predicted);
+  } else {
+    std::vector<hmm::Vote> per;
+    hmm::evaluate_vote(models, trials, cut, &per, among);
+    for (size_t i = 0; i < per.size(); ++i)
+      right.push_back(per[i].predicted < 0 || !trials[i]->label
+                          ? -1
+                          : per[i].classes[per[i].predicted] == outcome_name(*trials[i]->label));
+  }
+  return right;
+}
+
+// `--against`: this classifier and another on the same trials, paired (hmm.h, mcnemar_exact_p):
+// only the trials both score count; b of them only this one gets right, c only the other.
+struct Against {
+  int both_scored = 0, other_right = 0, only_this = 0, only_other = 0;
+  double p = 1;
+};
+Against pair_against(const std::vector<int>& mine, const std::vector<int>& other) {
+  Against a;
+  for (size_t i = 0; i < mine.size(); ++i) {
+    if (mine[i] < 0 || other[i] < 0) continue;
+    ++a.both_scored;
+    a.other_right += other[i];
+    a.only_this += mine[i] && !other[i];
+    a.only_other += !mine[i] && other[i];
+  }
+  a.p = hmm::mcnemar_exact_p(a.only_this, a.only_other);
+  return a;
+}
+
 }  // namespace
 
 int run_classify(int argc, char** argv) {
@@ -101,11 +142,14 @@ int run_classify(int argc, char** argv) {
         "  --participant P[,Q...]  only these participants' trials (leave-one-participant-out)\n"
         "  --among C[,C...]        decide among these classes only, e.g. good,missed: the question a\n"
         "                          classifier trained on the study's recordings (no caught trial) answers\n"
+        "  --against B.dgm[,...]   also classify the same trials (same cut, same --among) by another model\n"
+        "                          or committee, and pair the two: the trials only one of them gets right\n"
+        "                          and McNemar's exact p (is the difference more than these trials' noise?)\n"
         "  --json                  print a machine-readable result");
     return 0;
   }
   args.allow_only({"help", "json", "no-plot", "model", "data", "truncate-at", "sweep", "sweep-out", "participant",
-                    "among"});
+                    "among", "against"});
   const std::string model_list = args.require("model"), data = args.require("data");
   const double truncate = args.number("truncate-at", std::numeric_limits<double>::infinity());
   if (!(truncate > 0)) throw UsageError("--truncate-at must be positive");
@@ -119,24 +163,34 @@ int run_classify(int argc, char** argv) {
   }
   const auto only = split_list(args.get("participant").value_or(""));
 
-  std::vector<model::OutcomeModel> models;
-  const std::vector<std::string> model_paths = split_in_order(model_list);
-  for (const auto& path : model_paths) {
-    try {
-      models.push_back(model::read_model(path));
-    } catch (const model::ModelError& e) {
-      throw InputError(e.what());
-    }
-  }
-  if (models.empty()) throw UsageError("--model needs at least one model file");
   const hmm::ClassChoice among = split_in_order(args.get("among").value_or(""));
   if (args.get("among") && among.empty()) throw UsageError("--among needs at least one class name");
-  for (size_t k = 0; k < models.size(); ++k)
-    for (const auto& name : among)
-      if (models[k].class_index(name) < 0)
-        throw UsageError("--among: '" + name + "' is not a class of " + model_paths[k]);
+  // A comma list of model files (--model, --against), each read and checked against --among.
+  auto read_models = [&](const std::string& option, const std::vector<std::string>& paths) {
+    std::vector<model::OutcomeModel> ms;
+    for (const auto& path : paths) {
+      try {
+        ms.push_back(model::read_model(path));
+      } catch (const model::ModelError& e) {
+        throw InputError(e.what());
+      }
+      for (const auto& name : among)
+        if (ms.back().class_index(name) < 0)
+          throw UsageError("--among: '" + name + "' is not a class of " + path);
+    }
+    if (ms.empty()) throw UsageError("--" + option + " needs at least one model file");
+    return ms;
+  };
+  const std::vector<std::string> model_paths = split_in_order(model_list);
+  const std::vector<model::OutcomeModel> models = read_models("model", model_paths);
   std::vector<const model::OutcomeModel*> committee;
   for (const auto& m : models) committee.push_back(&m);
+  const std::vector<std::string> against_paths = split_in_order(args.get("against").value_or(""));
+  if (args.get("against") && !sweep.empty()) throw UsageError("--against pairs the models at one cut, not with --sweep");
+  const std::vector<model::OutcomeModel> against_models =
+      args.get("against") ? read_models("against", against_paths) : std::vector<model::OutcomeModel>{};
+  std::vector<const model::OutcomeModel*> against_committee;
+  for (const auto& m : against_models) against_committee.push_back(&m);
   // One model classifies as it always did (its log-likelihoods in the JSON); several vote.
   const model::OutcomeModel* single = models.size() == 1 ? &models[0] : nullptr;
   const Dataset ds = load_dataset(data);
@@ -145,6 +199,23 @@ int run_classify(int argc, char** argv) {
     if (only.empty() || only.count(t.participant)) trials.push_back(&t);
   if (trials.empty()) throw InputError(data + ": no trials" + (only.empty() ? "" : " of the given participants"));
   const bool json = args.has("json");
+  // --against: the pairing, its JSON member and its text line (printed after the summary).
+  std::string against_json, against_text;
+  if (!against_committee.empty()) {
+    const Against a = pair_against(right_per_trial(committee, trials, truncate, among),
+                                   right_per_trial(against_committee, trials, truncate, among));
+    std::string paths;
+    for (const auto& path : against_paths) paths += (paths.empty() ? "" : ", ") + hmm::json_string(path);
+    against_json = ", \"against\": {\"models\": [" + paths + "], \"trials\": " + std::to_string(a.both_scored) +
+                   ", \"correct\": " + std::to_string(a.other_right) + ", \"only_this_right\": " +
+                   std::to_string(a.only_this) + ", \"only_against_right\": " + std::to_string(a.only_other) +
+                   ", \"mcnemar_exact_p\": " + hmm::json_number(a.p) + "}";
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  "against %s: %d/%d right; only this one right on %d, only the other on %d: McNemar's exact p %.3g\n",
+                  args.get("against")->c_str(), a.other_right, a.both_scored, a.only_this, a.only_other, a.p);
+    against_text = line;
+  }
   auto evaluate_at = [&](double d) {
     return single ? hmm::evaluate(*single, trials, d, nullptr, among) : hmm::evaluate_vote(committee, trials, d, nullptr, among);
   };
@@ -208,9 +279,9 @@ int run_classify(int argc, char** argv) {
                 "], \"posterior_sum\": [" + sums + "]}";
       }
       for (const auto& path : model_paths) paths += (paths.empty() ? "" : ", ") + hmm::json_string(path);
-      std::printf("{\"models\": [%s], \"data\": %s, \"truncate_at\": %s, \"trials\": [%s], \"evaluation\": %s}\n",
+      std::printf("{\"models\": [%s], \"data\": %s, \"truncate_at\": %s, \"trials\": [%s], \"evaluation\": %s%s}\n",
                   paths.c_str(), hmm::json_string(data).c_str(), hmm::json_number(truncate).c_str(), rows.c_str(),
-                  hmm::evaluation_json(ev).c_str());
+                  hmm::evaluation_json(ev).c_str(), against_json.c_str());
       return 0;
     }
     std::printf("%-24s %-6s %7s %-8s %-8s %6s\n", "trial", "part.", "samples", "truth", "predicted", "votes");
@@ -223,6 +294,7 @@ int run_classify(int argc, char** argv) {
                   truth == v.classes[v.predicted] ? "" : "   WRONG");
     }
     print_summary(ev, committee.size());
+    std::printf("%s", against_text.c_str());
     return 0;
   }
   std::vector<hmm::TrialResult> per;
@@ -242,9 +314,9 @@ int run_classify(int argc, char** argv) {
               hmm::json_string(single->classes[r.result.predicted].name) + ", \"log_likelihood\": [" + ll + "], \"posterior\": [" +
               post + "]}";
     }
-    std::printf("{\"model\": %s, \"data\": %s, \"truncate_at\": %s, \"trials\": [%s], \"evaluation\": %s}\n",
+    std::printf("{\"model\": %s, \"data\": %s, \"truncate_at\": %s, \"trials\": [%s], \"evaluation\": %s%s}\n",
                 hmm::json_string(model_list).c_str(), hmm::json_string(data).c_str(), hmm::json_number(truncate).c_str(),
-                rows.c_str(), hmm::evaluation_json(ev).c_str());
+                rows.c_str(), hmm::evaluation_json(ev).c_str(), against_json.c_str());
     return 0;
   }
   std::printf("%-24s %-6s %7s %-8s %-8s %9s\n", "trial", "part.", "samples", "truth", "predicted", "posterior");
@@ -255,6 +327,7 @@ int run_classify(int argc, char** argv) {
                 r.result.posterior[r.result.predicted], r.truth == r.result.predicted ? "" : "   WRONG");
   }
   print_summary(ev, 1);
+  std::printf("%s", against_text.c_str());
   return 0;
 }
 

@@ -136,6 +136,27 @@ TEST_F(CliTest, CommitteeOfModelsVotes) {
     EXPECT_EQ(line, std::string(d) + ",0.333333,6,18");
   }
 
+  // --against pairs two classifiers on the same trials (McNemar): the right model against the liar
+  // differs on the 12 good and missed trials, all of them the right model's (p = 2 / 2^12), and
+  // agrees on the 6 caught ones; against itself nothing is discordant (p = 1).
+  const auto vs = run("classify --model " + m + " --against " + liar + " --data " + test + " --json");
+  ASSERT_EQ(vs.code, 0) << vs.err;
+  const size_t at = vs.out.find("\"against\"");
+  ASSERT_NE(at, std::string::npos) << vs.out;
+  EXPECT_EQ(json_field(vs.out, "trials", at), 18.0) << vs.out;
+  EXPECT_EQ(json_field(vs.out, "correct", at), 6.0) << vs.out;
+  EXPECT_EQ(json_field(vs.out, "only_this_right", at), 12.0) << vs.out;
+  EXPECT_EQ(json_field(vs.out, "only_against_right", at), 0.0) << vs.out;
+  EXPECT_NEAR(json_field(vs.out, "mcnemar_exact_p", at), 2.0 / 4096, 1e-15) << vs.out;
+  const auto same = run("classify --model " + m + "," + m + "," + liar + " --against " + m + " --data " + test);
+  ASSERT_EQ(same.code, 0) << same.err;
+  EXPECT_NE(same.out.find("18/18 right; only this one right on 0, only the other on 0: McNemar's exact p 1"),
+            std::string::npos) << same.out;
+  const auto sweep_vs = run("classify --model " + m + " --against " + liar + " --data " + test +
+                            " --sweep 0.05:0.15:0.05 --sweep-out " + (dir / "sv").string() + " --no-plot");
+  EXPECT_EQ(sweep_vs.code, 2);
+  EXPECT_NE(sweep_vs.err.find("--against"), std::string::npos) << sweep_vs.err;
+
   const auto missing = run("classify --model " + m + "," + (dir / "none.dgm").string() + " --data " + test);
   EXPECT_EQ(missing.code, 2);
   EXPECT_NE(missing.err.find("none.dgm"), std::string::npos) << missing.err;
