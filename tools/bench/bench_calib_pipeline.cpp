@@ -42,8 +42,8 @@
 //     trials of the people other than its own), beside the baseline classifier BC trained on the
 //     2-3 measured sequences each calibration was fitted to (paper VI-B.1); the vote of the
 //     single STCs of the people other than P (hmm::evaluate_vote) and, for comparison, their
-//     mixture (per class the mean likelihood of the raw forces). The vote and the 1-NN are then
-//     compared trial by trial at each cut: how many trials only one of them gets right, McNemar's
+//     mixture (per class the mean likelihood of the raw forces). Each STC and its BC, and the
+//     vote and the 1-NN, are also compared trial by trial at each cut: how many trials only one of them gets right, McNemar's
 //     exact p of that split and each accuracy's 95 % Wilson interval (hmm.h), because 22 trials
 //     leave a few trials' difference inside the noise. Prints the table and
 //     each simulator's early cue against the people's and its own person's, writes DIR/pooled.json (plot:
@@ -500,11 +500,28 @@ int run_timing(const std::map<std::string, std::string>& a) {
 }
 
 
-// Correct classifications of a model over `test`, whole and at the four cuts (out[0] whole).
+// Which trials a classifier got right, by id, whole and at each cut ([0] whole): pairs two
+// classifiers on the same trials (hmm::mcnemar_exact_p).
+using RightIds = std::array<std::set<std::string>, 5>;
+
+// Correct classifications of a model over `test`, whole and at the four cuts (out[0] whole); with
+// `ids`, also which trials.
 void count_right(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& test, int out[5],
-                 const std::vector<std::string>& among = {}) {
-  out[0] += count_correct(m, test, std::numeric_limits<double>::infinity(), nullptr, among);
-  for (int c = 0; c < 4; ++c) out[c + 1] += count_correct(m, test, kCuts[c], nullptr, among);
+                 const std::vector<std::string>& among = {}, RightIds* ids = nullptr) {
+  for (int c = 0; c < 5; ++c) {
+    const double cut = c == 0 ? std::numeric_limits<double>::infinity() : kCuts[c - 1];
+    if (!ids) {
+      out[c] += count_correct(m, test, cut, nullptr, among);
+      continue;
+    }
+    std::vector<const HapticSequence*> labelled;  // count_correct's trials
+    for (const auto* t : test)
+      if (t->label && !t->samples.empty()) labelled.push_back(t);
+    std::vector<hmm::TrialResult> per;
+    out[c] += hmm::evaluate(m, labelled, cut, &per, among).correct;
+    for (const auto& r : per)
+      if (r.truth >= 0 && r.truth == r.result.predicted) (*ids)[c].insert(r.trial->id);
+  }
 }
 
 // The index of a synthesized trial, from its id (synthesis_trial_id: "sim-high-007" -> 7).
@@ -826,7 +843,8 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     auto per_calibration = [&](const char* key, const char* all_name,
                                const std::function<std::vector<HapticSequence>(const Source&)>& training,
                                const std::function<std::string(const Source&)>& name,
-                               std::vector<model::OutcomeModel>* keep = nullptr) {
+                               std::vector<model::OutcomeModel>* keep = nullptr,
+                               std::vector<RightIds>* ids = nullptr) {
       int sum[5] = {}, n_all = 0;
       Json rows = Json::array();
       for (const auto& src : sources) {
@@ -837,7 +855,8 @@ int run_pooled(const std::map<std::string, std::string>& a) {
           if (t->participant != src.participant) test.push_back(t);
         int right[5] = {};
         model::OutcomeModel m = train(tr, fs_.second_axis, name(src));
-        count_right(m, test, right);
+        if (ids) ids->emplace_back();
+        count_right(m, test, right, {}, ids ? &ids->back() : nullptr);
         if (keep) keep->push_back(std::move(m));
         for (int c = 0; c < 5; ++c) sum[c] += right[c];
         n_all += static_cast<int>(test.size());
@@ -854,8 +873,10 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     };
     // Each calibration's own STC.
     std::vector<model::OutcomeModel> singles;  // in the order of `sources`
+    std::vector<RightIds> single_ids, bc_ids;     // likewise: paired with the BC's below
     per_calibration("single", "alone, all of them", [](const Source& src) { return src.set.trials; },
-                    [](const Source& src) { return "alone: " + fs::path(src.file).stem().string(); }, &singles);
+                    [](const Source& src) { return "alone: " + fs::path(src.file).stem().string(); }, &singles,
+                    &single_ids);
     // The same STCs with priors the shares of their training sets (hmm::set_log_priors, build-model
     // --priors training) instead of the paper's equal priors: where the forces barely differ yet
     // (0.15 m), the prior decides. The rows below also ask each of them "good or missed?": the
@@ -890,7 +911,33 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     // that each calibration was fitted to (the study holds no caught trial, so BC knows good and
     // missed only).
     per_calibration("bc", "BC, all of them", [&](const Source& src) { return select_inputs(ds, src.participant, 1); },
-                    [](const Source& src) { return "BC: participant " + src.participant + "'s measured inputs"; });
+                    [](const Source& src) { return "BC: participant " + src.participant + "'s measured inputs"; },
+                    nullptr, &bc_ids);
+    // Each STC against its BC on the same trials (the other people's): b / c the trials only the
+    // STC / only the BC gets right, and McNemar's exact p (hmm.h), whole and at each cut.
+    {
+      Json rows = Json::array();
+      for (std::size_t s = 0; s < sources.size(); ++s) {
+        std::printf("  %-44s", ("STC vs BC, b/c p: " + fs::path(sources[s].file).stem().string()).c_str());
+        Json jb = Json::array(), jc = Json::array(), jp = Json::array();
+        for (int c = 0; c < 5; ++c) {
+          int b = 0, cc = 0;
+          for (const auto& id : single_ids[s][c]) b += !bc_ids[s][c].count(id);
+          for (const auto& id : bc_ids[s][c]) cc += !single_ids[s][c].count(id);
+          const double p = hmm::mcnemar_exact_p(b, cc);
+          std::printf(" %d/%d %.2f", b, cc, p);
+          jb.push(b), jc.push(cc), jp.push(p);
+        }
+        std::printf("\n");
+        Json j = Json::object();
+        j.set("calibration", sources[s].file);
+        j.set("only_stc_right_whole_and_cuts", jb);
+        j.set("only_bc_right_whole_and_cuts", jc);
+        j.set("mcnemar_exact_p_whole_and_cuts", jp);
+        rows.push(j);
+      }
+      jset.set("single_against_bc", rows);
+    }
     // The pools: per test person, every calibration of someone else; the same pool cut to one
     // set's size beside it. Models are cached by their pool.
     int pooled_right[5] = {}, equal_right[5] = {}, n = 0;
