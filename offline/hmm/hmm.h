@@ -204,8 +204,8 @@ Evaluation evaluate_vote(const std::vector<const model::OutcomeModel*>& models,
 
 // ---- two classifiers on the same trials ------------------------------------------------------
 
-// How sure a measured accuracy is: the Wilson score interval (Wilson 1927) of `right` out of `n`
-// trials at the normal quantile z (1.96: 95 %),
+// How sure a measured accuracy is: the Wilson score interval (Wilson 1927) of k = `right` out of
+// `n` trials at the normal quantile z (1.96: 95 %),
 //
 //   centre = (k + z^2 / 2) / (n + z^2),   half = z sqrt(k (n - k) / n + z^2 / 4) / (n + z^2),
 //
@@ -215,19 +215,22 @@ Evaluation evaluate_vote(const std::vector<const model::OutcomeModel*>& models,
 struct AccuracyInterval {
   double lower = 0, upper = 1;
 };
+// Throws std::invalid_argument unless 0 <= right <= n and n > 0.
 AccuracyInterval wilson_interval(int right, int n, double z = 1.959963984540054);
 
 // Whether two classifiers scored on the same trials differ: McNemar's test in its exact form
 // (McNemar 1947; Dietterich 1998 for classifiers). Only the trials on which exactly one of them
 // is right count: `only_first` of them the first got right, `only_second` the second. If both
 // were equally good, each such trial would go either way with probability 1/2, so with
-// n = b + c discordant trials and m = min(b, c) the two-sided p-value is
+// b = only_first, c = only_second, n = b + c discordant trials and m = min(b, c) the two-sided
+// p-value is
 //
 //   p = min(1, 2 sum_{i=0}^{m} C(n, i) / 2^n),
 //
 // and 1 when n = 0. Why not two accuracies side by side: the trials both classifiers get right
 // or both get wrong say nothing about which is better, and on 22 trials a difference of two
-// trials is as likely as not (b = 2, c = 4: p = 0.69).
+// trials is as likely as not (b = 2, c = 4: p = 0.69). Throws std::invalid_argument on a
+// negative count.
 double mcnemar_exact_p(int only_first, int only_second);
 
 }  // namespace dressguard::hmm
