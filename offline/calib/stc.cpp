@@ -83,12 +83,12 @@ StcAxes choose_stc_axes(const std::vector<SequenceFit>& fits, bool lateral_fitte
 }
 
 int count_correct(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials, double truncate_at,
-                  int* counted, const std::vector<std::string>& among) {
+                  int* counted, const std::vector<std::string>& among, std::vector<hmm::TrialResult>* per_trial) {
   std::vector<const HapticSequence*> labelled;
   for (const auto* t : trials)
     if (t->label && !t->samples.empty()) labelled.push_back(t);
   if (counted) *counted = static_cast<int>(labelled.size());
-  return labelled.empty() ? 0 : hmm::evaluate(m, labelled, truncate_at, nullptr, among).correct;
+  return labelled.empty() ? 0 : hmm::evaluate(m, labelled, truncate_at, per_trial, among).correct;
 }
 
 double accuracy(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials, double truncate_at,

@@ -9,6 +9,7 @@
 #include "calibration.h"
 #include "dataset.h"
 #include "dgm.h"
+#include "hmm.h"
 
 namespace dressguard::calib {
 
@@ -54,9 +55,11 @@ model::OutcomeModel build_outcome_model(const std::vector<const HapticSequence*>
 // `truncate_at` metres of travel (infinity: whole), deciding `among` the named classes only
 // (empty: all; hmm::classify). A trial whose label is not a class of the model counts as wrong
 // (a model trained on simulated data without any "good" trial cannot be right about a good
-// trial); `counted` receives the number of labelled trials.
+// trial); `counted` receives the number of labelled trials, `per_trial` (may be null) each labelled
+// trial's result (hmm::evaluate).
 int count_correct(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials,
-                  double truncate_at, int* counted = nullptr, const std::vector<std::string>& among = {});
+                  double truncate_at, int* counted = nullptr, const std::vector<std::string>& among = {},
+                  std::vector<hmm::TrialResult>* per_trial = nullptr);
 
 // The same as a fraction of the labelled trials (0 when there are none).
 double accuracy(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials,

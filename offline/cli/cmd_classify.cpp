@@ -82,9 +82,8 @@ void print_summary(const hmm::Evaluation& ev, size_t models) {
   std::printf("%s", hmm::confusion_text(ev).c_str());
 }
 
-// Per trial of `trials`: 1 when the model (one) or the committee (several, voting) names its label
-// at the cut, 0 when it names another class, -1 when the trial is not scored (unlabelled, a label
-// no model has, or empty after the cut) -- the same rules as hmm::evaluate and evaluate_vote.
+// Per trial of `trials`: hmm::right_or_not of the model (one) or of the committee (several,
+// voting) at the cut.
 std::vector<int> right_per_trial(const std::vector<const model::OutcomeModel*>& models,
                                  const std::vector<const HapticSequence*>& trials, double cut,
                                  const hmm::ClassChoice& among) {
@@ -92,14 +91,11 @@ std::vector<int> right_per_trial(const std::vector<const model::OutcomeModel*>& 
   if (models.size() == 1) {
     std::vector<hmm::TrialResult> per;
     hmm::evaluate(*models[0], trials, cut, &per, among);
-    for (const auto& r : per) right.push_back(r.truth < 0 || r.result.predicted < 0 ? -1 : r.truth == r.result.predicted);
+    for (const auto& r : per) right.push_back(hmm::right_or_not(r));
   } else {
     std::vector<hmm::Vote> per;
     hmm::evaluate_vote(models, trials, cut, &per, among);
-    for (size_t i = 0; i < per.size(); ++i)
-      right.push_back(per[i].predicted < 0 || !trials[i]->label
-                          ? -1
-                          : per[i].classes[per[i].predicted] == outcome_name(*trials[i]->label));
+    for (size_t i = 0; i < per.size(); ++i) right.push_back(hmm::right_or_not(per[i], *trials[i]));
   }
   return right;
 }

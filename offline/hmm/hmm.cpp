@@ -692,6 +692,16 @@ Evaluation evaluate_vote(const std::vector<const model::OutcomeModel*>& models,
   return ev;
 }
 
+int right_or_not(const TrialResult& r) {
+  if (r.truth < 0 || r.result.predicted < 0) return -1;
+  return r.result.predicted == r.truth;
+}
+
+int right_or_not(const Vote& v, const HapticSequence& trial) {
+  if (v.predicted < 0 || !trial.label) return -1;
+  return v.classes[v.predicted] == outcome_name(*trial.label);
+}
+
 AccuracyInterval wilson_interval(int right, int n, double z) {
   if (n <= 0 || right < 0 || right > n) throw std::invalid_argument("wilson_interval: need 0 <= right <= n, n > 0");
   const double k = right, N = n, z2 = z * z;

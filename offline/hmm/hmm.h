@@ -204,6 +204,14 @@ Evaluation evaluate_vote(const std::vector<const model::OutcomeModel*>& models,
 
 // ---- two classifiers on the same trials ------------------------------------------------------
 
+// Whether one classifier got one trial right: 1 when it names the trial's label, 0 when it names
+// another class, -1 when the trial is not scored (unlabelled, a label the classifier does not
+// know, or nothing left after the cut), the rules by which evaluate() and evaluate_vote() count.
+// Pairing two classifiers trial by trial (mcnemar_exact_p, below) starts here.
+int right_or_not(const TrialResult& r);
+int right_or_not(const Vote& v, const HapticSequence& trial);
+
+
 // How sure a measured accuracy is: the Wilson score interval (Wilson 1927) of k = `right` out of
 // `n` trials at the normal quantile z (1.96: 95 %),
 //

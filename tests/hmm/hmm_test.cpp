@@ -435,6 +435,37 @@ TEST(HmmVote, ClassesAreTheUnionOfTheModels) {
   EXPECT_EQ(two.skipped, 1);
 }
 
+// right_or_not, one model and a committee, on a right, a wrong, an unlabelled and a caught trial
+// (a label the two-class model does not know): 1, 0, -1, -1, and the 1s are evaluate()'s correct.
+TEST(HmmCompare, RightOrNotFollowsTheEvaluationRules) {
+  const auto a = one_state_model(0, 3), b = one_state_model(0, 2), c = one_state_model(3, 0);
+  HapticSequence right = one_sample(0.2, Outcome::Good), wrong = one_sample(0.2, Outcome::Missed),
+                 unlabelled = one_sample(0.2, Outcome::Good), caught = one_sample(0.2, Outcome::Caught);
+  unlabelled.label.reset();
+  const std::vector<const HapticSequence*> trials = {&right, &wrong, &unlabelled, &caught};
+  std::vector<hmm::TrialResult> per;
+  const auto ev = hmm::evaluate(a, trials, std::numeric_limits<double>::infinity(), &per);
+  ASSERT_EQ(per.size(), 4u);
+  EXPECT_EQ(hmm::right_or_not(per[0]), 1);
+  EXPECT_EQ(hmm::right_or_not(per[1]), 0);
+  EXPECT_EQ(hmm::right_or_not(per[2]), -1);
+  EXPECT_EQ(hmm::right_or_not(per[3]), -1);
+  EXPECT_EQ(ev.correct, 1);
+  EXPECT_EQ(ev.total, 2);
+  std::vector<hmm::Vote> votes;
+  const std::vector<const model::OutcomeModel*> committee = {&a, &b, &c};
+  const auto vev = hmm::evaluate_vote(committee, trials, std::numeric_limits<double>::infinity(), &votes);
+  ASSERT_EQ(votes.size(), 4u);
+  std::vector<int> got;
+  for (size_t i = 0; i < 4; ++i) got.push_back(hmm::right_or_not(votes[i], *trials[i]));
+  EXPECT_EQ(got, (std::vector<int>{1, 0, -1, -1}));
+  EXPECT_EQ(vev.correct, 1);
+  // Cut before the first sample (travel 0): nothing left, not scored.
+  std::vector<hmm::TrialResult> cut;
+  hmm::evaluate(a, {&right}, -1.0, &cut);
+  EXPECT_EQ(hmm::right_or_not(cut[0]), -1);
+}
+
 // Deciding among some classes: a trial at x = 8 is caught for a model with means good 0,
 // missed 3, caught 10 (the nearest mean, equal priors); asked "good or missed?" it is missed,
 // with the two-class posterior of the closed form and caught at exactly 0, its log-likelihood

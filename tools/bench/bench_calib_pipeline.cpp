@@ -510,17 +510,10 @@ void count_right(const model::OutcomeModel& m, const std::vector<const HapticSeq
                  const std::vector<std::string>& among = {}, RightIds* ids = nullptr) {
   for (int c = 0; c < 5; ++c) {
     const double cut = c == 0 ? std::numeric_limits<double>::infinity() : kCuts[c - 1];
-    if (!ids) {
-      out[c] += count_correct(m, test, cut, nullptr, among);
-      continue;
-    }
-    std::vector<const HapticSequence*> labelled;  // count_correct's trials
-    for (const auto* t : test)
-      if (t->label && !t->samples.empty()) labelled.push_back(t);
     std::vector<hmm::TrialResult> per;
-    out[c] += hmm::evaluate(m, labelled, cut, &per, among).correct;
+    out[c] += count_correct(m, test, cut, nullptr, among, ids ? &per : nullptr);
     for (const auto& r : per)
-      if (r.truth >= 0 && r.truth == r.result.predicted) (*ids)[c].insert(r.trial->id);
+      if (hmm::right_or_not(r) == 1) (*ids)[c].insert(r.trial->id);
   }
 }
 
@@ -1009,8 +1002,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
           std::vector<hmm::Vote> votes;
           vote_right[c] += hmm::evaluate_vote(members, test, cut, &votes).correct;
           for (std::size_t i = 0; i < test.size(); ++i)
-            vote_right_of[c][test[i]] = votes[i].predicted >= 0 && test[i]->label &&
-                                        votes[i].classes[votes[i].predicted] == outcome_name(*test[i]->label);
+            vote_right_of[c][test[i]] = hmm::right_or_not(votes[i], *test[i]) == 1;
           vote2_right[c] += hmm::evaluate_vote(members, test, cut, nullptr, good_or_missed).correct;
           share_right[c] += hmm::evaluate_vote(share_members, test, cut).correct;
           share2_right[c] += hmm::evaluate_vote(share_members, test, cut, nullptr, good_or_missed).correct;
