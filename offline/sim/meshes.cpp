@@ -5,6 +5,22 @@
 
 namespace dressguard::sim {
 
+namespace {
+
+// Quad p q / r s (p, q along u; r, s the next row) as two triangles, split along p-s or q-r by
+// `parity`: alternating diagonals keep a grid free of a preferred shear direction.
+void add_quad(ClothMesh& m, int p, int q, int r, int s, int parity) {
+  if (parity == 0) {
+    m.tris.push_back({p, q, s});
+    m.tris.push_back({p, s, r});
+  } else {
+    m.tris.push_back({p, q, r});
+    m.tris.push_back({q, s, r});
+  }
+}
+
+}  // namespace
+
 ClothMesh grid_patch(std::array<double, 3> o, std::array<double, 3> a, std::array<double, 3> b, int nu, int nv) {
   ClothMesh m;
   m.name = "patch";
@@ -15,14 +31,8 @@ ClothMesh grid_patch(std::array<double, 3> o, std::array<double, 3> a, std::arra
     }
   for (int iv = 0; iv + 1 < nv; ++iv)
     for (int iu = 0; iu + 1 < nu; ++iu) {
-      const int p = iv * nu + iu, q = p + 1, r = p + nu, s = r + 1;
-      if ((iu + iv) % 2 == 0) {
-        m.tris.push_back({p, q, s});
-        m.tris.push_back({p, s, r});
-      } else {
-        m.tris.push_back({p, q, r});
-        m.tris.push_back({q, s, r});
-      }
+      const int p = iv * nu + iu;
+      add_quad(m, p, p + 1, p + nu, p + nu + 1, (iu + iv) % 2);
     }
   return m;
 }
@@ -37,14 +47,8 @@ ClothMesh ring_mesh(int nu, int nv, F&& ring) {
     for (int iu = 0; iu < nu; ++iu) m.x.push_back(ring(iv, iu));
   for (int iv = 0; iv + 1 < nv; ++iv)
     for (int iu = 0; iu < nu; ++iu) {
-      const int p = iv * nu + iu, q = iv * nu + (iu + 1) % nu, r = p + nu, s = q + nu;
-      if ((iu + iv) % 2 == 0) {
-        m.tris.push_back({p, q, s});
-        m.tris.push_back({p, s, r});
-      } else {
-        m.tris.push_back({p, q, r});
-        m.tris.push_back({q, s, r});
-      }
+      const int p = iv * nu + iu, q = iv * nu + (iu + 1) % nu;
+      add_quad(m, p, q, p + nu, q + nu, (iu + iv) % 2);
     }
   return m;
 }
