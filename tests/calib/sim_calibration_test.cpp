@@ -398,6 +398,14 @@ TEST(SimCalibration, Participant3sLongerCalibrationFitsTheirSequences) {
   expect_fits_own_sequences_to_the_bit("participant3-longer.json", 0.65);
 }
 
+// Participant 3 in smaller steps (8 x 32, sigma0 0.03, by the sum, seed 1, from
+// participant3-longer.json; sessions 42-43, resumed from its checkpoint): L 1.371 from 1.409, good
+// 0.324, middle missed 0.606, missed 0.441 (0.362 / 0.629 / 0.417 before). Not at the issue's
+// 0.3; bounded here by 0.607.
+TEST(SimCalibration, Participant3sSmallerStepCalibrationFitsTheirSequences) {
+  expect_fits_own_sequences_to_the_bit("participant3-fine.json", 0.607);
+}
+
 // Participant 2 searched longer (20 x 32, sigma0 0.1, from participant2-simulator.json; sessions
 // 25-26): L 1.292 from 1.646. Every sequence gained (good 0.384 from 0.468, middle missed 0.549
 // from 0.643, missed 0.359 from 0.535) and none reaches the 0.3; bounded here by 0.6.
