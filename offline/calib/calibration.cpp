@@ -308,6 +308,27 @@ double rig_travel_of(const std::vector<HapticSequence>& inputs) {
   return travel > 0 ? travel : 0.85;
 }
 
+Calibration calibration_of(const std::string& participant, const CalibrationResult& r,
+                           const ParameterSpace& space, const CalibrationOptions& o,
+                           const std::vector<HapticSequence>& inputs, const std::string& gown) {
+  Calibration cal;
+  cal.participant = participant;
+  cal.cloth = r.cloth;
+  cal.offsets = r.offsets;
+  for (ArmHeight h : space.offset_heights) cal.offset_calibrated[static_cast<int>(h)] = true;
+  cal.objective = r.objective;
+  cal.fits = r.fits;
+  cal.contrast_weight = o.contrast_weight;
+  cal.contrast = r.contrast;
+  cal.lateral_weight = o.lateral_weight;
+  cal.lateral = r.lateral;
+  cal.objective_kind = std::string(objective_name(o.objective));
+  cal.combine = std::string(combine_name(o.combine));
+  cal.gown = gown;
+  cal.rig_travel = rig_travel_of(inputs);
+  return cal;
+}
+
 // ---- one candidate's objective ------------------------------------------------------------------
 
 std::string_view combine_name(SequenceCombine c) { return c == SequenceCombine::Worst ? "worst" : "sum"; }

@@ -439,6 +439,14 @@ struct Calibration {
   double rig_travel = 0.85;                   // [m] end of travel for synthesis (rig_travel_of)
   Json provenance = Json::object();           // dataset, seed, budget, evaluations, timing, tool
 };
+// The calibration file of a finished search `r` on `inputs` (calibrate's arguments `space` and
+// `o`): its values, the heights whose offsets it calibrated, its objective with how it was made
+// (kind, combination, the extra terms' weights), the scene `gown` and the rig's end of travel.
+// The axis fits (measure_axis_fits) and the provenance are the caller's to add.
+Calibration calibration_of(const std::string& participant, const CalibrationResult& r,
+                           const ParameterSpace& space, const CalibrationOptions& o,
+                           const std::vector<HapticSequence>& inputs, const std::string& gown);
+
 // Starts a search where calibration `c` ended (`calibrate --start`): every initial value of `b`
 // becomes c's (the five cloth values, the person parameters, each calibrated height's own
 // offset), so that a longer or wider search continues from a fit instead of from a bounds file

@@ -265,21 +265,7 @@ int run_calibrate(int argc, char** argv) {
     }
     return 0;
   }
-  Calibration cal;
-  cal.participant = participant;
-  cal.cloth = r.cloth;
-  cal.offsets = r.offsets;
-  for (ArmHeight h : space.offset_heights) cal.offset_calibrated[static_cast<int>(h)] = true;
-  cal.objective = r.objective;
-  cal.fits = r.fits;
-  cal.contrast_weight = o.contrast_weight;
-  cal.contrast = r.contrast;
-  cal.lateral_weight = o.lateral_weight;
-  cal.lateral = r.lateral;
-  cal.objective_kind = std::string(objective_name(o.objective));
-  cal.combine = std::string(combine_name(o.combine));
-  cal.gown = gown;
-  cal.rig_travel = rig_travel_of(inputs);
+  Calibration cal = calibration_of(participant, r, space, o, inputs, gown);
   Json prov = Json::object();
   prov.set("tool", "dressguard calibrate");
   prov.set("created", utc_now());

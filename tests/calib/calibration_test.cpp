@@ -280,6 +280,50 @@ TEST(Calibration, SequencesCombineAsSumOrWorst) {
   EXPECT_FALSE(parse_combine("max"));
 }
 
+// The file of a finished search: what calibrate writes (calibration_of) holds the result's values
+// and fits, marks the offsets of the heights it searched (high and low here, not middle), and
+// records how its objective was made and where the rig's travel ends (the longest input not
+// stopped by force: here the two trials cut at 0.60 and 0.70 m, as a rig that stopped early).
+TEST(Calibration, FileOfASearchRecordsItsChoices) {
+  auto inputs = fake_inputs(Truth{});
+  for (int k = 0; k < 2; ++k) {
+    auto& x = inputs[k].samples;
+    while (!x.empty() && (x.back().travel > 0.6 + 0.1 * k || stopped_by_force(inputs[k]))) x.pop_back();
+  }
+  const ParameterSpace space = space_for(inputs);
+  CalibrationResult r;
+  r.cloth = ClothValues{0.1, 0.2, 0.3, 0.4, 0.5};
+  r.offsets = {0.01, 0.0, -0.02};
+  r.objective = 0.7;
+  r.fits.resize(2);
+  r.fits[1].objective = 0.25;
+  r.contrast = 0.05;
+  r.lateral = 0.06;
+  CalibrationOptions o;
+  o.combine = SequenceCombine::Worst;
+  o.objective = ObjectiveKind::PositionWeighted;
+  o.contrast_weight = 5;
+  o.lateral_weight = 1;
+  const Calibration c = calibration_of("9", r, space, o, inputs, "full");
+  EXPECT_EQ(c.participant, "9");
+  EXPECT_EQ(c.cloth.friction, 0.4);
+  EXPECT_EQ(c.offsets, r.offsets);
+  EXPECT_EQ(c.offset_calibrated, (std::array<bool, 3>{true, false, true}));
+  EXPECT_EQ(c.objective, 0.7);
+  ASSERT_EQ(c.fits.size(), 2u);
+  EXPECT_EQ(c.fits[1].objective, 0.25);
+  EXPECT_EQ(c.contrast_weight, 5);
+  EXPECT_EQ(c.contrast, 0.05);
+  EXPECT_EQ(c.lateral_weight, 1);
+  EXPECT_EQ(c.lateral, 0.06);
+  EXPECT_EQ(c.combine, "worst");
+  EXPECT_EQ(c.objective_kind, objective_name(ObjectiveKind::PositionWeighted));
+  EXPECT_EQ(c.gown, "full");
+  ASSERT_FALSE(inputs[1].samples.empty());
+  std::printf("  the inputs end at %.3f and %.3f m\n", inputs[0].samples.back().travel, inputs[1].samples.back().travel);
+  EXPECT_NEAR(c.rig_travel, 0.7, 0.002);  // the low input's last sample: 1 mm apart at 0.1 m/s, 100 Hz
+}
+
 // Two sequences that no single cloth fits (made with friction 0.9 and 0.3, no offsets to fit):
 // the search must trade one against the other. At the two minimisers, a (Worst) and b (Sum),
 // max(a) + rho sum(a) <= max(b) + rho sum(b) and sum(b) <= sum(a), hence max(a) <= max(b): the
@@ -316,12 +360,8 @@ TEST(Calibration, WorstCombineFitsTheWorstSequenceBetter) {
   EXPECT_EQ(resumed.objective, rw.objective);
   EXPECT_TRUE(resumed.best_unit == rw.best_unit);
 
-  Calibration cal;
-  cal.participant = "9";
-  cal.cloth = rw.cloth;
-  cal.objective = rw.objective;
-  cal.fits = rw.fits;
-  cal.combine = "worst";
+  Calibration cal = calibration_of("9", rw, space, o, inputs, "reduced");
+  EXPECT_EQ(cal.combine, "worst");
   write_calibration(dir / "w.json", cal);
   EXPECT_EQ(read_calibration(dir / "w.json").combine, "worst");
   cal.combine = "sum";

@@ -295,15 +295,7 @@ int run_eval(const std::map<std::string, std::string>& a) {
     auto o = co;
     o.checkpoint = work / ("p" + p + ".ckpt");
     const CalibrationResult r = calibrate(inputs, space, sim.trials, o, Comm::world());
-    Calibration cal;
-    cal.participant = p;
-    cal.cloth = r.cloth;
-    cal.offsets = r.offsets;
-    for (ArmHeight h : space.offset_heights) cal.offset_calibrated[static_cast<int>(h)] = true;
-    cal.objective = r.objective;
-    cal.fits = r.fits;
-    cal.gown = gown;
-    cal.rig_travel = rig_travel_of(inputs);
+    Calibration cal = calibration_of(p, r, space, o, inputs, gown);
     std::vector<TrialRequest> requests;
     for (const auto& s : inputs) requests.push_back(request_for(s, r.offsets));
     const std::vector<SimulatedTrial> curves = sim.trials(r.cloth, requests);
@@ -479,10 +471,7 @@ int run_timing(const std::map<std::string, std::string>& a) {
   // predict), with the targets in groups that settle once (the default) and, as the same run's
   // baseline, every target settled on its own; the same tables, byte for byte, are required.
   if (get(a, "predict", "0") == "1") {
-    Calibration cal;
-    cal.participant = "4";
-    cal.cloth = r.cloth;
-    cal.offsets = r.offsets;
+    const Calibration cal = calibration_of("4", r, space, o, inputs, gown);
     t0 = std::chrono::steady_clock::now();
     const Prediction grouped = predict_others(cal, ds, sim.trials, o.threads, Comm::world());
     const double grouped_s = seconds_since(t0);
