@@ -211,7 +211,6 @@ Evaluation evaluate_vote(const std::vector<const model::OutcomeModel*>& models,
 int right_or_not(const TrialResult& r);
 int right_or_not(const Vote& v, const HapticSequence& trial);
 
-
 // How sure a measured accuracy is: the Wilson score interval (Wilson 1927) of k = `right` out of
 // `n` trials at the normal quantile z (1.96: 95 %),
 //
