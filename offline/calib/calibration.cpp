@@ -329,7 +329,54 @@ Calibration calibration_of(const std::string& participant, const CalibrationResu
   return cal;
 }
 
+void rescore(Calibration& c, const std::vector<HapticSequence>& inputs, const std::vector<SimulatedTrial>& simulated,
+             const std::string& why, const std::string& when) {
+  if (inputs.size() != c.fits.size() || simulated.size() != inputs.size())
+    throw std::invalid_argument("rescore: the file has " + std::to_string(c.fits.size()) + " sequences, given " +
+                                std::to_string(inputs.size()) + " inputs and " + std::to_string(simulated.size()) +
+                                " simulated trials");
+  const auto kind = parse_objective(c.objective_kind);
+  const auto combine = parse_combine(c.combine);
+  if (!kind || !combine) throw std::invalid_argument("rescore: unknown objective '" + c.objective_kind + "' or combination '" + c.combine + "'");
+  Json before = Json::object();
+  before.set("objective", c.objective);
+  Json fits = Json::object();
+  std::vector<double> terms;
+  for (std::size_t k = 0; k < inputs.size(); ++k) {
+    if (inputs[k].id != c.fits[k].trial_id)
+      throw std::invalid_argument("rescore: input " + std::to_string(k) + " is " + inputs[k].id + ", the file's is " +
+                                  c.fits[k].trial_id);
+    fits.set(c.fits[k].trial_id, c.fits[k].objective);
+    c.fits[k].objective = sequence_term(*kind, simulated[k], inputs[k]);
+    terms.push_back(c.fits[k].objective);
+  }
+  before.set("fits", fits);
+  before.set("contrast", c.contrast);
+  before.set("lateral", c.lateral);
+  c.contrast = contrast_term(inputs, simulated, c.contrast_weight);
+  c.lateral = lateral_term(inputs, simulated, c.lateral_weight);
+  if (c.contrast_weight > 0) terms.push_back(c.contrast);
+  if (c.lateral_weight > 0) terms.push_back(c.lateral);
+  c.objective = combined_objective(terms.data(), static_cast<int>(inputs.size()), static_cast<int>(terms.size()),
+                                   *combine);
+  measure_axis_fits(c.fits, inputs, simulated);
+  Json r = Json::object();
+  r.set("when", when);
+  r.set("why", why);
+  r.set("before", before);
+  // A file rescored twice keeps the first figures too: each entry says what it replaced.
+  Json history = c.provenance.has("rescored") ? c.provenance.at("rescored") : Json::array();
+  history.push(r);
+  c.provenance.set("rescored", history);
+}
+
 // ---- one candidate's objective ------------------------------------------------------------------
+
+double sequence_term(ObjectiveKind kind, const SimulatedTrial& st, const HapticSequence& measured) {
+  if (!st.finite || st.samples.empty()) return std::numeric_limits<double>::infinity();
+  const double v = sequence_objective(kind, st.samples, measured.samples);
+  return std::isfinite(v) ? v : std::numeric_limits<double>::infinity();
+}
 
 std::string_view combine_name(SequenceCombine c) { return c == SequenceCombine::Worst ? "worst" : "sum"; }
 
@@ -557,10 +604,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
     return run_batch(static_cast<int>(xs.size()), T, thread_count(options.threads), comm, [&](int c, double* out) {
       const std::vector<SimulatedTrial> sts = simulate_inputs(sim, space.cloth(xs[c]), space.offsets(xs[c]), inputs);
       for (int k = 0; k < K; ++k) {
-        const SimulatedTrial& st = sts[k];
-        double v = std::numeric_limits<double>::infinity();
-        if (st.finite && !st.samples.empty()) v = sequence_objective(options.objective, st.samples, inputs[k].samples);
-        out[k] = std::isfinite(v) ? v : std::numeric_limits<double>::infinity();
+        out[k] = sequence_term(options.objective, sts[k], inputs[k]);
       }
       if (ic >= 0) out[ic] = contrast_term(inputs, sts, options.contrast_weight);
       if (il >= 0) out[il] = lateral_term(inputs, sts, options.lateral_weight);

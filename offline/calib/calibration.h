@@ -292,6 +292,10 @@ std::optional<SequenceCombine> parse_combine(std::string_view s);
 // term gives infinity. Sums in index order (the same bits on every rank and thread count).
 double combined_objective(const double* terms, int K, int T, SequenceCombine c);
 
+// One sequence's term: the chosen objective of a simulated trial against its measured input;
+// infinity when the simulation blew up or gave nothing (so no combination can prefer it).
+double sequence_term(ObjectiveKind kind, const SimulatedTrial& st, const HapticSequence& measured);
+
 struct CalibrationOptions {
   int generations = 50;            // paper IV-B.4: 50 iterations ...
   int population = 32;             // ... of 32 samples
@@ -446,6 +450,16 @@ struct Calibration {
 Calibration calibration_of(const std::string& participant, const CalibrationResult& r,
                            const ParameterSpace& space, const CalibrationOptions& o,
                            const std::vector<HapticSequence>& inputs, const std::string& gown);
+
+// Scores calibration `c` again on its own inputs (in its fits' order) by this build's objective,
+// its values unchanged (`calibrate --rescore`): each sequence's L, the extra terms, the combined
+// objective and the axis fits, from `simulated` = simulate_inputs() of c's values. For a change of
+// the objective's definition (session 45: objective.h, "Where the pairs begin"), so that a file's
+// figures are what this build computes from it. The figures it replaces go into provenance
+// "rescored" (a list: when, why, before). Throws std::invalid_argument when the inputs are not
+// the file's sequences.
+void rescore(Calibration& c, const std::vector<HapticSequence>& inputs, const std::vector<SimulatedTrial>& simulated,
+             const std::string& why, const std::string& when);
 
 // Starts a search where calibration `c` ended (`calibrate --start`): every initial value of `b`
 // becomes c's (the five cloth values, the person parameters, each calibrated height's own

@@ -52,22 +52,37 @@ double force_at(const std::vector<HapticSample>& seq, double x, ForceAxis a) {
   return (1.0 - t) * force(lo, a) + t * force(hi, a);
 }
 
+// The first index of `seq` with travel >= x, or its last index.
+std::size_t first_at_or_beyond(const std::vector<HapticSample>& seq, double x) {
+  const auto it = std::lower_bound(seq.begin(), seq.end(), x,
+                                   [](const HapticSample& s, double v) { return s.travel < v; });
+  return std::min(static_cast<std::size_t>(it - seq.begin()), seq.size() - 1);
+}
+
 }  // namespace
+
+PairedStart paired_start(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured) {
+  require_samples(sim, measured);
+  const double xs = sim.front().travel, xm = measured.front().travel;
+  if (xm - xs > kLateStart) return {first_at_or_beyond(sim, xm), 0};
+  if (xs - xm > kLateStart) return {0, first_at_or_beyond(measured, xs)};
+  return {};
+}
 
 double area_error(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured, ForceAxis axis,
                   double w) {
-  require_samples(sim, measured);
-  const std::size_t m = sim.size() - 1, n = measured.size() - 1;  // last indices, as in eq. 4
+  const PairedStart p = paired_start(sim, measured);
+  // i counts pairs from p; m and n are the last pair indices, as in eq. 4.
+  const std::size_t m = sim.size() - 1 - p.sim, n = measured.size() - 1 - p.measured;
+  auto s = [&](std::size_t i) { return force(sim[p.sim + i], axis); };
+  auto r = [&](std::size_t i) { return force(measured[p.measured + i], axis); };
   double e = 0.0;
   // i = 0 has no travel before it: d = 0. Both running: dx |s_i - r_i| with the measured dx.
-  for (std::size_t i = 1; i <= std::min(m, n); ++i)
-    e += step(measured, i) * std::abs(force(sim[i], axis) - force(measured[i], axis));
+  for (std::size_t i = 1; i <= std::min(m, n); ++i) e += step(measured, p.measured + i) * std::abs(s(i) - r(i));
   // Simulation longer: w dx |s_i - r_n|, dx the simulation's travel.
-  for (std::size_t i = n + 1; i <= m; ++i)
-    e += w * step(sim, i) * std::abs(force(sim[i], axis) - force(measured[n], axis));
+  for (std::size_t i = n + 1; i <= m; ++i) e += w * step(sim, p.sim + i) * std::abs(s(i) - r(n));
   // Measurement longer: w dx |s_m - r_i|, dx the measurement's travel.
-  for (std::size_t i = m + 1; i <= n; ++i)
-    e += w * step(measured, i) * std::abs(force(sim[m], axis) - force(measured[i], axis));
+  for (std::size_t i = m + 1; i <= n; ++i) e += w * step(measured, p.measured + i) * std::abs(s(m) - r(i));
   return e;
 }
 

@@ -17,6 +17,16 @@
 // unsigned area between the two curves over travel [N m], plus a w-weighted penalty for a
 // different length (a trial that stops at 10 N too early or too late).
 //
+// Where the pairs begin. Pairing by index assumes both sequences start with the pull. 21 of the
+// study's 22 recordings do, within 1.1 mm of travel (the recorder's start-up, the first 0.05 s of
+// the 1 m/s^2 ramp); s0-middlemiss-10, the one trial at 0.15 m/s, starts 0.0958 m into its pull.
+// Paired from the simulation's first sample, each of its samples met a simulated one 0.096 m
+// behind it, and the 67 simulated samples left at the end were scored at w = 20 (session 45:
+// 0.53 of participant 0's middle-arm L 1.10). So when one sequence starts more than kLateStart
+// further along than the other, the earlier one's samples before that travel are skipped and
+// i = 0 pairs the later start with the first sample at or beyond its travel (paired_start).
+// The 5 mm leave every recording that starts with the pull paired as the paper pairs it.
+//
 // PositionWeighted: the variant in the paper's public code (gt-rad/learning-forces,
 // physx_simulation CMAES HapticObjective, evalObj), described here in our own words as we read
 // it: walk the *measured* samples; at each measured travel x_i the simulated force is linearly
@@ -29,8 +39,9 @@
 // Both axes are summed inside, so it is a whole-sequence error (no per-axis split).
 #pragma once
 
-#include <string_view>
+#include <cstddef>
 #include <optional>
+#include <string_view>
 #include <vector>
 
 #include "haptic.h"
@@ -45,7 +56,18 @@ enum class ForceAxis { Motion, Vertical, Lateral };
 
 inline constexpr double kLengthPenaltyWeight = 20.0;  // w of eq. 4
 
-// eq. 3-4 for one axis. `sim` and `measured` need at least one sample each.
+inline constexpr double kLateStart = 0.005;  // [m] see "Where the pairs begin" above
+
+// The first index of each sequence that eq. 3 pairs (i = 0): both 0 unless one starts more than
+// kLateStart further along; then the other's first sample at or beyond that travel (its last
+// sample if it never gets there).
+struct PairedStart {
+  std::size_t sim = 0;
+  std::size_t measured = 0;
+};
+PairedStart paired_start(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured);
+
+// eq. 3-4 for one axis, paired from paired_start(). `sim` and `measured` need at least one sample each.
 double area_error(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured, ForceAxis axis,
                   double w = kLengthPenaltyWeight);
 

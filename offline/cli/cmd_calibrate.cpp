@@ -29,6 +29,50 @@ namespace {
   return buf;
 }
 
+// calibrate --rescore: a calibration file's figures again by this build's objective, its values
+// unchanged (calibration.h, rescore). Its own inputs, gown and offsets; one batch of simulations.
+int rescore_file(const Args& args) {
+  args.allow_only({"help", "json", "rescore", "data", "out", "why"});
+  const std::string file = args.require("rescore");
+  const std::string data = args.require("data");
+  const std::string out = args.require("out");
+  Calibration cal;
+  try {
+    cal = read_calibration(file);
+  } catch (const std::exception& e) {
+    throw UsageError("--rescore " + file + ": " + e.what());
+  }
+  std::vector<std::string> ids;
+  for (const SequenceFit& f : cal.fits) ids.push_back(f.trial_id);
+  std::vector<HapticSequence> inputs;
+  try {
+    inputs = inputs_by_id(load_dataset(data), cal.participant, ids);
+  } catch (const InputError& e) {
+    throw UsageError("--rescore " + file + ": its inputs in " + data + "/manifest.csv: " + e.what());
+  }
+#ifndef DRESSGUARD_HAVE_SIM
+  throw UsageError("this dressguard was built without the cloth simulator (offline/sim); --rescore needs it");
+#else
+  const ClothSimulator sim = make_cloth_simulator(cal.gown);
+  const std::vector<SimulatedTrial> curves = simulate_inputs(sim.trials, cal.cloth, cal.offsets, inputs);
+  const Calibration before = cal;
+  rescore(cal, inputs, curves, args.get("why").value_or("the objective's definition changed"), utc_now());
+  write_calibration(out, cal);
+  write_file_atomic(out + ".curves.csv", overlay_csv(inputs, curves, "simulated"));
+  if (args.has("json")) {
+    std::printf("%s\n", calibration_to_json(cal).dump(0).c_str());
+  } else {
+    std::printf("%s, participant %s: L = %.4f (recorded %.4f)\n", file.c_str(), cal.participant.c_str(), cal.objective,
+                before.objective);
+    for (std::size_t k = 0; k < cal.fits.size(); ++k)
+      std::printf("  %-18s L = %.4f (recorded %.4f)\n", cal.fits[k].trial_id.c_str(), cal.fits[k].objective,
+                  before.fits[k].objective);
+    std::printf("wrote %s and %s.curves.csv\n", out.c_str(), out.c_str());
+  }
+  return 0;
+#endif
+}
+
 }  // namespace
 
 int run_calibrate(int argc, char** argv) {
@@ -99,9 +143,15 @@ int run_calibrate(int argc, char** argv) {
         "  --stop-after-generations K   stop after K generations in this process (resume later)\n"
         "  --json              machine-readable summary on stdout\n"
         "  Writes CAL.json and CAL.json.curves.csv (measured and simulated curves; plot them with\n"
-        "  tools/plot/calib_overlay.py). Under mpirun every rank runs a share of each generation.");
+        "  tools/plot/calib_overlay.py). Under mpirun every rank runs a share of each generation.\n"
+        "\n"
+        "       dressguard calibrate --rescore CAL.json --data DATASET --out NEW.json [--why TEXT]\n"
+        "  Scores CAL.json again on its own sequences by this build's objective, its values\n"
+        "  unchanged (after a change of the objective's definition); the figures it replaces go\n"
+        "  into NEW.json's provenance \"rescored\" with TEXT. Writes NEW.json.curves.csv too.");
     return 0;
   }
+  if (args.has("rescore")) return rescore_file(args);
   args.allow_only({"help", "json", "no-arm-offset", "data", "participant", "profile", "bounds", "start", "seed", "out",
                    "checkpoint", "objective", "gown", "threads", "generations", "population",
                    "stop-after-generations", "arm-compliance", "fist-shift", "rim-shift", "sigma0", "hem",

@@ -324,6 +324,53 @@ TEST(Calibration, FileOfASearchRecordsItsChoices) {
   EXPECT_NEAR(c.rig_travel, 0.7, 0.002);  // the low input's last sample: 1 mm apart at 0.1 m/s, 100 Hz
 }
 
+// calibrate --rescore: a file's figures again from its values' curves by this build's objective,
+// its values kept, and what each figure was in provenance "rescored", one entry per rescoring.
+// The curves are the inputs with F_motion 0.1 N and 0.2 N lower, so each L is that offset times
+// the travel the pairs cover (eq. 3 in closed form); the second input is recorded from its 100th
+// sample on, as s0-middlemiss-10 is, and is paired from the same travel (objective.h).
+TEST(Calibration, RescoreScoresTheFileAgainAndKeepsWhatItReplaced) {
+  auto inputs = fake_inputs(Truth{});
+  ASSERT_EQ(inputs.size(), 2u);
+  std::vector<SimulatedTrial> sims(2);
+  for (std::size_t k = 0; k < 2; ++k) {
+    sims[k].samples = inputs[k].samples;
+    for (auto& x : sims[k].samples) x.f_motion -= 0.1 * static_cast<double>(k + 1);
+  }
+  auto& late = inputs[1].samples;
+  late.erase(late.begin(), late.begin() + 100);
+  ASSERT_GT(late.front().travel, kLateStart);
+  Calibration c;
+  c.participant = "9";
+  c.cloth.friction = 0.4;
+  c.fits.resize(2);
+  for (std::size_t k = 0; k < 2; ++k) {
+    c.fits[k].trial_id = inputs[k].id;
+    c.fits[k].objective = 5.0 + static_cast<double>(k);
+  }
+  c.objective = 11.0;
+  rescore(c, inputs, sims, "a test", "2026-11-29T00:00:00Z");
+  for (std::size_t k = 0; k < 2; ++k) {
+    const auto& m = inputs[k].samples;
+    EXPECT_EQ(c.fits[k].objective, area_objective(sims[k].samples, m));
+    EXPECT_NEAR(c.fits[k].objective, 0.1 * static_cast<double>(k + 1) * (m.back().travel - m.front().travel), 1e-9);
+    EXPECT_TRUE(c.fits[k].motion.measured());
+  }
+  EXPECT_EQ(c.objective, c.fits[0].objective + c.fits[1].objective);
+  EXPECT_EQ(c.cloth.friction, 0.4);
+  const double first = c.objective;
+  rescore(c, inputs, sims, "again", "2026-11-30T00:00:00Z");
+  const auto& entries = c.provenance.at("rescored").items();
+  ASSERT_EQ(entries.size(), 2u);
+  EXPECT_EQ(entries[0].at("why").string(), "a test");
+  EXPECT_EQ(entries[0].at("before").at("objective").number(), 11.0);
+  EXPECT_EQ(entries[0].at("before").at("fits").at(inputs[1].id).number(), 6.0);
+  EXPECT_EQ(entries[1].at("before").at("objective").number(), first);
+  EXPECT_EQ(c.objective, first);
+  std::swap(inputs[0], inputs[1]);  // not in the file's order
+  EXPECT_THROW(rescore(c, inputs, sims, "", ""), std::invalid_argument);
+}
+
 // Two sequences that no single cloth fits (made with friction 0.9 and 0.3, no offsets to fit):
 // the search must trade one against the other. At the two minimisers, a (Worst) and b (Sum),
 // max(a) + rho sum(a) <= max(b) + rho sum(b) and sum(b) <= sum(a), hence max(a) <= max(b): the

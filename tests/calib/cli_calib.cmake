@@ -225,6 +225,24 @@ if(STUDY)
   if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/c1-progress.png)
     message(FATAL_ERROR "calib_overlay.py progress on calibrate's log (${rc}): ${err}")
   endif()
+  # Scored again by this build (calibrate --rescore): a file this build just wrote keeps every
+  # figure to its last digit (the objective, each sequence's L and axis fits, both terms); the
+  # provenance gains what it replaced and why. Bad input names the file.
+  execute_process(COMMAND ${DG} calibrate --rescore ${WORK}/c1.json --data ${WORK}/study --out ${WORK}/c1r.json
+                          --why "a test"
+                  RESULT_VARIABLE rrc OUTPUT_VARIABLE rout ERROR_VARIABLE rerr)
+  if(EXISTS ${WORK}/c1r.json)
+    file(READ ${WORK}/c1r.json c1r)
+    string(REGEX REPLACE ",\n +\"rescored\": \\[.*\\]\n  }\n}\n$" "\n  }\n}\n" c1r_unrescored "${c1r}")
+  endif()
+  if(NOT rrc EQUAL 0 OR NOT EXISTS ${WORK}/c1r.json.curves.csv OR NOT c1r_unrescored STREQUAL c1
+     OR NOT c1r MATCHES "\"rescored\": \\[\n +{\n +\"when\": \"[0-9T:Z-]+\",\n +\"why\": \"a test\",\n +\"before\": {\n +\"objective\": [0-9]"
+     OR NOT rout MATCHES "participant 4: L = ([0-9.]+) \\(recorded ([0-9.]+)\\)\n  s4-good-3 "
+     OR NOT CMAKE_MATCH_1 STREQUAL CMAKE_MATCH_2)
+    message(FATAL_ERROR "calibrate --rescore on a file of this build (${rrc}):\n${rout}\n${rerr}")
+  endif()
+  expect_fail("rescore a missing file" "--rescore ${WORK}/none.json" calibrate --rescore ${WORK}/none.json --data ${WORK}/study --out ${WORK}/x.json)
+  expect_fail("rescore with a calibrate option" "--participant" calibrate --rescore ${WORK}/c1.json --data ${WORK}/study --out ${WORK}/x.json --participant 4)
   # Its curves (with F_lateral since 2026-11-25) overlaid on the measured ones.
   file(STRINGS ${WORK}/c1.json.curves.csv header LIMIT_COUNT 1)
   execute_process(COMMAND /usr/bin/python3 ${PLOT} fit ${WORK}/c1.json.curves.csv --out ${WORK}/c1-fit.png

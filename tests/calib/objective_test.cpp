@@ -94,6 +94,43 @@ TEST(Objective, ContrastErrorClosedForm) {
   EXPECT_THROW(contrast_error({}, flat, flat, flat, kLatestCut), std::invalid_argument);
 }
 
+// A recording that starts late (objective.h, "Where the pairs begin"). The measured curve is the
+// simulated one from 0.096 m on, sample for sample (the forces a function of travel only): paired
+// from the simulation's first sample its L would be the area between the curve and itself
+// shifted by 0.096 m plus the w = 20 tail; paired from the same travel it is 0, exactly, both ways
+// round. A start within kLateStart pairs as the paper pairs (index 0 with 0).
+TEST(Objective, LateStartPairsFromTheSameTravel) {
+  const double h = 0.001;
+  auto f = [](int k) { return -0.01 * k; };  // F_motion -10 N/m of travel, sample k at k mm
+  std::vector<HapticSample> sim, late;
+  for (int k = 0; k <= 850; ++k) sim.push_back({k * 0.01, k * h, f(k), 0.0, 0.5 * f(k)});
+  for (int k = 96; k <= 850; ++k) late.push_back({(k - 96) * 0.01, k * h, f(k), 0.0, 0.5 * f(k)});
+  const PairedStart p = paired_start(sim, late);
+  EXPECT_EQ(p.sim, 96u);
+  EXPECT_EQ(p.measured, 0u);
+  EXPECT_EQ(area_objective(sim, late), 0.0);
+  EXPECT_EQ(area_objective(late, sim), 0.0);
+  EXPECT_EQ(paired_start(late, sim).measured, 96u);
+  // Shifted back to start with the pull, the same samples are 0.096 m off: 0.96 N (and 0.48 N)
+  // over 0.754 m, plus the simulation's 96 extra samples at w = 20, all in closed form.
+  auto early = late;
+  for (std::size_t i = 0; i < early.size(); ++i) early[i].travel = static_cast<double>(i) * h;
+  double tail = 0;
+  for (int k = 755; k <= 850; ++k) tail += kLengthPenaltyWeight * h * 1.5 * std::abs(f(k) - f(850));
+  EXPECT_NEAR(area_objective(sim, early), 1.5 * 0.96 * 0.754 + tail, 1e-9);
+  // 4 mm late: within kLateStart, paired by index as eq. 3 does.
+  std::vector<HapticSample> near(sim.begin() + 4, sim.end());
+  EXPECT_EQ(paired_start(sim, near).sim, 0u);
+  EXPECT_EQ(paired_start(sim, near).measured, 0u);
+  // A simulation that stops before the late start pairs its last sample with the first measured
+  // one; the rest is the measurement running longer (eq. 4's third case).
+  const std::vector<HapticSample> short_sim(sim.begin(), sim.begin() + 51);
+  EXPECT_EQ(paired_start(short_sim, late).sim, 50u);
+  double longer = 0;
+  for (int k = 97; k <= 850; ++k) longer += kLengthPenaltyWeight * h * 1.5 * std::abs(f(50) - f(k));
+  EXPECT_NEAR(area_objective(short_sim, late), longer, 1e-9);
+}
+
 TEST(Objective, ParseNames) {
   EXPECT_EQ(parse_objective("area"), ObjectiveKind::Area);
   EXPECT_EQ(parse_objective("position-weighted"), ObjectiveKind::PositionWeighted);
@@ -140,6 +177,27 @@ TEST(Objective, YardstickOnMeasuredRepeats) {
   // Symmetry between repeats: swapping the roles moves L by less than 0.001 (dx choice).
   EXPECT_NEAR(L("s1-good-3", "s1-good-1"), good, 1e-3);
   EXPECT_NEAR(L("s1-miss-4", "s1-miss-1"), missed, 1e-3);
+}
+
+// The study's starts, which kLateStart rests on: every recording but one starts within 1.1 mm of its
+// pull's start; s0-middlemiss-10 (0.15 m/s) starts 0.0958 m in, and only it pairs from a later
+// simulated sample against a pull from 0.
+TEST(Objective, OneStudyRecordingStartsLate) {
+  const auto dir = study_dir();
+  if (dir.empty()) GTEST_SKIP() << "shared/data/kapusta2016-calibration-trials not present";
+  const Dataset ds = import_study(dir);
+  const std::vector<HapticSample> pull = constant_curve(901, 0.001, 0.0, 0.0);  // from travel 0
+  for (const auto& t : ds.trials) {
+    const PairedStart p = paired_start(pull, t.samples);
+    if (t.id == "s0-middlemiss-10") {
+      EXPECT_NEAR(t.samples.front().travel, 0.0958, 5e-5);
+      EXPECT_EQ(p.sim, 96u) << "the simulated sample at 0.096 m";
+    } else {
+      EXPECT_LT(t.samples.front().travel, 0.0011) << t.id;
+      EXPECT_EQ(p.sim, 0u) << t.id;
+    }
+    EXPECT_EQ(p.measured, 0u) << t.id;
+  }
 }
 
 // Across people (same class, different participants): the issue states medians 0.57 (good),

@@ -358,9 +358,11 @@ TEST(SimCalibration, Participant1sSmallStepCalibrationFitsTheirSequences) {
 }
 
 // Participant 0, three sequences (8 x 24 from their session-11 values; session 18). Far from the
-// issue's 0.3: 0.705, 1.522 and 0.873, bounded here by 1.55, below session 11's worst, 1.562.
+// issue's 0.3: 0.705, 1.522 and 0.873 as searched; the middle 0.888 since session 45 paired its
+// late-starting recording from the same travel (objective.h; the file rescored: calibrate
+// --rescore). Bounded here by 0.89.
 TEST(SimCalibration, Participant0sCalibrationFitsTheirSequences) {
-  expect_fits_own_sequences_to_the_bit("participant0-simulator.json", 1.55);
+  expect_fits_own_sequences_to_the_bit("participant0-simulator.json", 0.89);
 }
 
 // Participant 2, three sequences (6 x 16 from their session-12 values as that session's table
@@ -445,15 +447,17 @@ TEST(SimCalibration, Participant5sContrastCalibrationFitsTheirSequences) {
 
 // Participant 0 with the heights' contrast in the objective (calibrate --contrast-weight 5, 6 x 16,
 // sigma0 0.05, from their shipped file; sessions 21-22): every sequence fits better than the
-// shipped file's (0.705, 1.522, 0.873): 0.631, 1.231 and 0.829, bounded here by 1.25.
+// shipped file's (0.705, 1.522, 0.873): 0.631, 1.231 and 0.829; rescored in session 45, the middle
+// 0.764 (as above). Bounded here by 0.83.
 TEST(SimCalibration, Participant0sContrastCalibrationFitsTheirSequences) {
-  expect_fits_own_sequences_to_the_bit("participant0-contrast.json", 1.25);
+  expect_fits_own_sequences_to_the_bit("participant0-contrast.json", 0.83);
 }
 
 // Participant 0 searched on from it by the paper's sum (8 x 32, sigma0 0.03, seed 1, one thread;
-// session 41): 0.502, 1.104 and 0.767, every sequence lower again; bounded here by 1.11.
+// session 41): 0.502, 1.104 and 0.767, every sequence lower again; rescored in session 45, the
+// middle 0.838 (as above; the search had fitted the misaligned curve). Bounded here by 0.84.
 TEST(SimCalibration, Participant0sSmallerStepCalibrationFitsTheirSequences) {
-  expect_fits_own_sequences_to_the_bit("participant0-fine.json", 1.11);
+  expect_fits_own_sequences_to_the_bit("participant0-fine.json", 0.84);
 }
 
 // Participant 1 likewise (6 x 16, sigma0 0.05; sessions 21-22): good 0.248 (was 0.428), missed
