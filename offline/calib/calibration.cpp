@@ -337,7 +337,9 @@ void rescore(Calibration& c, const std::vector<HapticSequence>& inputs, const st
                                 " simulated trials");
   const auto kind = parse_objective(c.objective_kind);
   const auto combine = parse_combine(c.combine);
-  if (!kind || !combine) throw std::invalid_argument("rescore: unknown objective '" + c.objective_kind + "' or combination '" + c.combine + "'");
+  if (!kind || !combine)
+    throw std::invalid_argument("rescore: unknown objective '" + c.objective_kind + "' or combination '" + c.combine +
+                                "'");
   Json before = Json::object();
   before.set("objective", c.objective);
   Json fits = Json::object();
