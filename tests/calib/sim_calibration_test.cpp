@@ -467,6 +467,12 @@ TEST(SimCalibration, Participant0sPairedFromTheSameTravelFitsTheirSequences) {
   expect_fits_own_sequences_to_the_bit("participant0-fine2.json", 0.806);
 }
 
+// A second round from it (10 x 32, the same command; session 45): 0.2721, 0.4914 and 0.6519, sum
+// 1.415; the good sequence within the 0.3. Bounded here by 0.652.
+TEST(SimCalibration, Participant0sSecondPairedRoundFitsTheirSequences) {
+  expect_fits_own_sequences_to_the_bit("participant0-fine3.json", 0.652);
+}
+
 // Participant 1 likewise (6 x 16, sigma0 0.05; sessions 21-22): good 0.248 (was 0.428), missed
 // 0.477 (was 0.414), bounded here by 0.5.
 TEST(SimCalibration, Participant1sContrastCalibrationFitsTheirSequences) {
