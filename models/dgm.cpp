@@ -1,6 +1,7 @@
 // The .dgm model file: encoding, decoding and validation. The byte layout is FORMAT.md's.
 #include "dgm.h"
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <cmath>
@@ -9,6 +10,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 #include <system_error>
 
 #include <unistd.h>
@@ -26,6 +28,26 @@ int OutcomeModel::class_index(std::string_view name) const {
   for (size_t i = 0; i < classes.size(); ++i)
     if (classes[i].name == name) return static_cast<int>(i);
   return -1;
+}
+
+ClassHmm left_right_chain(int n_states, double stay, int band) {
+  if (n_states < 1) throw std::invalid_argument("left_right_chain: n_states must be >= 1");
+  const int n = n_states;
+  ClassHmm h;
+  h.n_states = n;
+  h.initial.assign(n, 0.0);
+  h.initial[0] = 1.0;
+  h.transition.assign(n * n, 0.0);
+  for (int i = 0; i < n; ++i) {
+    const int reach = std::min(band, n - 1 - i);
+    if (reach <= 0) {
+      h.transition[i * n + i] = 1.0;
+      continue;
+    }
+    h.transition[i * n + i] = stay;
+    for (int d = 1; d <= reach; ++d) h.transition[i * n + i + d] = (1.0 - stay) / reach;
+  }
+  return h;
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -73,6 +73,12 @@ struct ClassHmm {
   double log_prior = 0.0;                  // log P(class), from the training counts
 };
 
+// A left-right chain of n states, starting in state 0: each state stays with probability
+// `stay` (a mean dwell of 1 / (1 - stay) samples) and moves on by 1..band states with equal shares
+// of the rest, (1 - stay) / reach, reach = min(band, n - 1 - i); the last state absorbs. The
+// name, the emissions and the prior are left for the caller (tests, benchmarks, fixtures).
+ClassHmm left_right_chain(int n_states, double stay, int band = 1);
+
 struct OutcomeModel {
   // Creation metadata: which tool made the file, when, from what, and how the training went.
   std::string tool_version;      // e.g. "dressguard 0.1.0"

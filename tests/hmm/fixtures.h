@@ -16,21 +16,8 @@ namespace dressguard::fx {
 // (as a force profile progresses with travel; neighbours >= 5 standard deviations apart), covariance [[0.30 0.08][0.08 0.20]] scaled by `spread`, stay probability `stay`
 // (mean dwell 1/(1-stay) samples), the last state absorbing. `phase` makes different classes.
 inline model::ClassHmm known_left_right(int n, double stay, double phase = 0.0, double spread = 1.0, int band = 1) {
-  model::ClassHmm h;
+  model::ClassHmm h = model::left_right_chain(n, stay, band);
   h.name = "class";
-  h.n_states = n;
-  h.initial.assign(n, 0.0);
-  h.initial[0] = 1.0;
-  h.transition.assign(n * n, 0.0);
-  for (int i = 0; i < n; ++i) {
-    const int reach = std::min(band, n - 1 - i);
-    if (reach == 0) {
-      h.transition[i * n + i] = 1.0;
-      continue;
-    }
-    h.transition[i * n + i] = stay;
-    for (int d = 1; d <= reach; ++d) h.transition[i * n + i + d] = (1.0 - stay) / reach;
-  }
   for (int j = 0; j < n; ++j) {
     model::GaussianEmission e;
     e.mean[0] = 3.0 * j - 1.5 * n + phase;

@@ -7,7 +7,9 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "dgm.h"
 
@@ -28,16 +30,8 @@ OutcomeModel sample_model() {
   m.features.scale[1] = 0.5;
   const char* names[] = {"good", "missed", "caught"};
   for (int c = 0; c < 3; ++c) {
-    ClassHmm h;
+    ClassHmm h = left_right_chain(10, 0.875);
     h.name = names[c];
-    h.n_states = 10;
-    h.initial.assign(10, 0.0);
-    h.initial[0] = 1.0;
-    h.transition.assign(100, 0.0);
-    for (int i = 0; i < 10; ++i) {
-      h.transition[i * 10 + i] = i == 9 ? 1.0 : 0.875;
-      if (i < 9) h.transition[i * 10 + i + 1] = 0.125;
-    }
     for (int j = 0; j < 10; ++j) {
       GaussianEmission e;
       e.mean[0] = 0.5 * j + c;
@@ -90,6 +84,21 @@ void expect_rejected(const std::vector<uint8_t>& b, const std::string& what) {
 }
 
 }  // namespace
+
+// The chain the tests and benchmarks build their models on: stays, moves on by 1..band states in
+// equal shares, absorbs at the end, starts in state 0; every row a distribution.
+TEST(LeftRightChain, StaysMovesOnWithinTheBandAndAbsorbsAtTheEnd) {
+  const ClassHmm a = left_right_chain(4, 0.75);
+  const std::vector<double> expect = {0.75, 0.25, 0, 0,  0, 0.75, 0.25, 0,  0, 0, 0.75, 0.25,  0, 0, 0, 1};
+  EXPECT_EQ(a.n_states, 4);
+  EXPECT_EQ(a.transition, expect);
+  EXPECT_EQ(a.initial, (std::vector<double>{1, 0, 0, 0}));
+  const ClassHmm b = left_right_chain(4, 0.5, 2);  // reach 2, 2, 1, 0
+  const std::vector<double> band2 = {0.5, 0.25, 0.25, 0,  0, 0.5, 0.25, 0.25,  0, 0, 0.5, 0.5,  0, 0, 0, 1};
+  EXPECT_EQ(b.transition, band2);
+  EXPECT_EQ(left_right_chain(1, 0.9).transition, std::vector<double>{1.0});
+  EXPECT_THROW(left_right_chain(0, 0.9), std::invalid_argument);
+}
 
 // The standard check value of CRC-32/IEEE.
 TEST(ModelFile, Crc32KnownAnswer) {

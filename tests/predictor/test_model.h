@@ -16,20 +16,8 @@ namespace dressguard::testkit {
 // vertical -1 N). Unit covariances: a sample at -6 N gives caught a likelihood ratio of e^8 over
 // good, so the posterior crosses 0.9 within a few samples.
 inline model::ClassHmm test_class(const std::string& name, double m0, double m1, int states = 2) {
-  model::ClassHmm c;
+  model::ClassHmm c = model::left_right_chain(states, 0.9);
   c.name = name;
-  c.n_states = states;
-  c.initial.assign(states, 0.0);
-  c.initial[0] = 1.0;
-  c.transition.assign(states * states, 0.0);
-  for (int i = 0; i < states; ++i) {
-    if (i + 1 < states) {
-      c.transition[i * states + i] = 0.9;
-      c.transition[i * states + i + 1] = 0.1;
-    } else {
-      c.transition[i * states + i] = 1.0;
-    }
-  }
   for (int i = 0; i < states; ++i) {
     model::GaussianEmission e;
     e.mean[0] = m0;

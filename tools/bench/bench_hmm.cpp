@@ -29,17 +29,8 @@ namespace {
 
 // Class c's 10-state left-right HMM: means progress along the states, class-specific.
 model::ClassHmm class_hmm(int c, int n, double mean_len) {
-  model::ClassHmm h;
+  model::ClassHmm h = model::left_right_chain(n, 1.0 - n / mean_len);  // dwell mean_len / n
   h.name = c == 0 ? "good" : c == 1 ? "missed" : "caught";
-  h.n_states = n;
-  h.initial.assign(n, 0.0);
-  h.initial[0] = 1.0;
-  h.transition.assign(n * n, 0.0);
-  const double stay = 1.0 - n / mean_len;
-  for (int i = 0; i < n; ++i) {
-    h.transition[i * n + i] = i == n - 1 ? 1.0 : stay;
-    if (i < n - 1) h.transition[i * n + i + 1] = 1.0 - stay;
-  }
   for (int j = 0; j < n; ++j) {
     model::GaussianEmission e;
     e.mean[0] = -2.0 + (4.0 + c) * j / n;

@@ -44,16 +44,10 @@ model::OutcomeModel bench_model() {
   const char* names[3] = {"good", "missed", "caught"};
   const double end_drag[3] = {-5.0, -4.5, -10.0}, end_vert[3] = {0.0, -1.7, -6.0};
   for (int c = 0; c < 3; ++c) {
-    model::ClassHmm h;
-    h.name = names[c];
     const int n = 10;
-    h.n_states = n;
-    h.initial.assign(n, 0.0);
-    h.initial[0] = 1.0;
-    h.transition.assign(n * n, 0.0);
+    model::ClassHmm h = model::left_right_chain(n, 0.98);
+    h.name = names[c];
     for (int i = 0; i < n; ++i) {
-      h.transition[i * n + i] = i + 1 < n ? 0.98 : 1.0;
-      if (i + 1 < n) h.transition[i * n + i + 1] = 0.02;
       model::GaussianEmission e;
       e.mean[0] = end_drag[c] * i / (n - 1);
       e.mean[1] = end_vert[c] * i / (n - 1);

@@ -31,16 +31,7 @@ double relp(double a, double b) { return std::fabs(a - b) / std::max(std::fabs(b
 // The left-right truth the data are drawn from: n states whose means progress smoothly, dwell
 // mean_len/n samples, a full covariance that rotates along the states.
 model::ClassHmm truth(int n, double mean_len) {
-  model::ClassHmm h;
-  h.n_states = n;
-  h.initial.assign(n, 0.0);
-  h.initial[0] = 1.0;
-  h.transition.assign(n * n, 0.0);
-  const double stay = 1.0 - n / mean_len;
-  for (int i = 0; i < n; ++i) {
-    h.transition[i * n + i] = i == n - 1 ? 1.0 : stay;
-    if (i < n - 1) h.transition[i * n + i + 1] = 1.0 - stay;
-  }
+  model::ClassHmm h = model::left_right_chain(n, 1.0 - n / mean_len);
   for (int j = 0; j < n; ++j) {
     model::GaussianEmission e;
     e.mean[0] = -3.0 + 6.0 * j / n + 0.5 * std::sin(1.3 * j);
