@@ -475,6 +475,13 @@ TEST(SimCalibration, Participant0sThirdPairedRoundFitsTheirSequences) {
   expect_fits_own_sequences_to_the_bit("participant0-fine4.json", 0.6411);
 }
 
+// A fourth round from it (10 x 32; session 46): 0.2606, 0.4413 and 0.6027, sum 1.305; the worst
+// and the sum lower again, the good sequence back within 0.3; the fist at its box's edge
+// (0.15 m toward the elbow). Bounded here by 0.6028.
+TEST(SimCalibration, Participant0sFourthPairedRoundFitsTheirSequences) {
+  expect_fits_own_sequences_to_the_bit("participant0-fine5.json", 0.6028);
+}
+
 // Participant 1 likewise (6 x 16, sigma0 0.05; sessions 21-22): good 0.248 (was 0.428), missed
 // 0.477 (was 0.414), bounded here by 0.5.
 TEST(SimCalibration, Participant1sContrastCalibrationFitsTheirSequences) {
