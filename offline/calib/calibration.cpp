@@ -134,7 +134,11 @@ Bounds read_bounds(const std::filesystem::path& path) {
 
 namespace {
 double to_unit(const ParamBound& b, double v) { return (v - b.lower) / (b.upper - b.lower); }
-double from_unit(const ParamBound& b, double u) { return b.lower + u * (b.upper - b.lower); }
+// u is within [0, 1] (CMA-ES hands out repaired points); the clamp keeps the rounding of u = 1
+// from landing past the box (-0.05 + 1 x 0.2 = 0.15000000000000002), where --start refuses it.
+double from_unit(const ParamBound& b, double u) {
+  return std::clamp(b.lower + u * (b.upper - b.lower), b.lower, b.upper);
+}
 }  // namespace
 
 Eigen::VectorXd ParameterSpace::initial_unit() const {
@@ -704,7 +708,12 @@ void measure_axis_fits(std::vector<SequenceFit>& fits, const std::vector<HapticS
 }
 
 void start_from(Bounds& b, const Calibration& c) {
-  auto check = [](const ParamBound& pb, double v, const std::string& name) {
+  // A value past its box by no more than rounding is the box's edge: files written before
+  // from_unit() clamped (session 46) end there when their search did (participant0-fine5.json).
+  auto check = [](const ParamBound& pb, double& v, const std::string& name) {
+    const double slack = 1e-12 * (pb.upper - pb.lower);
+    if (v > pb.upper && v <= pb.upper + slack) v = pb.upper;
+    if (v < pb.lower && v >= pb.lower - slack) v = pb.lower;
     if (!(v >= pb.lower && v <= pb.upper)) {
       char buf[200];
       std::snprintf(buf, sizeof buf, "%s %g is outside its bounds [%g, %g]", name.c_str(), v, pb.lower, pb.upper);
@@ -712,13 +721,14 @@ void start_from(Bounds& b, const Calibration& c) {
     }
   };
   for (int i = 0; i < kClothParams; ++i) {
-    check(b.cloth[i], cloth_value(c.cloth, i), kClothParamNames[i]);
-    b.cloth[i].initial = cloth_value(c.cloth, i);
+    double v = cloth_value(c.cloth, i);
+    check(b.cloth[i], v, kClothParamNames[i]);
+    b.cloth[i].initial = v;
   }
   for (int i = 0; i < kPersonParams; ++i) {
     // The paper's value outside the box (no support, where the box holds one) keeps the box's
     // own start: the start file simply did not have it.
-    const double v = person_value(c.cloth, i);
+    double v = person_value(c.cloth, i);
     if (v == kPersonParamInfo[i].paper && !(v >= b.person[i].lower && v <= b.person[i].upper)) continue;
     check(b.person[i], v, kPersonParamInfo[i].name);
     b.person[i].initial = v;
@@ -727,8 +737,9 @@ void start_from(Bounds& b, const Calibration& c) {
   for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
     const int k = static_cast<int>(h);
     if (!c.offset_calibrated[k]) continue;
-    check(b.arm_offset, c.offsets[k], "arm_offset_" + std::string(arm_height_name(h)));
-    b.offset_initial[k] = c.offsets[k];
+    double v = c.offsets[k];
+    check(b.arm_offset, v, "arm_offset_" + std::string(arm_height_name(h)));
+    b.offset_initial[k] = v;
   }
 }
 

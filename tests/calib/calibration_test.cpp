@@ -734,6 +734,25 @@ TEST(Calibration, StartFromACalibration) {
   Calibration high = c;
   high.offsets[0] = 0.1;
   EXPECT_NE(refused(high).find("arm_offset_high 0.1"), std::string::npos) << refused(high);
+  // A search that ends at a box's edge: u = 1 is the edge exactly (not 0.15000000000000002 for
+  // the fist's [-0.05, 0.15]), and a file that holds the edge rounded past it, as files written
+  // before session 46 do, starts at the edge; a real step past it is refused.
+  ParameterSpace es;
+  es.bounds = default_bounds();
+  ASSERT_TRUE(set_person_param(es, kFistShift, "fit"));
+  Eigen::VectorXd ue = es.initial_unit();
+  ASSERT_EQ(ue.size(), kClothParams + 1);
+  ue[kClothParams] = 1.0;
+  EXPECT_EQ(es.cloth(ue).fist_shift, 0.15);
+  Calibration edge = c;
+  edge.cloth.fist_shift = -0.05 + 1.0 * (0.15 - -0.05);
+  ASSERT_GT(edge.cloth.fist_shift, 0.15);
+  Bounds eb = default_bounds();
+  start_from(eb, edge);
+  EXPECT_EQ(eb.person[kFistShift].initial, 0.15);
+  Calibration past = c;
+  past.cloth.fist_shift = 0.1501;
+  EXPECT_NE(refused(past).find("fist_shift 0.1501 is outside its bounds"), std::string::npos) << refused(past);
   // A start without a support (the paper's 0, outside the support's box) keeps the box's own
   // start; one with a support starts from it; a support outside the box is refused.
   ASSERT_TRUE(set_person_param(s, kSupportDepth, "fit"));
