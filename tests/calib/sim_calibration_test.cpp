@@ -482,6 +482,13 @@ TEST(SimCalibration, Participant0sFourthPairedRoundFitsTheirSequences) {
   expect_fits_own_sequences_to_the_bit("participant0-fine5.json", 0.6028);
 }
 
+// A fifth round from it at the small step (5 x 32, sigma0 0.001; session 47), where a third of
+// the landscape's points lay below it: 0.2310, 0.4074 and 0.5879, sum 1.226; every sequence
+// lower. Bounded here by 0.588.
+TEST(SimCalibration, Participant0sSmallStepRoundFitsTheirSequences) {
+  expect_fits_own_sequences_to_the_bit("participant0-fine6.json", 0.588);
+}
+
 // Participant 1 likewise (6 x 16, sigma0 0.05; sessions 21-22): good 0.248 (was 0.428), missed
 // 0.477 (was 0.414), bounded here by 0.5.
 TEST(SimCalibration, Participant1sContrastCalibrationFitsTheirSequences) {
