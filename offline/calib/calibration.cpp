@@ -710,36 +710,32 @@ void measure_axis_fits(std::vector<SequenceFit>& fits, const std::vector<HapticS
 void start_from(Bounds& b, const Calibration& c) {
   // A value past its box by no more than rounding is the box's edge: files written before
   // from_unit() clamped (session 46) end there when their search did (participant0-fine5.json).
-  auto check = [](const ParamBound& pb, double& v, const std::string& name) {
+  // Returns v, or the edge it is past by rounding alone; throws when it is outside the box.
+  auto in_box = [](const ParamBound& pb, double v, const std::string& name) {
     const double slack = 1e-12 * (pb.upper - pb.lower);
-    if (v > pb.upper && v <= pb.upper + slack) v = pb.upper;
-    if (v < pb.lower && v >= pb.lower - slack) v = pb.lower;
+    if (v > pb.upper && v <= pb.upper + slack) return pb.upper;
+    if (v < pb.lower && v >= pb.lower - slack) return pb.lower;
     if (!(v >= pb.lower && v <= pb.upper)) {
       char buf[200];
       std::snprintf(buf, sizeof buf, "%s %g is outside its bounds [%g, %g]", name.c_str(), v, pb.lower, pb.upper);
       throw std::invalid_argument(buf);
     }
+    return v;
   };
-  for (int i = 0; i < kClothParams; ++i) {
-    double v = cloth_value(c.cloth, i);
-    check(b.cloth[i], v, kClothParamNames[i]);
-    b.cloth[i].initial = v;
-  }
+  for (int i = 0; i < kClothParams; ++i)
+    b.cloth[i].initial = in_box(b.cloth[i], cloth_value(c.cloth, i), kClothParamNames[i]);
   for (int i = 0; i < kPersonParams; ++i) {
     // The paper's value outside the box (no support, where the box holds one) keeps the box's
     // own start: the start file simply did not have it.
-    double v = person_value(c.cloth, i);
+    const double v = person_value(c.cloth, i);
     if (v == kPersonParamInfo[i].paper && !(v >= b.person[i].lower && v <= b.person[i].upper)) continue;
-    check(b.person[i], v, kPersonParamInfo[i].name);
-    b.person[i].initial = v;
+    b.person[i].initial = in_box(b.person[i], v, kPersonParamInfo[i].name);
   }
   // The offsets share one box; each calibrated height starts from its own value.
   for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
     const int k = static_cast<int>(h);
     if (!c.offset_calibrated[k]) continue;
-    double v = c.offsets[k];
-    check(b.arm_offset, v, "arm_offset_" + std::string(arm_height_name(h)));
-    b.offset_initial[k] = v;
+    b.offset_initial[k] = in_box(b.arm_offset, c.offsets[k], "arm_offset_" + std::string(arm_height_name(h)));
   }
 }
 
