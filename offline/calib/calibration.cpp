@@ -427,6 +427,9 @@ std::string fingerprint(const std::vector<HapticSequence>& inputs, const Paramet
   if (o.contrast_weight > 0) f << ";contrast=" << hexd(o.contrast_weight);  // (older checkpoints resume)
   if (o.lateral_weight > 0) f << ";lateral=" << hexd(o.lateral_weight);     // likewise
   if (o.combine != SequenceCombine::Sum) f << ";combine=" << combine_name(o.combine);  // likewise
+  // The gown when it is not the default reduced one (likewise). Before session 49 it was not
+  // carried, and a reduced-gown checkpoint would have resumed a full-gown run.
+  if (o.gown != "reduced") f << ";gown=" << o.gown;
   f << ";names=";
   for (const auto& n : space.names()) f << n << ',';
   f << ";bounds=";

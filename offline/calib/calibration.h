@@ -309,6 +309,9 @@ struct CalibrationOptions {
   // paper's, which scores F_motion and F_vertical only.
   double lateral_weight = 0;
   SequenceCombine combine = SequenceCombine::Sum;
+  // The scene the simulator runs (Calibration::gown): not seen by the search, but a checkpoint
+  // of a run on one gown must not continue a run on another (the fingerprint carries it).
+  std::string gown = "reduced";
   int threads = 0;                 // 0 = all cores
   std::filesystem::path checkpoint;  // empty = none
   int stop_after_generations = 0;  // > 0: stop (as if killed) after this many generations in this process

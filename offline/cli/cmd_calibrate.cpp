@@ -196,6 +196,7 @@ int run_calibrate(int argc, char** argv) {
   o.stop_after_generations = static_cast<int>(args.integer("stop-after-generations", 0));
   const std::string gown = args.get("gown").value_or("reduced");
   if (gown != "full" && gown != "reduced" && gown != "coarse") throw UsageError("--gown must be full, reduced or coarse");
+  o.gown = gown;
 
   ParameterSpace space;
   // --arm-compliance, --fist-shift, --rim-shift, --density, --arm-lateral, --fist-lateral.

@@ -594,6 +594,9 @@ TEST(Calibration, CheckpointOfAnotherRunIsRefused) {
   o.contrast_weight = 1;  // and one with the heights' contrast in its objective
   EXPECT_THROW(calibrate(inputs, space, testing::fake_simulate, o, Comm::world()), InputError);
   o.contrast_weight = 0;
+  o.gown = "full";  // and the same search on the full gown: the simulator differs, not the search
+  EXPECT_THROW(calibrate(inputs, space, testing::fake_simulate, o, Comm::world()), InputError);
+  o.gown = "reduced";
   EXPECT_NO_THROW(calibrate(inputs, space, testing::fake_simulate, o, Comm::world()));  // its own run resumes
   write_file_atomic(o.checkpoint, "garbage\n");
   EXPECT_THROW(calibrate(inputs, space, testing::fake_simulate, o, Comm::world()), InputError);
