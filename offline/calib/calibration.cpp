@@ -8,6 +8,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <mutex>
 #include <sstream>
 #include <utility>
 
@@ -609,14 +610,27 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   // gown once for them (sim::simulate_trials; 15-25% of a candidate's time). Session 2 ran one
   // task per (candidate, sequence) for finer grains; with 10-32 candidates a generation the
   // coarser grain still keeps 2 cores busy.
-  auto evaluate = [&](const std::vector<Eigen::VectorXd>& xs) {
-    return run_batch(static_cast<int>(xs.size()), T, thread_count(options.threads), comm, [&](int c, double* out) {
+  // `generation`: which one these candidates are (0: the start), for candidate_progress alone.
+  std::mutex progress_mutex;
+  auto evaluate = [&](const std::vector<Eigen::VectorXd>& xs, int generation) {
+    const int n = static_cast<int>(xs.size());
+    const auto began = std::chrono::steady_clock::now();
+    CandidateProgress cp;
+    cp.generation = generation;
+    cp.total = (n + comm.size() - 1) / comm.size();  // run_batch: the root takes indices 0, size, ...
+    return run_batch(n, T, thread_count(options.threads), comm, [&](int c, double* out) {
       const std::vector<SimulatedTrial> sts = simulate_inputs(sim, space.cloth(xs[c]), space.offsets(xs[c]), inputs);
       for (int k = 0; k < K; ++k) {
         out[k] = sequence_term(options.objective, sts[k], inputs[k]);
       }
       if (ic >= 0) out[ic] = contrast_term(inputs, sts, options.contrast_weight);
       if (il >= 0) out[il] = lateral_term(inputs, sts, options.lateral_weight);
+      if (options.candidate_progress && comm.is_root()) {
+        std::lock_guard<std::mutex> lock(progress_mutex);
+        ++cp.done;
+        cp.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+        options.candidate_progress(cp);
+      }
     });
   };
 
@@ -628,7 +642,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   // the same bits as an uninterrupted run) and returned if nothing the search found beats it.
   // The search itself is unchanged: the start does not enter CMA-ES's update.
   const Eigen::VectorXd start = space.initial_unit();
-  const std::vector<double> start_fits = evaluate({start});
+  const std::vector<double> start_fits = evaluate({start}, 0);
   const double start_f = combined_objective(start_fits.data(), K, T, options.combine);
 
   int done_here = 0;
@@ -636,7 +650,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
     if (options.stop_after_generations > 0 && done_here >= options.stop_after_generations) break;
     const std::vector<Eigen::VectorXd> xs = es.ask();
     const int lambda = static_cast<int>(xs.size());
-    const std::vector<double> per = evaluate(xs);
+    const std::vector<double> per = evaluate(xs, done + 1);
     std::vector<double> f(static_cast<std::size_t>(lambda), 0.0);
     for (int c = 0; c < lambda; ++c)
       f[c] = combined_objective(per.data() + static_cast<std::size_t>(c) * T, K, T, options.combine);

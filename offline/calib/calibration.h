@@ -296,6 +296,16 @@ double combined_objective(const double* terms, int K, int T, SequenceCombine c);
 // infinity when the simulation blew up or gave nothing (so no combination can prefer it).
 double sequence_term(ObjectiveKind kind, const SimulatedTrial& st, const HapticSequence& measured);
 
+// One candidate's simulations finished within a generation, on the root rank (under mpirun each
+// rank simulates every size-th candidate: `total` is the root's share). A generation on the full
+// gown takes about 20 minutes on two cores; this is what says in between that the run moves.
+struct CandidateProgress {
+  int generation = 0;     // the generation being evaluated, 1-based; 0: the start (evaluated once)
+  int done = 0;           // of this rank's candidates in it, in the order they finish
+  int total = 0;
+  double elapsed_s = 0;   // since this generation's evaluation began
+};
+
 struct CalibrationOptions {
   int generations = 50;            // paper IV-B.4: 50 iterations ...
   int population = 32;             // ... of 32 samples
@@ -315,6 +325,9 @@ struct CalibrationOptions {
   int threads = 0;                 // 0 = all cores
   std::filesystem::path checkpoint;  // empty = none
   int stop_after_generations = 0;  // > 0: stop (as if killed) after this many generations in this process
+  // Optional: called on the root rank as each of its candidates finishes, one call at a time
+  // (under a lock; the simulations of other candidates go on meanwhile). Changes no result.
+  std::function<void(const CandidateProgress&)> candidate_progress;
 };
 
 struct GenerationProgress {

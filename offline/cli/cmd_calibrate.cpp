@@ -279,6 +279,20 @@ int run_calibrate(int argc, char** argv) {
                      args.get("start")->c_str(), was.c_str(), ids.c_str());
     }
   }
+  // Within a generation, a line a minute at most: one of the full gown takes about 20 min on two
+  // cores, and a generation's own line says when it ends.
+  int line_generation = -1;
+  double line_at = 0;  // the generation's elapsed time at its last line
+  o.candidate_progress = [&](const CandidateProgress& c) {
+    if (c.generation != line_generation) {
+      line_generation = c.generation;
+      line_at = 0;
+    }
+    if (c.done == c.total || c.elapsed_s - line_at < 60) return;
+    line_at = c.elapsed_s;
+    std::fprintf(stderr, "  generation %d/%d: %d of %d candidates on this rank in %s\n", c.generation,
+                 o.generations, c.done, c.total, minutes(c.elapsed_s).c_str());
+  };
   bool first_line = true;
   const CalibrationResult r = calibrate(inputs, space, sim.trials, o, comm, [&](const GenerationProgress& p) {
     std::string per;  // the best point's L per sequence

@@ -474,6 +474,35 @@ TEST(Calibration, ResultDoesNotDependOnThreadCount) {
   EXPECT_TRUE(a.best_unit == b.best_unit);
 }
 
+// Within a generation each candidate is reported once as it finishes: the start as generation 0
+// (one candidate), then every generation's population counted 1, 2, ..., population in order
+// (the reports are serialised), with a clock that does not run back. Reporting changes nothing.
+TEST(Calibration, EachCandidateIsReportedOnceAsItFinishes) {
+  const auto inputs = fake_inputs(Truth{});
+  const auto space = space_for(inputs);
+  const auto plain = calibrate(inputs, space, testing::fake_simulate, quick(4, 3), Comm::world());
+  auto o = quick(4, 3);
+  std::vector<CandidateProgress> seen;
+  o.candidate_progress = [&](const CandidateProgress& c) { seen.push_back(c); };
+  const auto reported = calibrate(inputs, space, testing::fake_simulate, o, Comm::world());
+  EXPECT_EQ(reported.objective, plain.objective);  // bitwise
+  EXPECT_TRUE(reported.best_unit == plain.best_unit);
+  ASSERT_EQ(seen.size(), 1u + 4u * 16u);
+  EXPECT_EQ(seen[0].generation, 0);
+  EXPECT_EQ(seen[0].done, 1);
+  EXPECT_EQ(seen[0].total, 1);
+  for (int g = 1; g <= 4; ++g)
+    for (int c = 1; c <= 16; ++c) {
+      const CandidateProgress& p = seen[static_cast<std::size_t>(1 + (g - 1) * 16 + (c - 1))];
+      EXPECT_EQ(p.generation, g);
+      EXPECT_EQ(p.done, c);
+      EXPECT_EQ(p.total, 16);
+      if (c > 1) {
+        EXPECT_GE(p.elapsed_s, seen[static_cast<std::size_t>((g - 1) * 16 + (c - 1))].elapsed_s);
+      }
+    }
+}
+
 // Interrupt after 5 generations (as a kill after the 5th checkpoint would), resume: the final
 // result equals an uninterrupted run's, bit for bit.
 TEST(Calibration, ResumeFromCheckpointGivesTheUninterruptedResult) {
