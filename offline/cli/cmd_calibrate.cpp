@@ -142,6 +142,8 @@ int run_calibrate(int argc, char** argv) {
         "  --checkpoint FILE   default CAL.json.ckpt; an existing one is resumed\n"
         "  --stop-after-generations K   stop after K generations in this process (resume later)\n"
         "  --json              machine-readable summary on stdout\n"
+        "  On stderr: a line per generation (best L per sequence, elapsed, ETA) and, within a\n"
+        "  generation longer than a minute (the full gown's take about 20), a line a minute.\n"
         "  Writes CAL.json and CAL.json.curves.csv (measured and simulated curves; plot them with\n"
         "  tools/plot/calib_overlay.py). Under mpirun every rank runs a share of each generation.\n"
         "\n"
