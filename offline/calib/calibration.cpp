@@ -315,7 +315,7 @@ double rig_travel_of(const std::vector<HapticSequence>& inputs) {
 
 Calibration calibration_of(const std::string& participant, const CalibrationResult& r,
                            const ParameterSpace& space, const CalibrationOptions& o,
-                           const std::vector<HapticSequence>& inputs, const std::string& gown) {
+                           const std::vector<HapticSequence>& inputs) {
   Calibration cal;
   cal.participant = participant;
   cal.cloth = r.cloth;
@@ -329,7 +329,7 @@ Calibration calibration_of(const std::string& participant, const CalibrationResu
   cal.lateral = r.lateral;
   cal.objective_kind = std::string(objective_name(o.objective));
   cal.combine = std::string(combine_name(o.combine));
-  cal.gown = gown;
+  cal.gown = o.gown;
   cal.rig_travel = rig_travel_of(inputs);
   return cal;
 }

@@ -461,11 +461,11 @@ struct Calibration {
 };
 // The calibration file of a finished search `r` on `inputs` (calibrate's arguments `space` and
 // `o`): its values, the heights whose offsets it calibrated, its objective with how it was made
-// (kind, combination, the extra terms' weights), the scene `gown` and the rig's end of travel.
+// (kind, combination, the extra terms' weights), the scene (`o.gown`) and the rig's end of travel.
 // The axis fits (measure_axis_fits) and the provenance are the caller's to add.
 Calibration calibration_of(const std::string& participant, const CalibrationResult& r,
                            const ParameterSpace& space, const CalibrationOptions& o,
-                           const std::vector<HapticSequence>& inputs, const std::string& gown);
+                           const std::vector<HapticSequence>& inputs);
 
 // Scores calibration `c` again on its own inputs (in its fits' order) by this build's objective,
 // its values unchanged (`calibrate --rescore`): each sequence's L, the extra terms, the combined

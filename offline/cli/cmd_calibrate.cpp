@@ -332,7 +332,7 @@ int run_calibrate(int argc, char** argv) {
     }
     return 0;
   }
-  Calibration cal = calibration_of(participant, r, space, o, inputs, gown);
+  Calibration cal = calibration_of(participant, r, space, o, inputs);
   Json prov = Json::object();
   prov.set("tool", "dressguard calibrate");
   prov.set("created", utc_now());

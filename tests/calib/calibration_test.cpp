@@ -304,7 +304,8 @@ TEST(Calibration, FileOfASearchRecordsItsChoices) {
   o.objective = ObjectiveKind::PositionWeighted;
   o.contrast_weight = 5;
   o.lateral_weight = 1;
-  const Calibration c = calibration_of("9", r, space, o, inputs, "full");
+  o.gown = "full";
+  const Calibration c = calibration_of("9", r, space, o, inputs);
   EXPECT_EQ(c.participant, "9");
   EXPECT_EQ(c.cloth.friction, 0.4);
   EXPECT_EQ(c.offsets, r.offsets);
@@ -407,7 +408,7 @@ TEST(Calibration, WorstCombineFitsTheWorstSequenceBetter) {
   EXPECT_EQ(resumed.objective, rw.objective);
   EXPECT_TRUE(resumed.best_unit == rw.best_unit);
 
-  Calibration cal = calibration_of("9", rw, space, o, inputs, "reduced");
+  Calibration cal = calibration_of("9", rw, space, o, inputs);
   EXPECT_EQ(cal.combine, "worst");
   write_calibration(dir / "w.json", cal);
   EXPECT_EQ(read_calibration(dir / "w.json").combine, "worst");

@@ -246,6 +246,7 @@ int run_eval(const std::map<std::string, std::string>& a) {
   so.per_height = std::stoi(get(a, "per-height", "100"));
   so.threads = co.threads;
   const std::string gown = get(a, "gown", "reduced");
+  co.gown = gown;  // the calibration files' scene; a checkpoint of another gown's run is refused
   ParameterSpace person;  // the person parameters of every participant's space
   std::array<std::string, kPersonParams> person_words;
   if (!set_person_flags(a, person, person_words)) return 2;
@@ -295,7 +296,7 @@ int run_eval(const std::map<std::string, std::string>& a) {
     auto o = co;
     o.checkpoint = work / ("p" + p + ".ckpt");
     const CalibrationResult r = calibrate(inputs, space, sim.trials, o, Comm::world());
-    Calibration cal = calibration_of(p, r, space, o, inputs, gown);
+    Calibration cal = calibration_of(p, r, space, o, inputs);
     std::vector<TrialRequest> requests;
     for (const auto& s : inputs) requests.push_back(request_for(s, r.offsets));
     const std::vector<SimulatedTrial> curves = sim.trials(r.cloth, requests);
@@ -429,6 +430,7 @@ int run_timing(const std::map<std::string, std::string>& a) {
   o.threads = std::stoi(get(a, "threads", "0"));
   auto t0 = std::chrono::steady_clock::now();
   const ClothSimulator sim = make_cloth_simulator(gown);
+  o.gown = gown;
   const double scene_s = seconds_since(t0);
   t0 = std::chrono::steady_clock::now();
   const SimulatedTrial one = sim.trial(ClothValues{}, request_for(inputs[0], {}));
@@ -471,7 +473,7 @@ int run_timing(const std::map<std::string, std::string>& a) {
   // predict), with the targets in groups that settle once (the default) and, as the same run's
   // baseline, every target settled on its own; the same tables, byte for byte, are required.
   if (get(a, "predict", "0") == "1") {
-    const Calibration cal = calibration_of("4", r, space, o, inputs, gown);
+    const Calibration cal = calibration_of("4", r, space, o, inputs);
     t0 = std::chrono::steady_clock::now();
     const Prediction grouped = predict_others(cal, ds, sim.trials, o.threads, Comm::world());
     const double grouped_s = seconds_since(t0);
