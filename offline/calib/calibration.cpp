@@ -591,7 +591,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
       const Checkpoint c = decode_checkpoint(text, options.checkpoint);
       if (c.fingerprint != fp)
         throw_input_error(options.checkpoint, 2,
-                          "checkpoint belongs to a different calibration (inputs, seed, budget, bounds or "
+                          "checkpoint belongs to a different calibration (inputs, seed, budget, bounds, gown or "
                           "objective differ); remove it or choose another --checkpoint");
       if (static_cast<int>(c.best_fits.size()) != T) throw_input_error(options.checkpoint, 4, "wrong number of fits");
       try {
