@@ -23,9 +23,10 @@
 // Paired from the simulation's first sample, each of its samples met a simulated one 0.096 m
 // behind it, and the 67 simulated samples left at the end were scored at w = 20 (session 45:
 // 0.53 of participant 0's middle-arm L 1.10). So when one sequence starts more than kLateStart
-// further along than the other, the earlier one's samples before that travel are skipped and
-// i = 0 pairs the later start with the first sample at or beyond its travel (paired_start).
-// The 5 mm leave every recording that starts with the pull paired as the paper pairs it.
+// (5 mm, core/haptic.h) further along than the other, the earlier one's samples before that
+// travel are skipped and i = 0 pairs the later start with the first sample at or beyond its
+// travel (paired_start). The 5 mm leave every recording that starts with the pull paired as the
+// paper pairs it.
 //
 // PositionWeighted: the variant in the paper's public code (gt-rad/learning-forces,
 // physx_simulation CMAES HapticObjective, evalObj), described here in our own words as we read
@@ -55,8 +56,6 @@ std::optional<ObjectiveKind> parse_objective(std::string_view s);
 enum class ForceAxis { Motion, Vertical, Lateral };
 
 inline constexpr double kLengthPenaltyWeight = 20.0;  // w of eq. 4
-
-inline constexpr double kLateStart = 0.005;  // [m] see "Where the pairs begin" above
 
 // The first index of each sequence that eq. 3 pairs (i = 0): both 0 unless one starts more than
 // kLateStart further along; then the other's first sample at or beyond that travel (its last

@@ -67,6 +67,15 @@ std::filesystem::path find_plot_script() {
 
 // The accuracy line (with its 95 % Wilson interval: on the study's 22 trials a few trials either
 // way are noise, hmm.h) and the confusion matrix.
+// One line per trial whose recording starts late, saying how the HMMs scored it (hmm.h,
+// FeatureSequence::unobserved): a reader of the table should not take it for a pull from 0.
+void print_late_starts(const std::vector<const HapticSequence*>& trials) {
+  for (const auto* t : trials)
+    if (const size_t k = unrecorded_samples(*t); k > 0)
+      std::printf("%s starts %.4f m into its pull: scored from the state distribution %zu samples on\n",
+                  t->id.c_str(), t->samples.front().travel, k);
+}
+
 void print_summary(const hmm::Evaluation& ev, size_t models) {
   std::string interval;
   if (ev.total > 0) {
@@ -270,7 +279,8 @@ int run_classify(int argc, char** argv) {
         }
         rows += (rows.empty() ? "" : ", ") + std::string("{\"id\": ") + hmm::json_string(trials[i]->id) +
                 ", \"participant\": " + hmm::json_string(trials[i]->participant) + ", \"samples\": " +
-                std::to_string(v.samples) + ", \"truth\": " + hmm::json_string(outcome_name(*trials[i]->label)) +
+                std::to_string(v.samples) + ", \"unrecorded_samples\": " + std::to_string(unrecorded_samples(*trials[i])) +
+                ", \"truth\": " + hmm::json_string(outcome_name(*trials[i]->label)) +
                 ", \"predicted\": " + hmm::json_string(v.classes[v.predicted]) + ", \"votes\": [" + votes +
                 "], \"posterior_sum\": [" + sums + "]}";
       }
@@ -289,6 +299,7 @@ int run_classify(int argc, char** argv) {
                   v.samples, truth.c_str(), v.classes[v.predicted].c_str(), v.votes[v.predicted], committee.size(),
                   truth == v.classes[v.predicted] ? "" : "   WRONG");
     }
+    print_late_starts(trials);
     print_summary(ev, committee.size());
     std::printf("%s", against_text.c_str());
     return 0;
@@ -306,7 +317,7 @@ int run_classify(int argc, char** argv) {
       }
       rows += (rows.empty() ? "" : ", ") + std::string("{\"id\": ") + hmm::json_string(r.trial->id) +
               ", \"participant\": " + hmm::json_string(r.trial->participant) + ", \"samples\": " + std::to_string(r.samples) +
-              ", \"truth\": " + hmm::json_string(single->classes[r.truth].name) + ", \"predicted\": " +
+              ", \"unrecorded_samples\": " + std::to_string(unrecorded_samples(*r.trial)) + ", \"truth\": " + hmm::json_string(single->classes[r.truth].name) + ", \"predicted\": " +
               hmm::json_string(single->classes[r.result.predicted].name) + ", \"log_likelihood\": [" + ll + "], \"posterior\": [" +
               post + "]}";
     }
@@ -322,6 +333,7 @@ int run_classify(int argc, char** argv) {
                 single->classes[r.truth].name.c_str(), single->classes[r.result.predicted].name.c_str(),
                 r.result.posterior[r.result.predicted], r.truth == r.result.predicted ? "" : "   WRONG");
   }
+  print_late_starts(trials);
   print_summary(ev, 1);
   std::printf("%s", against_text.c_str());
   return 0;

@@ -1,5 +1,8 @@
 #include "haptic.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace dressguard {
 
 std::string_view outcome_name(Outcome o) {
@@ -32,6 +35,20 @@ std::optional<ArmHeight> parse_arm_height(std::string_view s) {
   if (s == "middle") return ArmHeight::Middle;
   if (s == "low") return ArmHeight::Low;
   return std::nullopt;
+}
+
+double pull_time_at(double travel, double speed, double acceleration) {
+  const double ramp = speed * speed / (2.0 * acceleration);  // [m] travelled while accelerating
+  if (travel <= ramp) return std::sqrt(2.0 * std::max(travel, 0.0) / acceleration);
+  return travel / speed + speed / (2.0 * acceleration);
+}
+
+std::size_t unrecorded_samples(const HapticSequence& trial) {
+  if (trial.samples.empty() || trial.samples.front().travel <= kLateStart) return 0;
+  const size_t n = trial.samples.size();
+  const double period = n >= 2 ? (trial.samples.back().t - trial.samples.front().t) / static_cast<double>(n - 1) : 0.01;
+  if (!(period > 0.0)) return 0;  // a recording without time: nothing to say where it began
+  return static_cast<std::size_t>(std::lround(pull_time_at(trial.samples.front().travel, trial.speed) / period));
 }
 
 }  // namespace dressguard

@@ -6,6 +6,7 @@
 // F_motion ("X") and F_vertical ("Y"), section V-B.
 #pragma once
 
+#include <cstddef>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -21,6 +22,22 @@ struct HapticSample {
   double f_lateral = 0.0;   // [N] sideways
   double f_vertical = 0.0;  // [N] up positive, static weight removed (sensor bias)
 };
+
+// The rig's motion (shared/data/README.md): from rest at kRigAcceleration up to the pull's speed,
+// then at that speed. The simulator's TrialSpec::acceleration defaults to it.
+inline constexpr double kRigAcceleration = 1.0;  // [m/s^2]
+
+// A recording "starts late" when its first sample is more than kLateStart into the pull. 21 of
+// the study's 22 recordings start within 1.1 mm (the recorder's start-up, the first 0.05 s of the
+// ramp); s0-middlemiss-10, the one trial at 0.15 m/s, starts 0.0958 m in. Whatever compares such
+// a recording with one that starts with the pull must begin at the same point of the pull: the
+// objective pairs from the same travel (calib/objective.h, "Where the pairs begin"), the HMMs
+// start their chain that many samples on (hmm/hmm.h, FeatureSequence::unobserved).
+inline constexpr double kLateStart = 0.005;  // [m]
+
+// [s] when a pull from rest reaches `travel` [m]: sqrt(2 x / a) on the ramp (x <= v^2 / 2a), and
+// x / v + v / 2a after it (the ramp loses v / 2a against a pull at v from the start).
+double pull_time_at(double travel, double speed, double acceleration = kRigAcceleration);
 
 // The three outcomes of the task (paper section V-A).
 enum class Outcome { Good = 0, Missed = 1, Caught = 2 };
@@ -46,5 +63,11 @@ struct HapticSequence {
   std::optional<Outcome> label;    // empty when unknown
   std::vector<HapticSample> samples;
 };
+
+// How many samples of `trial`'s pull went unrecorded before its first one: 0 unless it starts
+// late (kLateStart); then the pull's time at the first sample's travel (pull_time_at, at the
+// trial's speed) over the recording's mean sample period, rounded (0.01 s when it has fewer than
+// two samples). s0-middlemiss-10: 0.0958 m at 0.15 m/s is 0.714 s, 71 samples of 10.0 ms.
+std::size_t unrecorded_samples(const HapticSequence& trial);
 
 }  // namespace dressguard

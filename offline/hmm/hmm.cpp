@@ -388,6 +388,27 @@ double emission_log_density(const model::GaussianEmission& e, const double x[kFe
   return -kLog2Pi - std::log(l00 * l11) - 0.5 * (z0 * z0 + z1 * z1);
 }
 
+// The state distribution after `steps` transitions from pi with nothing observed: pi A^steps
+// (FeatureSequence::unobserved). Each product keeps the sum 1 of a stochastic A, so it is
+// renormalised only against rounding.
+namespace {
+std::vector<double> initial_after(const ClassHmm& h, size_t steps) {
+  const int n = h.n_states;
+  std::vector<double> p(h.initial), q(n);
+  for (size_t k = 0; k < steps; ++k) {
+    double z = 0.0;
+    for (int j = 0; j < n; ++j) {
+      double sum = 0.0;
+      for (int i = 0; i < n; ++i) sum += p[i] * h.transition[i * n + j];
+      q[j] = sum;
+      z += sum;
+    }
+    for (int j = 0; j < n; ++j) p[j] = q[j] / z;
+  }
+  return p;
+}
+}  // namespace
+
 std::vector<double> forward_prefix_log_likelihoods(const ClassHmm& h, const FeatureSequence& s) {
   // General (full-matrix) scaled forward with Cholesky densities: an implementation independent
   // of the filter's band path, so the two can check each other.
@@ -397,7 +418,7 @@ std::vector<double> forward_prefix_log_likelihoods(const ClassHmm& h, const Feat
   double ll = 0.0;
   for (size_t t = 0; t < s.size(); ++t) {
     if (t == 0) {
-      pred = h.initial;
+      pred = initial_after(h, s.unobserved);
     } else {
       for (int j = 0; j < n; ++j) {
         double sum = 0.0;
@@ -436,7 +457,8 @@ ViterbiResult viterbi(const ClassHmm& h, const FeatureSequence& s) {
   std::vector<double> logA(n * n), delta(n), nd(n);
   for (int k = 0; k < n * n; ++k) logA[k] = lg(h.transition[k]);
   std::vector<int> back(T * n, -1);
-  for (int j = 0; j < n; ++j) delta[j] = lg(h.initial[j]) + emission_log_density(h.emission[j], s.at(0));
+  const std::vector<double> start = initial_after(h, s.unobserved);
+  for (int j = 0; j < n; ++j) delta[j] = lg(start[j]) + emission_log_density(h.emission[j], s.at(0));
   for (size_t t = 1; t < T; ++t) {
     for (int j = 0; j < n; ++j) {
       double best = kNegInf;
@@ -494,6 +516,7 @@ FeatureSequence sample(const ClassHmm& h, size_t T, std::mt19937_64& rng, std::v
 
 FeatureSequence features_of(const HapticSequence& trial, const model::FeatureConvention& fc, double truncate_at) {
   FeatureSequence s;
+  s.unobserved = unrecorded_samples(trial);
   s.x.reserve(trial.samples.size() * kFeatures);
   for (const auto& smp : trial.samples) {
     if (smp.travel > truncate_at) break;

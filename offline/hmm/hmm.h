@@ -44,8 +44,20 @@ using model::ClassHmm;
 using model::kFeatures;
 
 // One sequence of feature vectors (x_t in feature units), row-major: x[t*kFeatures + k].
+//
+// A sequence that starts late. The HMMs are trained on pulls recorded from their start, so their
+// chain's time is the pull's time. A recording that begins `unobserved` samples into its pull
+// (core/haptic.h, unrecorded_samples; one study trial begins 71 samples in) is scored from the
+// state distribution the chain has reached by then with nothing observed, pi A^k: the forward
+// recursion over k samples whose emission densities are all 1, i.e. the missing start
+// marginalised out. Scored from pi instead, the late recording's first forces (a pull 0.1 m in)
+// meet the states of a pull's first centimetres. forward_*, viterbi and classify read
+// `unobserved`; training does not (every training sequence is taken to start with its pull: the
+// synthesized ones do, and a late measured one re-estimates pi from where it begins), and neither
+// does the robot's filter, which hears every pull from its start.
 struct FeatureSequence {
   std::vector<double> x;
+  size_t unobserved = 0;  // samples of the pull before x_1 (0: recorded from the start)
   size_t size() const { return x.size() / kFeatures; }
   const double* at(size_t t) const { return x.data() + t * kFeatures; }
 };
@@ -103,7 +115,8 @@ FeatureSequence sample(const ClassHmm& hmm, size_t T, std::mt19937_64& rng, std:
 
 // ---- outcome models from datasets ----------------------------------------------------------
 
-// The feature vectors of one trial, cut after the last sample with travel <= truncate_at.
+// The feature vectors of one trial, cut after the last sample with travel <= truncate_at, with
+// `unobserved` = unrecorded_samples(trial).
 FeatureSequence features_of(const HapticSequence& trial, const model::FeatureConvention& fc,
                             double truncate_at = std::numeric_limits<double>::infinity());
 

@@ -152,7 +152,7 @@ struct TrialSpec {
   ArmHeight height = ArmHeight::High;
   double arm_offset = 0.0;      // [m] added to the height's nominal arm height (paper IV-B.2)
   double speed = 0.1;           // [m/s] pull speed (0.1 or 0.15 in the study)
-  double acceleration = 1.0;    // [m/s^2] the rig's acceleration up to `speed`
+  double acceleration = kRigAcceleration;  // [m/s^2] the rig's acceleration up to `speed`
   uint64_t seed = 0;            // drives the perturbation force
   bool gown_noise = false;      // paper V-A: uniform X/lateral force up to 6 N over all vertices
   bool arm_noise = false;       // paper V-A: arm height + U[-1.5, 1.5] cm (high, low), U[-6, 0] cm (middle)

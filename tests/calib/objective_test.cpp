@@ -192,9 +192,13 @@ TEST(Objective, OneStudyRecordingStartsLate) {
     if (t.id == "s0-middlemiss-10") {
       EXPECT_NEAR(t.samples.front().travel, 0.0958, 5e-5);
       EXPECT_EQ(p.sim, 96u) << "the simulated sample at 0.096 m";
+      // 0.0958 / 0.15 + 0.15 / 2 = 0.714 s into the pull at its 10.0 ms period: the HMMs start
+      // their chain 71 samples on (hmm.h, FeatureSequence::unobserved).
+      EXPECT_EQ(unrecorded_samples(t), 71u);
     } else {
       EXPECT_LT(t.samples.front().travel, 0.0011) << t.id;
       EXPECT_EQ(p.sim, 0u) << t.id;
+      EXPECT_EQ(unrecorded_samples(t), 0u) << t.id;
     }
     EXPECT_EQ(p.measured, 0u) << t.id;
   }

@@ -147,3 +147,23 @@ TEST(Study, RigEndOfTravel) {
     }
   }
 }
+
+// The rig's pull (haptic.h): on the ramp x = a t^2 / 2, after it x = v (t - v / 2a); the two
+// meet at x = v^2 / 2a, t = v / a. A recording counts its unrecorded start in its own periods.
+TEST(Pull, TimeAtTravelAndUnrecordedStart) {
+  EXPECT_NEAR(pull_time_at(0.005, 0.15), 0.1, 1e-15);                 // sqrt(2 * 0.005 / 1)
+  EXPECT_NEAR(pull_time_at(0.01125, 0.15), 0.15, 1e-15);              // the ramp's end, both forms
+  EXPECT_NEAR(pull_time_at(0.0958, 0.15), 0.0958 / 0.15 + 0.075, 1e-15);
+  EXPECT_NEAR(pull_time_at(0.5, 0.1, 2.0), 0.5 / 0.1 + 0.025, 1e-15);
+  EXPECT_EQ(pull_time_at(0.0, 0.1), 0.0);
+
+  HapticSequence s;
+  s.speed = 0.1;
+  for (int i = 0; i < 50; ++i) s.samples.push_back({0.01 * i, 0.004 + 0.001 * i, 0, 0, 0});
+  EXPECT_EQ(unrecorded_samples(s), 0u) << "4 mm in is within kLateStart: recorded from the start";
+  for (auto& smp : s.samples) smp.travel += 0.1;  // 0.104 m in: 0.104 / 0.1 + 0.05 = 1.09 s
+  EXPECT_EQ(unrecorded_samples(s), 109u);
+  for (auto& smp : s.samples) smp.t *= 3.0;       // the same start at a 30 ms period
+  EXPECT_EQ(unrecorded_samples(s), 36u);          // 1.09 / 0.03 = 36.3
+  EXPECT_EQ(unrecorded_samples(HapticSequence{}), 0u);
+}

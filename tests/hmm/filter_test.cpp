@@ -28,7 +28,10 @@ void expect_prefix_agreement(const model::OutcomeModel& m, const std::vector<con
   filter::ForwardFilter f(m);
   long checked = 0;
   for (const auto* t : trials) {
-    const auto seq = hmm::features_of(*t, m.features);
+    // The filter hears a pull from wherever its recording begins, as the robot's filter hears
+    // every pull from its start; so the offline side is asked the same (no unobserved start).
+    auto seq = hmm::features_of(*t, m.features);
+    seq.unobserved = 0;
     std::vector<std::vector<double>> pre;
     for (const auto& h : m.classes) pre.push_back(hmm::forward_prefix_log_likelihoods(h, seq));
     f.reset();

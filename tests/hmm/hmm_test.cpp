@@ -94,6 +94,36 @@ TEST(HmmKnownAnswer, LeftRightThreeStateMatchesEnumeration) {
   for (size_t t = 1; t < v.path.size(); ++t) EXPECT_GE(v.path[t], v.path[t - 1]) << "left-right path went back";
 }
 
+// A sequence that starts late (hmm.h, FeatureSequence::unobserved). Closed form on two states:
+// pi = (1, 0), A = [[a, 1 - a], [0, 1]], so after k unobserved steps the chain is in state 0 with
+// probability a^k, and one observed sample x has p(x) = a^k N_0(x) + (1 - a^k) N_1(x); Viterbi's
+// best path is the larger of the two terms. With k = 0 it is the plain forward's pi.
+TEST(HmmKnownAnswer, AnUnobservedStartIsMarginalisedOut) {
+  model::ClassHmm h;
+  h.n_states = 2;
+  const double a = 0.8;
+  h.initial = {1.0, 0.0};
+  h.transition = {a, 1.0 - a, 0.0, 1.0};
+  h.emission.resize(2);
+  h.emission[0].mean[0] = 0.0, h.emission[0].mean[1] = 0.0;
+  h.emission[1].mean[0] = 1.0, h.emission[1].mean[1] = -0.5;
+  for (auto& e : h.emission) e.cov[0][0] = 1.0, e.cov[1][1] = 0.5, e.cov[0][1] = e.cov[1][0] = 0.2;
+  const double x[model::kFeatures] = {0.7, -0.1};
+  const double n0 = std::exp(hmm::emission_log_density(h.emission[0], x));
+  const double n1 = std::exp(hmm::emission_log_density(h.emission[1], x));
+  for (size_t k : {0u, 1u, 3u, 12u}) {
+    FeatureSequence s{std::vector<double>(x, x + model::kFeatures)};
+    s.unobserved = k;
+    const double in0 = std::pow(a, static_cast<double>(k));
+    const double expect = std::log(in0 * n0 + (1.0 - in0) * n1);
+    EXPECT_NEAR(hmm::forward_log_likelihood(h, s), expect, 1e-12) << "k = " << k;
+    const auto v = hmm::viterbi(h, s);
+    const double best = std::max(std::log(in0 * n0), std::log((1.0 - in0) * n1));  // log 0 = -inf
+    EXPECT_NEAR(v.log_probability, best, 1e-12) << "k = " << k;
+    EXPECT_EQ(v.path.front(), in0 * n0 >= (1.0 - in0) * n1 ? 0 : 1) << "k = " << k;
+  }
+}
+
 // Closed form: a one-state HMM is i.i.d. Gaussian, so log p = sum log N(x_t), and one Baum-Welch
 // step gives the sample mean and the (1/N) sample covariance exactly.
 TEST(HmmKnownAnswer, OneStateIsIidGaussian) {
