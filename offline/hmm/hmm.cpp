@@ -88,6 +88,36 @@ void floor_covariance(double cov[2][2], double floor) {
   cov[0][1] = cov[1][0] = (l1 - l2) * v0 * v1;
 }
 
+// The chain's state distributions before a sequence's first sample when its first `steps` samples
+// went unobserved (hmm.h, FeatureSequence::unobserved): rows f_0 = pi, f_{s+1} = f_s A, so row
+// s is p(state at s) with nothing observed and f_steps is where the observed sequence begins.
+// Each product keeps the sum 1 of a stochastic A; it is renormalised only against rounding.
+// (steps + 1) x n, row-major, into `rows`.
+void unobserved_rows(const ClassHmm& h, size_t steps, std::vector<double>& rows) {
+  const int n = h.n_states;
+  rows.assign((steps + 1) * n, 0.0);
+  std::copy(h.initial.begin(), h.initial.end(), rows.begin());
+  for (size_t k = 0; k < steps; ++k) {
+    const double* p = &rows[k * n];
+    double* q = &rows[(k + 1) * n];
+    double z = 0.0;
+    for (int j = 0; j < n; ++j) {
+      double sum = 0.0;
+      for (int i = 0; i < n; ++i) sum += p[i] * h.transition[i * n + j];
+      q[j] = sum;
+      z += sum;
+    }
+    for (int j = 0; j < n; ++j) q[j] /= z;
+  }
+}
+
+// pi A^steps: unobserved_rows' last row.
+std::vector<double> initial_after(const ClassHmm& h, size_t steps) {
+  std::vector<double> rows;
+  unobserved_rows(h, steps, rows);
+  return std::vector<double>(rows.end() - h.n_states, rows.end());
+}
+
 // Scratch for one sequence's forward-backward pass, reused across sequences.
 // One HMM laid out for the filter's update kernel: padded structure-of-arrays emissions and the
 // band diagonals B_d[j] = A_{j-d,j} (band -1: the caller predicts with the full matrix).
@@ -129,9 +159,10 @@ struct Workspace {
   KernelModel km;
   std::vector<double> row, pred, logb, ex;     // one padded row for the kernel
   std::vector<double> v;                        // bs * beta / c of the row after
+  std::vector<double> prefix, g, gn;            // an unobserved start: its rows, two backward rows
   Workspace(const ClassHmm& h, const Band& band)
       : km(h, band), row(filter::kBandPad + km.np, 0.0), pred(km.np, 0.0), logb(km.np, 0.0), ex(km.np, 0.0),
-        v(h.n_states, 0.0) {}
+        v(h.n_states, 0.0), g(h.n_states, 0.0), gn(h.n_states, 0.0) {}
   void resize(size_t T, int n) {
     if (alpha.size() < T * n) {
       alpha.resize(T * n);
@@ -148,6 +179,39 @@ struct Accumulators {
   std::vector<double> g0, g, s0, s1, s00, s01, s11, xi;
   explicit Accumulators(int n_) : n(n_), g0(n_), g(n_), s0(n_), s1(n_), s00(n_), s01(n_), s11(n_), xi(n_ * n_) {}
 };
+
+// The statistics of an unobserved start (hmm.h, FeatureSequence::unobserved), after the backward
+// pass has reached the first observed sample with beta_0. The k unobserved steps s = 0..k-1 are
+// steps with emission density 1, so with f_s = pi A^s (unobserved_rows) and
+//   g_k = v,  v_j = bs_0(j) beta_0(j) / c_0     (the observed sequence given the state at k)
+//   g_s = A g_{s+1}                               (the same, given the state at s)
+// the posteriors are xi_s(i,j) = f_s(i) A_ij g_{s+1}(j) and gamma_0(i) = pi_i g_0(i); they need no
+// normaliser, because sum_l f_k(l) v_l = sum_l alpha_0(l) beta_0(l) = 1. The transitions of the
+// unobserved span go into xi and its first state into pi's statistic; the emissions get nothing.
+void unobserved_statistics(const ClassHmm& h, const Band& band, Workspace& w, size_t k, const double* beta0,
+                           Accumulators& acc) {
+  const int n = h.n_states;
+  const double* A = h.transition.data();
+  const double ic = 1.0 / w.scale[0];
+  double* g = w.g.data();
+  double* gn = w.gn.data();
+  for (int j = 0; j < n; ++j) g[j] = w.bs[j] * beta0[j] * ic;
+  for (size_t st = k; st-- > 0;) {
+    const double* f = &w.prefix[st * n];
+    for (int i = 0; i < n; ++i) {
+      double sum = 0.0;
+      double* xi = acc.xi.data() + i * n;
+      for (int j = band.slo[i]; j <= band.shi[i]; ++j) {
+        const double pr = A[i * n + j] * g[j];
+        sum += pr;
+        xi[j] += f[i] * pr;
+      }
+      gn[i] = sum;
+    }
+    std::swap(g, gn);
+  }
+  for (int i = 0; i < n; ++i) acc.g0[i] += h.initial[i] * g[i];
+}
 
 // Scaled forward-backward on one sequence, band-restricted; adds its statistics to acc and returns
 // log p(seq). bs(t,j) = b_j(x_t) exp(-m_t), zero for unreachable states (pred = 0): then every
@@ -166,13 +230,16 @@ double forward_backward(const ClassHmm& h, const EmissionCache& em, const Band& 
   // copied out to the T x n arrays the backward pass reads.
   const KernelModel& km = w.km;
   double* row = w.row.data() + filter::kBandPad;
+  const size_t k = s.unobserved;
+  if (k > 0) unobserved_rows(h, k, w.prefix);
+  const double* start = k > 0 ? &w.prefix[k * n] : h.initial.data();  // pi A^k
   for (size_t t = 0; t < T; ++t) {
     double* al = &w.alpha[t * n];
     double* b = &w.bs[t * n];
     const double* x = s.at(t);
     bool given = false;
     if (t == 0) {
-      for (int j = 0; j < km.np; ++j) w.pred[j] = j < n ? h.initial[j] : 0.0;
+      for (int j = 0; j < km.np; ++j) w.pred[j] = j < n ? start[j] : 0.0;
       given = true;
     } else if (km.block.band < 0) {
       for (int j = 0; j < n; ++j) {
@@ -232,8 +299,9 @@ double forward_backward(const ClassHmm& h, const EmissionCache& em, const Band& 
       acc.s01[j] += gm * d0 * d1;
       acc.s11[j] += gm * d1 * d1;
     }
-    if (tt == 0)
+    if (tt == 0 && k == 0)
       for (int j = 0; j < n; ++j) acc.g0[j] += al[j] * cur[j];
+    if (tt == 0 && k > 0) unobserved_statistics(h, band, w, k, cur, acc);
     std::swap(nb, cur);
   }
   return ll;
@@ -288,17 +356,19 @@ ClassHmm initial_left_right(const std::vector<FeatureSequence>& seqs, const Trai
   h.initial[0] = 1.0;
   h.transition.assign(n * n, 0.0);
   h.emission.assign(n, model::GaussianEmission{});
-  // Equal segments: sample t of a length-T sequence belongs to state floor(t n / T).
+  // Equal segments of the pull: sample t of a length-T sequence that starts k samples late
+  // (FeatureSequence::unobserved) belongs to state floor((k + t) n / (k + T)).
   std::vector<double> cnt(n), s0(n), s1(n), s00(n), s01(n), s11(n);
   double total_len = 0.0;
   size_t used = 0;
   for (const auto& s : seqs) {
     const size_t T = s.size();
     if (T < static_cast<size_t>(n)) continue;
-    total_len += static_cast<double>(T);
+    const size_t k = s.unobserved;
+    total_len += static_cast<double>(k + T);
     ++used;
     for (size_t t = 0; t < T; ++t) {
-      const int j = static_cast<int>(t * static_cast<size_t>(n) / T);
+      const int j = static_cast<int>((k + t) * static_cast<size_t>(n) / (k + T));
       const double* x = s.at(t);
       cnt[j] += 1;
       s0[j] += x[0];
@@ -309,6 +379,10 @@ ClassHmm initial_left_right(const std::vector<FeatureSequence>& seqs, const Trai
     }
   }
   if (used == 0) throw std::invalid_argument("no training sequence has at least as many samples as states (" + std::to_string(n) + ")");
+  for (int j = 0; j < n; ++j)
+    if (cnt[j] == 0)
+      throw std::invalid_argument("no training sample falls in state " + std::to_string(j) +
+                                  "'s segment (every sequence starts after it: too few states for how late they start)");
   for (int j = 0; j < n; ++j) {
     auto& e = h.emission[j];
     e.mean[0] = s0[j] / cnt[j];
@@ -387,27 +461,6 @@ double emission_log_density(const model::GaussianEmission& e, const double x[kFe
   const double z1 = ((x[1] - e.mean[1]) - l10 * z0) / l11;
   return -kLog2Pi - std::log(l00 * l11) - 0.5 * (z0 * z0 + z1 * z1);
 }
-
-// The state distribution after `steps` transitions from pi with nothing observed: pi A^steps
-// (FeatureSequence::unobserved). Each product keeps the sum 1 of a stochastic A, so it is
-// renormalised only against rounding.
-namespace {
-std::vector<double> initial_after(const ClassHmm& h, size_t steps) {
-  const int n = h.n_states;
-  std::vector<double> p(h.initial), q(n);
-  for (size_t k = 0; k < steps; ++k) {
-    double z = 0.0;
-    for (int j = 0; j < n; ++j) {
-      double sum = 0.0;
-      for (int i = 0; i < n; ++i) sum += p[i] * h.transition[i * n + j];
-      q[j] = sum;
-      z += sum;
-    }
-    for (int j = 0; j < n; ++j) p[j] = q[j] / z;
-  }
-  return p;
-}
-}  // namespace
 
 std::vector<double> forward_prefix_log_likelihoods(const ClassHmm& h, const FeatureSequence& s) {
   // General (full-matrix) scaled forward with Cholesky densities: an implementation independent

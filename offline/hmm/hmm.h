@@ -11,9 +11,10 @@
 // far out that such a state alone explains it.
 //
 // Training (Rabiner eq. 40, 52-54 for the Gaussian case):
-//   initialisation: every sequence split into n equal segments, segment j feeding state j's mean
-//     and covariance; pi = (1, 0, ..., 0); A_ii = 1 - n / mean length, the rest of the row spread
-//     over the band j = i+1..i+w with weights halving per step (the last state absorbs).
+//   initialisation: every sequence (with the samples it did not record, FeatureSequence::
+//     unobserved) split into n equal segments, segment j feeding state j's mean and covariance;
+//     pi = (1, 0, ..., 0); A_ii = 1 - n / mean length, the rest of the row spread over the band
+//     j = i+1..i+w with weights halving per step (the last state absorbs).
 //   E-step: scaled forward-backward per sequence, restricted to the band; the forward pass runs
 //     through the online filter's vector update (predictor/filter/emission_update.h), so training
 //     and the robot compute the same recursion.
@@ -51,10 +52,11 @@ using model::kFeatures;
 // state distribution the chain has reached by then with nothing observed, pi A^k: the forward
 // recursion over k samples whose emission densities are all 1, i.e. the missing start
 // marginalised out. Scored from pi instead, the late recording's first forces (a pull 0.1 m in)
-// meet the states of a pull's first centimetres. forward_*, viterbi and classify read
-// `unobserved`; training does not (every training sequence is taken to start with its pull: the
-// synthesized ones do, and a late measured one re-estimates pi from where it begins), and neither
-// does the robot's filter, which hears every pull from its start.
+// meet the states of a pull's first centimetres. Everything here reads `unobserved`: the forward,
+// Viterbi, classify, and training (the equal segments are of the whole pull, and Baum-Welch's
+// E-step runs the k unobserved steps with emission density 1, so their transitions count in A
+// and their first state in pi, exactly; hmm.cpp, unobserved_statistics). The robot's filter
+// does not: it hears every pull from its start.
 struct FeatureSequence {
   std::vector<double> x;
   size_t unobserved = 0;  // samples of the pull before x_1 (0: recorded from the start)
