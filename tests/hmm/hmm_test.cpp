@@ -94,20 +94,26 @@ TEST(HmmKnownAnswer, LeftRightThreeStateMatchesEnumeration) {
   for (size_t t = 1; t < v.path.size(); ++t) EXPECT_GE(v.path[t], v.path[t - 1]) << "left-right path went back";
 }
 
+// pi = (1, 0), A = [[a, 1 - a], [0, 1]]: the chain leaves state 0 once, after a geometric dwell;
+// the emissions overlap, so one sample says little about the state.
+static model::ClassHmm two_state_chain(double a) {
+  model::ClassHmm h;
+  h.n_states = 2;
+  h.initial = {1.0, 0.0};
+  h.transition = {a, 1.0 - a, 0.0, 1.0};
+  h.emission.resize(2);
+  h.emission[1].mean[0] = 1.0, h.emission[1].mean[1] = -0.5;
+  for (auto& e : h.emission) e.cov[0][0] = 1.0, e.cov[1][1] = 0.5, e.cov[0][1] = e.cov[1][0] = 0.2;
+  return h;
+}
+
 // A sequence that starts late (hmm.h, FeatureSequence::unobserved). Closed form on two states:
 // pi = (1, 0), A = [[a, 1 - a], [0, 1]], so after k unobserved steps the chain is in state 0 with
 // probability a^k, and one observed sample x has p(x) = a^k N_0(x) + (1 - a^k) N_1(x); Viterbi's
 // best path is the larger of the two terms. With k = 0 it is the plain forward's pi.
 TEST(HmmKnownAnswer, AnUnobservedStartIsMarginalisedOut) {
-  model::ClassHmm h;
-  h.n_states = 2;
   const double a = 0.8;
-  h.initial = {1.0, 0.0};
-  h.transition = {a, 1.0 - a, 0.0, 1.0};
-  h.emission.resize(2);
-  h.emission[0].mean[0] = 0.0, h.emission[0].mean[1] = 0.0;
-  h.emission[1].mean[0] = 1.0, h.emission[1].mean[1] = -0.5;
-  for (auto& e : h.emission) e.cov[0][0] = 1.0, e.cov[1][1] = 0.5, e.cov[0][1] = e.cov[1][0] = 0.2;
+  const model::ClassHmm h = two_state_chain(a);
   const double x[model::kFeatures] = {0.7, -0.1};
   const double n0 = std::exp(hmm::emission_log_density(h.emission[0], x));
   const double n1 = std::exp(hmm::emission_log_density(h.emission[1], x));
@@ -130,14 +136,8 @@ TEST(HmmKnownAnswer, AnUnobservedStartIsMarginalisedOut) {
 // tau - 1 self-transitions and one 0 -> 1 for a leave at tau, k self-transitions for a stay, so
 // the M-step's A_00 = E[n00] / (E[n00] + E[n01]); pi stays (1, 0), and the step returns log Z.
 TEST(HmmKnownAnswer, BaumWelchCountsTheUnobservedTransitions) {
-  model::ClassHmm h;
-  h.n_states = 2;
   const double a = 0.8;
-  h.initial = {1.0, 0.0};
-  h.transition = {a, 1.0 - a, 0.0, 1.0};
-  h.emission.resize(2);
-  h.emission[1].mean[0] = 1.0, h.emission[1].mean[1] = -0.5;
-  for (auto& e : h.emission) e.cov[0][0] = 1.0, e.cov[1][1] = 0.5, e.cov[0][1] = e.cov[1][0] = 0.2;
+  const model::ClassHmm h = two_state_chain(a);
   const double x[model::kFeatures] = {0.4, -0.2};
   const double n0 = std::exp(hmm::emission_log_density(h.emission[0], x));
   const double n1 = std::exp(hmm::emission_log_density(h.emission[1], x));
@@ -217,7 +217,7 @@ TEST(HmmInit, EqualSegments) {
 // equal segments of sampled sequences blur neighbouring states, and EM from there can settle in a
 // local optimum (two true states merged in one) however well separated the states are. That is
 // EM's basin, not a bug; the equal-segment path is exercised by the outcome-model and GHMM tests.
-model::ClassHmm perturbed_start(const model::ClassHmm& truth) {
+static model::ClassHmm perturbed_start(const model::ClassHmm& truth) {
   const int n_states = truth.n_states;
   model::ClassHmm start = truth;
   for (int j = 0; j < n_states; ++j) {
