@@ -162,7 +162,12 @@ ClothValues ParameterSpace::cloth(const Eigen::VectorXd& unit) const {
     set_person_value(c, i, person[i].fit ? from_unit(bounds.person[i], unit[k++]) : person[i].value);
   c.hem_width = hem_width;
   c.hem_bend_ratio = hem_bend_ratio;
+  c.friction_scheme = friction_scheme;
   return c;
+}
+
+bool friction_scheme_known(const std::string& name) {
+  return std::find(kFrictionSchemes.begin(), kFrictionSchemes.end(), name) != kFrictionSchemes.end();
 }
 
 std::array<double, 3> ParameterSpace::offsets(const Eigen::VectorXd& unit) const {
@@ -452,6 +457,8 @@ std::string fingerprint(const std::vector<HapticSequence>& inputs, const Paramet
   }
   // The cuff only when there is one (older checkpoints resume).
   if (space.hem_width > 0) f << ";hem=" << hexd(space.hem_width) << ',' << hexd(space.hem_bend_ratio);
+  // The friction scheme only when it is not the paper's (older checkpoints resume).
+  if (space.friction_scheme != kFrictionSchemes[0]) f << ";friction=" << space.friction_scheme;
   f << ";inputs=";
   for (const auto& s : inputs) f << s.id << '/' << s.samples.size() << ',';
   return f.str();
@@ -775,6 +782,8 @@ Json calibration_to_json(const Calibration& c) {
   for (int i = 0; i < kPersonParams; ++i)
     if (person_value(c.cloth, i) != kPersonParamInfo[i].paper)
       cloth.set(kPersonParamInfo[i].name, person_value(c.cloth, i));
+  // The friction scheme only when it is not the paper's, last: older files keep their bytes.
+  if (c.cloth.friction_scheme != kFrictionSchemes[0]) cloth.set("friction_scheme", c.cloth.friction_scheme);
   j.set("cloth", cloth);
   Json off = Json::object();
   for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
@@ -847,6 +856,12 @@ Calibration calibration_from_json(const Json& j, const std::filesystem::path& so
       c.cloth.hem_bend_ratio = j.at("cloth").at("hem_bend_ratio").number();
       if (!hem_in_range(c.cloth.hem_width, c.cloth.hem_bend_ratio))
         throw std::runtime_error("cloth.hem_width / hem_bend_ratio must be within [0, 0.2] m / [1, 10000]");
+    }
+    if (j.at("cloth").has("friction_scheme")) {
+      c.cloth.friction_scheme = j.at("cloth").at("friction_scheme").string();
+      if (!friction_scheme_known(c.cloth.friction_scheme))
+        throw std::runtime_error("cloth.friction_scheme '" + c.cloth.friction_scheme +
+                                 "' is not one of improved, constraint, stock");
     }
     for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
       const Json& e = j.at("arm_offsets").at(std::string(arm_height_name(h)));

@@ -65,7 +65,16 @@ struct ClothValues {
   // kSupportDepth, kSupportLateral below): its axis below the grasp (0: none) and sideways.
   double support_depth = 0.0;
   double support_lateral = 0.0;
+  // How friction acts (sim/trial.h FrictionScheme, by its name; kFrictionSchemes below): the
+  // paper's improved scheme unless a calibration chose another. Held, never fitted
+  // (ParameterSpace::friction_scheme): fitted friction coefficients belong to the scheme they were
+  // searched under (offline/calib/MEASUREMENTS.md, session 49), so the file carries it.
+  std::string friction_scheme = "improved";
 };
+// The simulator's friction schemes by name (sim::friction_scheme_name; sim_bridge.cpp checks the
+// two lists agree): the first is the paper's and every calibration's without one in its file.
+inline constexpr std::array<const char*, 3> kFrictionSchemes = {"improved", "constraint", "stock"};
+bool friction_scheme_known(const std::string& name);
 inline constexpr double kPaperArealDensity = 0.145;
 inline constexpr int kClothParams = 5;
 // A cuff's limits (sim/params.cpp checks the same): width in [0, 0.2] m, ratio in [1, 1e4].
@@ -218,6 +227,8 @@ struct ParameterSpace {
   std::array<Person, kPersonParams> person = paper_person();
   // The gown's cuff every candidate is simulated with (ClothValues::hem_width, hem_bend_ratio).
   double hem_width = 0.0, hem_bend_ratio = 1.0;
+  // The friction scheme every candidate is simulated with (ClothValues::friction_scheme).
+  std::string friction_scheme = kFrictionSchemes[0];
   int fitted_person_params() const {
     int n = 0;
     for (const Person& p : person) n += p.fit ? 1 : 0;

@@ -63,8 +63,16 @@ static_assert(kMaxHemWidth == sim::kMaxHemWidth && kMaxHemBendRatio == sim::kMax
 static_assert(kSimMiddleBelowHigh - kMiddleBelowHigh < 1e-12 && kMiddleBelowHigh - kSimMiddleBelowHigh < 1e-12,
               "the middle arm's nominal height differs between synthesis.h and sim/trial.h");
 
-sim::TrialSpec spec_of(const TrialRequest& r) {
+// The simulator's scheme of a calibration's name for it (ClothValues::friction_scheme).
+sim::FrictionScheme friction_scheme_of(const std::string& name) {
+  for (sim::FrictionScheme f : {sim::FrictionScheme::Improved, sim::FrictionScheme::Constraint, sim::FrictionScheme::Stock})
+    if (name == sim::friction_scheme_name(f)) return f;
+  throw std::invalid_argument("unknown friction scheme '" + name + "' (expected improved, constraint or stock)");
+}
+
+sim::TrialSpec spec_of(const ClothValues& c, const TrialRequest& r) {
   sim::TrialSpec spec;
+  spec.friction_scheme = friction_scheme_of(c.friction_scheme);
   spec.height = r.height;
   spec.arm_offset = r.arm_offset;
   spec.speed = r.speed;
@@ -142,11 +150,11 @@ ClothSimulator make_cloth_simulator(const std::string& gown) {
   auto scenes = std::make_shared<SceneCache>(res);
   ClothSimulator cs;
   cs.trial = [scenes](const ClothValues& c, const TrialRequest& r) {
-    return simulated(sim::simulate_trial(*scenes->get(c.rim_shift), cloth_params_of(c), spec_of(r)));
+    return simulated(sim::simulate_trial(*scenes->get(c.rim_shift), cloth_params_of(c), spec_of(c, r)));
   };
   cs.trials = [scenes](const ClothValues& c, const std::vector<TrialRequest>& rs) {
     std::vector<sim::TrialSpec> specs;
-    for (const TrialRequest& r : rs) specs.push_back(spec_of(r));
+    for (const TrialRequest& r : rs) specs.push_back(spec_of(c, r));
     std::vector<sim::TrialResult> res = sim::simulate_trials(*scenes->get(c.rim_shift), cloth_params_of(c), specs);
     std::vector<SimulatedTrial> out;
     for (sim::TrialResult& r : res) out.push_back(simulated(std::move(r)));

@@ -137,6 +137,10 @@ int run_calibrate(int argc, char** argv) {
         "                      default), none (the paper's, the default) or at M metres (0: none)\n"
         "  --support-lateral fit|fixed|M   the support sideways (negative: toward the person; in\n"
         "                      [-0.2, 0.05] m by default when fitted); only with a support\n"
+        "  --friction improved|constraint|stock   how friction acts in the simulator (offline/sim/\n"
+        "                      trial.h, FrictionScheme; default improved, the paper's): held, not\n"
+        "                      fitted; recorded in CAL.json, so synthesis and predict use it too\n"
+        "                      (the fitted coefficients belong to the scheme they were searched in)\n"
         "  --gown full|reduced|coarse   simulator gown (default reduced)\n"
         "  --threads N         threads per process (default: all cores)\n"
         "  --checkpoint FILE   default CAL.json.ckpt; an existing one is resumed\n"
@@ -158,7 +162,7 @@ int run_calibrate(int argc, char** argv) {
                    "checkpoint", "objective", "gown", "threads", "generations", "population",
                    "stop-after-generations", "arm-compliance", "fist-shift", "rim-shift", "sigma0", "hem",
                    "density", "contrast-weight", "lateral-weight", "combine", "arm-lateral", "fist-lateral",
-                   "support-depth", "support-lateral", "inputs"});
+                   "support-depth", "support-lateral", "inputs", "friction"});
   const std::string data = args.require("data");
   const std::string participant = args.require("participant");
   const std::string out = args.require("out");
@@ -219,6 +223,10 @@ int run_calibrate(int argc, char** argv) {
     space.hem_width = w;
     space.hem_bend_ratio = r;
   }
+  if (const auto f = args.get("friction")) {
+    if (!friction_scheme_known(*f)) throw UsageError("--friction must be improved, constraint or stock, not '" + *f + "'");
+    space.friction_scheme = *f;
+  }
   space.bounds = args.get("bounds") ? read_bounds(*args.get("bounds")) : default_bounds();
   std::optional<Calibration> start_cal;
   if (const auto start = args.get("start")) {
@@ -255,8 +263,10 @@ int run_calibrate(int argc, char** argv) {
     std::string ids;  // the selected sequences, "s4-good-3, s4-miss-2"
     for (const HapticSequence& s : inputs) ids += (ids.empty() ? "" : ", ") + s.id;
     std::fprintf(stderr, "calibrate: participant %s, %zu sequences (%s), %d parameters, %d x %d, %d rank(s) x %d "
-                 "thread(s), gown %s\n", participant.c_str(), inputs.size(), ids.c_str(), space.dimension(),
-                 o.generations, o.population, comm.size(), thread_count(o.threads), gown.c_str());
+                 "thread(s), gown %s%s%s\n", participant.c_str(), inputs.size(), ids.c_str(), space.dimension(),
+                 o.generations, o.population, comm.size(), thread_count(o.threads), gown.c_str(),
+                 space.friction_scheme == kFrictionSchemes[0] ? "" : ", friction ",
+                 space.friction_scheme == kFrictionSchemes[0] ? "" : space.friction_scheme.c_str());
     // Said before the first generation (minutes away at the paper's budget): whether this run
     // starts afresh or continues a stopped one. A checkpoint of another command is refused then.
     std::fprintf(stderr, "calibrate: checkpoint %s (%s)\n", o.checkpoint.c_str(),
@@ -265,6 +275,10 @@ int run_calibrate(int argc, char** argv) {
     // Continuing a calibration of the same person on other trials than the file was fitted to (its
     // offsets included) is legitimate but rarely what was meant: said before the hours of search,
     // with the --inputs value that would fit the file's own trials.
+    if (start_cal && start_cal->cloth.friction_scheme != space.friction_scheme)
+      std::fprintf(stderr, "calibrate: note: --start %s was searched under the %s friction scheme, this run "
+                   "simulates %s (--friction): its values are a start, not a fit, here\n",
+                   args.get("start")->c_str(), start_cal->cloth.friction_scheme.c_str(), space.friction_scheme.c_str());
     if (start_cal && start_cal->participant == participant) {
       std::string was;
       std::string flag;  // the same as --inputs' value, "s4-good-3,s4-miss-2"
@@ -409,6 +423,8 @@ int run_calibrate(int argc, char** argv) {
           std::printf("  %-14s %.4f%s\n", kPersonParamInfo[i].name, person_value(r.cloth, i), space.person[i].fit ? "" : " (held)");
       if (r.cloth.hem_width > 0)
         std::printf("  hem           %.3f m, bending x %g (held)\n", r.cloth.hem_width, r.cloth.hem_bend_ratio);
+      if (r.cloth.friction_scheme != kFrictionSchemes[0])
+        std::printf("  friction      the %s scheme (held)\n", r.cloth.friction_scheme.c_str());
       for (ArmHeight h : space.offset_heights)
         std::printf("  arm offset %-6s %+.4f m\n", std::string(arm_height_name(h)).c_str(), r.offsets[static_cast<int>(h)]);
       std::printf("wrote %s and %s.curves.csv\n", out.c_str(), out.c_str());

@@ -95,7 +95,8 @@ int run_simulate(int argc, char** argv) {
         "  --gown G          full | reduced | coarse (default reduced): the measured gown at ~20k, 5k,\n"
         "                    1.5k triangles (the gown module's parametric gown without shared/data)\n"
         "  --parametric      the gown module's parametric gown even when the measured one is present\n"
-        "  --friction F      stock | improved | constraint (default improved)\n"
+        "  --friction F      stock | improved | constraint (default improved, or the --calibration\n"
+        "                    file's)\n"
         "%s"
         "  --no-self-collision\n"
         "  --frames T1,T2,.. [s] since the start of the pull (negative: settling) to keep the gown\n"
@@ -130,7 +131,8 @@ int run_simulate(int argc, char** argv) {
   spec.gown_noise = args.has("noise");
   spec.arm_noise = args.has("arm-noise");
   spec.self_collision = !args.has("no-self-collision");
-  const std::string fr = args.get("friction").value_or("improved");
+  // A calibration's scheme unless --friction says otherwise: its coefficients were fitted under it.
+  const std::string fr = args.get("friction").value_or(cal ? cal->cloth.friction_scheme : "improved");
   if (fr == "stock") spec.friction_scheme = sim::FrictionScheme::Stock;
   else if (fr == "improved") spec.friction_scheme = sim::FrictionScheme::Improved;
   else if (fr == "constraint") spec.friction_scheme = sim::FrictionScheme::Constraint;

@@ -627,6 +627,10 @@ TEST(Calibration, CheckpointOfAnotherRunIsRefused) {
   o.gown = "full";  // and the same search on the full gown: the simulator differs, not the search
   EXPECT_THROW(calibrate(inputs, space, testing::fake_simulate, o, Comm::world()), InputError);
   o.gown = "reduced";
+  auto constraint = space;  // and under another friction scheme
+  constraint.friction_scheme = "constraint";
+  EXPECT_EQ(constraint.cloth(constraint.initial_unit()).friction_scheme, "constraint");
+  EXPECT_THROW(calibrate(inputs, constraint, testing::fake_simulate, o, Comm::world()), InputError);
   EXPECT_NO_THROW(calibrate(inputs, space, testing::fake_simulate, o, Comm::world()));  // its own run resumes
   write_file_atomic(o.checkpoint, "garbage\n");
   EXPECT_THROW(calibrate(inputs, space, testing::fake_simulate, o, Comm::world()), InputError);
@@ -944,6 +948,15 @@ TEST(Calibration, CalibrationFileRoundTripAndErrors) {
   c.cloth.hem_width = 0;
   c.cloth.hem_bend_ratio = 1;
   c.cloth.areal_density = kPaperArealDensity;
+  // The friction scheme: absent is the paper's improved one (not written, so older files keep
+  // their bytes); another reads back; a name the simulator does not know names the file and field.
+  EXPECT_EQ(read_file(dir / "cal_fist.json").find("friction_scheme"), std::string::npos);
+  EXPECT_EQ(d.cloth.friction_scheme, "improved");
+  c.cloth.friction_scheme = "constraint";
+  write_calibration(dir / "cal_friction.json", c);
+  EXPECT_EQ(read_calibration(dir / "cal_friction.json").cloth.friction_scheme, "constraint");
+  expect_refused("cal_friction.json", "friction_scheme", "\"constraint\"", "\"sticky\"");
+  c.cloth.friction_scheme = "improved";
   EXPECT_EQ(d.participant, "4");
   EXPECT_EQ(d.cloth.self_friction, 0.5);
   EXPECT_EQ(d.offsets[2], 0.011);

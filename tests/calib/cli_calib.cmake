@@ -28,6 +28,7 @@ expect_fail("calibrate with a softening --hem" "--hem" calibrate --data ${WORK}/
 expect_fail("calibrate with a negative contrast weight" "--contrast-weight must be in [0, 1000]" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --contrast-weight -1)
 expect_fail("calibrate with a negative lateral weight" "--lateral-weight must be in [0, 1000]" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --lateral-weight -1)
 expect_fail("calibrate with an unknown way to combine the sequences" "--combine must be sum or worst, not 'max'" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --combine max)
+expect_fail("calibrate with an unknown friction scheme" "--friction must be improved, constraint or stock, not 'sticky'" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --friction sticky)
 expect_fail("calibrate with a support's side but no support" "--support-lateral needs a support" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --support-lateral fit)
 expect_fail("calibrate with the support beyond the gown" "--support-depth must be fit, fixed or a value (support_depth must be within 0 (no support) and 1.5 m" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --support-depth 2)
 expect_fail("calibrate with the arm beside the opening" "--arm-lateral must be fit, fixed or a value (arm_lateral must be within +-0.1 m" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --arm-lateral 0.15)

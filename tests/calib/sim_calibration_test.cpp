@@ -113,6 +113,57 @@ TEST(SimCalibration, RimShiftIsTheScenesGrasp) {
   }
 }
 
+// A calibration's friction scheme reaches the simulator: each named scheme gives, bit for bit,
+// the trial that sim::simulate_trial gives with that TrialSpec::friction_scheme, in both forms,
+// and the three differ from each other (the low arm, where the sleeve drags on the forearm). A
+// name the simulator does not know is refused with the name. The two lists of names agree.
+TEST(SimCalibration, FrictionSchemeIsTheTrialsScheme) {
+  const ClothSimulator both = make_cloth_simulator("coarse");
+  const sim::Scene scene = sim::make_default_scene(sim::GownResolution::Coarse);  // the bridge's own grasp
+  TrialRequest r;
+  r.height = ArmHeight::Low;
+  r.max_travel = 0.25;  // short: identity, not physics
+  std::vector<SimulatedTrial> runs;
+  for (std::size_t k = 0; k < kFrictionSchemes.size(); ++k) {
+    SCOPED_TRACE(kFrictionSchemes[k]);
+    const sim::FrictionScheme f = k == 0 ? sim::FrictionScheme::Improved : k == 1 ? sim::FrictionScheme::Constraint
+                                                                                 : sim::FrictionScheme::Stock;
+    ASSERT_STREQ(sim::friction_scheme_name(f), kFrictionSchemes[k]);
+    EXPECT_TRUE(friction_scheme_known(kFrictionSchemes[k]));
+    ClothValues c;
+    c.friction_scheme = kFrictionSchemes[k];
+    sim::TrialSpec spec;
+    spec.height = r.height;
+    spec.max_travel = r.max_travel;
+    spec.friction_scheme = f;
+    const sim::TrialResult direct = sim::simulate_trial(scene, cloth_params_of(c), spec);
+    runs.push_back(both.trial(c, r));
+    const std::vector<SimulatedTrial> batch = both.trials(c, {r});
+    ASSERT_EQ(runs.back().samples.size(), direct.seq.samples.size());
+    ASSERT_EQ(batch.at(0).samples.size(), direct.seq.samples.size());
+    for (std::size_t i = 0; i < direct.seq.samples.size(); ++i) {
+      EXPECT_EQ(runs.back().samples[i].f_motion, direct.seq.samples[i].f_motion);
+      EXPECT_EQ(batch[0].samples[i].f_motion, direct.seq.samples[i].f_motion);
+    }
+  }
+  for (std::size_t a = 0; a < runs.size(); ++a)
+    for (std::size_t b = a + 1; b < runs.size(); ++b) {
+      bool differs = runs[a].samples.size() != runs[b].samples.size();
+      for (std::size_t i = 0; i < std::min(runs[a].samples.size(), runs[b].samples.size()); ++i)
+        differs |= runs[a].samples[i].f_motion != runs[b].samples[i].f_motion;
+      EXPECT_TRUE(differs) << kFrictionSchemes[a] << " and " << kFrictionSchemes[b] << " gave the same trial";
+    }
+  ClothValues unknown;
+  unknown.friction_scheme = "sticky";
+  EXPECT_FALSE(friction_scheme_known("sticky"));
+  try {
+    both.trial(unknown, r);
+    ADD_FAILURE() << "an unknown friction scheme was simulated";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("'sticky'"), std::string::npos) << e.what();
+  }
+}
+
 // The prediction of other people through the batch form (one settling per group of targets)
 // gives the one-trial form's bits. The targets are three trials of another person, one per arm
 // height, cut at 0.15 m so that the pulls are short; their curves come from the stand-in
