@@ -242,6 +242,34 @@ if(STUDY)
      OR NOT CMAKE_MATCH_1 STREQUAL CMAKE_MATCH_2)
     message(FATAL_ERROR "calibrate --rescore on a file of this build (${rrc}):\n${rout}\n${rerr}")
   endif()
+  # Under another friction scheme (--friction constraint; coarse gown, 1 x 4, ~20 s): the run says
+  # so, the file records it, and --rescore simulates under it, so the file's own figure comes back
+  # to its last digit; the same file with the scheme taken out (the improved one) scores another L.
+  execute_process(COMMAND ${DG} calibrate --data ${WORK}/study --participant 4 --out ${WORK}/cf.json --gown coarse
+                          --generations 1 --population 4 --threads 2 --seed 1 --friction constraint
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(EXISTS ${WORK}/cf.json)
+    file(READ ${WORK}/cf.json cf)
+  endif()
+  if(NOT rc EQUAL 0 OR NOT cf MATCHES "\"friction_scheme\": \"constraint\""
+     OR NOT err MATCHES "gown coarse, friction constraint\n" OR NOT out MATCHES "\n  friction      the constraint scheme \\(held\\)\n")
+    message(FATAL_ERROR "calibrate --friction constraint (${rc}):\n${out}\n${err}")
+  endif()
+  string(REGEX REPLACE ",\n +\"friction_scheme\": \"constraint\"" "" cf_improved "${cf}")
+  file(WRITE ${WORK}/cf-improved.json "${cf_improved}")
+  foreach(f cf cf-improved)
+    execute_process(COMMAND ${DG} calibrate --rescore ${WORK}/${f}.json --data ${WORK}/study --out ${WORK}/${f}-r.json
+                    RESULT_VARIABLE rc OUTPUT_VARIABLE out_${f} ERROR_VARIABLE err)
+    if(NOT rc EQUAL 0 OR NOT out_${f} MATCHES "participant 4: L = ([0-9.]+) \\(recorded ([0-9.]+)\\)")
+      message(FATAL_ERROR "calibrate --rescore ${f}.json (${rc}):\n${out_${f}}\n${err}")
+    endif()
+    set(now_${f} ${CMAKE_MATCH_1})
+    set(was_${f} ${CMAKE_MATCH_2})
+  endforeach()
+  if(NOT now_cf STREQUAL was_cf OR now_cf-improved STREQUAL was_cf-improved)
+    message(FATAL_ERROR "rescore under the file's friction scheme: ${now_cf} (recorded ${was_cf}); the same "
+                        "values under the improved scheme ${now_cf-improved} (recorded ${was_cf-improved})")
+  endif()
   expect_fail("rescore a missing file" "--rescore ${WORK}/none.json" calibrate --rescore ${WORK}/none.json --data ${WORK}/study --out ${WORK}/x.json)
   expect_fail("rescore with a calibrate option" "--participant" calibrate --rescore ${WORK}/c1.json --data ${WORK}/study --out ${WORK}/x.json --participant 4)
   # Its curves (with F_lateral since 2026-11-25) overlaid on the measured ones.
