@@ -65,8 +65,8 @@ static_assert(kSimMiddleBelowHigh - kMiddleBelowHigh < 1e-12 && kMiddleBelowHigh
 
 // The simulator's scheme of a calibration's name for it (ClothValues::friction_scheme).
 sim::FrictionScheme friction_scheme_of(const std::string& name) {
-  for (sim::FrictionScheme f : {sim::FrictionScheme::Improved, sim::FrictionScheme::Constraint, sim::FrictionScheme::Stock})
-    if (name == sim::friction_scheme_name(f)) return f;
+  sim::FrictionScheme f{};
+  if (sim::parse_friction_scheme(name, &f)) return f;
   throw std::invalid_argument("unknown friction scheme '" + name + "' (expected improved, constraint or stock)");
 }
 

@@ -133,10 +133,8 @@ int run_simulate(int argc, char** argv) {
   spec.self_collision = !args.has("no-self-collision");
   // A calibration's scheme unless --friction says otherwise: its coefficients were fitted under it.
   const std::string fr = args.get("friction").value_or(cal ? cal->cloth.friction_scheme : "improved");
-  if (fr == "stock") spec.friction_scheme = sim::FrictionScheme::Stock;
-  else if (fr == "improved") spec.friction_scheme = sim::FrictionScheme::Improved;
-  else if (fr == "constraint") spec.friction_scheme = sim::FrictionScheme::Constraint;
-  else throw UsageError("--friction must be stock, improved or constraint, not '" + fr + "'");
+  if (!sim::parse_friction_scheme(fr, &spec.friction_scheme))
+    throw UsageError("--friction must be stock, improved or constraint, not '" + fr + "'");
   const std::string gs = args.get("gown").value_or(cal ? cal->gown : "reduced");
   sim::GownResolution res;
   if (gs == "full") res = sim::GownResolution::Full;

@@ -145,6 +145,15 @@ const char* friction_scheme_name(FrictionScheme s) {
   return "?";
 }
 
+bool parse_friction_scheme(const std::string& name, FrictionScheme* out) {
+  for (FrictionScheme f : {FrictionScheme::Stock, FrictionScheme::Improved, FrictionScheme::Constraint})
+    if (name == friction_scheme_name(f)) {
+      *out = f;
+      return true;
+    }
+  return false;
+}
+
 int Scene::vertex_count() const { return static_cast<int>(d_->rest.size()); }
 int Scene::triangle_count() const { return static_cast<int>(d_->mesh.tris.size()); }
 double Scene::gown_mass() const { return d_->rest_area * ClothParams{}.areal_density; }

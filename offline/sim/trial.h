@@ -146,6 +146,8 @@ inline constexpr double kMaxHemWidth = 0.2, kMaxHemBendRatio = 1e4;
 //              al. 2014 "Unified particle physics", XPBD rigid bodies 2020).
 enum class FrictionScheme { Stock = 0, Improved = 1, Constraint = 2 };
 const char* friction_scheme_name(FrictionScheme s);
+// The scheme named `name` (friction_scheme_name's inverse); false, and *out untouched, if none is.
+bool parse_friction_scheme(const std::string& name, FrictionScheme* out);
 
 // One trial's conditions.
 struct TrialSpec {

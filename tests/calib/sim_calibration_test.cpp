@@ -129,6 +129,10 @@ TEST(SimCalibration, FrictionSchemeIsTheTrialsScheme) {
     const sim::FrictionScheme f = k == 0 ? sim::FrictionScheme::Improved : k == 1 ? sim::FrictionScheme::Constraint
                                                                                  : sim::FrictionScheme::Stock;
     ASSERT_STREQ(sim::friction_scheme_name(f), kFrictionSchemes[k]);
+    sim::FrictionScheme parsed = sim::FrictionScheme::Stock;
+    if (f == parsed) parsed = sim::FrictionScheme::Improved;  // so a parse that writes nothing fails
+    ASSERT_TRUE(sim::parse_friction_scheme(kFrictionSchemes[k], &parsed));
+    EXPECT_EQ(parsed, f);
     EXPECT_TRUE(friction_scheme_known(kFrictionSchemes[k]));
     ClothValues c;
     c.friction_scheme = kFrictionSchemes[k];
@@ -156,6 +160,9 @@ TEST(SimCalibration, FrictionSchemeIsTheTrialsScheme) {
   ClothValues unknown;
   unknown.friction_scheme = "sticky";
   EXPECT_FALSE(friction_scheme_known("sticky"));
+  sim::FrictionScheme untouched = sim::FrictionScheme::Constraint;
+  EXPECT_FALSE(sim::parse_friction_scheme("sticky", &untouched));
+  EXPECT_EQ(untouched, sim::FrictionScheme::Constraint);
   try {
     both.trial(unknown, r);
     ADD_FAILURE() << "an unknown friction scheme was simulated";
