@@ -5,7 +5,9 @@ Modes:
   fit:      calib_overlay.py fit CAL.json.curves.csv [--compare CAL0.json.curves.csv] --out fit.png
             One row per calibration input, F_motion, F_vertical and (curve files since
             2026-11-25) F_lateral over travel: measured (red, solid), simulated with the calibrated arm offsets (green, dashed) and, with --compare,
-            the simulator calibrated without arm offsets (blue, dotted), as in Fig. 9.
+            the simulator calibrated without arm offsets (blue, dotted), as in Fig. 9. With
+            --compare-label TEXT, --compare's simulated curves are drawn blue and dotted under that
+            label whatever they are called (e.g. one calibration's `--rescore` on the other gown).
   dataset:  calib_overlay.py dataset SYNTH_DIR --measured STUDY_DIR --participant P --out data.png
             All synthesized trials per outcome (thin) with the participant's measured trials (bold),
             as in Fig. 7 and 8.
@@ -99,12 +101,15 @@ def plot_fit(args):
     fig, axes = plt.subplots(len(curves), len(panels), figsize=(5 * len(panels), 3 * len(curves)), squeeze=False)
     styles = {"measured": ("tab:red", "-", "measured"),
               "simulated": ("tab:green", "--", "simulated, with arm offset"),
-              "simulated-no-offset": ("tab:blue", ":", "simulated, without arm offset")}
+              "simulated-no-offset": ("tab:blue", ":", "simulated, without arm offset"),
+              "compare": ("tab:blue", ":", args.compare_label)}
     for row, (key, sources) in enumerate(curves.items()):
         merged = dict(sources)
         for src, pts in other.get(key, {}).items():
             if src != "measured":
-                merged[src] = pts
+                # Named by --compare-label, the other file's curves never take the place of this
+                # file's own, whatever their source is called.
+                merged["compare" if args.compare_label else src] = pts
         for col, (idx, name) in enumerate(panels):
             ax = axes[row][col]
             for src, pts in merged.items():
@@ -420,6 +425,7 @@ def main():
     f = sub.add_parser("fit")
     f.add_argument("curves")
     f.add_argument("--compare")
+    f.add_argument("--compare-label", help="draw --compare's simulated curves under this label (e.g. another gown)")
     f.add_argument("--out", required=True)
     d = sub.add_parser("dataset")
     d.add_argument("dataset")
