@@ -170,6 +170,15 @@ bool friction_scheme_known(const std::string& name) {
   return std::find(kFrictionSchemes.begin(), kFrictionSchemes.end(), name) != kFrictionSchemes.end();
 }
 
+std::string friction_scheme_choices() {
+  std::string s;
+  for (std::size_t k = 0; k < kFrictionSchemes.size(); ++k) {
+    if (k > 0) s += k + 1 == kFrictionSchemes.size() ? " or " : ", ";
+    s += kFrictionSchemes[k];
+  }
+  return s;
+}
+
 std::array<double, 3> ParameterSpace::offsets(const Eigen::VectorXd& unit) const {
   std::array<double, 3> o{};
   for (std::size_t k = 0; k < offset_heights.size(); ++k)
@@ -861,7 +870,7 @@ Calibration calibration_from_json(const Json& j, const std::filesystem::path& so
       c.cloth.friction_scheme = j.at("cloth").at("friction_scheme").string();
       if (!friction_scheme_known(c.cloth.friction_scheme))
         throw std::runtime_error("cloth.friction_scheme '" + c.cloth.friction_scheme +
-                                 "' is not one of improved, constraint, stock");
+                                 "' is not one of " + friction_scheme_choices());
     }
     for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
       const Json& e = j.at("arm_offsets").at(std::string(arm_height_name(h)));

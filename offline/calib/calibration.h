@@ -75,6 +75,8 @@ struct ClothValues {
 // two lists agree): the first is the paper's and every calibration's without one in its file.
 inline constexpr std::array<const char*, 3> kFrictionSchemes = {"improved", "constraint", "stock"};
 bool friction_scheme_known(const std::string& name);
+// The names above as an error message lists them: "improved, constraint or stock".
+std::string friction_scheme_choices();
 inline constexpr double kPaperArealDensity = 0.145;
 inline constexpr int kClothParams = 5;
 // A cuff's limits (sim/params.cpp checks the same): width in [0, 0.2] m, ratio in [1, 1e4].

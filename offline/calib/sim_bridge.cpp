@@ -67,7 +67,7 @@ static_assert(kSimMiddleBelowHigh - kMiddleBelowHigh < 1e-12 && kMiddleBelowHigh
 sim::FrictionScheme friction_scheme_of(const std::string& name) {
   sim::FrictionScheme f{};
   if (sim::parse_friction_scheme(name, &f)) return f;
-  throw std::invalid_argument("unknown friction scheme '" + name + "' (expected improved, constraint or stock)");
+  throw std::invalid_argument("unknown friction scheme '" + name + "' (expected " + friction_scheme_choices() + ")");
 }
 
 sim::TrialSpec spec_of(const ClothValues& c, const TrialRequest& r) {

@@ -224,7 +224,7 @@ int run_calibrate(int argc, char** argv) {
     space.hem_bend_ratio = r;
   }
   if (const auto f = args.get("friction")) {
-    if (!friction_scheme_known(*f)) throw UsageError("--friction must be improved, constraint or stock, not '" + *f + "'");
+    if (!friction_scheme_known(*f)) throw UsageError("--friction must be " + friction_scheme_choices() + ", not '" + *f + "'");
     space.friction_scheme = *f;
   }
   space.bounds = args.get("bounds") ? read_bounds(*args.get("bounds")) : default_bounds();

@@ -134,7 +134,7 @@ int run_simulate(int argc, char** argv) {
   // A calibration's scheme unless --friction says otherwise: its coefficients were fitted under it.
   const std::string fr = args.get("friction").value_or(cal ? cal->cloth.friction_scheme : "improved");
   if (!sim::parse_friction_scheme(fr, &spec.friction_scheme))
-    throw UsageError("--friction must be stock, improved or constraint, not '" + fr + "'");
+    throw UsageError("--friction must be " + calib::friction_scheme_choices() + ", not '" + fr + "'");
   const std::string gs = args.get("gown").value_or(cal ? cal->gown : "reduced");
   sim::GownResolution res;
   if (gs == "full") res = sim::GownResolution::Full;

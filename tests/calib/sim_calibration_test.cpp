@@ -168,7 +168,10 @@ TEST(SimCalibration, FrictionSchemeIsTheTrialsScheme) {
     ADD_FAILURE() << "an unknown friction scheme was simulated";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("'sticky'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(friction_scheme_choices()), std::string::npos) << e.what();
   }
+  // Every error that names the schemes lists them from kFrictionSchemes, the default first.
+  EXPECT_EQ(friction_scheme_choices(), "improved, constraint or stock");
 }
 
 // The prediction of other people through the batch form (one settling per group of targets)
