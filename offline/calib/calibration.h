@@ -31,6 +31,13 @@ namespace dressguard::calib {
 
 // ---- what calibration needs from a simulator ---------------------------------------------------
 
+// The simulator's friction schemes by name (sim::friction_scheme_name; sim_bridge.cpp checks the
+// two lists agree): the first is the paper's and every calibration's without one in its file.
+inline constexpr std::array<const char*, 3> kFrictionSchemes = {"improved", "constraint", "stock"};
+bool friction_scheme_known(const std::string& name);
+// The names above as an error message lists them: "improved, constraint or stock".
+std::string friction_scheme_choices();
+
 // The five cloth parameters of paper IV-B.2, in the simulator's units.
 struct ClothValues {
   double stretch = 0.8;        // isotropic stretch stiffness (vertical = horizontal)
@@ -65,18 +72,12 @@ struct ClothValues {
   // kSupportDepth, kSupportLateral below): its axis below the grasp (0: none) and sideways.
   double support_depth = 0.0;
   double support_lateral = 0.0;
-  // How friction acts (sim/trial.h FrictionScheme, by its name; kFrictionSchemes below): the
+  // How friction acts (sim/trial.h FrictionScheme, by its name; kFrictionSchemes above): the
   // paper's improved scheme unless a calibration chose another. Held, never fitted
   // (ParameterSpace::friction_scheme): fitted friction coefficients belong to the scheme they were
   // searched under (offline/calib/MEASUREMENTS.md, session 49), so the file carries it.
-  std::string friction_scheme = "improved";
+  std::string friction_scheme = kFrictionSchemes[0];
 };
-// The simulator's friction schemes by name (sim::friction_scheme_name; sim_bridge.cpp checks the
-// two lists agree): the first is the paper's and every calibration's without one in its file.
-inline constexpr std::array<const char*, 3> kFrictionSchemes = {"improved", "constraint", "stock"};
-bool friction_scheme_known(const std::string& name);
-// The names above as an error message lists them: "improved, constraint or stock".
-std::string friction_scheme_choices();
 inline constexpr double kPaperArealDensity = 0.145;
 inline constexpr int kClothParams = 5;
 // A cuff's limits (sim/params.cpp checks the same): width in [0, 0.2] m, ratio in [1, 1e4].

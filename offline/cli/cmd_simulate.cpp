@@ -132,7 +132,7 @@ int run_simulate(int argc, char** argv) {
   spec.arm_noise = args.has("arm-noise");
   spec.self_collision = !args.has("no-self-collision");
   // A calibration's scheme unless --friction says otherwise: its coefficients were fitted under it.
-  const std::string fr = args.get("friction").value_or(cal ? cal->cloth.friction_scheme : "improved");
+  const std::string fr = args.get("friction").value_or(cal ? cal->cloth.friction_scheme : calib::kFrictionSchemes[0]);
   if (!sim::parse_friction_scheme(fr, &spec.friction_scheme))
     throw UsageError("--friction must be " + calib::friction_scheme_choices() + ", not '" + fr + "'");
   const std::string gs = args.get("gown").value_or(cal ? cal->gown : "reduced");
