@@ -36,6 +36,11 @@ execute_process(COMMAND ${DG} simulate --gown coarse --height low --max-travel 0
 if(NOT rc EQUAL 0 OR NOT out MATCHES "\"travel\": 0.050000" OR NOT out MATCHES "\"label\": \"missed\"")
   message(FATAL_ERROR "--max-travel 0.05 did not end the trial at 0.05 m: rc=${rc} ${out} ${err}")
 endif()
+# Without --friction or --calibration the trial runs under the paper's scheme (IV-A.2), the first
+# of calib::kFrictionSchemes.
+if(NOT out MATCHES "\"friction\": \"improved\"")
+  message(FATAL_ERROR "the default friction scheme is not the paper's improved one: ${out}")
+endif()
 # The summary says what bend means as a fabric: the default bend 0.7 is B of 1-99 mN m, a
 # bending length of centimetres to decimetres (offline/sim/model.h, bending_length()).
 if(NOT out MATCHES "\"bending_rigidity\": 0\\.0[0-9]" OR NOT out MATCHES "\"bending_length\": 0\\.[0-2]")
