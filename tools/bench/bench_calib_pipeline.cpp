@@ -892,9 +892,11 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       jset.set("single_training_priors_good_or_missed_accuracy_whole_and_cuts", pct(sum, n_all));
     }
     // The baseline classifier (paper VI-B.1): the same HMMs trained on the 2-3 measured sequences
-    // that each calibration was fitted to (the study holds no caught trial, so BC knows good and
-    // missed only).
-    per_calibration("bc", "BC, all of them", [&](const Source& src) { return select_inputs(ds, src.participant, 1); },
+    // that each calibration was fitted to (the file's inputs, which need not be the seed's
+    // selection since `calibrate --inputs`; the study holds no caught trial, so BC knows good and
+    // missed only), with the paper's equal priors (`dressguard train` defaults to the training
+    // shares: on participant 0's three inputs that is one trial more right at 0.15 m).
+    per_calibration("bc", "BC, all of them", [](const Source& src) { return src.inputs; },
                     [](const Source& src) { return "BC: participant " + src.participant + "'s measured inputs"; },
                     nullptr, &bc_ids);
     // Each STC against its BC on the same trials (the other people's): b / c the trials only the
