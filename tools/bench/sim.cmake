@@ -2,3 +2,8 @@
 # gown; pull alone and whole trial), peak memory per simulation, against a baseline in the same run.
 add_executable(bench_sim ${CMAKE_CURRENT_LIST_DIR}/bench_sim.cpp)
 target_link_libraries(bench_sim PRIVATE dg_sim)
+# bench_sim_elements: one strain element per triangle against the edges + shear, and how stiff
+# bending is per substep (offline/sim/MEASUREMENTS.md, session 57).
+add_executable(bench_sim_elements ${CMAKE_CURRENT_LIST_DIR}/bench_sim_elements.cpp)
+target_link_libraries(bench_sim_elements PRIVATE dg_sim)
+target_compile_options(bench_sim_elements PRIVATE $<$<CXX_COMPILER_ID:GNU,Clang>:-ffp-contract=off>)
