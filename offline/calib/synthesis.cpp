@@ -415,7 +415,9 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
   s.high_band = high_band;
   s.low_band = low_band;
   for (int t = 0; t < total; ++t) {
-    s.per_label[static_cast<int>(res[kBlock * t])]++;
+    const int label = static_cast<int>(res[kBlock * t]);
+    s.per_label[label]++;
+    s.per_height_label[static_cast<int>(heights[t / options.per_height])][label]++;
     s.resumed += res[kBlock * t + 1] > 0.5;
   }
   if (comm.is_root()) {

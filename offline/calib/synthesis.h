@@ -140,6 +140,11 @@ struct SynthesisSummary {
   MiddleEdge edge;             // with MiddleArm::CaughtEdge: where the middle arm's noise sat
   ArmBand high_band, low_band;  // with HighLowArm::RepeatBand: where the high and low arms' noise sat
   int per_label[kOutcomeCount] = {};
+  // The same per arm height, [ArmHeight][Outcome]. Why: the study's high arm was never caught
+  // (120 good of 120, ../shared/data/README.md), so a set whose high arm is caught has met an edge
+  // that no person showed, in the arm's noise or the gown's push (offline/calib/MEASUREMENTS.md,
+  // session 61: that push is what cost participant 3's support file its STC).
+  int per_height_label[3][kOutcomeCount] = {};
   double elapsed_s = 0;
 };
 

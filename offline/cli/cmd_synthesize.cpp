@@ -1,5 +1,6 @@
 // dressguard synthesize: simulated, automatically labelled trials from a calibration (paper V-A).
 #include <cstdio>
+#include <string>
 
 #include "args.h"
 #include "calibration.h"
@@ -69,6 +70,14 @@ SynthesisSummary run_synthesis(const Calibration& cal, const std::string& gown, 
                    "%s; eq. 3-5 distance <= %.3f)\n",
                    b == &s.high_band ? "high" : "low", b->lower, b->upper,
                    std::string(outcome_name(b->at_calibrated)).c_str(), b->tolerance);
+  // The study never caught the high arm (synthesis.h, SynthesisSummary::per_height_label).
+  const int high_caught = s.per_height_label[static_cast<int>(ArmHeight::High)][static_cast<int>(Outcome::Caught)];
+  if (high_caught > 0 && comm.is_root())
+    std::fprintf(stderr,
+                 "synthesize: note: %d of %d high-arm trials were caught, where the study's high arm never was "
+                 "(120 good of 120): the arm's noise or the gown's push met an edge that no person showed "
+                 "(within the repeat band, the push: offline/calib/MEASUREMENTS.md, session 61)\n",
+                 high_caught, o.per_height);
   return s;
 #endif
 }
@@ -107,16 +116,35 @@ int run_synthesize(int argc, char** argv) {
   const std::string gown = args.get("gown").value_or(cal.gown);
   const SynthesisSummary s = run_synthesis(cal, gown, o, out);
   if (Comm::world().is_root()) {
-    if (args.has("json"))
+    const auto& by = s.per_height_label;
+    const int g = static_cast<int>(Outcome::Good), m = static_cast<int>(Outcome::Missed),
+              c = static_cast<int>(Outcome::Caught);
+    if (args.has("json")) {
+      std::string heights;
+      for (const ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
+        const auto& n = by[static_cast<int>(h)];
+        char buf[128];
+        std::snprintf(buf, sizeof buf, "%s\"%s\": {\"good\": %d, \"missed\": %d, \"caught\": %d}",
+                      heights.empty() ? "" : ", ", std::string(arm_height_name(h)).c_str(), n[g], n[m], n[c]);
+        heights += buf;
+      }
       std::printf("{\"trials\": %d, \"resumed\": %d, \"good\": %d, \"missed\": %d, \"caught\": %d, "
+                  "\"per_height\": {%s}, "
                   "\"middle\": \"%s\", \"middle_base_m\": %.6f, \"high_low\": \"%s\", \"high_band_m\": [%.6f, %.6f], "
                   "\"low_band_m\": [%.6f, %.6f], \"out\": \"%s\"}\n",
-                  s.trials, s.resumed, s.per_label[0], s.per_label[1], s.per_label[2], middle_arm_name(o.middle),
-                  o.middle == MiddleArm::CaughtEdge ? s.edge.offset : 0.0, high_low_arm_name(o.high_low),
-                  s.high_band.lower, s.high_band.upper, s.low_band.lower, s.low_band.upper, out.c_str());
-    else
+                  s.trials, s.resumed, s.per_label[g], s.per_label[m], s.per_label[c], heights.c_str(),
+                  middle_arm_name(o.middle), o.middle == MiddleArm::CaughtEdge ? s.edge.offset : 0.0,
+                  high_low_arm_name(o.high_low), s.high_band.lower, s.high_band.upper, s.low_band.lower,
+                  s.low_band.upper, out.c_str());
+    } else {
       std::printf("synthesized %d trials (%d kept from an earlier run): %d good, %d missed, %d caught -> %s\n",
-                  s.trials, s.resumed, s.per_label[0], s.per_label[1], s.per_label[2], out.c_str());
+                  s.trials, s.resumed, s.per_label[g], s.per_label[m], s.per_label[c], out.c_str());
+      for (const ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
+        const auto& n = by[static_cast<int>(h)];
+        std::printf("  %-6s arm: %d good, %d missed, %d caught\n", std::string(arm_height_name(h)).c_str(), n[g],
+                    n[m], n[c]);
+      }
+    }
   }
   return 0;
 }

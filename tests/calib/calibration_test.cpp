@@ -1395,6 +1395,20 @@ TEST(Synthesis, DatasetIsIndependentOfThreadsAndResumes) {
   EXPECT_EQ(sa.per_label[0] + sa.per_label[1] + sa.per_label[2], 30);
   EXPECT_GT(sa.per_label[static_cast<int>(Outcome::Missed)], 0);  // the low arm misses
   EXPECT_GT(sa.per_label[static_cast<int>(Outcome::Good)], 0);    // the high arm goes in
+  // Per height: each row holds that height's trials, the columns sum to per_label, and the
+  // labels sit where the manifest puts them.
+  int column[kOutcomeCount] = {};
+  for (int h = 0; h < 3; ++h) {
+    int row = 0;
+    for (int l = 0; l < kOutcomeCount; ++l) row += sa.per_height_label[h][l], column[l] += sa.per_height_label[h][l];
+    EXPECT_EQ(row, o.per_height) << "height " << h;
+  }
+  for (int l = 0; l < kOutcomeCount; ++l) EXPECT_EQ(column[l], sa.per_label[l]) << "label " << l;
+  int in_manifest[3][kOutcomeCount] = {};
+  for (const auto& t : load_dataset(a).trials) in_manifest[static_cast<int>(t.height)][static_cast<int>(*t.label)]++;
+  for (int h = 0; h < 3; ++h)
+    for (int l = 0; l < kOutcomeCount; ++l) EXPECT_EQ(sa.per_height_label[h][l], in_manifest[h][l]) << h << " " << l;
+  EXPECT_EQ(sa.per_height_label[static_cast<int>(ArmHeight::Low)][static_cast<int>(Outcome::Missed)], o.per_height);
   // Partial run in b: simulate everything, then delete a third of the trials as a kill would
   // have left them missing; the rerun simulates only those.
   o.threads = 3;

@@ -117,6 +117,28 @@ if(HMM)
   if(NOT rc EQUAL 0 OR NOT n EQUAL 6 OR NOT same OR NOT alone STREQUAL pooled)
     message(FATAL_ERROR "the pooled build's set of calB is not what synthesize makes alone (${rc}, ${n} trials):\n${err}")
   endif()
+  # The same set once more (every trial kept): --json counts the labels per arm height, and each
+  # count is the manifest's.
+  execute_process(COMMAND ${DG} synthesize --calibration ${WORK}/calB.json --out ${WORK}/sB ${synth_opts} --json
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE js ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR NOT js MATCHES "\"resumed\": 6,")
+    message(FATAL_ERROR "synthesize --json on a finished set (${rc}):\n${js}\n${err}")
+  endif()
+  file(STRINGS ${WORK}/sB/manifest.csv rows)
+  foreach(h high middle low)
+    foreach(l good missed caught)
+      string(JSON k GET "${js}" per_height ${h} ${l})
+      set(m 0)
+      foreach(r IN LISTS rows)
+        if(r MATCHES "^[^,]*,[^,]*,${h},[^,]*,${l},")
+          math(EXPR m "${m} + 1")
+        endif()
+      endforeach()
+      if(NOT k EQUAL m)
+        message(FATAL_ERROR "synthesize --json: ${h} ${l} ${k}, the manifest ${m}:\n${js}")
+      endif()
+    endforeach()
+  endforeach()
   # The model from the two sets given as data: the same model, its source naming other folders
   # (the bytes differ there only).
   execute_process(COMMAND ${DG} build-model --data ${WORK}/pooled.dgm.synth/cal4,${WORK}/sB --out ${WORK}/pooled2.dgm
