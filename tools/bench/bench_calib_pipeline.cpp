@@ -29,7 +29,7 @@
 //                               [--seed S] [--threads T] [--states K]
 //                               [--seed S1,S2,... --synth DIR1,DIR2,...]
 //                               [--discrepancy on|off] [--arm-noise on|off] [--gown-noise on|off]
-//                               [--high-low paper|repeat-band]
+//                               [--high-low paper|repeat-band] [--middle nominal|caught-edge]
 //     The pooled STC (paper VII: HMMs trained on the simulators of several people and tested on a
 //     person none of them was calibrated on) against each calibration's own STC and the 1-NN on
 //     the people's real trials. Each calibration synthesizes its set into DIR/<file's name>/, as
@@ -628,6 +628,14 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     return 2;
   }
   so.high_low = *high_low;
+  // Where the middle arm's noise sits (synthesis.h, MiddleArm): the paper's nominal height, or
+  // below the simulator's own good/caught edge, where its middle arm is caught as the study's were.
+  const std::string middle_arg = get(a, "middle", "nominal");
+  if (middle_arg != "nominal" && middle_arg != "caught-edge") {
+    std::fprintf(stderr, "pooled: --middle takes nominal or caught-edge, not '%s'\n", middle_arg.c_str());
+    return 2;
+  }
+  so.middle = middle_arg == "caught-edge" ? MiddleArm::CaughtEdge : MiddleArm::Nominal;
 
   // Each calibration's synthesized set, its trials kept for the whole run.
   struct Source {
@@ -653,6 +661,9 @@ int run_pooled(const std::map<std::string, std::string>& a) {
                     100 * sum.high_band.lower, 100 * sum.high_band.upper,
                     std::string(outcome_name(sum.high_band.at_calibrated)).c_str(), 100 * sum.low_band.lower,
                     100 * sum.low_band.upper, std::string(outcome_name(sum.low_band.at_calibrated)).c_str());
+      if (so.middle == MiddleArm::CaughtEdge)
+        std::printf("  middle edge: its noise below %+.2f cm from the nominal middle (good at %+.2f cm, %s below)\n",
+                    100 * sum.edge.offset, 100 * sum.edge.good_at, std::string(outcome_name(sum.edge.below)).c_str());
       // The s-th seed's trial i of a height is that height's trial s x per_height + i of the
       // union, so that ids stay unique and the equal-size pool below splits the union evenly.
       for (auto& t : load_dataset(dir).trials) {
@@ -722,6 +733,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
   out.set("arm_noise", so.arm_noise);
   out.set("gown_noise", so.gown_noise);
   out.set("high_low", high_low_arm_name(so.high_low));
+  out.set("middle", middle_arm_name(so.middle));
   Json jsources = Json::array();
   for (const auto& src : sources) {
     Json j = Json::object();
@@ -1094,6 +1106,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
   if (!so.arm_noise) json_name += "-no-arm-noise";
   if (!so.gown_noise) json_name += "-no-gown-noise";
   if (so.high_low != HighLowArm::Paper) json_name += std::string("-") + high_low_arm_name(so.high_low);
+  if (so.middle != MiddleArm::Nominal) json_name += std::string("-middle-") + middle_arm_name(so.middle);
   json_name += ".json";
   write_file_atomic(work / json_name, out.dump() + "\n");
   std::printf("wrote %s\n", (work / json_name).string().c_str());
