@@ -23,6 +23,12 @@ std::string synthesis_trial_id(ArmHeight height, int index) {
 
 const char* middle_arm_name(MiddleArm m) { return m == MiddleArm::CaughtEdge ? "caught-edge" : "nominal"; }
 const char* high_low_arm_name(HighLowArm a) { return a == HighLowArm::RepeatBand ? "repeat-band" : "paper"; }
+std::optional<MiddleArm> parse_middle_arm(std::string_view s) {
+  for (MiddleArm m : {MiddleArm::Nominal, MiddleArm::CaughtEdge})
+    if (s == middle_arm_name(m)) return m;
+  return std::nullopt;
+}
+
 std::optional<HighLowArm> parse_high_low_arm(std::string_view s) {
   for (HighLowArm a : {HighLowArm::Paper, HighLowArm::RepeatBand})
     if (s == high_low_arm_name(a)) return a;

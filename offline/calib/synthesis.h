@@ -54,6 +54,7 @@ enum class MiddleArm {
   CaughtEdge,  // U[-6, 0] cm below the simulator's good/not-good edge (locate_middle_edge)
 };
 const char* middle_arm_name(MiddleArm m);  // "nominal", "caught-edge"
+std::optional<MiddleArm> parse_middle_arm(std::string_view s);  // the inverse; nullopt otherwise
 
 enum class HighLowArm {
   Paper,       // calibrated offset + U[-1.5, +1.5] cm (the paper)

@@ -26,10 +26,9 @@ SynthesisOptions synthesis_options_from(const Args& args) {
   if (seed < 0) throw UsageError("--seed must be non-negative");
   o.seed = static_cast<std::uint64_t>(seed);
   o.threads = static_cast<int>(args.integer("threads", 0));
-  const std::string middle = args.get("middle").value_or("nominal");
-  if (middle == "nominal") o.middle = MiddleArm::Nominal;
-  else if (middle == "caught-edge") o.middle = MiddleArm::CaughtEdge;
-  else throw UsageError("--middle must be nominal or caught-edge");
+  const auto middle = parse_middle_arm(args.get("middle").value_or("nominal"));
+  if (!middle) throw UsageError("--middle must be nominal or caught-edge");
+  o.middle = *middle;
   const auto high_low = parse_high_low_arm(args.get("high-low").value_or("paper"));
   if (!high_low) throw UsageError("--high-low must be paper or repeat-band");
   o.high_low = *high_low;

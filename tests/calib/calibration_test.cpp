@@ -1229,6 +1229,8 @@ TEST(Synthesis, RepeatBandEndsAtTheFistEdge) {
   EXPECT_THROW(locate_repeat_band(cal, sim, ArmHeight::Middle, 1, Comm::world()), std::invalid_argument);
   for (HighLowArm a : {HighLowArm::Paper, HighLowArm::RepeatBand}) EXPECT_EQ(parse_high_low_arm(high_low_arm_name(a)), a);
   EXPECT_FALSE(parse_high_low_arm("band"));
+  for (MiddleArm m : {MiddleArm::Nominal, MiddleArm::CaughtEdge}) EXPECT_EQ(parse_middle_arm(middle_arm_name(m)), m);
+  EXPECT_FALSE(parse_middle_arm("edge"));
 
   // The synthesis draws the high and low arms within their bands (both ends nearly reached by
   // 100 draws), leaves the middle arm as the paper has it, and keeps the bands for a resumed run.

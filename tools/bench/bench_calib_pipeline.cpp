@@ -631,11 +631,12 @@ int run_pooled(const std::map<std::string, std::string>& a) {
   // Where the middle arm's noise sits (synthesis.h, MiddleArm): the paper's nominal height, or
   // below the simulator's own good/caught edge, where its middle arm is caught as the study's were.
   const std::string middle_arg = get(a, "middle", "nominal");
-  if (middle_arg != "nominal" && middle_arg != "caught-edge") {
+  const auto middle = parse_middle_arm(middle_arg);
+  if (!middle) {
     std::fprintf(stderr, "pooled: --middle takes nominal or caught-edge, not '%s'\n", middle_arg.c_str());
     return 2;
   }
-  so.middle = middle_arg == "caught-edge" ? MiddleArm::CaughtEdge : MiddleArm::Nominal;
+  so.middle = *middle;
 
   // Each calibration's synthesized set, its trials kept for the whole run.
   struct Source {
