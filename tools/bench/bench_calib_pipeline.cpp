@@ -621,21 +621,20 @@ int run_pooled(const std::map<std::string, std::string>& a) {
   const bool discrepancy = switches.at("discrepancy");
   so.arm_noise = switches.at("arm-noise");
   so.gown_noise = switches.at("gown-noise");
-  const std::string high_low_arg = get(a, "high-low", "paper");
-  const auto high_low = parse_high_low_arm(high_low_arg);
-  if (!high_low) {
-    std::fprintf(stderr, "pooled: --high-low takes paper or repeat-band, not '%s'\n", high_low_arg.c_str());
-    return 2;
-  }
+  // The two arm-noise placements (synthesis.h): each option's value through its parser, or a
+  // one-line reason and exit 2.
+  auto placement = [&](const char* name, const char* fallback, auto parse, const char* choices) {
+    const std::string v = get(a, name, fallback);
+    const auto parsed = parse(v);
+    if (!parsed) std::fprintf(stderr, "pooled: --%s takes %s, not '%s'\n", name, choices, v.c_str());
+    return parsed;
+  };
+  const auto high_low = placement("high-low", "paper", parse_high_low_arm, "paper or repeat-band");
+  // Where the middle arm's noise sits: the paper's nominal height, or below the simulator's own
+  // good/caught edge, where its middle arm is caught as the study's were.
+  const auto middle = placement("middle", "nominal", parse_middle_arm, "nominal or caught-edge");
+  if (!high_low || !middle) return 2;
   so.high_low = *high_low;
-  // Where the middle arm's noise sits (synthesis.h, MiddleArm): the paper's nominal height, or
-  // below the simulator's own good/caught edge, where its middle arm is caught as the study's were.
-  const std::string middle_arg = get(a, "middle", "nominal");
-  const auto middle = parse_middle_arm(middle_arg);
-  if (!middle) {
-    std::fprintf(stderr, "pooled: --middle takes nominal or caught-edge, not '%s'\n", middle_arg.c_str());
-    return 2;
-  }
   so.middle = *middle;
 
   // Each calibration's synthesized set, its trials kept for the whole run.
