@@ -310,9 +310,15 @@ TrialRequest request_for(const HapticSequence& input, const std::array<double, 3
 
 std::vector<SimulatedTrial> simulate_inputs(const TrialBatchSimulator& sim, const ClothValues& cloth,
                                             const std::array<double, 3>& offsets,
-                                            const std::vector<HapticSequence>& inputs) {
+                                            const std::vector<HapticSequence>& inputs,
+                                            const std::vector<TrialWatch>& watches) {
+  if (!watches.empty() && watches.size() != inputs.size())
+    throw std::logic_error("simulate_inputs: one watch per input, or none");
   std::vector<TrialRequest> rs;
-  for (const HapticSequence& in : inputs) rs.push_back(request_for(in, offsets));
+  for (std::size_t k = 0; k < inputs.size(); ++k) {
+    rs.push_back(request_for(inputs[k], offsets));
+    if (!watches.empty()) rs.back().watch = watches[k];
+  }
   std::vector<SimulatedTrial> sts = sim(cloth, rs);
   if (sts.size() != inputs.size()) throw std::logic_error("calibrate: the simulator returned a wrong count");
   return sts;
@@ -395,7 +401,10 @@ void rescore(Calibration& c, const std::vector<HapticSequence>& inputs, const st
 
 double sequence_term(ObjectiveKind kind, const SimulatedTrial& st, const HapticSequence& measured) {
   if (!st.finite || st.samples.empty()) return std::numeric_limits<double>::infinity();
-  const double v = sequence_objective(kind, st.samples, measured.samples);
+  if (st.cut && kind != ObjectiveKind::Area)
+    throw std::logic_error("sequence_term: a cut trial has a lower bound only under the area objective");
+  const double v = st.cut ? area_objective_so_far(st.samples, measured.samples)
+                          : sequence_objective(kind, st.samples, measured.samples);
   return std::isfinite(v) ? v : std::numeric_limits<double>::infinity();
 }
 
@@ -445,6 +454,7 @@ std::string fingerprint(const std::vector<HapticSequence>& inputs, const Paramet
   // The gown when it is not the default reduced one (likewise). Before session 49 it was not
   // carried, and a reduced-gown checkpoint would have resumed a full-gown run.
   if (o.gown != "reduced") f << ";gown=" << o.gown;
+  if (o.prune > 0) f << ";prune=" << hexd(o.prune);  // likewise
   f << ";names=";
   for (const auto& n : space.names()) f << n << ',';
   f << ";bounds=";
@@ -577,6 +587,10 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
     throw std::invalid_argument("calibrate: the contrast weight must be 0 or positive");
   if (options.lateral_weight < 0 || !std::isfinite(options.lateral_weight))
     throw std::invalid_argument("calibrate: the lateral weight must be 0 or positive");
+  if (options.prune < 0 || !std::isfinite(options.prune))
+    throw std::invalid_argument("calibrate: the prune factor must be 0 (off) or positive");
+  if (options.prune > 0 && options.objective != ObjectiveKind::Area)
+    throw std::invalid_argument("calibrate: pruning needs the area objective (its lower bound, objective.h)");
   // The terms of a candidate's objective: one per input sequence, then the contrast term and the
   // lateral term when they are asked for, at `ic` and `il` (-1: none), so that a run without them
   // keeps its old layout and its checkpoints resume.
@@ -627,20 +641,40 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   // task per (candidate, sequence) for finer grains; with 10-32 candidates a generation the
   // coarser grain still keeps 2 cores busy.
   // `generation`: which one these candidates are (0: the start), for candidate_progress alone.
+  // `bound` (pruning, see calibration.h): a candidate whose objective's lower bound passes it is
+  // cut; infinity: none is. Each candidate's T terms are followed by 1 when it was cut, else 0.
+  const int W = T + 1;
   std::mutex progress_mutex;
-  auto evaluate = [&](const std::vector<Eigen::VectorXd>& xs, int generation) {
+  auto evaluate = [&](const std::vector<Eigen::VectorXd>& xs, int generation, double bound) {
     const int n = static_cast<int>(xs.size());
     const auto began = std::chrono::steady_clock::now();
     CandidateProgress cp;
     cp.generation = generation;
     cp.total = (n + comm.size() - 1) / comm.size();  // run_batch: the root takes indices 0, size, ...
-    return run_batch(n, T, thread_count(options.threads), comm, [&](int c, double* out) {
-      const std::vector<SimulatedTrial> sts = simulate_inputs(sim, space.cloth(xs[c]), space.offsets(xs[c]), inputs);
+    return run_batch(n, W, thread_count(options.threads), comm, [&](int c, double* out) {
+      // The candidate's terms as far as they are known: each sequence's bound while it runs, its
+      // whole L once it ended; the extra terms 0 (>= 0, known only at the end).
+      std::vector<double> known(static_cast<std::size_t>(T), 0.0);
+      std::vector<TrialWatch> watches;
+      if (bound < std::numeric_limits<double>::infinity())
+        for (int k = 0; k < K; ++k)
+          watches.push_back([&, k](const std::vector<HapticSample>& so_far, bool ended) {
+            const auto& measured = inputs[static_cast<std::size_t>(k)].samples;
+            known[static_cast<std::size_t>(k)] =
+                !ended ? area_objective_so_far(so_far, measured)
+                       : (so_far.empty() ? std::numeric_limits<double>::infinity() : area_objective(so_far, measured));
+            return combined_objective(known.data(), K, T, options.combine) > bound;
+          });
+      const std::vector<SimulatedTrial> sts =
+          simulate_inputs(sim, space.cloth(xs[c]), space.offsets(xs[c]), inputs, watches);
+      bool cut = false;
       for (int k = 0; k < K; ++k) {
         out[k] = sequence_term(options.objective, sts[k], inputs[k]);
+        cut = cut || sts[k].cut;
       }
-      if (ic >= 0) out[ic] = contrast_term(inputs, sts, options.contrast_weight);
-      if (il >= 0) out[il] = lateral_term(inputs, sts, options.lateral_weight);
+      if (ic >= 0) out[ic] = cut ? 0.0 : contrast_term(inputs, sts, options.contrast_weight);
+      if (il >= 0) out[il] = cut ? 0.0 : lateral_term(inputs, sts, options.lateral_weight);
+      out[T] = cut ? 1.0 : 0.0;
       if (options.candidate_progress && comm.is_root()) {
         std::lock_guard<std::mutex> lock(progress_mutex);
         ++cp.done;
@@ -658,23 +692,57 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   // the same bits as an uninterrupted run) and returned if nothing the search found beats it.
   // The search itself is unchanged: the start does not enter CMA-ES's update.
   const Eigen::VectorXd start = space.initial_unit();
-  const std::vector<double> start_fits = evaluate({start}, 0);
+  const double no_bound = std::numeric_limits<double>::infinity();
+  std::vector<double> start_fits = evaluate({start}, 0, no_bound);
+  start_fits.resize(static_cast<std::size_t>(T));
   const double start_f = combined_objective(start_fits.data(), K, T, options.combine);
 
   int done_here = 0;
+  long pruned_total = 0, resimulated_total = 0;
   while (!es.stopped()) {
     if (options.stop_after_generations > 0 && done_here >= options.stop_after_generations) break;
     const std::vector<Eigen::VectorXd> xs = es.ask();
     const int lambda = static_cast<int>(xs.size());
-    const std::vector<double> per = evaluate(xs, done + 1);
+    const auto& medians = es.state().median_history;
+    const double bound = options.prune > 0 && !medians.empty() ? options.prune * medians.back() : no_bound;
+    std::vector<double> per = evaluate(xs, done + 1, bound);
     std::vector<double> f(static_cast<std::size_t>(lambda), 0.0);
-    for (int c = 0; c < lambda; ++c)
-      f[c] = combined_objective(per.data() + static_cast<std::size_t>(c) * T, K, T, options.combine);
+    std::vector<char> cut(static_cast<std::size_t>(lambda), 0);
+    auto take = [&](int c) {
+      f[c] = combined_objective(per.data() + static_cast<std::size_t>(c) * W, K, T, options.combine);
+      cut[c] = per[static_cast<std::size_t>(c) * W + T] != 0.0;
+    };
+    for (int c = 0; c < lambda; ++c) take(c);
+    const int pruned = static_cast<int>(std::count(cut.begin(), cut.end(), 1));
+    // Keep the mu best exact (calibration.h): simulate again, in whole, the cut candidates of the
+    // lowest bounds until mu fully simulated ones score at or below every bound left.
+    int resimulated = 0;
+    for (;;) {
+      std::vector<int> cuts;
+      for (int c = 0; c < lambda; ++c)
+        if (cut[c]) cuts.push_back(c);
+      if (cuts.empty()) break;
+      std::stable_sort(cuts.begin(), cuts.end(), [&](int a, int b) { return f[a] < f[b]; });
+      int below = 0;
+      for (int c = 0; c < lambda; ++c) below += !cut[c] && f[c] <= f[cuts.front()] ? 1 : 0;
+      const int need = std::min(es.mu() - below, static_cast<int>(cuts.size()));
+      if (need <= 0) break;
+      std::vector<Eigen::VectorXd> again;
+      for (int i = 0; i < need; ++i) again.push_back(xs[static_cast<std::size_t>(cuts[i])]);
+      const std::vector<double> redo = evaluate(again, done + 1, no_bound);
+      for (int i = 0; i < need; ++i) {
+        std::copy_n(redo.begin() + static_cast<long>(i) * W, W, per.begin() + static_cast<long>(cuts[i]) * W);
+        take(cuts[i]);
+      }
+      resimulated += need;
+    }
+    pruned_total += pruned;
+    resimulated_total += resimulated;
     const double best_before = es.best_f();
     const int arg = static_cast<int>(std::min_element(f.begin(), f.end()) - f.begin());
     es.tell(f);
     if (f[arg] < best_before)
-      for (int k = 0; k < T; ++k) best_fits[k] = per[static_cast<std::size_t>(arg) * T + k];
+      for (int k = 0; k < T; ++k) best_fits[k] = per[static_cast<std::size_t>(arg) * W + k];
     ++done;
     ++done_here;
     if (comm.is_root()) {
@@ -693,6 +761,9 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
         p.best_lateral = il >= 0 ? p.best_fits[static_cast<std::size_t>(il)] : 0.0;
         p.best_fits.resize(static_cast<std::size_t>(K));
         p.generation_best = f[arg];
+        p.pruned = pruned;
+        p.resimulated = resimulated;
+        p.prune_bound = bound;
         p.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         p.eta_s = p.elapsed_s / done_here * std::max(0, options.generations - done);
         p.resumed = resumed;
@@ -705,6 +776,8 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   r.complete = es.stopped();
   r.generations_done = done;
   r.evaluations = es.state().evaluations + 1;  // and the start
+  r.pruned = pruned_total;
+  r.resimulated = resimulated_total;
   r.start_objective = start_f;
   const bool keep_start = !(es.best_f() <= start_f);  // also when the search found nothing finite
   r.objective = keep_start ? start_f : es.best_f();

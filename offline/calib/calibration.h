@@ -147,6 +147,10 @@ struct TrialRequest {
   std::uint64_t seed = 0;    // the gown perturbation's random stream
   bool gown_noise = false;   // paper V-A perturbation (6 N, 0.5 s) on or off
   double max_travel = 0.85;  // [m] end of the rig's travel (the paper's 0.85 m; see request_for)
+  // Optional (calibrate --prune): asked after each simulated sample with the samples so far and
+  // whether the trial has ended; `true` stops a trial that has not (SimulatedTrial::cut). A
+  // simulator that cannot stop early may ignore it (its trials are then never cut).
+  std::function<bool(const std::vector<HapticSample>& so_far, bool ended)> watch;
 };
 
 struct SimulatedTrial {
@@ -158,6 +162,7 @@ struct SimulatedTrial {
   // simulator does not say (a test's stand-in).
   double d_behind = std::numeric_limits<double>::quiet_NaN();
   double d_ahead = std::numeric_limits<double>::quiet_NaN();
+  bool cut = false;  // TrialRequest::watch stopped it: `samples` end there, the label is not a trial's
 };
 
 // Must be deterministic and callable from several threads at once.
@@ -307,7 +312,9 @@ std::optional<SequenceCombine> parse_combine(std::string_view s);
 double combined_objective(const double* terms, int K, int T, SequenceCombine c);
 
 // One sequence's term: the chosen objective of a simulated trial against its measured input;
-// infinity when the simulation blew up or gave nothing (so no combination can prefer it).
+// infinity when the simulation blew up or gave nothing (so no combination can prefer it). For a
+// trial that was cut (SimulatedTrial::cut), the area objective's lower bound so far
+// (area_objective_so_far); a cut trial under another objective throws std::logic_error.
 double sequence_term(ObjectiveKind kind, const SimulatedTrial& st, const HapticSequence& measured);
 
 // One candidate's simulations finished within a generation, on the root rank (under mpirun each
@@ -339,6 +346,10 @@ struct CalibrationOptions {
   int threads = 0;                 // 0 = all cores
   std::filesystem::path checkpoint;  // empty = none
   int stop_after_generations = 0;  // > 0: stop (as if killed) after this many generations in this process
+  // > 0 (calibrate --prune, area objective only): stop simulating a candidate once the lower bound
+  // of its objective (its sequences' area_objective_so_far, its extra terms taken as 0, combined)
+  // passes `prune` times the previous generation's median objective. See calibrate() below.
+  double prune = 0;
   // Optional: called on the root rank as each of its candidates finishes, one call at a time
   // (under a lock; the simulations of other candidates go on meanwhile). Changes no result.
   std::function<void(const CandidateProgress&)> candidate_progress;
@@ -353,6 +364,9 @@ struct GenerationProgress {
   double best_contrast = 0;       // its weighted contrast term (0 without one)
   double best_lateral = 0;        // its weighted lateral term (0 without one)
   double generation_best = 0;
+  int pruned = 0;           // this generation's candidates cut short (options.prune) ...
+  int resimulated = 0;      // ... and of those, the ones simulated again in whole
+  double prune_bound = std::numeric_limits<double>::infinity();  // the bound they were cut at
   double elapsed_s = 0;     // this process
   double eta_s = 0;         // estimated remaining, from this process's pace
   bool resumed = false;     // this process continued from a checkpoint
@@ -386,6 +400,7 @@ struct CalibrationResult {
   bool complete = false;          // false: stopped by stop_after_generations (resume later)
   int generations_done = 0;
   long evaluations = 0;           // candidate evaluations (each = one simulation per sequence), the start's included
+  long pruned = 0, resimulated = 0;  // in this process: candidates cut short, and simulated again (options.prune)
   double objective = 0;           // L of the best candidate (the start, when no sample beat it)
   double start_objective = 0;     // L of the start (the bounds' initial values)
   Eigen::VectorXd best_unit;      // in the unit box
@@ -419,11 +434,27 @@ double lateral_term(const std::vector<HapticSequence>& inputs, const std::vector
                     double weight);
 
 // Runs (or resumes from options.checkpoint) the calibration. The start (the bounds' initial
-// values) is evaluated first, and is the result when no candidate of the search beats it. Every rank of `comm` must call it
-// with the same arguments; they evaluate shares of each generation and end with identical
-// results; only rank 0 writes the checkpoint and calls `progress`. A generation's tasks are its
-// candidates, each simulating all input sequences with one batch call; a one-trial simulator
-// runs them one after another (one_by_one). The result does not depend on which is given.
+// values) is evaluated first, and is the result when no candidate of the search beats it. Every
+// rank of `comm` must call it with the same arguments; they evaluate shares of each generation
+// and end with identical results; only rank 0 writes the checkpoint and calls `progress`. A
+// generation's tasks are its candidates, each simulating all input sequences with one batch
+// call; a one-trial simulator runs them one after another (one_by_one). The result does not
+// depend on which is given.
+//
+// Pruning (options.prune = kappa > 0). Every term of eq. 3-5 is >= 0, so a candidate's objective
+// summed over the samples simulated so far bounds its whole objective from below. From the second
+// generation of a search on, a candidate is stopped once that bound passes B = kappa x the
+// previous generation's median objective (CmaesState::median_history, so a resume has the same B),
+// and enters the ranking with the bound. A search with a wrong guess needs them all: a sleeve
+// that misses where the measured one caught runs the rig's whole travel, charged at w = 20 from
+// where the measurement stopped. Afterwards, while fewer than mu of the fully simulated candidates
+// score at or below the lowest bound among the cut ones, the `mu minus that count` cut candidates
+// with the lowest bounds are simulated again in whole: so the mu best candidates, which set the
+// mean and the positive weights (tutorial eq. 41-47), are always known exactly. What the bound
+// leaves approximate is the order among the rest: the negative weights of active CMA (eq. 53)
+// go by it, and the boundary penalty's scale (the values' inter-quartile range) uses it, so a
+// pruned search is not the unpruned one to the bit. It is deterministic, the same on any thread
+// or rank count, and resumes to the same bits.
 CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const ParameterSpace& space,
                             const TrialSimulator& sim, const CalibrationOptions& options, const Comm& comm,
                             const std::function<void(const GenerationProgress&)>& progress = {});
@@ -440,10 +471,13 @@ TrialRequest request_for(const HapticSequence& input, const std::array<double, 3
 
 // The calibration's inputs simulated with one cloth and its offsets (request_for each, one batch:
 // the search's evaluation of a candidate and the curves `calibrate` writes are this call), in the
-// inputs' order. Throws std::logic_error when the simulator returns another count.
+// inputs' order. `watches`: empty, or one TrialRequest::watch per input. Throws
+// std::logic_error when the simulator returns another count.
+using TrialWatch = std::function<bool(const std::vector<HapticSample>& so_far, bool ended)>;
 std::vector<SimulatedTrial> simulate_inputs(const TrialBatchSimulator& sim, const ClothValues& cloth,
                                             const std::array<double, 3>& offsets,
-                                            const std::vector<HapticSequence>& inputs);
+                                            const std::vector<HapticSequence>& inputs,
+                                            const std::vector<TrialWatch>& watches = {});
 
 // True when a measured trial ended at the force threshold (|F| >= 9.5 N on motion or vertical at
 // its last sample; the rig's limit is 10 N, the last sample may sit just under it).

@@ -116,6 +116,7 @@ class Cmaes {
   StopReason stop_reason() const { return state_.stopped; }
   const CmaesState& state() const { return state_; }
   const CmaesSettings& settings() const { return settings_; }
+  int mu() const { return mu_; }  // how many of the best candidates get a positive weight (eq. 49)
   const Eigen::VectorXd& best_x() const { return state_.best_x; }
   double best_f() const { return state_.best_f; }
 

@@ -69,8 +69,12 @@ PairedStart paired_start(const std::vector<HapticSample>& sim, const std::vector
   return {};
 }
 
-double area_error(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured, ForceAxis axis,
-                  double w) {
+namespace {
+
+// eq. 3-4; `sim_goes_on`: the simulation may have samples still to come, so the terms that its
+// last sample decides (measurement longer, s_m) are left out.
+double area_error_of(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured, ForceAxis axis,
+                     double w, bool sim_goes_on) {
   const PairedStart p = paired_start(sim, measured);
   // i counts pairs from p; m and n are the last pair indices, as in eq. 4.
   const std::size_t m = sim.size() - 1 - p.sim, n = measured.size() - 1 - p.measured;
@@ -82,12 +86,30 @@ double area_error(const std::vector<HapticSample>& sim, const std::vector<Haptic
   // Simulation longer: w dx |s_i - r_n|, dx the simulation's travel.
   for (std::size_t i = n + 1; i <= m; ++i) e += w * step(sim, p.sim + i) * std::abs(s(i) - r(n));
   // Measurement longer: w dx |s_m - r_i|, dx the measurement's travel.
-  for (std::size_t i = m + 1; i <= n; ++i) e += w * step(measured, p.measured + i) * std::abs(s(m) - r(i));
+  if (!sim_goes_on)
+    for (std::size_t i = m + 1; i <= n; ++i) e += w * step(measured, p.measured + i) * std::abs(s(m) - r(i));
   return e;
+}
+
+}  // namespace
+
+double area_error(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured, ForceAxis axis,
+                  double w) {
+  return area_error_of(sim, measured, axis, w, false);
 }
 
 double area_objective(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured, double w) {
   return area_error(sim, measured, ForceAxis::Vertical, w) + area_error(sim, measured, ForceAxis::Motion, w);
+}
+
+double area_objective_so_far(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured,
+                             double w) {
+  if (sim.empty()) {
+    require_samples(measured, measured);
+    return 0.0;
+  }
+  return area_error_of(sim, measured, ForceAxis::Vertical, w, true) +
+         area_error_of(sim, measured, ForceAxis::Motion, w, true);
 }
 
 double position_weighted_objective(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured) {

@@ -74,6 +74,17 @@ double area_error(const std::vector<HapticSample>& sim, const std::vector<Haptic
 double area_objective(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured,
                       double w = kLengthPenaltyWeight);
 
+// A lower bound of area_objective() for a simulation still under way (calibrate --prune): its
+// terms that no later sample can change. Every term of eq. 3-4 is >= 0; the pairs up to the
+// simulation's last sample and the w-weighted ones where it already runs longer than the
+// measurement stay as they are, and the measurement-longer terms, which pair the measurement
+// with the simulation's final sample, are left out (they may vanish as it goes on). So it
+// never decreases as samples come, and area_objective() of the whole simulation is at least it.
+// While the simulation has not reached the travel where a late-starting measurement begins
+// (paired_start) it is 0. An empty simulation scores 0.
+double area_objective_so_far(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured,
+                             double w = kLengthPenaltyWeight);
+
 // The public code's position-weighted error (see above), both axes.
 double position_weighted_objective(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured);
 

@@ -79,6 +79,7 @@ sim::TrialSpec spec_of(const ClothValues& c, const TrialRequest& r) {
   spec.seed = r.seed;
   spec.gown_noise = r.gown_noise;
   spec.max_travel = r.max_travel;
+  spec.pull_watch = r.watch;
   return spec;
 }
 
@@ -89,6 +90,7 @@ SimulatedTrial simulated(sim::TrialResult&& res) {
   out.finite = res.finite;
   out.d_behind = res.d_behind;
   out.d_ahead = res.d_ahead;
+  out.cut = res.cut;
   return out;
 }
 

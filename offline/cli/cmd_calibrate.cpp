@@ -104,6 +104,10 @@ int run_calibrate(int argc, char** argv) {
         "  --lateral-weight K  add K times the lateral force's area error to the objective (eq. 3\n"
         "                      on F_lateral, over the travel both cover; offline/calib/calibration.h,\n"
         "                      lateral_term). Default 0: eq. 3-5 alone\n"
+        "  --prune KAPPA       stop simulating a candidate once its objective's lower bound (the\n"
+        "                      area so far; eq. 3-5's terms are >= 0) passes KAPPA times the last\n"
+        "                      generation's median, keeping the mu best exact (offline/calib/\n"
+        "                      calibration.h). Area objective only. Default 0: every candidate whole\n"
         "  --no-arm-offset     do not optimise the arm offsets (paper Fig. 9 comparison)\n"
         "  --arm-compliance fit|fixed|C   the person's arm: fit its compliance [m/N] too (one more\n"
         "                      parameter; offline/sim/arm_spring.h), hold it fixed (the paper's, the\n"
@@ -162,7 +166,7 @@ int run_calibrate(int argc, char** argv) {
                    "checkpoint", "objective", "gown", "threads", "generations", "population",
                    "stop-after-generations", "arm-compliance", "fist-shift", "rim-shift", "sigma0", "hem",
                    "density", "contrast-weight", "lateral-weight", "combine", "arm-lateral", "fist-lateral",
-                   "support-depth", "support-lateral", "inputs", "friction"});
+                   "support-depth", "support-lateral", "inputs", "friction", "prune"});
   const std::string data = args.require("data");
   const std::string participant = args.require("participant");
   const std::string out = args.require("out");
@@ -196,6 +200,11 @@ int run_calibrate(int argc, char** argv) {
     o.lateral_weight = args.number("lateral-weight", 0);
     if (!(o.lateral_weight >= 0 && o.lateral_weight <= 1000))
       throw UsageError("--lateral-weight must be in [0, 1000], not '" + *lw + "'");
+  }
+  if (const auto pr = args.get("prune")) {
+    o.prune = args.number("prune", 0);
+    if (!(o.prune >= 0 && o.prune <= 100)) throw UsageError("--prune must be in [0, 100], not '" + *pr + "'");
+    if (o.prune > 0 && o.objective != ObjectiveKind::Area) throw UsageError("--prune needs --objective area");
   }
   o.threads = static_cast<int>(args.integer("threads", 0));
   o.checkpoint = args.get("checkpoint").value_or(out + ".ckpt");
@@ -331,9 +340,12 @@ int run_calibrate(int argc, char** argv) {
     char resumed[64] = "";
     if (p.resumed && first_line) std::snprintf(resumed, sizeof resumed, "  (resumed after generation %d)", p.generation - 1);
     first_line = false;
-    std::fprintf(stderr, "generation %d/%d  best L %.4f (%s)  (this generation %.4f)  elapsed %s  ETA %s%s\n",
-                 p.generation, p.generations, p.best, per.c_str(), p.generation_best, minutes(p.elapsed_s).c_str(),
-                 minutes(p.eta_s).c_str(), resumed);
+    char pruned[64] = "";
+    if (o.prune > 0)
+      std::snprintf(pruned, sizeof pruned, "  pruned %d/%d (%d again)", p.pruned, o.population, p.resimulated);
+    std::fprintf(stderr, "generation %d/%d  best L %.4f (%s)  (this generation %.4f)%s  elapsed %s  ETA %s%s\n",
+                 p.generation, p.generations, p.best, per.c_str(), p.generation_best, pruned,
+                 minutes(p.elapsed_s).c_str(), minutes(p.eta_s).c_str(), resumed);
   });
   if (!r.complete) {
     if (comm.is_root()) {
@@ -363,6 +375,11 @@ int run_calibrate(int argc, char** argv) {
   prov.set("ranks", comm.size());
   prov.set("threads_per_rank", thread_count(o.threads));
   prov.set("elapsed_s_last_process", r.elapsed_s);
+  if (o.prune > 0) {  // only when asked (files of unpruned runs keep their fields)
+    prov.set("prune", o.prune);
+    prov.set("pruned_last_process", r.pruned);
+    prov.set("resimulated_last_process", r.resimulated);
+  }
   Json names = Json::array();
   for (const auto& n : space.names()) names.push(n);
   prov.set("parameters", names);
@@ -393,6 +410,9 @@ int run_calibrate(int argc, char** argv) {
       std::printf("participant %s: L = %.4f after %d generations (%ld evaluations, %s; the start's L %.4f)\n",
                   participant.c_str(), r.objective, r.generations_done, r.evaluations, minutes(r.elapsed_s).c_str(),
                   r.start_objective);
+      if (o.prune > 0)
+        std::printf("  pruned at %g x the last generation's median: %ld candidates cut, %ld of them simulated again "
+                    "(this process)\n", o.prune, r.pruned, r.resimulated);
       if (o.combine == SequenceCombine::Worst) {
         double sum = 0;
         for (const auto& f : cal.fits) sum += f.objective;

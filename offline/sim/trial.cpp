@@ -393,10 +393,30 @@ TrialResult finish_pull(const GownModel& m, Pulling& p, const TrialSpec& spec, c
   return std::move(r);
 }
 
+// The caller's watch after one of the trial's own samples (TrialSpec::pull_watch): a pull that
+// it stops ends here, cut.
+void ask_watch(Pulling& p, const TrialSpec& spec) {
+  if (!spec.pull_watch) return;
+  if (spec.pull_watch(p.r.seq.samples, p.ended) && !p.ended) {
+    p.ended = true;
+    p.r.cut = true;
+  }
+}
+
+// The rest of a trial's pull on its own, from wherever p is. A pull that ended before (in a
+// shared part, or not finite at the start) is still told to the watch, once.
+void pull_alone(const GownModel& m, Pulling& p, const TrialSpec& spec, const Settled& at_rest) {
+  if (p.ended) ask_watch(p, spec);
+  while (!p.ended) {
+    pull_sample(m, p, spec, at_rest);
+    ask_watch(p, spec);
+  }
+}
+
 // The whole pull of one trial from the settled state.
 TrialResult pull(const GownModel& m, GownState s, const TrialSpec& spec, const Settled& at_rest, TrialResult r) {
   Pulling p = start_pull(m, std::move(s), spec, std::move(r));
-  while (!p.ended) pull_sample(m, p, spec, at_rest);
+  pull_alone(m, p, spec, at_rest);
   return finish_pull(m, p, spec, at_rest);
 }
 
@@ -477,7 +497,7 @@ void pull_together(const std::vector<GownModel>& models, const std::vector<size_
     p.r.seq.height = specs[b].height;
     p.r.seq.id = std::string("sim-") + std::string(arm_height_name(specs[b].height)) + "-" + std::to_string(specs[b].seed);
     p.r.pull_shared_travel = k > 0 ? shared_travel : 0.0;
-    while (!p.ended) pull_sample(models[k], p, specs[b], at_rest);
+    pull_alone(models[k], p, specs[b], at_rest);
     out[b] = finish_pull(models[k], p, specs[b], at_rest);
   }
 }

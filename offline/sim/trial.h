@@ -24,6 +24,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -180,6 +181,12 @@ struct TrialSpec {
   bool keep_frames = false;     // keep gown positions at `frame_times` (for pictures)
   bool record_arm_parts = false;  // fill TrialResult::arm_parts (one ArmPartLoads per sample)
   std::vector<double> frame_times;  // [s] since the start of the pull; negative = before the pull
+  // Optional: asked after each sample of the trial's own pull with the samples so far and whether
+  // the pull has ended; `true` ends a pull that has not (TrialResult::cut). A caller that only
+  // needs to know that a trial is worse than some bound stops it there (calibrate --prune). Not
+  // asked in a pull that simulate_trials() shares between trials (no arm has touched the gown
+  // yet); the first sample after is. It changes no bit of the samples it lets through.
+  std::function<bool(const std::vector<HapticSample>& so_far, bool ended)> pull_watch;
 };
 
 // Per-vertex contact force on the arm (paper eq. 2, f = m dx_col / dt^2), time-averaged over
@@ -264,6 +271,9 @@ struct TrialResult {
   // simulate_trials(): the travel [m] up to which this trial's pull was another's, pulled as one
   // while no arm touched the gown (0: its own from the start).
   double pull_shared_travel = 0;
+  // TrialSpec::pull_watch stopped the pull before the rig would have: the samples end there, and
+  // the label and the end-of-pull figures are of that moment, not of a whole trial.
+  bool cut = false;
 };
 
 // The arm (data README; paper IV: capsules, fixed, uniform friction). Spheres fist, wrist,

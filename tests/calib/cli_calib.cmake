@@ -28,6 +28,8 @@ expect_fail("calibrate with a softening --hem" "--hem" calibrate --data ${WORK}/
 expect_fail("calibrate with a negative contrast weight" "--contrast-weight must be in [0, 1000]" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --contrast-weight -1)
 expect_fail("calibrate with a negative lateral weight" "--lateral-weight must be in [0, 1000]" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --lateral-weight -1)
 expect_fail("calibrate with an unknown way to combine the sequences" "--combine must be sum or worst, not 'max'" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --combine max)
+expect_fail("calibrate with a negative prune factor" "--prune must be in [0, 100], not '-1'" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --prune -1)
+expect_fail("calibrate pruning the position-weighted objective" "--prune needs --objective area" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --prune 1 --objective position-weighted)
 expect_fail("calibrate with an unknown friction scheme" "--friction must be improved, constraint or stock, not 'sticky'" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --friction sticky)
 expect_fail("calibrate with a support's side but no support" "--support-lateral needs a support" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --support-lateral fit)
 expect_fail("calibrate with the support beyond the gown" "--support-depth must be fit, fixed or a value (support_depth must be within 0 (no support) and 1.5 m" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --support-depth 2)
@@ -240,6 +242,20 @@ if(STUDY)
      OR NOT out MATCHES "\n  the lateral force over the common travel: [0-9.]+ N m, times 3: [0-9.]+ of L\n"
      OR NOT err MATCHES "generation 1/1  best L [0-9.]+ \\(s4-good-3 [0-9.]+, s4-miss-2 [0-9.]+, contrast [0-9.]+, lateral [0-9.]+\\)  \\(this generation")
     message(FATAL_ERROR "calibrate on the coarse gown (${rc}):\n${out}\n${err}")
+  endif()
+  # Pruned (--prune): from the second generation on its progress lines say how many candidates
+  # were cut and simulated again, and the file records the factor and the counts.
+  execute_process(COMMAND ${DG} calibrate --data ${WORK}/study --participant 4 --out ${WORK}/c1p.json --gown coarse
+                          --generations 2 --population 4 --threads 2 --seed 1 --prune 1
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE pout ERROR_VARIABLE perr)
+  if(EXISTS ${WORK}/c1p.json)
+    file(READ ${WORK}/c1p.json c1p)
+  endif()
+  if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/c1p.json
+     OR NOT perr MATCHES "generation 1/2  best L [^\n]*\\(this generation [0-9.]+\\)  pruned 0/4 \\(0 again\\)  elapsed"
+     OR NOT perr MATCHES "generation 2/2  best L [^\n]*  pruned [0-4]/4 \\([0-4] again\\)  elapsed"
+     OR NOT c1p MATCHES "\"prune\": 1,\n +\"pruned_last_process\": [0-9]+,\n +\"resimulated_last_process\": [0-9]+")
+    message(FATAL_ERROR "calibrate --prune on the coarse gown (${rc}):\n${pout}\n${perr}")
   endif()
   # Its progress as a picture (tools/plot/calib_overlay.py progress reads the kept stderr).
   file(WRITE ${WORK}/c1.log "${err}")

@@ -54,7 +54,13 @@ inline SimulatedTrial fake_simulate(const ClothValues& c, const TrialRequest& r)
       out.d_behind = out.d_ahead = 0.0;
       break;
     }
+    // The watch stops a pull as the cloth simulator's does (sim::TrialSpec::pull_watch).
+    if (r.watch && r.watch(out.samples, false)) {
+      out.cut = true;
+      return out;
+    }
   }
+  if (r.watch) r.watch(out.samples, true);
   return out;
 }
 

@@ -48,6 +48,37 @@ TEST(Objective, LengthMismatchIsPenalisedWithW) {
   EXPECT_NEAR(area_objective(s, r, /*w=*/1.0), expected / kLengthPenaltyWeight, 1e-12);
 }
 
+// area_objective_so_far (calibrate --prune) on every prefix of a simulation: it never decreases
+// as samples come, never exceeds the whole simulation's L, and is exact in closed form. A
+// simulation 50 samples longer than the measurement at -4 N against -1: each prefix of k <= 301
+// samples scores the offset 0.3 N over its (k - 1) h of travel (no measurement-longer term), and
+// beyond the measurement's end w h |-4 - (-1)| more per sample, reaching area_objective at the
+// end. The mirror case (a measurement longer than the finished simulation) keeps its w terms
+// only in the whole L: the bound of the whole simulation is L less those terms.
+TEST(Objective, SoFarIsALowerBoundThatGrowsToTheWholeL) {
+  const double h = 0.001;
+  const auto r = constant_curve(301, h, -1.0, 0.0);
+  auto s = constant_curve(301, h, -1.3, 0.0);
+  for (int i = 301; i < 351; ++i) s.push_back({i * 0.01, i * h, -4.0, 0.0, 0.0});
+  const double whole = area_objective(s, r);
+  double last = 0.0;
+  for (std::size_t k = 1; k <= s.size(); ++k) {
+    const std::vector<HapticSample> prefix(s.begin(), s.begin() + static_cast<long>(k));
+    const double b = area_objective_so_far(prefix, r);
+    const double beyond = k > 301 ? kLengthPenaltyWeight * static_cast<double>(k - 301) * h * 3.0 : 0.0;
+    ASSERT_NEAR(b, 0.3 * static_cast<double>(std::min<std::size_t>(k, 301) - 1) * h + beyond, 1e-12) << k;
+    ASSERT_GE(b, last) << k;
+    ASSERT_LE(b, whole + 1e-12) << k;
+    last = b;
+  }
+  EXPECT_NEAR(last, whole, 1e-12);
+  // A simulation that stopped 100 samples short of the measurement, -1.3 N where it stopped.
+  const std::vector<HapticSample> stopped(s.begin(), s.begin() + 201);
+  EXPECT_NEAR(area_objective_so_far(stopped, r), 0.3 * 200 * h, 1e-12);
+  EXPECT_NEAR(area_objective(stopped, r), 0.3 * 200 * h + kLengthPenaltyWeight * 100 * h * 0.3, 1e-12);
+  EXPECT_DOUBLE_EQ(area_objective_so_far({}, r), 0.0);
+}
+
 // Position-weighted (the public code's variant): identical curves give 0; a constant offset c on
 // travel [0, X] gives sum exp(x_i) c h -> c (e^X - 1) as h -> 0 (right Riemann sum: relative
 // error about h/2, 5e-4 here, so 1e-3 relative tolerance).
@@ -202,6 +233,36 @@ TEST(Objective, OneStudyRecordingStartsLate) {
     }
     EXPECT_EQ(p.measured, 0u) << t.id;
   }
+}
+
+// The bound on the study's own trials, each prefix of one trial scored against another trial of
+// the same person (the late-starting s0-middlemiss-10 among them, paired from its travel): never
+// above the whole L, never decreasing, equal to it at the end when the first runs at least as
+// long as the second.
+TEST(Objective, SoFarBoundsTheWholeLOnMeasuredTrials) {
+  const auto dir = study_dir();
+  if (dir.empty()) GTEST_SKIP() << "shared/data/kapusta2016-calibration-trials not present";
+  const Dataset ds = import_study(dir);
+  int pairs = 0;
+  for (const auto& a : ds.trials)
+    for (const auto& b : ds.trials) {
+      if (&a == &b || a.participant != b.participant) continue;
+      const double whole = area_objective(a.samples, b.samples);
+      double last = 0.0;
+      for (std::size_t k = 1; k <= a.samples.size(); k += 7) {
+        const std::vector<HapticSample> prefix(a.samples.begin(), a.samples.begin() + static_cast<long>(k));
+        const double v = area_objective_so_far(prefix, b.samples);
+        ASSERT_GE(v, last) << a.id << " against " << b.id << ", " << k << " samples";
+        ASSERT_LE(v, whole * (1 + 1e-12) + 1e-12) << a.id << " against " << b.id << ", " << k << " samples";
+        last = v;
+      }
+      const PairedStart p = paired_start(a.samples, b.samples);
+      if (a.samples.size() - p.sim >= b.samples.size() - p.measured) {  // no measurement-longer term
+        EXPECT_NEAR(area_objective_so_far(a.samples, b.samples), whole, 1e-9 * (1 + whole)) << a.id << " against " << b.id;
+      }
+      ++pairs;
+    }
+  EXPECT_GT(pairs, 20);
 }
 
 // Across people (same class, different participants): the issue states medians 0.57 (good),

@@ -646,6 +646,55 @@ TEST(SimTrial, SharedPullUntilAnArmTouchesGivesEachTrialItsOwnBits) {
   EXPECT_EQ(together[3].pull_shared_travel, 0.0) << "another speed pulls alone";
 }
 
+// TrialSpec::pull_watch (calibrate --prune): it is asked after every sample of a trial's own
+// pull and once at its end, it stops a pull where it says so (cut), and the samples it lets
+// through are the uncut trial's to the bit, also after a pull that simulate_trials() shared.
+TEST(SimTrial, PullWatchCutsThePullAndKeepsItsBits) {
+  std::vector<TrialSpec> specs(2);
+  specs[0].height = ArmHeight::Low;
+  specs[1].height = ArmHeight::High;
+  for (TrialSpec& s : specs) s.max_travel = 0.2;
+  const std::vector<TrialResult> whole = simulate_trials(coarse_scene(), ClothParams{}, specs);
+  ASSERT_GT(whole[1].pull_shared_travel, 0.0) << "the high arm's pull should begin shared with the low arm's";
+
+  // A watch that lets every sample through: asked once per sample after the shared part, told
+  // of the end once, and nothing cut.
+  std::vector<size_t> asked(2, 0), ended(2, 0);
+  std::vector<TrialSpec> watched = specs;
+  for (size_t k = 0; k < 2; ++k)
+    watched[k].pull_watch = [&asked, &ended, k](const std::vector<HapticSample>&, bool end) {
+      ++asked[k];
+      if (end) ++ended[k];
+      return false;
+    };
+  const std::vector<TrialResult> seen = simulate_trials(coarse_scene(), ClothParams{}, watched);
+  for (size_t k = 0; k < 2; ++k) {
+    expect_same_trial(seen[k], whole[k], ("watched trial " + std::to_string(k)).c_str());
+    EXPECT_FALSE(seen[k].cut);
+    EXPECT_EQ(ended[k], 1u) << "trial " << k;
+    // Both pulls (the first one's too) were one up to the second's pull_shared_travel.
+    const auto shared = static_cast<size_t>(std::count_if(
+        whole[k].seq.samples.begin(), whole[k].seq.samples.end(),
+        [&](const HapticSample& h) { return h.travel <= whole[1].pull_shared_travel; }));
+    EXPECT_EQ(asked[k], whole[k].seq.samples.size() - shared) << "trial " << k;
+  }
+
+  // A watch that stops each pull at 0.1 m: cut there, the samples before it the same bits.
+  std::vector<TrialSpec> cut = specs;
+  for (TrialSpec& s : cut)
+    s.pull_watch = [](const std::vector<HapticSample>& so_far, bool) { return so_far.back().travel >= 0.1; };
+  const std::vector<TrialResult> short_ = simulate_trials(coarse_scene(), ClothParams{}, cut);
+  for (size_t k = 0; k < 2; ++k) {
+    const auto& got = short_[k].seq.samples;
+    EXPECT_TRUE(short_[k].cut) << "trial " << k;
+    ASSERT_FALSE(got.empty());
+    EXPECT_GE(got.back().travel, 0.1);
+    EXPECT_LT(got[got.size() - 2].travel, 0.1) << "trial " << k << " went on past the watch";
+    ASSERT_LT(got.size(), whole[k].seq.samples.size());
+    EXPECT_EQ(0, std::memcmp(got.data(), whole[k].seq.samples.data(), got.size() * sizeof(HapticSample))) << "trial " << k;
+  }
+}
+
 namespace {
 
 // The self-collision pairs that step() must find from positions x, by brute force over all
