@@ -104,10 +104,8 @@ double area_objective(const std::vector<HapticSample>& sim, const std::vector<Ha
 
 double area_objective_so_far(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured,
                              double w) {
-  if (sim.empty()) {
-    require_samples(measured, measured);
-    return 0.0;
-  }
+  if (measured.empty()) throw std::invalid_argument("objective: the measured sequence has no samples");
+  if (sim.empty()) return 0.0;  // nothing simulated yet: nothing known
   return area_error_of(sim, measured, ForceAxis::Vertical, w, true) +
          area_error_of(sim, measured, ForceAxis::Motion, w, true);
 }

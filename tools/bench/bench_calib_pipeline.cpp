@@ -50,13 +50,15 @@
 //     tools/plot/pooled_stc.py). With several seeds, each seed's sets go in its own folder and each
 //     simulator trains on the union (N x seeds per height); the file is DIR1/pooled-S1-S2-....json.
 //   bench_calib_pipeline timing [--gown ...] [--generations G --population N] [--threads T]
-//                               [--arm-compliance ... --fist-shift ... --rim-shift ... --density ...]
+//                               [--arm-compliance ... --fist-shift ... --rim-shift ... --density ...] [--prune K]
 //     Wall time per simulation and of a G x N calibration of participant 4, with the final
 //     objective, and the projection to the paper's 50 x 32 budget from the measured pace. Under
 //     mpirun (e.g. -n 1 and -n 2 with --threads 1) the calibration's wall time gives the MPI
 //     scaling efficiency T1 / (2 T2). --baseline 1: the calibration once more with every trial
 //     settled and pulled on its own; --predict 1: the calibration's prediction of the other participants'
 //     trials with one settling per group of targets against one per target (same tables required).
+//     --prune K: the calibration once more with `calibrate --prune K` (calibration.h), timed
+//     against the unpruned run above as its baseline, with the candidates cut and simulated again.
 //
 // Everything runs through dg_calib's public API (the same code as the commands).
 #include <algorithm>
@@ -453,6 +455,17 @@ int run_timing(const std::map<std::string, std::string>& a) {
     base_s = seconds_since(t0);
     same = b.objective == r.objective && b.best_unit == r.best_unit;
   }
+  // --prune K: the same calibration pruned (calibration.h), the run above its baseline.
+  const double prune = std::stod(get(a, "prune", "0"));
+  CalibrationResult pruned;
+  double pruned_s = 0;
+  if (prune > 0) {
+    CalibrationOptions op = o;
+    op.prune = prune;
+    t0 = std::chrono::steady_clock::now();
+    pruned = calibrate(inputs, space, sim.trials, op, Comm::world());
+    pruned_s = seconds_since(t0);
+  }
   // The start is evaluated too (calibrate(): CalibrationResult::start_objective), one candidate more.
   const double sims = (static_cast<double>(o.generations) * o.population + 1) * inputs.size();
   const double full_sims = 50.0 * 32 * inputs.size();
@@ -469,6 +482,11 @@ int run_timing(const std::map<std::string, std::string>& a) {
                 "%.2fx faster; same result: %s\n", base_s, base_s / sims, base_s / cal_s, same ? "yes" : "NO");
   std::printf("projection to the paper's 50 x 32 (%.0f simulations) at this pace: %.1f h wall on this machine\n",
               full_sims, cal_s / sims * full_sims / 3600.0);
+  if (prune > 0)
+    std::printf("pruned at %g x the last generation's median: %.1f s wall, %.3f of the unpruned run's; %ld of %d "
+                "candidates cut, %ld simulated again; final L = %.4f (unpruned %.4f); projection to 50 x 32: "
+                "%.1f h\n", prune, pruned_s, pruned_s / cal_s, pruned.pruned, o.generations * o.population,
+                pruned.resimulated, pruned.objective, r.objective, pruned_s / sims * full_sims / 3600.0);
   // --predict 1: the calibration just found predicts the other participants' trials (dressguard
   // predict), with the targets in groups that settle once (the default) and, as the same run's
   // baseline, every target settled on its own; the same tables, byte for byte, are required.
