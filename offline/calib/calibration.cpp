@@ -443,6 +443,22 @@ std::string hexd(double v) {
 }
 
 // What must match for a checkpoint to continue this run.
+// Pruning's rule for the mu best (calibration.h): the cut candidates (cut[c]) to simulate again
+// in whole, the lowest bounds f[c] first, so that mu whole candidates score at or below every
+// bound left; none when that already holds.
+std::vector<int> to_simulate_again(const std::vector<double>& f, const std::vector<char>& cut, int mu) {
+  std::vector<int> cuts;
+  for (std::size_t c = 0; c < f.size(); ++c)
+    if (cut[c]) cuts.push_back(static_cast<int>(c));
+  if (cuts.empty()) return {};
+  std::stable_sort(cuts.begin(), cuts.end(), [&](int a, int b) { return f[a] < f[b]; });
+  int below = 0;
+  for (std::size_t c = 0; c < f.size(); ++c) below += !cut[c] && f[c] <= f[cuts.front()] ? 1 : 0;
+  const int need = std::min(mu - below, static_cast<int>(cuts.size()));
+  cuts.resize(static_cast<std::size_t>(std::max(need, 0)));
+  return cuts;
+}
+
 std::string fingerprint(const std::vector<HapticSequence>& inputs, const ParameterSpace& space,
                         const CalibrationOptions& o) {
   std::ostringstream f;
@@ -717,24 +733,15 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
     // Keep the mu best exact (calibration.h): simulate again, in whole, the cut candidates of the
     // lowest bounds until mu fully simulated ones score at or below every bound left.
     int resimulated = 0;
-    for (;;) {
-      std::vector<int> cuts;
-      for (int c = 0; c < lambda; ++c)
-        if (cut[c]) cuts.push_back(c);
-      if (cuts.empty()) break;
-      std::stable_sort(cuts.begin(), cuts.end(), [&](int a, int b) { return f[a] < f[b]; });
-      int below = 0;
-      for (int c = 0; c < lambda; ++c) below += !cut[c] && f[c] <= f[cuts.front()] ? 1 : 0;
-      const int need = std::min(es.mu() - below, static_cast<int>(cuts.size()));
-      if (need <= 0) break;
-      std::vector<Eigen::VectorXd> again;
-      for (int i = 0; i < need; ++i) again.push_back(xs[static_cast<std::size_t>(cuts[i])]);
-      const std::vector<double> redo = evaluate(again, done + 1, no_bound);
-      for (int i = 0; i < need; ++i) {
-        std::copy_n(redo.begin() + static_cast<long>(i) * W, W, per.begin() + static_cast<long>(cuts[i]) * W);
-        take(cuts[i]);
+    for (std::vector<int> again; !(again = to_simulate_again(f, cut, es.mu())).empty();) {
+      std::vector<Eigen::VectorXd> xs_again;
+      for (int c : again) xs_again.push_back(xs[static_cast<std::size_t>(c)]);
+      const std::vector<double> redo = evaluate(xs_again, done + 1, no_bound);
+      for (std::size_t i = 0; i < again.size(); ++i) {
+        std::copy_n(redo.begin() + static_cast<long>(i) * W, W, per.begin() + static_cast<long>(again[i]) * W);
+        take(again[i]);
       }
-      resimulated += need;
+      resimulated += static_cast<int>(again.size());
     }
     pruned_total += pruned;
     resimulated_total += resimulated;
