@@ -10,6 +10,7 @@
 #include <map>
 #include <mutex>
 #include <sstream>
+#include <stdexcept>
 #include <utility>
 
 #include "cmaes.h"
@@ -661,12 +662,35 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   // cut; infinity: none is. Each candidate's T terms are followed by 1 when it was cut, else 0.
   const int W = T + 1;
   std::mutex progress_mutex;
+  // A candidate's terms and its cut flag (out[T]) from its simulated inputs.
+  auto score = [&](const std::vector<SimulatedTrial>& sts, double* out) {
+    bool cut = false;
+    for (int k = 0; k < K; ++k) {
+      out[k] = sequence_term(options.objective, sts[k], inputs[k]);
+      cut = cut || sts[k].cut;
+    }
+    if (ic >= 0) out[ic] = cut ? 0.0 : contrast_term(inputs, sts, options.contrast_weight);
+    if (il >= 0) out[il] = cut ? 0.0 : lateral_term(inputs, sts, options.lateral_weight);
+    out[T] = cut ? 1.0 : 0.0;
+  };
+  auto report = [&](CandidateProgress& cp, std::chrono::steady_clock::time_point began) {
+    if (!options.candidate_progress || !comm.is_root()) return;
+    std::lock_guard<std::mutex> lock(progress_mutex);
+    ++cp.done;
+    cp.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+    options.candidate_progress(cp);
+  };
+  // Pruning: the simulated inputs of the generation's cut candidates (held[c]), on the rank that
+  // simulated them, until the generation is ranked; a cut candidate that must be known whole
+  // goes on from them (finish_cut).
+  std::vector<std::vector<SimulatedTrial>> held;
   auto evaluate = [&](const std::vector<Eigen::VectorXd>& xs, int generation, double bound) {
     const int n = static_cast<int>(xs.size());
     const auto began = std::chrono::steady_clock::now();
     CandidateProgress cp;
     cp.generation = generation;
     cp.total = (n + comm.size() - 1) / comm.size();  // run_batch: the root takes indices 0, size, ...
+    held.assign(static_cast<std::size_t>(n), {});
     return run_batch(n, W, thread_count(options.threads), comm, [&](int c, double* out) {
       // The candidate's terms as far as they are known: each sequence's bound while it runs, its
       // whole L once it ended; the extra terms 0 (>= 0, known only at the end).
@@ -681,22 +705,42 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
                        : (so_far.empty() ? std::numeric_limits<double>::infinity() : area_objective(so_far, measured));
             return combined_objective(known.data(), K, T, options.combine) > bound;
           });
-      const std::vector<SimulatedTrial> sts =
-          simulate_inputs(sim, space.cloth(xs[c]), space.offsets(xs[c]), inputs, watches);
-      bool cut = false;
-      for (int k = 0; k < K; ++k) {
-        out[k] = sequence_term(options.objective, sts[k], inputs[k]);
-        cut = cut || sts[k].cut;
+      std::vector<SimulatedTrial> sts = simulate_inputs(sim, space.cloth(xs[c]), space.offsets(xs[c]), inputs, watches);
+      score(sts, out);
+      if (out[T] != 0.0) held[static_cast<std::size_t>(c)] = std::move(sts);  // each c on one thread
+      report(cp, began);
+    });
+  };
+  // The cut candidates `again` of the generation `xs` simulated in whole: each cut input goes on
+  // from where it was cut (SimulatedTrial::rest; the same bits as simulating it again), or, when
+  // the simulator kept no state, the candidate is simulated again. The batch runs over all of the
+  // generation's indices so that each candidate lands on the rank that holds its trials.
+  auto finish_cut = [&](const std::vector<Eigen::VectorXd>& xs, const std::vector<int>& again, int generation) {
+    const int n = static_cast<int>(xs.size());
+    std::vector<char> wanted(static_cast<std::size_t>(n), 0);
+    for (int c : again) wanted[static_cast<std::size_t>(c)] = 1;
+    const auto began = std::chrono::steady_clock::now();
+    CandidateProgress cp;
+    cp.generation = generation;
+    for (int c = comm.rank(); c < n; c += comm.size()) cp.total += wanted[static_cast<std::size_t>(c)];
+    return run_batch(n, W, thread_count(options.threads), comm, [&](int c, double* out) {
+      if (!wanted[static_cast<std::size_t>(c)]) return;
+      std::vector<SimulatedTrial>& sts = held[static_cast<std::size_t>(c)];
+      if (static_cast<int>(sts.size()) != K)
+        throw std::logic_error("calibrate: cut candidate " + std::to_string(c) + "'s trials are not on this rank");
+      const bool resumable = std::all_of(sts.begin(), sts.end(), [](const SimulatedTrial& t) { return !t.cut || t.rest; });
+      if (resumable) {
+        for (SimulatedTrial& t : sts)
+          if (t.cut) {
+            t = t.rest();
+            if (t.cut) throw std::logic_error("calibrate: the rest of a cut trial came back cut (SimulatedTrial::rest)");
+          }
+      } else {
+        sts = simulate_inputs(sim, space.cloth(xs[c]), space.offsets(xs[c]), inputs);
       }
-      if (ic >= 0) out[ic] = cut ? 0.0 : contrast_term(inputs, sts, options.contrast_weight);
-      if (il >= 0) out[il] = cut ? 0.0 : lateral_term(inputs, sts, options.lateral_weight);
-      out[T] = cut ? 1.0 : 0.0;
-      if (options.candidate_progress && comm.is_root()) {
-        std::lock_guard<std::mutex> lock(progress_mutex);
-        ++cp.done;
-        cp.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
-        options.candidate_progress(cp);
-      }
+      score(sts, out);
+      sts = {};  // its paused simulations are not needed again
+      report(cp, began);
     });
   };
 
@@ -734,15 +778,14 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
     // lowest bounds until mu fully simulated ones score at or below every bound left.
     int resimulated = 0;
     for (std::vector<int> again; !(again = to_simulate_again(f, cut, es.mu())).empty();) {
-      std::vector<Eigen::VectorXd> xs_again;
-      for (int c : again) xs_again.push_back(xs[static_cast<std::size_t>(c)]);
-      const std::vector<double> redo = evaluate(xs_again, done + 1, no_bound);
-      for (std::size_t i = 0; i < again.size(); ++i) {
-        std::copy_n(redo.begin() + static_cast<long>(i) * W, W, per.begin() + static_cast<long>(again[i]) * W);
-        take(again[i]);
+      const std::vector<double> redo = finish_cut(xs, again, done + 1);
+      for (int c : again) {
+        std::copy_n(redo.begin() + static_cast<long>(c) * W, W, per.begin() + static_cast<long>(c) * W);
+        take(c);
       }
       resimulated += static_cast<int>(again.size());
     }
+    held.clear();
     pruned_total += pruned;
     resimulated_total += resimulated;
     const double best_before = es.best_f();

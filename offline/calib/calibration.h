@@ -163,6 +163,11 @@ struct SimulatedTrial {
   double d_behind = std::numeric_limits<double>::quiet_NaN();
   double d_ahead = std::numeric_limits<double>::quiet_NaN();
   bool cut = false;  // TrialRequest::watch stopped it: `samples` end there, the label is not a trial's
+  // A cut trial's rest, when the simulator kept its state at the cut: the whole trial, the same
+  // bits as simulating the request again without its watch, for the cost of the part after the
+  // cut (the cloth simulator: sim::resume_trial). Empty when the simulator keeps no state (the
+  // caller simulates the request again). Callable on the process that made it, from any thread.
+  std::function<SimulatedTrial()> rest;
 };
 
 // Must be deterministic and callable from several threads at once.
@@ -365,7 +370,7 @@ struct GenerationProgress {
   double best_lateral = 0;        // its weighted lateral term (0 without one)
   double generation_best = 0;
   int pruned = 0;           // this generation's candidates cut short (options.prune) ...
-  int resimulated = 0;      // ... and of those, the ones simulated again in whole
+  int resimulated = 0;      // ... and of those, the ones simulated in whole after all (on from the cut, or again)
   double prune_bound = std::numeric_limits<double>::infinity();  // the bound they were cut at
   double elapsed_s = 0;     // this process
   double eta_s = 0;         // estimated remaining, from this process's pace
@@ -400,7 +405,7 @@ struct CalibrationResult {
   bool complete = false;          // false: stopped by stop_after_generations (resume later)
   int generations_done = 0;
   long evaluations = 0;           // candidate evaluations (each = one simulation per sequence), the start's included
-  long pruned = 0, resimulated = 0;  // in this process: candidates cut short, and simulated again (options.prune)
+  long pruned = 0, resimulated = 0;  // in this process: candidates cut short, and finished whole after all (options.prune)
   double objective = 0;           // L of the best candidate (the start, when no sample beat it)
   double start_objective = 0;     // L of the start (the bounds' initial values)
   Eigen::VectorXd best_unit;      // in the unit box
@@ -449,7 +454,9 @@ double lateral_term(const std::vector<HapticSequence>& inputs, const std::vector
 // that misses where the measured one caught runs the rig's whole travel, charged at w = 20 from
 // where the measurement stopped. Afterwards, while fewer than mu of the fully simulated candidates
 // score at or below the lowest bound among the cut ones, the `mu minus that count` cut candidates
-// with the lowest bounds are simulated again in whole: so the mu best candidates, which set the
+// with the lowest bounds are simulated in whole: each cut trial goes on from where it was cut
+// when the simulator kept its state (SimulatedTrial::rest: the cloth simulator does), else the
+// candidate is simulated again; both give the same bits. So the mu best candidates, which set the
 // mean and the positive weights (tutorial eq. 41-47), are always known exactly. What the bound
 // leaves approximate is the order among the rest: the negative weights of active CMA (eq. 53)
 // go by it, and the boundary penalty's scale (the values' inter-quartile range) uses it, so a

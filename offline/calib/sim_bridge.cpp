@@ -83,7 +83,9 @@ sim::TrialSpec spec_of(const ClothValues& c, const TrialRequest& r) {
   return spec;
 }
 
-SimulatedTrial simulated(sim::TrialResult&& res) {
+// `scene`: the one that simulated `res`; a cut trial's rest keeps it alive (the paused model
+// points into it, and the scene cache below may drop it meanwhile).
+SimulatedTrial simulated(sim::TrialResult&& res, const std::shared_ptr<const sim::Scene>& scene) {
   SimulatedTrial out;
   out.samples = std::move(res.seq.samples);
   out.outcome = res.outcome;
@@ -91,6 +93,8 @@ SimulatedTrial simulated(sim::TrialResult&& res) {
   out.d_behind = res.d_behind;
   out.d_ahead = res.d_ahead;
   out.cut = res.cut;
+  if (res.paused)
+    out.rest = [scene, paused = std::move(res.paused)] { return simulated(sim::resume_trial(*paused), scene); };
   return out;
 }
 
@@ -152,14 +156,16 @@ ClothSimulator make_cloth_simulator(const std::string& gown) {
   auto scenes = std::make_shared<SceneCache>(res);
   ClothSimulator cs;
   cs.trial = [scenes](const ClothValues& c, const TrialRequest& r) {
-    return simulated(sim::simulate_trial(*scenes->get(c.rim_shift), cloth_params_of(c), spec_of(c, r)));
+    const std::shared_ptr<const sim::Scene> scene = scenes->get(c.rim_shift);
+    return simulated(sim::simulate_trial(*scene, cloth_params_of(c), spec_of(c, r)), scene);
   };
   cs.trials = [scenes](const ClothValues& c, const std::vector<TrialRequest>& rs) {
     std::vector<sim::TrialSpec> specs;
     for (const TrialRequest& r : rs) specs.push_back(spec_of(c, r));
-    std::vector<sim::TrialResult> res = sim::simulate_trials(*scenes->get(c.rim_shift), cloth_params_of(c), specs);
+    const std::shared_ptr<const sim::Scene> scene = scenes->get(c.rim_shift);
+    std::vector<sim::TrialResult> res = sim::simulate_trials(*scene, cloth_params_of(c), specs);
     std::vector<SimulatedTrial> out;
-    for (sim::TrialResult& r : res) out.push_back(simulated(std::move(r)));
+    for (sim::TrialResult& r : res) out.push_back(simulated(std::move(r), scene));
     return out;
   };
   // The bending length is the mesh's: a grasp moves the gown, it does not change its triangles.

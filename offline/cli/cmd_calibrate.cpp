@@ -106,8 +106,10 @@ int run_calibrate(int argc, char** argv) {
         "                      lateral_term). Default 0: eq. 3-5 alone\n"
         "  --prune KAPPA       stop simulating a candidate once its objective's lower bound (the\n"
         "                      area so far; eq. 3-5's terms are >= 0) passes KAPPA times the last\n"
-        "                      generation's median, keeping the mu best exact (offline/calib/\n"
-        "                      calibration.h). Area objective only. Default 0: every candidate whole\n"
+        "                      generation's median, keeping the mu best exact: a cut one among them\n"
+        "                      is simulated on from its cut ('again' in the progress lines;\n"
+        "                      offline/calib/calibration.h). Area objective only. Default 0: every\n"
+        "                      candidate whole\n"
         "  --no-arm-offset     do not optimise the arm offsets (paper Fig. 9 comparison)\n"
         "  --arm-compliance fit|fixed|C   the person's arm: fit its compliance [m/N] too (one more\n"
         "                      parameter; offline/sim/arm_spring.h), hold it fixed (the paper's, the\n"
@@ -411,8 +413,8 @@ int run_calibrate(int argc, char** argv) {
                   participant.c_str(), r.objective, r.generations_done, r.evaluations, minutes(r.elapsed_s).c_str(),
                   r.start_objective);
       if (o.prune > 0)
-        std::printf("  pruned at %g x the last generation's median: %ld candidates cut, %ld of them simulated again "
-                    "(this process)\n", o.prune, r.pruned, r.resimulated);
+        std::printf("  pruned at %g x the last generation's median: %ld candidates cut, %ld of them finished whole "
+                    "from the cut (this process)\n", o.prune, r.pruned, r.resimulated);
       if (o.combine == SequenceCombine::Worst) {
         double sum = 0;
         for (const auto& f : cal.fits) sum += f.objective;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <random>
 
 #include "arm_spring.h"
@@ -403,13 +404,39 @@ void ask_watch(Pulling& p, const TrialSpec& spec) {
   }
 }
 
+}  // namespace
+
+// A cut pull as it stood after its last sample: everything pull_sample() reads and writes, so
+// that going on from it computes what the uncut pull computed. The model is a copy (its arm is
+// the trial's own; simulate_trials() keeps a model per trial only while it runs).
+struct PausedPull {
+  GownModel m;
+  Pulling p;        // p.r: the result so far, not yet finished (finish_pull), not marked cut
+  TrialSpec spec;   // without its watch
+  Settled at_rest;
+};
+
+namespace {
+
 // The rest of a trial's pull on its own, from wherever p is. A pull that ended before (in a
-// shared part, or not finite at the start) is still told to the watch, once.
+// shared part, or not finite at the start) is still told to the watch, once. A pull the watch
+// cuts keeps its state in p.r.paused (resume_trial()): one copy of the gown, the model and the
+// spec per cut trial, against the seconds of simulation it saves when the caller needs the rest.
 void pull_alone(const GownModel& m, Pulling& p, const TrialSpec& spec, const Settled& at_rest) {
-  if (p.ended) ask_watch(p, spec);
+  if (p.ended) {
+    ask_watch(p, spec);
+    return;
+  }
   while (!p.ended) {
     pull_sample(m, p, spec, at_rest);
     ask_watch(p, spec);
+  }
+  if (p.r.cut) {
+    auto paused = std::make_shared<PausedPull>(PausedPull{m, p, spec, at_rest});
+    paused->p.ended = false;
+    paused->p.r.cut = false;
+    paused->spec.pull_watch = nullptr;
+    p.r.paused = std::move(paused);
   }
 }
 
@@ -440,6 +467,12 @@ TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const 
   r.arm_offset = d.arm_offset;
   const Settled at_rest = settle(m, s, spec, d, {}, r);
   return pull(m, std::move(s), spec, at_rest, std::move(r));
+}
+
+TrialResult resume_trial(const PausedPull& paused) {
+  PausedPull q = paused;
+  pull_alone(q.m, q.p, q.spec, q.at_rest);
+  return finish_pull(q.m, q.p, q.spec, q.at_rest);
 }
 
 namespace {

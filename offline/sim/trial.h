@@ -233,6 +233,9 @@ struct OpeningShape {
   double rim_low_above_fist = 0;  // [m] the lowest rim vertex above this trial's fist centre
 };
 
+// What resume_trial() goes on from (trial.cpp).
+struct PausedPull;
+
 struct TrialResult {
   double arm_offset = 0;            // [m] the arm offset used (spec.arm_offset plus the arm noise)
   HapticSequence seq;               // samples from the start of the pull; label set
@@ -274,6 +277,9 @@ struct TrialResult {
   // TrialSpec::pull_watch stopped the pull before the rig would have: the samples end there, and
   // the label and the end-of-pull figures are of that moment, not of a whole trial.
   bool cut = false;
+  // A cut trial's simulation at the cut (the gown, the arm, the rig; opaque), for resume_trial().
+  // Shared by copies of this result; null when not cut.
+  std::shared_ptr<const PausedPull> paused;
 };
 
 // The arm (data README; paper IV: capsules, fixed, uniform friction). Spheres fist, wrist,
@@ -379,6 +385,13 @@ TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const 
 // (TrialResult::pull_shared_travel); where the rig stops one of them, they part before.
 std::vector<TrialResult> simulate_trials(const Scene& scene, const ClothParams& params,
                                          const std::vector<TrialSpec>& specs);
+
+// The rest of a trial that TrialSpec::pull_watch cut (TrialResult::cut, paused), from the sample
+// where it was cut, without the watch: the same bits as the trial simulated whole without one
+// (samples, label, forces, frames; not the wall times), because the paused state is the whole
+// state of the pull. The paused state stays as it was, so a trial can be resumed more than once.
+// The scene that simulated the trial must still exist (the model points into it).
+TrialResult resume_trial(const PausedPull& paused);
 
 // The label rule of paper V-A from the final state; exposed for tests.
 Outcome label_outcome(bool full_travel, double d_max);

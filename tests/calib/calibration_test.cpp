@@ -541,7 +541,9 @@ TEST(Calibration, ResumeFromCheckpointGivesTheUninterruptedResult) {
 }
 
 // Pruning (calibrate --prune, calibration.h). The stand-in honours the watch as the cloth
-// simulator does. Every candidate of a search is also simulated whole beside it, here: each cut
+// simulator does; here it keeps no rest of a cut trial (SimulatedTrial::rest), so a cut
+// candidate that must be known whole is simulated again (PruningGoesOnFromTheCut: with the
+// rest). Every candidate of a search is also simulated whole beside it, here: each cut
 // one's whole objective lies above the generation's bound (the bound so far is a lower bound),
 // and each generation's mu best by their whole objective were simulated whole in the search
 // (the positive weights are exact). Candidates are cut, the search still recovers the stand-in's
@@ -565,6 +567,7 @@ TEST(Calibration, PruningCutsOnlyCandidatesWorseThanTheBoundAndKeepsTheBestExact
       plain.watch = nullptr;
       whole += area_objective(testing::fake_simulate(c, plain).samples, inputs[out.size()].samples);
       out.push_back(testing::fake_simulate(c, r));
+      out.back().rest = nullptr;
       cut = cut || out.back().cut;
     }
     generation.push_back({whole, cut});
@@ -627,6 +630,77 @@ TEST(Calibration, PruningCutsOnlyCandidatesWorseThanTheBoundAndKeepsTheBestExact
   // Pruning needs the area objective's bound.
   o.objective = ObjectiveKind::PositionWeighted;
   EXPECT_THROW(calibrate(inputs, space, testing::fake_simulate, o, Comm::world()), std::invalid_argument);
+}
+
+// Pruning with a simulator that keeps a cut trial's rest (SimulatedTrial::rest, the cloth
+// simulator's sim::resume_trial): a cut candidate that must be known whole goes on from its cut
+// trials instead of being simulated again. The rest is the whole trial's bits, so the search is
+// the one that simulates again, to the bit, in every generation (its progress and its result),
+// on 1 and 3 threads; it asks the simulator for no candidate twice; and it calls the rest of
+// each cut trial of exactly the candidates it reports as simulated again in whole.
+TEST(Calibration, PruningGoesOnFromTheCutInsteadOfSimulatingAgain) {
+  const auto inputs = fake_inputs(Truth{});
+  const auto space = space_for(inputs);
+  std::atomic<long> batches{0}, rests{0};
+  const TrialBatchSimulator keeps = [&](const ClothValues& c, const std::vector<TrialRequest>& rs) {
+    ++batches;
+    std::vector<SimulatedTrial> out;
+    for (const TrialRequest& r : rs) {
+      out.push_back(testing::fake_simulate(c, r));
+      if (out.back().rest)
+        out.back().rest = [&rests, inner = out.back().rest] {
+          ++rests;
+          return inner();
+        };
+    }
+    return out;
+  };
+  const TrialBatchSimulator again = [&](const ClothValues& c, const std::vector<TrialRequest>& rs) {
+    ++batches;
+    std::vector<SimulatedTrial> out;
+    for (const TrialRequest& r : rs) {
+      out.push_back(testing::fake_simulate(c, r));
+      out.back().rest = nullptr;
+    }
+    return out;
+  };
+  struct Seen {
+    double best, generation_best;
+    int pruned, resimulated;
+  };
+  auto run = [&](const TrialBatchSimulator& sim, int threads, std::vector<Seen>* seen) {
+    auto o = quick(40, threads);
+    o.prune = 1.0;
+    return calibrate(inputs, space, sim, o, Comm::world(), [&](const GenerationProgress& p) {
+      if (seen) seen->push_back({p.best, p.generation_best, p.pruned, p.resimulated});
+    });
+  };
+  std::vector<Seen> by_rest, by_again;
+  const auto a = run(again, 1, &by_again);
+  const long again_batches = batches.exchange(0);
+  const auto r = run(keeps, 1, &by_rest);
+  ASSERT_GT(r.resimulated, 0) << "the test needs cut candidates that must be known whole";
+  EXPECT_EQ(batches.load(), 1 + 40 * 16) << "the start and each candidate once";
+  EXPECT_EQ(again_batches, 1 + 40 * 16 + a.resimulated);
+  // Each cut candidate known whole had at least one cut trial, at most one per input.
+  EXPECT_GE(rests.load(), r.resimulated);
+  EXPECT_LE(rests.load(), r.resimulated * static_cast<long>(inputs.size()));
+  std::printf("  pruned %ld of %d candidates, %ld known whole from %ld rests\n", r.pruned, 40 * 16, r.resimulated,
+              rests.load());
+  ASSERT_EQ(by_rest.size(), by_again.size());
+  for (std::size_t g = 0; g < by_rest.size(); ++g) {
+    EXPECT_EQ(by_rest[g].best, by_again[g].best) << "generation " << g + 1;
+    EXPECT_EQ(by_rest[g].generation_best, by_again[g].generation_best) << "generation " << g + 1;
+    EXPECT_EQ(by_rest[g].pruned, by_again[g].pruned) << "generation " << g + 1;
+    EXPECT_EQ(by_rest[g].resimulated, by_again[g].resimulated) << "generation " << g + 1;
+  }
+  EXPECT_EQ(r.objective, a.objective);
+  EXPECT_TRUE(r.best_unit == a.best_unit);
+  EXPECT_EQ(r.pruned, a.pruned);
+  EXPECT_EQ(r.resimulated, a.resimulated);
+  const auto three = run(keeps, 3, nullptr);
+  EXPECT_EQ(three.objective, r.objective);
+  EXPECT_TRUE(three.best_unit == r.best_unit);
 }
 
 // The heights' contrast as a term of the objective (calibrate --contrast-weight): the best

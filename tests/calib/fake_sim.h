@@ -54,9 +54,14 @@ inline SimulatedTrial fake_simulate(const ClothValues& c, const TrialRequest& r)
       out.d_behind = out.d_ahead = 0.0;
       break;
     }
-    // The watch stops a pull as the cloth simulator's does (sim::TrialSpec::pull_watch).
+    // The watch stops a pull as the cloth simulator's does (sim::TrialSpec::pull_watch), and
+    // its rest is the trial without the watch (sim::resume_trial's contract; here simulated
+    // again, having no state to go on from).
     if (r.watch && r.watch(out.samples, false)) {
       out.cut = true;
+      TrialRequest plain = r;
+      plain.watch = nullptr;
+      out.rest = [c, plain] { return fake_simulate(c, plain); };
       return out;
     }
   }

@@ -41,6 +41,16 @@ int main(int argc, char** argv) {
   o.seed = 5;
   o.threads = 2;
   const CalibrationResult r = calibrate(inputs, space, testing::fake_simulate, o, comm);
+  // Pruned (calibrate --prune): a cut candidate known whole goes on from its cut trials
+  // (SimulatedTrial::rest), which only the rank that simulated it holds.
+  CalibrationOptions op = o;
+  op.prune = 1.0;
+  const CalibrationResult rp = calibrate(inputs, space, testing::fake_simulate, op, comm);
+  if (rp.resimulated == 0) {
+    std::fprintf(stderr, "calib_mpi_check: the pruned calibration had no cut candidate to know whole (%ld cut): "
+                 "it checks nothing of SimulatedTrial::rest\n", rp.pruned);
+    return 1;
+  }
   Calibration cal;
   cal.cloth = r.cloth;
   cal.offsets = r.offsets;
@@ -52,6 +62,8 @@ int main(int argc, char** argv) {
     std::printf("ranks %d\n", comm.size());  // not part of the compared digest (first line)
     std::printf("objective %a evaluations %ld\n", r.objective, r.evaluations);
     for (long i = 0; i < r.best_unit.size(); ++i) std::printf("x%ld %a\n", i, r.best_unit[i]);
+    std::printf("pruned objective %a cut %ld known whole %ld\n", rp.objective, rp.pruned, rp.resimulated);
+    for (long i = 0; i < rp.best_unit.size(); ++i) std::printf("pruned x%ld %a\n", i, rp.best_unit[i]);
     std::printf("labels %d %d %d\n", s.per_label[0], s.per_label[1], s.per_label[2]);
     const Dataset ds = load_dataset(dir / "synth");
     std::size_t bytes = 0;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <thread>
 
 #include "calibration.h"
@@ -69,6 +70,48 @@ TEST(SimCalibration, BridgeIsDeterministicAcrossThreads) {
   for (std::size_t i = 0; i < a.samples.size(); ++i) EXPECT_EQ(ab[0].samples[i].f_motion, a.samples[i].f_motion);
   for (std::size_t i = 0; i < h.samples.size(); ++i) EXPECT_EQ(ab[1].samples[i].f_vertical, h.samples[i].f_vertical);
   EXPECT_EQ(ab[1].outcome, h.outcome);
+}
+
+// The cloth simulator keeps a cut trial's rest (SimulatedTrial::rest, sim::resume_trial): it is
+// the uncut trial to the bit, for the one-trial and the batch forms, and it outlives its scene in
+// the bridge's cache (a cloth with its own grasp, then four other grasps that push its scene out
+// of the cache: the rest keeps it).
+TEST(SimCalibration, CutTrialsRestIsTheUncutTrial) {
+  const ClothSimulator both = make_cloth_simulator("coarse");
+  ClothValues cloth;
+  cloth.rim_shift = 0.01;
+  TrialRequest low;
+  low.height = ArmHeight::Low;
+  low.max_travel = 0.3;  // short: this test checks identity, not physics
+  TrialRequest high = low;
+  high.height = ArmHeight::High;
+  const std::vector<SimulatedTrial> whole = both.trials(cloth, {low, high});
+  std::vector<TrialRequest> watched{low, high};
+  for (TrialRequest& r : watched) r.watch = [](const std::vector<HapticSample>& so_far, bool) { return so_far.back().travel >= 0.15; };
+  std::vector<SimulatedTrial> cut = both.trials(cloth, watched);
+  cut.push_back(both.trial(cloth, watched[0]));
+  ClothValues other = cloth;
+  TrialRequest brief = low;
+  brief.max_travel = 0.005;
+  for (double shift : {0.002, 0.004, 0.006, 0.008}) {
+    other.rim_shift = shift;
+    both.trial(other, brief);
+  }
+  for (std::size_t k = 0; k < cut.size(); ++k) {
+    const SimulatedTrial& w = whole[k % 2];
+    ASSERT_TRUE(cut[k].cut) << "trial " << k;
+    ASSERT_TRUE(cut[k].rest) << "trial " << k;
+    ASSERT_LT(cut[k].samples.size(), w.samples.size()) << "trial " << k;
+    const SimulatedTrial rest = cut[k].rest();
+    EXPECT_FALSE(rest.cut);
+    EXPECT_FALSE(rest.rest);
+    ASSERT_EQ(rest.samples.size(), w.samples.size()) << "trial " << k;
+    EXPECT_EQ(0, std::memcmp(rest.samples.data(), w.samples.data(), w.samples.size() * sizeof(HapticSample))) << "trial " << k;
+    EXPECT_EQ(rest.outcome, w.outcome) << "trial " << k;
+    EXPECT_EQ(rest.d_behind, w.d_behind) << "trial " << k;
+    EXPECT_EQ(rest.d_ahead, w.d_ahead) << "trial " << k;
+  }
+  EXPECT_FALSE(whole[0].rest);
 }
 
 // A calibration's rim_shift reaches the simulator as the scene's grasp: a cloth with the rim

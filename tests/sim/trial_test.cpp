@@ -695,6 +695,54 @@ TEST(SimTrial, PullWatchCutsThePullAndKeepsItsBits) {
   }
 }
 
+// resume_trial() (calibrate --prune keeps the mu best exact without simulating a cut candidate
+// again): a cut pull goes on from its paused state to the uncut trial's bits, with a compliant
+// arm (its spring state carries over) and after a pull that simulate_trials() shared; the cut is
+// placed past each trial's first contact, so the arm has moved and the contacts are live. The
+// paused state is left as it was (a second resume gives the same bits), and a trial that was not
+// cut keeps none.
+TEST(SimTrial, ACutPullResumesToTheUncutTrialsBits) {
+  ClothParams cloth;
+  cloth.arm_compliance = 0.005;
+  std::vector<TrialSpec> specs(2);
+  specs[0].height = ArmHeight::Low;
+  specs[1].height = ArmHeight::High;
+  for (TrialSpec& s : specs) s.max_travel = 0.3;
+  const std::vector<TrialResult> whole = simulate_trials(coarse_scene(), cloth, specs);
+  std::vector<TrialSpec> cut = specs;
+  for (size_t k = 0; k < 2; ++k) {
+    ASSERT_GT(whole[k].contact_travel, 0.0) << "trial " << k << " never touches the arm";
+    ASSERT_LT(whole[k].contact_travel + 0.05, whole[k].travel) << "trial " << k << " ends too soon after its contact";
+    EXPECT_FALSE(whole[k].paused) << "trial " << k;
+    const double at = whole[k].contact_travel + 0.03;
+    cut[k].pull_watch = [at](const std::vector<HapticSample>& so_far, bool) { return so_far.back().travel >= at; };
+  }
+  ASSERT_GT(whole[1].pull_shared_travel, 0.0) << "the high arm's pull should begin shared with the low arm's";
+  const std::vector<TrialResult> short_ = simulate_trials(coarse_scene(), cloth, cut);
+  for (size_t k = 0; k < 2; ++k) {
+    const std::string what = "trial " + std::to_string(k);
+    ASSERT_TRUE(short_[k].cut) << what;
+    ASSERT_TRUE(short_[k].paused) << what;
+    ASSERT_LT(short_[k].seq.samples.size(), whole[k].seq.samples.size()) << what;
+    for (int twice = 0; twice < 2; ++twice) {
+      const TrialResult rest = resume_trial(*short_[k].paused);
+      expect_same_trial(rest, whole[k], (what + " resumed").c_str());
+      EXPECT_FALSE(rest.cut) << what;
+      EXPECT_FALSE(rest.paused) << what;
+      EXPECT_EQ(rest.stopped_by_force, whole[k].stopped_by_force) << what;
+      EXPECT_EQ(rest.area_ratio, whole[k].area_ratio) << what;
+      EXPECT_EQ(rest.arm_shift_max, whole[k].arm_shift_max) << what;
+      EXPECT_EQ(rest.pull_shared_travel, whole[k].pull_shared_travel) << what;
+      ASSERT_EQ(rest.contacts.size(), whole[k].contacts.size()) << what;
+      for (size_t i = 0; i < rest.contacts.size(); ++i) {
+        EXPECT_EQ(rest.contacts[i].vertex, whole[k].contacts[i].vertex) << what;
+        EXPECT_EQ(rest.contacts[i].force, whole[k].contacts[i].force) << what;
+      }
+    }
+  }
+  EXPECT_GT(whole[0].arm_shift_max, 0.0) << "the compliant arm should have moved";
+}
+
 namespace {
 
 // The self-collision pairs that step() must find from positions x, by brute force over all

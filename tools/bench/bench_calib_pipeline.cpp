@@ -484,7 +484,7 @@ int run_timing(const std::map<std::string, std::string>& a) {
               full_sims, cal_s / sims * full_sims / 3600.0);
   if (prune > 0)
     std::printf("pruned at %g x the last generation's median: %.1f s wall, %.3f of the unpruned run's; %ld of %d "
-                "candidates cut, %ld simulated again; final L = %.4f (unpruned %.4f); projection to 50 x 32: "
+                "candidates cut, %ld finished whole; final L = %.4f (unpruned %.4f); projection to 50 x 32: "
                 "%.1f h\n", prune, pruned_s, pruned_s / cal_s, pruned.pruned, o.generations * o.population,
                 pruned.resimulated, pruned.objective, r.objective, pruned_s / sims * full_sims / 3600.0);
   // --predict 1: the calibration just found predicts the other participants' trials (dressguard
