@@ -443,9 +443,15 @@ std::string hexd(double v) {
   return buf;
 }
 
-// What must match for a checkpoint to continue this run.
-// Pruning's rule for the mu best (calibration.h): the cut candidates (cut[c]) to simulate again
-// in whole, the lowest bounds f[c] first, so that mu whole candidates score at or below every
+// [s] the cloth time a candidate's simulated inputs cost (SimulatedTrial::simulated_s).
+double simulated_time(const std::vector<SimulatedTrial>& sts) {
+  double s = 0.0;
+  for (const SimulatedTrial& t : sts) s += t.simulated_s;
+  return s;
+}
+
+// Pruning's rule for the mu best (calibration.h): the cut candidates (cut[c]) to simulate in
+// whole, the lowest bounds f[c] first, so that mu whole candidates score at or below every
 // bound left; none when that already holds.
 std::vector<int> to_simulate_again(const std::vector<double>& f, const std::vector<char>& cut, int mu) {
   std::vector<int> cuts;
@@ -460,6 +466,7 @@ std::vector<int> to_simulate_again(const std::vector<double>& f, const std::vect
   return cuts;
 }
 
+// What must match for a checkpoint to continue this run.
 std::string fingerprint(const std::vector<HapticSequence>& inputs, const ParameterSpace& space,
                         const CalibrationOptions& o) {
   std::ostringstream f;
@@ -660,15 +667,17 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   // `generation`: which one these candidates are (0: the start), for candidate_progress alone.
   // `bound` (pruning, see calibration.h): a candidate whose objective's lower bound passes it is
   // cut; infinity: none is. Each candidate's T terms are followed by 1 when it was cut, else 0.
-  const int W = T + 1;
+  // Each candidate's block: its T terms, 1 when it was cut (else 0), its simulated cloth time.
+  const int W = T + 2;
   std::mutex progress_mutex;
-  // A candidate's terms and its cut flag (out[T]) from its simulated inputs.
-  auto score = [&](const std::vector<SimulatedTrial>& sts, double* out) {
+  // A candidate's block from its simulated inputs; `work`: the cloth time they cost.
+  auto score = [&](const std::vector<SimulatedTrial>& sts, double work, double* out) {
     bool cut = false;
     for (int k = 0; k < K; ++k) {
       out[k] = sequence_term(options.objective, sts[k], inputs[k]);
       cut = cut || sts[k].cut;
     }
+    out[T + 1] = work;
     if (ic >= 0) out[ic] = cut ? 0.0 : contrast_term(inputs, sts, options.contrast_weight);
     if (il >= 0) out[il] = cut ? 0.0 : lateral_term(inputs, sts, options.lateral_weight);
     out[T] = cut ? 1.0 : 0.0;
@@ -706,7 +715,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
             return combined_objective(known.data(), K, T, options.combine) > bound;
           });
       std::vector<SimulatedTrial> sts = simulate_inputs(sim, space.cloth(xs[c]), space.offsets(xs[c]), inputs, watches);
-      score(sts, out);
+      score(sts, simulated_time(sts), out);
       if (out[T] != 0.0) held[static_cast<std::size_t>(c)] = std::move(sts);  // each c on one thread
       report(cp, began);
     });
@@ -729,16 +738,19 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
       if (static_cast<int>(sts.size()) != K)
         throw std::logic_error("calibrate: cut candidate " + std::to_string(c) + "'s trials are not on this rank");
       const bool resumable = std::all_of(sts.begin(), sts.end(), [](const SimulatedTrial& t) { return !t.cut || t.rest; });
+      double work = 0.0;
       if (resumable) {
         for (SimulatedTrial& t : sts)
           if (t.cut) {
             t = t.rest();
             if (t.cut) throw std::logic_error("calibrate: the rest of a cut trial came back cut (SimulatedTrial::rest)");
+            work += t.simulated_s;
           }
       } else {
         sts = simulate_inputs(sim, space.cloth(xs[c]), space.offsets(xs[c]), inputs);
+        work = simulated_time(sts);
       }
-      score(sts, out);
+      score(sts, work, out);
       sts = {};  // its paused simulations are not needed again
       report(cp, began);
     });
@@ -754,6 +766,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   const Eigen::VectorXd start = space.initial_unit();
   const double no_bound = std::numeric_limits<double>::infinity();
   std::vector<double> start_fits = evaluate({start}, 0, no_bound);
+  double simulated_total = start_fits[static_cast<std::size_t>(T) + 1];
   start_fits.resize(static_cast<std::size_t>(T));
   const double start_f = combined_objective(start_fits.data(), K, T, options.combine);
 
@@ -772,7 +785,11 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
       f[c] = combined_objective(per.data() + static_cast<std::size_t>(c) * W, K, T, options.combine);
       cut[c] = per[static_cast<std::size_t>(c) * W + T] != 0.0;
     };
-    for (int c = 0; c < lambda; ++c) take(c);
+    double work = 0.0;  // the generation's simulated cloth time
+    for (int c = 0; c < lambda; ++c) {
+      take(c);
+      work += per[static_cast<std::size_t>(c) * W + T + 1];
+    }
     const int pruned = static_cast<int>(std::count(cut.begin(), cut.end(), 1));
     // Keep the mu best exact (calibration.h): simulate again, in whole, the cut candidates of the
     // lowest bounds until mu fully simulated ones score at or below every bound left.
@@ -782,12 +799,14 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
       for (int c : again) {
         std::copy_n(redo.begin() + static_cast<long>(c) * W, W, per.begin() + static_cast<long>(c) * W);
         take(c);
+        work += redo[static_cast<std::size_t>(c) * W + T + 1];
       }
       resimulated += static_cast<int>(again.size());
     }
     held.clear();
     pruned_total += pruned;
     resimulated_total += resimulated;
+    simulated_total += work;
     const double best_before = es.best_f();
     const int arg = static_cast<int>(std::min_element(f.begin(), f.end()) - f.begin());
     es.tell(f);
@@ -814,6 +833,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
         p.pruned = pruned;
         p.resimulated = resimulated;
         p.prune_bound = bound;
+        p.simulated_s = work;
         p.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         p.eta_s = p.elapsed_s / done_here * std::max(0, options.generations - done);
         p.resumed = resumed;
@@ -828,6 +848,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   r.evaluations = es.state().evaluations + 1;  // and the start
   r.pruned = pruned_total;
   r.resimulated = resimulated_total;
+  r.simulated_s = simulated_total;
   r.start_objective = start_f;
   const bool keep_start = !(es.best_f() <= start_f);  // also when the search found nothing finite
   r.objective = keep_start ? start_f : es.best_f();

@@ -168,6 +168,11 @@ struct SimulatedTrial {
   // cut (the cloth simulator: sim::resume_trial). Empty when the simulator keeps no state (the
   // caller simulates the request again). Callable on the process that made it, from any thread.
   std::function<SimulatedTrial()> rest;
+  // [s] the cloth time this result cost on its own, the work a calibration's wall time follows:
+  // its settling unless it started from another trial's, and its pull after the part pulled as
+  // one with another trial (sim::simulate_trials); for a rest, the pull after the cut. A batch's
+  // results sum to what it simulated. 0: the simulator does not say.
+  double simulated_s = 0;
 };
 
 // Must be deterministic and callable from several threads at once.
@@ -372,6 +377,7 @@ struct GenerationProgress {
   int pruned = 0;           // this generation's candidates cut short (options.prune) ...
   int resimulated = 0;      // ... and of those, the ones simulated in whole after all (on from the cut, or again)
   double prune_bound = std::numeric_limits<double>::infinity();  // the bound they were cut at
+  double simulated_s = 0;   // [s] cloth time this generation simulated, all ranks (SimulatedTrial::simulated_s)
   double elapsed_s = 0;     // this process
   double eta_s = 0;         // estimated remaining, from this process's pace
   bool resumed = false;     // this process continued from a checkpoint
@@ -406,6 +412,7 @@ struct CalibrationResult {
   int generations_done = 0;
   long evaluations = 0;           // candidate evaluations (each = one simulation per sequence), the start's included
   long pruned = 0, resimulated = 0;  // in this process: candidates cut short, and finished whole after all (options.prune)
+  double simulated_s = 0;            // [s] cloth time simulated in this process's generations and its start, all ranks
   double objective = 0;           // L of the best candidate (the start, when no sample beat it)
   double start_objective = 0;     // L of the start (the bounds' initial values)
   Eigen::VectorXd best_unit;      // in the unit box

@@ -83,18 +83,42 @@ sim::TrialSpec spec_of(const ClothValues& c, const TrialRequest& r) {
   return spec;
 }
 
+// [s] the pull's time after `from` [s] (its samples' times; one sample is three output steps).
+double pull_time_after(const sim::TrialResult& res, double from) {
+  return res.seq.samples.empty() ? 0.0 : res.seq.samples.back().t - from;
+}
+
+// The time of the last sample pulled as one with another trial (TrialResult::pull_shared_travel),
+// 0 when the pull was its own from the start.
+double shared_pull_time(const sim::TrialResult& res) {
+  double t = 0.0;
+  if (res.pull_shared_travel > 0)
+    for (const HapticSample& h : res.seq.samples) {
+      if (h.travel > res.pull_shared_travel) break;
+      t = h.t;
+    }
+  return t;
+}
+
 // `scene`: the one that simulated `res`; a cut trial's rest keeps it alive (the paused model
-// points into it, and the scene cache below may drop it meanwhile).
-SimulatedTrial simulated(sim::TrialResult&& res, const std::shared_ptr<const sim::Scene>& scene) {
+// points into it, and the scene cache below may drop it meanwhile). `resumed_at`: for a rest,
+// the time of the sample it was cut at (the pull before it was simulated already); else < 0.
+SimulatedTrial simulated(sim::TrialResult&& res, const std::shared_ptr<const sim::Scene>& scene, double resumed_at = -1) {
   SimulatedTrial out;
+  out.simulated_s = resumed_at >= 0 ? pull_time_after(res, resumed_at)
+                                    : (res.settle_shared ? 0.0 : res.settle_time) + pull_time_after(res, shared_pull_time(res));
   out.samples = std::move(res.seq.samples);
   out.outcome = res.outcome;
   out.finite = res.finite;
   out.d_behind = res.d_behind;
   out.d_ahead = res.d_ahead;
   out.cut = res.cut;
-  if (res.paused)
-    out.rest = [scene, paused = std::move(res.paused)] { return simulated(sim::resume_trial(*paused), scene); };
+  if (res.paused) {
+    const double cut_at = out.samples.empty() ? 0.0 : out.samples.back().t;
+    out.rest = [scene, paused = std::move(res.paused), cut_at] {
+      return simulated(sim::resume_trial(*paused), scene, cut_at);
+    };
+  }
   return out;
 }
 

@@ -345,9 +345,11 @@ int run_calibrate(int argc, char** argv) {
     char pruned[64] = "";
     if (o.prune > 0)
       std::snprintf(pruned, sizeof pruned, "  pruned %d/%d (%d again)", p.pruned, o.population, p.resimulated);
-    std::fprintf(stderr, "generation %d/%d  best L %.4f (%s)  (this generation %.4f)%s  elapsed %s  ETA %s%s\n",
+    // The cloth time simulated: the work a generation's wall time follows, without the machine's noise.
+    std::fprintf(stderr, "generation %d/%d  best L %.4f (%s)  (this generation %.4f)%s  elapsed %s  ETA %s  "
+                 "%.0f s of cloth simulated%s\n",
                  p.generation, p.generations, p.best, per.c_str(), p.generation_best, pruned,
-                 minutes(p.elapsed_s).c_str(), minutes(p.eta_s).c_str(), resumed);
+                 minutes(p.elapsed_s).c_str(), minutes(p.eta_s).c_str(), p.simulated_s, resumed);
   });
   if (!r.complete) {
     if (comm.is_root()) {
@@ -377,6 +379,7 @@ int run_calibrate(int argc, char** argv) {
   prov.set("ranks", comm.size());
   prov.set("threads_per_rank", thread_count(o.threads));
   prov.set("elapsed_s_last_process", r.elapsed_s);
+  prov.set("simulated_s_last_process", r.simulated_s);  // cloth time, the start and this process's generations
   if (o.prune > 0) {  // only when asked (files of unpruned runs keep their fields)
     prov.set("prune", o.prune);
     prov.set("pruned_last_process", r.pruned);

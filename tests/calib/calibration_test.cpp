@@ -3,10 +3,12 @@
 // bounds files, input selection on the measured data, the calibration file.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <set>
 #include <sstream>
 
 #include <unistd.h>
@@ -636,49 +638,61 @@ TEST(Calibration, PruningCutsOnlyCandidatesWorseThanTheBoundAndKeepsTheBestExact
 // simulator's sim::resume_trial): a cut candidate that must be known whole goes on from its cut
 // trials instead of being simulated again. The rest is the whole trial's bits, so the search is
 // the one that simulates again, to the bit, in every generation (its progress and its result),
-// on 1 and 3 threads; it asks the simulator for no candidate twice; and it calls the rest of
-// each cut trial of exactly the candidates it reports as simulated again in whole.
+// on 1 and 3 threads; it asks the simulator for no candidate twice; it calls the rest of each
+// cut trial of exactly the candidates it reports as simulated again in whole; and the cloth time
+// it reports (SimulatedTrial::simulated_s, per generation and in all) is the other search's with
+// the rests in place of the candidates simulated again, which saves at least the cut parts.
 TEST(Calibration, PruningGoesOnFromTheCutInsteadOfSimulatingAgain) {
   const auto inputs = fake_inputs(Truth{});
   const auto space = space_for(inputs);
   std::atomic<long> batches{0}, rests{0};
+  std::atomic<double> saved{0.0}, rest_s{0.0};  // the cut parts of the trials gone on from; their rests
+  double again_s = 0.0;                           // the candidates simulated again (one thread)
+  std::set<std::array<double, 4>> asked;          // the cloths the simulator was asked for
   const TrialBatchSimulator keeps = [&](const ClothValues& c, const std::vector<TrialRequest>& rs) {
     ++batches;
     std::vector<SimulatedTrial> out;
     for (const TrialRequest& r : rs) {
       out.push_back(testing::fake_simulate(c, r));
       if (out.back().rest)
-        out.back().rest = [&rests, inner = out.back().rest] {
+        out.back().rest = [&rests, &saved, &rest_s, inner = out.back().rest, cut_s = out.back().simulated_s] {
           ++rests;
-          return inner();
+          saved.fetch_add(cut_s);
+          SimulatedTrial whole = inner();
+          rest_s.fetch_add(whole.simulated_s);
+          return whole;
         };
     }
     return out;
   };
   const TrialBatchSimulator again = [&](const ClothValues& c, const std::vector<TrialRequest>& rs) {
     ++batches;
+    const bool repeat = !asked.insert({c.stretch, c.shear, c.bend, c.friction}).second;
     std::vector<SimulatedTrial> out;
     for (const TrialRequest& r : rs) {
       out.push_back(testing::fake_simulate(c, r));
       out.back().rest = nullptr;
+      if (repeat) again_s += out.back().simulated_s;
     }
     return out;
   };
   struct Seen {
     double best, generation_best;
     int pruned, resimulated;
+    double simulated_s;
   };
   auto run = [&](const TrialBatchSimulator& sim, int threads, std::vector<Seen>* seen) {
     auto o = quick(40, threads);
     o.prune = 1.0;
     return calibrate(inputs, space, sim, o, Comm::world(), [&](const GenerationProgress& p) {
-      if (seen) seen->push_back({p.best, p.generation_best, p.pruned, p.resimulated});
+      if (seen) seen->push_back({p.best, p.generation_best, p.pruned, p.resimulated, p.simulated_s});
     });
   };
   std::vector<Seen> by_rest, by_again;
   const auto a = run(again, 1, &by_again);
   const long again_batches = batches.exchange(0);
   const auto r = run(keeps, 1, &by_rest);
+  const double saved_one_thread = saved.load(), rest_one_thread = rest_s.load();
   ASSERT_GT(r.resimulated, 0) << "the test needs cut candidates that must be known whole";
   EXPECT_EQ(batches.load(), 1 + 40 * 16) << "the start and each candidate once";
   EXPECT_EQ(again_batches, 1 + 40 * 16 + a.resimulated);
@@ -698,6 +712,20 @@ TEST(Calibration, PruningGoesOnFromTheCutInsteadOfSimulatingAgain) {
   EXPECT_TRUE(r.best_unit == a.best_unit);
   EXPECT_EQ(r.pruned, a.pruned);
   EXPECT_EQ(r.resimulated, a.resimulated);
+  // The cloth time: each run's generations and its start make its total, and going on from the
+  // cut saves exactly the cut parts of the trials gone on from.
+  double gens_rest = 0.0, gens_again = 0.0;
+  for (std::size_t g = 0; g < by_rest.size(); ++g) {
+    EXPECT_LE(by_rest[g].simulated_s, by_again[g].simulated_s + 1e-9) << "generation " << g + 1;
+    gens_rest += by_rest[g].simulated_s;
+    gens_again += by_again[g].simulated_s;
+  }
+  const double start_s = a.simulated_s - gens_again;
+  EXPECT_GT(start_s, 0.0);
+  EXPECT_NEAR(r.simulated_s - gens_rest, start_s, 1e-9);
+  EXPECT_GT(saved_one_thread, 0.0);
+  EXPECT_NEAR(a.simulated_s - again_s, r.simulated_s - rest_one_thread, 1e-6);
+  EXPECT_GE(a.simulated_s - r.simulated_s, saved_one_thread - 1e-6);
   const auto three = run(keeps, 3, nullptr);
   EXPECT_EQ(three.objective, r.objective);
   EXPECT_TRUE(three.best_unit == r.best_unit);

@@ -244,7 +244,8 @@ if(STUDY)
     message(FATAL_ERROR "calibrate on the coarse gown (${rc}):\n${out}\n${err}")
   endif()
   # Pruned (--prune): from the second generation on its progress lines say how many candidates
-  # were cut and simulated again, and the file records the factor and the counts.
+  # were cut and finished whole after all, each line the cloth time simulated, and the file
+  # records the factor, the counts and the cloth time.
   execute_process(COMMAND ${DG} calibrate --data ${WORK}/study --participant 4 --out ${WORK}/c1p.json --gown coarse
                           --generations 2 --population 4 --threads 2 --seed 1 --prune 1
                   RESULT_VARIABLE rc OUTPUT_VARIABLE pout ERROR_VARIABLE perr)
@@ -253,8 +254,9 @@ if(STUDY)
   endif()
   if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/c1p.json
      OR NOT perr MATCHES "generation 1/2  best L [^\n]*\\(this generation [0-9.]+\\)  pruned 0/4 \\(0 again\\)  elapsed"
-     OR NOT perr MATCHES "generation 2/2  best L [^\n]*  pruned [0-4]/4 \\([0-4] again\\)  elapsed"
-     OR NOT c1p MATCHES "\"prune\": 1,\n +\"pruned_last_process\": [0-9]+,\n +\"resimulated_last_process\": [0-9]+")
+     OR NOT perr MATCHES "generation 2/2  best L [^\n]*  pruned [0-4]/4 \\([0-4] again\\)  elapsed [^\n]*  ETA [^\n]*  [1-9][0-9]* s of cloth simulated\n"
+     OR NOT c1p MATCHES "\"prune\": 1,\n +\"pruned_last_process\": [0-9]+,\n +\"resimulated_last_process\": [0-9]+"
+     OR NOT c1p MATCHES "\"simulated_s_last_process\": [1-9]")
     message(FATAL_ERROR "calibrate --prune on the coarse gown (${rc}):\n${pout}\n${perr}")
   endif()
   # Its progress as a picture (tools/plot/calib_overlay.py progress reads the kept stderr).

@@ -56,16 +56,22 @@ inline SimulatedTrial fake_simulate(const ClothValues& c, const TrialRequest& r)
     }
     // The watch stops a pull as the cloth simulator's does (sim::TrialSpec::pull_watch), and
     // its rest is the trial without the watch (sim::resume_trial's contract; here simulated
-    // again, having no state to go on from).
+    // again, having no state to go on from), charged with the time after the cut alone.
     if (r.watch && r.watch(out.samples, false)) {
       out.cut = true;
+      out.simulated_s = 0.01 * static_cast<double>(out.samples.size());
       TrialRequest plain = r;
       plain.watch = nullptr;
-      out.rest = [c, plain] { return fake_simulate(c, plain); };
+      out.rest = [c, plain, done = out.simulated_s] {
+        SimulatedTrial whole = fake_simulate(c, plain);
+        whole.simulated_s -= done;
+        return whole;
+      };
       return out;
     }
   }
   if (r.watch) r.watch(out.samples, true);
+  out.simulated_s = 0.01 * static_cast<double>(out.samples.size());  // its sample period
   return out;
 }
 

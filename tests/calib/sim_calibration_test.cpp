@@ -110,8 +110,18 @@ TEST(SimCalibration, CutTrialsRestIsTheUncutTrial) {
     EXPECT_EQ(rest.outcome, w.outcome) << "trial " << k;
     EXPECT_EQ(rest.d_behind, w.d_behind) << "trial " << k;
     EXPECT_EQ(rest.d_ahead, w.d_ahead) << "trial " << k;
+    // The cloth time: the cut part and its rest make the whole trial's.
+    EXPECT_GT(cut[k].simulated_s, 0.0) << "trial " << k;
+    EXPECT_GT(rest.simulated_s, 0.0) << "trial " << k;
+    EXPECT_NEAR(cut[k].simulated_s + rest.simulated_s, w.simulated_s, 1e-9) << "trial " << k;
   }
   EXPECT_FALSE(whole[0].rest);
+  // The batch's cloth time is its one settling and each pull's own part: the one-trial form's
+  // trials add up to more by a settling and the shared part of the pull.
+  const SimulatedTrial low_alone = both.trial(cloth, low);
+  EXPECT_NEAR(low_alone.simulated_s, whole[0].simulated_s, 1e-9) << "the batch's first trial settles and pulls alone";
+  EXPECT_GT(low_alone.simulated_s, low_alone.samples.back().t + 1.0) << "at least a second of settling";
+  EXPECT_LT(whole[1].simulated_s, whole[1].samples.back().t) << "the high arm's pull began shared and its settling too";
 }
 
 // A calibration's rim_shift reaches the simulator as the scene's grasp: a cloth with the rim

@@ -58,7 +58,9 @@
 //     settled and pulled on its own; --predict 1: the calibration's prediction of the other participants'
 //     trials with one settling per group of targets against one per target (same tables required).
 //     --prune K: the calibration once more with `calibrate --prune K` (calibration.h), timed
-//     against the unpruned run above as its baseline, with the candidates cut and simulated again.
+//     against the unpruned run above as its baseline, with the candidates cut and finished whole,
+//     and the cloth time each simulated (CalibrationResult::simulated_s: the work, without the
+//     machine's noise).
 //
 // Everything runs through dg_calib's public API (the same code as the commands).
 #include <algorithm>
@@ -477,6 +479,9 @@ int run_timing(const std::map<std::string, std::string>& a) {
               "thread(s): %.1f s wall, %.2f s per simulation; final L = %.4f\n", inputs.size(), o.generations,
               o.population, inputs.size(), sims,
               thread_count(o.threads), cal_s, cal_s / sims, r.objective);
+  // The cloth time simulated is the work, free of the machine's noise; wall / cloth time is the pace.
+  std::printf("  cloth simulated: %.0f s (%.3f s wall per cloth second on %d thread(s))\n", r.simulated_s,
+              cal_s / r.simulated_s, thread_count(o.threads));
   if (base_s > 0)
     std::printf("baseline, each trial settled and pulled on its own: %.1f s wall, %.2f s per simulation; sharing them is "
                 "%.2fx faster; same result: %s\n", base_s, base_s / sims, base_s / cal_s, same ? "yes" : "NO");
@@ -487,6 +492,9 @@ int run_timing(const std::map<std::string, std::string>& a) {
                 "candidates cut, %ld finished whole; final L = %.4f (unpruned %.4f); projection to 50 x 32: "
                 "%.1f h\n", prune, pruned_s, pruned_s / cal_s, pruned.pruned, o.generations * o.population,
                 pruned.resimulated, pruned.objective, r.objective, pruned_s / sims * full_sims / 3600.0);
+  if (prune > 0)
+    std::printf("  pruned cloth simulated: %.0f s, %.3f of the unpruned run's (the work; the wall ratio above adds "
+                "the machine's noise)\n", pruned.simulated_s, pruned.simulated_s / r.simulated_s);
   // --predict 1: the calibration just found predicts the other participants' trials (dressguard
   // predict), with the targets in groups that settle once (the default) and, as the same run's
   // baseline, every target settled on its own; the same tables, byte for byte, are required.
