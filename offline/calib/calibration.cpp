@@ -666,7 +666,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   // coarser grain still keeps 2 cores busy.
   // `generation`: which one these candidates are (0: the start), for candidate_progress alone.
   // `bound` (pruning, see calibration.h): a candidate whose objective's lower bound passes it is
-  // cut; infinity: none is. Each candidate's T terms are followed by 1 when it was cut, else 0.
+  // cut; infinity: none is.
   // Each candidate's block: its T terms, 1 when it was cut (else 0), its simulated cloth time.
   const int W = T + 2;
   std::mutex progress_mutex;
@@ -791,8 +791,8 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
       work += per[static_cast<std::size_t>(c) * W + T + 1];
     }
     const int pruned = static_cast<int>(std::count(cut.begin(), cut.end(), 1));
-    // Keep the mu best exact (calibration.h): simulate again, in whole, the cut candidates of the
-    // lowest bounds until mu fully simulated ones score at or below every bound left.
+    // Keep the mu best exact (calibration.h): finish in whole the cut candidates of the lowest
+    // bounds until mu fully simulated ones score at or below every bound left.
     int resimulated = 0;
     for (std::vector<int> again; !(again = to_simulate_again(f, cut, es.mu())).empty();) {
       const std::vector<double> redo = finish_cut(xs, again, done + 1);
