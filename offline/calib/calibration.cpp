@@ -693,9 +693,11 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   // simulated them, until the generation is ranked; a cut candidate that must be known whole
   // goes on from them (finish_cut).
   std::vector<std::vector<SimulatedTrial>> held;
+  // When the generation's evaluation began: its finishing pass reports its time from there too.
+  std::chrono::steady_clock::time_point generation_began;
   auto evaluate = [&](const std::vector<Eigen::VectorXd>& xs, int generation, double bound) {
     const int n = static_cast<int>(xs.size());
-    const auto began = std::chrono::steady_clock::now();
+    const auto began = generation_began = std::chrono::steady_clock::now();
     CandidateProgress cp;
     cp.generation = generation;
     cp.total = (n + comm.size() - 1) / comm.size();  // run_batch: the root takes indices 0, size, ...
@@ -728,9 +730,10 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
     const int n = static_cast<int>(xs.size());
     std::vector<char> wanted(static_cast<std::size_t>(n), 0);
     for (int c : again) wanted[static_cast<std::size_t>(c)] = 1;
-    const auto began = std::chrono::steady_clock::now();
+    const auto began = generation_began;
     CandidateProgress cp;
     cp.generation = generation;
+    cp.finishing = true;
     for (int c = comm.rank(); c < n; c += comm.size()) cp.total += wanted[static_cast<std::size_t>(c)];
     return run_batch(n, W, thread_count(options.threads), comm, [&](int c, double* out) {
       if (!wanted[static_cast<std::size_t>(c)]) return;

@@ -334,7 +334,11 @@ struct CandidateProgress {
   int generation = 0;     // the generation being evaluated, 1-based; 0: the start (evaluated once)
   int done = 0;           // of this rank's candidates in it, in the order they finish
   int total = 0;
-  double elapsed_s = 0;   // since this generation's evaluation began
+  double elapsed_s = 0;   // since this generation's evaluation began (its finishing pass too)
+  // calibrate --prune: a report of the pass that finishes the generation's cut candidates that
+  // must be known whole; `done` and `total` then count those of the pass on this rank (a
+  // generation takes one pass or more, calibration.cpp).
+  bool finishing = false;
 };
 
 struct CalibrationOptions {

@@ -317,8 +317,8 @@ int run_calibrate(int argc, char** argv) {
     }
     if (c.done == c.total || c.elapsed_s - line_at < 60) return;
     line_at = c.elapsed_s;
-    std::fprintf(stderr, "  generation %d/%d: %d of %d candidates on this rank in %s\n", c.generation,
-                 o.generations, c.done, c.total, minutes(c.elapsed_s).c_str());
+    std::fprintf(stderr, "  generation %d/%d: %d of %d %s on this rank in %s\n", c.generation, o.generations,
+                 c.done, c.total, c.finishing ? "cut candidates finished" : "candidates", minutes(c.elapsed_s).c_str());
   };
   bool first_line = true;
   const CalibrationResult r = calibrate(inputs, space, sim.trials, o, comm, [&](const GenerationProgress& p) {

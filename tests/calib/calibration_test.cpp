@@ -506,6 +506,55 @@ TEST(Calibration, EachCandidateIsReportedOnceAsItFinishes) {
     }
 }
 
+// With pruning, a generation's cut candidates that must be known whole are finished in passes of
+// their own; their reports come after the generation's candidates, say so (`finishing`), count
+// exactly the candidates that the generation's line reports as finished (each pass 1, 2, ...,
+// its total), and keep the generation's clock: no report's time is below the one before it. A clock that
+// restarted for the finishing pass (sessions 62-63) fails the last check.
+TEST(Calibration, FinishingCutCandidatesIsReportedWithinItsGeneration) {
+  const auto inputs = fake_inputs(Truth{});
+  const auto space = space_for(inputs);
+  auto o = quick(12, 2);
+  o.prune = 1.0;
+  std::vector<CandidateProgress> seen;
+  std::vector<int> finished_per_generation;
+  o.candidate_progress = [&](const CandidateProgress& c) { seen.push_back(c); };
+  const auto r = calibrate(inputs, space, testing::fake_simulate, o, Comm::world(),
+                           [&](const GenerationProgress& p) { finished_per_generation.push_back(p.resimulated); });
+  ASSERT_GT(r.resimulated, 0) << "the test needs cut candidates that must be known whole";
+  ASSERT_EQ(finished_per_generation.size(), 12u);
+  std::size_t i = 1;  // seen[0]: the start
+  for (int g = 1; g <= 12; ++g) {
+    const int finished = finished_per_generation[static_cast<std::size_t>(g - 1)];
+    double last = -1.0;
+    for (int c = 1; c <= 16; ++c, ++i) {
+      ASSERT_LT(i, seen.size());
+      EXPECT_EQ(seen[i].generation, g);
+      EXPECT_FALSE(seen[i].finishing) << "generation " << g << ", candidate " << c;
+      EXPECT_GE(seen[i].elapsed_s, last);
+      last = seen[i].elapsed_s;
+    }
+    // One pass or more (until mu candidates known whole beat every bound left), each counted
+    // 1, 2, ..., its total.
+    int finishing = 0, in_pass = 0, pass_total = 0;
+    for (; i < seen.size() && seen[i].generation == g; ++i) {
+      EXPECT_TRUE(seen[i].finishing) << "generation " << g;
+      if (in_pass == pass_total) {
+        in_pass = 0;
+        pass_total = seen[i].total;
+      }
+      EXPECT_EQ(seen[i].done, ++in_pass) << "generation " << g;
+      EXPECT_EQ(seen[i].total, pass_total) << "generation " << g;
+      EXPECT_GE(seen[i].elapsed_s, last) << "generation " << g << ": the finishing pass restarted the clock";
+      last = seen[i].elapsed_s;
+      ++finishing;
+    }
+    EXPECT_EQ(in_pass, pass_total) << "generation " << g << ": a pass ended early";
+    EXPECT_EQ(finishing, finished) << "generation " << g;
+  }
+  EXPECT_EQ(i, seen.size());
+}
+
 // Interrupt after 5 generations (as a kill after the 5th checkpoint would), resume: the final
 // result equals an uninterrupted run's, bit for bit.
 TEST(Calibration, ResumeFromCheckpointGivesTheUninterruptedResult) {
