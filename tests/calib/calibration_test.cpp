@@ -509,8 +509,8 @@ TEST(Calibration, EachCandidateIsReportedOnceAsItFinishes) {
 // With pruning, a generation's cut candidates that must be known whole are finished in passes of
 // their own; their reports come after the generation's candidates, say so (`finishing`), count
 // exactly the candidates that the generation's line reports as finished (each pass 1, 2, ...,
-// its total), and keep the generation's clock: no report's time is below the one before it. A clock that
-// restarted for the finishing pass (sessions 62-63) fails the last check.
+// its total), and keep the generation's clock: no report's time is below the one before it. A
+// clock that restarted for the finishing pass (sessions 62-63) fails the last check.
 TEST(Calibration, FinishingCutCandidatesIsReportedWithinItsGeneration) {
   const auto inputs = fake_inputs(Truth{});
   const auto space = space_for(inputs);
