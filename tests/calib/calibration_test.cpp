@@ -282,6 +282,37 @@ TEST(Calibration, SequencesCombineAsSumOrWorst) {
   EXPECT_FALSE(parse_combine("max"));
 }
 
+// Bar against its closed form, and the ranking it exists for. Session 65's two points of
+// participant 2 (offline/calib/MEASUREMENTS.md): the support file (0.282 / 0.464 / 0.292, two
+// within the bar) and the wider box's round (0.363 / 0.372 / 0.391, none). Worst prefers the
+// second, whose max is lower; Bar the first, whose only excess is 0.164 against 0.226.
+TEST(Calibration, SequencesCombineByTheirExcessOverTheBar) {
+  const double terms[] = {0.2, 0.5, 0.05};  // one sequence within the bar, one 0.2 over it, one extra term
+  EXPECT_DOUBLE_EQ(combined_objective(terms, 2, 3, SequenceCombine::Bar), 0.2 + kWorstRho * 0.7 + 0.05);
+  const double within[] = {0.1, 0.29};  // within the bar only the rho term is left
+  EXPECT_DOUBLE_EQ(combined_objective(within, 2, 2, SequenceCombine::Bar), kWorstRho * 0.39);
+  const double support[] = {0.2821, 0.4642, 0.2921}, wider[] = {0.3627, 0.3725, 0.3914};
+  EXPECT_LT(combined_objective(wider, 3, 3, SequenceCombine::Worst),
+            combined_objective(support, 3, 3, SequenceCombine::Worst));
+  EXPECT_LT(combined_objective(support, 3, 3, SequenceCombine::Bar),
+            combined_objective(wider, 3, 3, SequenceCombine::Bar));
+  // Never lower when one sequence's L grows (a cut candidate's lower bounds bound it), and a
+  // sequence crossing the bar costs 1 + rho per unit beyond it against rho below it.
+  double x[] = {0.25, 0.4};
+  double last = combined_objective(x, 2, 2, SequenceCombine::Bar);
+  for (int i = 1; i <= 20; ++i) {
+    x[0] = 0.25 + 0.005 * i;  // 0.255 .. 0.35, across the bar at 0.3
+    const double f = combined_objective(x, 2, 2, SequenceCombine::Bar);
+    EXPECT_GE(f, last);
+    EXPECT_NEAR(f - last, x[0] <= kSequenceBar ? kWorstRho * 0.005 : (1 + kWorstRho) * 0.005, 1e-12);
+    last = f;
+  }
+  const double blown[] = {0.2, std::numeric_limits<double>::infinity()};
+  EXPECT_EQ(combined_objective(blown, 2, 2, SequenceCombine::Bar), std::numeric_limits<double>::infinity());
+  EXPECT_EQ(parse_combine("bar"), SequenceCombine::Bar);
+  EXPECT_EQ(combine_name(SequenceCombine::Bar), "bar");
+}
+
 // The file of a finished search: what calibrate writes (calibration_of) holds the result's values
 // and fits, marks the offsets of the heights it searched (high and low here, not middle), and
 // records how its objective was made and where the rig's travel ends (the longest input not

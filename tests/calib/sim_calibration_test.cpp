@@ -383,7 +383,7 @@ void expect_fits_own_sequences_to_the_bit(const std::string& file, double at_mos
   if (cal.contrast_weight > 0) std::printf("  the heights' contrast term: %.4f (weight %g)\n", cal.contrast, cal.contrast_weight);
   EXPECT_EQ(again.lateral, cal.lateral);
   if (cal.lateral_weight > 0) std::printf("  the lateral term: %.4f (weight %g)\n", cal.lateral, cal.lateral_weight);
-  // The recorded objective is what the search minimised (--combine sum or worst), to the bit.
+  // The recorded objective is what the search minimised (--combine sum, worst or bar), to the bit.
   EXPECT_EQ(again.objective, cal.objective);
 }
 
