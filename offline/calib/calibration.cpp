@@ -413,30 +413,35 @@ std::string_view combine_name(SequenceCombine c) {
   switch (c) {
     case SequenceCombine::Worst: return "worst";
     case SequenceCombine::Bar: return "bar";
+    case SequenceCombine::Count: return "count";
     case SequenceCombine::Sum: break;
   }
   return "sum";
 }
 
 std::optional<SequenceCombine> parse_combine(std::string_view s) {
-  for (auto c : {SequenceCombine::Sum, SequenceCombine::Worst, SequenceCombine::Bar})
+  for (auto c : {SequenceCombine::Sum, SequenceCombine::Worst, SequenceCombine::Bar,
+                 SequenceCombine::Count})
     if (s == combine_name(c)) return c;
   return std::nullopt;
 }
 
 double combined_objective(const double* terms, int K, int T, SequenceCombine c) {
   double sum = 0.0, worst = -std::numeric_limits<double>::infinity(), excess = 0.0;
+  int over = 0;
   for (int k = 0; k < K; ++k) {
     if (!std::isfinite(terms[k])) return std::numeric_limits<double>::infinity();
     sum += terms[k];
     worst = std::max(worst, terms[k]);
     excess += std::max(0.0, terms[k] - kSequenceBar);
+    over += terms[k] > kSequenceBar;
   }
   // Sum: the same additions in the same order as before the option existed (shipped files keep
   // their bits).
   double f = sum;
   if (c == SequenceCombine::Worst) f = worst + kWorstRho * sum;
   if (c == SequenceCombine::Bar) f = excess + kWorstRho * sum;
+  if (c == SequenceCombine::Count) f = over + (excess + kWorstRho * sum);
   for (int k = K; k < T; ++k) f += terms[k];
   return std::isfinite(f) ? f : std::numeric_limits<double>::infinity();
 }
@@ -1040,7 +1045,7 @@ Calibration calibration_from_json(const Json& j, const std::filesystem::path& so
     if (j.has("combine")) {
       c.combine = j.at("combine").string();
       if (!parse_combine(c.combine))
-        throw std::runtime_error("combine must be \"sum\", \"worst\" or \"bar\", not \"" + c.combine + "\"");
+        throw std::runtime_error("combine must be \"sum\", \"worst\", \"bar\" or \"count\", not \"" + c.combine + "\"");
     }
     if (j.has("contrast_weight")) {
       c.contrast_weight = j.at("contrast_weight").number();

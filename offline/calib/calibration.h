@@ -319,13 +319,27 @@ std::vector<HapticSequence> inputs_by_id(const Dataset& ds, const std::string& p
 // 65 measured it twice: participant 2's worst fell from 0.464 to 0.391 while his good and missed
 // sequences left the bar (0.282 / 0.292 to 0.363 / 0.391); participant 0's from 0.588 to 0.540
 // while his good one did (0.231 to 0.483). Under Bar a sequence within 0.3 costs rho per unit
-// until it crosses, and 1 + rho beyond, so the search lowers the ones above the bar and keeps the
-// others there. Like Sum and Worst it never decreases when one L_k grows, so a cut candidate's
-// lower bounds still bound it (`--prune`). CMA-ES ranks candidates, so the kinks do no harm.
-enum class SequenceCombine { Sum, Worst, Bar };
+// until it crosses, and 1 + rho beyond, so the search lowers the ones above the bar. It does not
+// keep the others there: a sequence at the bar is priced at its excess like any other, and is
+// traded as soon as another gains more (session 66: participant 2's good sequence 0.282 -> 0.330
+// for his middle one 0.464 -> 0.417; participant 7's missed one 0.302 -> 0.331 for his good one).
+//
+//   Count  the number of sequences over the bar first, then Bar:
+//                                     L = #{k : L_k > kSequenceBar} + Bar
+//
+// Why Count: issue 4 counts sequences within 0.3, and only a step in L keeps a sequence there
+// against a trade. While the Bar term stays below 1 (three sequences each under about 0.57, as
+// 3.3 L - 0.9 < 1) the order is lexicographic: fewer sequences over the bar always wins, and among
+// equals Bar decides. Session 66: from participant 2's support file at sigma0 0.003 it lowered
+// all three (0.282 / 0.464 / 0.292 to 0.262 / 0.443 / 0.279) where Bar, from the same first
+// draws, let the missed one cross (0.300).
+//
+// All four never decrease when one L_k grows, so a cut candidate's lower bounds still bound it
+// (`--prune`). CMA-ES uses only the candidates' ranks, so the kinks and the steps do no harm.
+enum class SequenceCombine { Sum, Worst, Bar, Count };
 inline constexpr double kWorstRho = 0.1;
 inline constexpr double kSequenceBar = 0.3;  // issue 4: own sequences at L <= 0.3 (the repeat floor)
-std::string_view combine_name(SequenceCombine c);           // "sum", "worst", "bar"
+std::string_view combine_name(SequenceCombine c);           // "sum", "worst", "bar", "count"
 std::optional<SequenceCombine> parse_combine(std::string_view s);
 
 // The number the search minimises for one candidate: `terms` holds its K sequences' L_k, then

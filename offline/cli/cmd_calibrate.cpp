@@ -94,11 +94,12 @@ int run_calibrate(int argc, char** argv) {
         "  --inputs ID,ID[,ID] fit these trials of P (one per height, good or missed) instead of\n"
         "                      the seed's choice; the seed then drives CMA-ES alone\n"
         "  --objective area|position-weighted   (default area: paper eq. 3-5)\n"
-        "  --combine sum|worst|bar   how the sequences' L combine: sum (the paper, the default),\n"
-        "                      worst (max_k L_k + 0.1 sum_k L_k: the worst-fitted sequence first,\n"
-        "                      as issue 4 judges each one) or bar (sum_k max(0, L_k - 0.3) +\n"
-        "                      0.1 sum_k L_k: each sequence's excess over issue 4's 0.3, so those\n"
-        "                      within it stay there; offline/calib/calibration.h)\n"
+        "  --combine sum|worst|bar|count   how the sequences' L combine: sum (the paper, the\n"
+        "                      default), worst (max_k L_k + 0.1 sum_k L_k: the worst-fitted sequence\n"
+        "                      first, as issue 4 judges each one), bar (sum_k max(0, L_k - 0.3) +\n"
+        "                      0.1 sum_k L_k: each sequence's excess over issue 4's 0.3) or count\n"
+        "                      (the number of sequences over 0.3, then bar: those within it stay\n"
+        "                      there; offline/calib/calibration.h)\n"
         "  --contrast-weight K   add K times the heights' contrast to the objective: how the high\n"
         "                      sequence's forces differ from the lower one's over the first 0.30 m,\n"
         "                      simulated against measured (offline/calib/objective.h, contrast_error;\n"
@@ -193,7 +194,7 @@ int run_calibrate(int argc, char** argv) {
   if (!kind) throw UsageError("--objective must be area or position-weighted");
   o.objective = *kind;
   const auto combine = parse_combine(args.get("combine").value_or("sum"));
-  if (!combine) throw UsageError("--combine must be sum, worst or bar, not '" + *args.get("combine") + "'");
+  if (!combine) throw UsageError("--combine must be sum, worst, bar or count, not '" + *args.get("combine") + "'");
   o.combine = *combine;
   if (const auto cw = args.get("contrast-weight")) {
     o.contrast_weight = args.number("contrast-weight", 0);
@@ -425,7 +426,10 @@ int run_calibrate(int argc, char** argv) {
         for (const auto& f : cal.fits) sum += f.objective;
         std::printf("  L combines the sequences as %s (%s + %g x sum); their sum, the paper's L: %.4f\n",
                     std::string(combine_name(o.combine)).c_str(),
-                    o.combine == SequenceCombine::Worst ? "max" : "the excesses over 0.3", kWorstRho, sum);
+                    o.combine == SequenceCombine::Worst ? "max"
+                    : o.combine == SequenceCombine::Bar ? "the excesses over 0.3"
+                                                        : "the count over 0.3 + the excesses over it",
+                    kWorstRho, sum);
       }
       for (const auto& f : cal.fits)
         std::printf("  %-18s %-6s L = %.4f; over the common travel F_motion %.3f (zero force %.3f), F_vertical %.3f "

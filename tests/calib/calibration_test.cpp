@@ -5,6 +5,7 @@
 
 #include <array>
 #include <atomic>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -311,6 +312,41 @@ TEST(Calibration, SequencesCombineByTheirExcessOverTheBar) {
   EXPECT_EQ(combined_objective(blown, 2, 2, SequenceCombine::Bar), std::numeric_limits<double>::infinity());
   EXPECT_EQ(parse_combine("bar"), SequenceCombine::Bar);
   EXPECT_EQ(combine_name(SequenceCombine::Bar), "bar");
+}
+
+// Count against its closed form, and the trade it exists to refuse. Session 66's first
+// generation from participant 2's support file (0.282 / 0.464 / 0.292) at sigma0 0.003 found
+// 0.330 / 0.417 / 0.284: Bar takes it (0.250 against 0.268), the good sequence leaving the bar
+// for the middle one's 0.047; Count keeps the file, which has one sequence over the bar, not two.
+TEST(Calibration, SequencesCombineByHowManyAreOverTheBarFirst) {
+  const double terms[] = {0.2, 0.5, 0.05};  // one within, one over, one extra term
+  EXPECT_DOUBLE_EQ(combined_objective(terms, 2, 3, SequenceCombine::Count), 1 + 0.2 + kWorstRho * 0.7 + 0.05);
+  const double within[] = {0.1, 0.29};  // none over: Count is Bar
+  EXPECT_DOUBLE_EQ(combined_objective(within, 2, 2, SequenceCombine::Count),
+                   combined_objective(within, 2, 2, SequenceCombine::Bar));
+  const double support[] = {0.2821, 0.4642, 0.2921}, traded[] = {0.3301, 0.4170, 0.2843};
+  EXPECT_LT(combined_objective(traded, 3, 3, SequenceCombine::Bar),
+            combined_objective(support, 3, 3, SequenceCombine::Bar));
+  EXPECT_LT(combined_objective(support, 3, 3, SequenceCombine::Count),
+            combined_objective(traded, 3, 3, SequenceCombine::Count));
+  // Never lower when one sequence's L grows; crossing the bar is a step of 1, and exactly at the
+  // bar a sequence is within it (issue 4: L <= 0.3).
+  double x[] = {0.25, 0.4};
+  double last = combined_objective(x, 2, 2, SequenceCombine::Count);
+  for (int i = 1; i <= 20; ++i) {
+    x[0] = 0.25 + 0.005 * i;
+    const double f = combined_objective(x, 2, 2, SequenceCombine::Count);
+    EXPECT_GE(f, last);
+    last = f;
+  }
+  const double at_bar[] = {kSequenceBar, 0.4}, past_bar[] = {std::nextafter(kSequenceBar, 1.0), 0.4};
+  EXPECT_NEAR(combined_objective(past_bar, 2, 2, SequenceCombine::Count) -
+                  combined_objective(at_bar, 2, 2, SequenceCombine::Count),
+              1.0, 1e-12);
+  const double blown[] = {0.2, std::numeric_limits<double>::infinity()};
+  EXPECT_EQ(combined_objective(blown, 2, 2, SequenceCombine::Count), std::numeric_limits<double>::infinity());
+  EXPECT_EQ(parse_combine("count"), SequenceCombine::Count);
+  EXPECT_EQ(combine_name(SequenceCombine::Count), "count");
 }
 
 // The file of a finished search: what calibrate writes (calibration_of) holds the result's values

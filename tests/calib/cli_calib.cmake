@@ -27,7 +27,7 @@ expect_fail("calibrate with a bad --hem" "--hem" calibrate --data ${WORK}/nothin
 expect_fail("calibrate with a softening --hem" "--hem" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --hem 0.03,0.5)
 expect_fail("calibrate with a negative contrast weight" "--contrast-weight must be in [0, 1000]" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --contrast-weight -1)
 expect_fail("calibrate with a negative lateral weight" "--lateral-weight must be in [0, 1000]" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --lateral-weight -1)
-expect_fail("calibrate with an unknown way to combine the sequences" "--combine must be sum, worst or bar, not 'max'" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --combine max)
+expect_fail("calibrate with an unknown way to combine the sequences" "--combine must be sum, worst, bar or count, not 'max'" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --combine max)
 expect_fail("calibrate with a negative prune factor" "--prune must be in [0, 100], not '-1'" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --prune -1)
 expect_fail("calibrate pruning the position-weighted objective" "--prune needs --objective area" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --prune 1 --objective position-weighted)
 expect_fail("calibrate with an unknown friction scheme" "--friction must be improved, constraint or stock, not 'sticky'" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --friction sticky)
