@@ -43,11 +43,12 @@
 //     2-3 measured sequences each calibration was fitted to (paper VI-B.1); the vote of the
 //     single STCs of the people other than P (hmm::evaluate_vote) and, for comparison, their
 //     mixture (per class the mean likelihood of the raw forces). Each STC and its BC, and the
-//     vote and the 1-NN, are also compared trial by trial at each cut: how many trials only one of them gets right, McNemar's
-//     exact p of that split and each accuracy's 95 % Wilson interval (hmm.h), because 22 trials
-//     leave a few trials' difference inside the noise. Prints the table and
-//     each simulator's early cue against the people's and its own person's, writes DIR/pooled.json (plot:
-//     tools/plot/pooled_stc.py). With several seeds, each seed's sets go in its own folder and each
+//     vote and the 1-NN, are also compared trial by trial at each cut: how many trials only one
+//     of them gets right, McNemar's exact p of that split and each accuracy's 95 % Wilson
+//     interval (hmm.h), because 22 trials leave a few trials' difference inside the noise; two
+//     calibrations of the same person are paired the same way (their STCs face the same trials:
+//     which file is the better source). Prints the table and each simulator's early cue against
+//     the people's and its own person's, writes DIR/pooled.json (plot: tools/plot/pooled_stc.py). With several seeds, each seed's sets go in its own folder and each
 //     simulator trains on the union (N x seeds per height); the file is DIR1/pooled-S1-S2-....json.
 //   bench_calib_pipeline timing [--gown ...] [--generations G --population N] [--threads T]
 //                               [--arm-compliance ... --fist-shift ... --rim-shift ... --density ...] [--prune K]
@@ -937,30 +938,53 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     per_calibration("bc", "BC, all of them", [](const Source& src) { return src.inputs; },
                     [](const Source& src) { return "BC: participant " + src.participant + "'s measured inputs"; },
                     nullptr, &bc_ids);
-    // Each STC against its BC on the same trials (the other people's): b / c the trials only the
-    // STC / only the BC gets right, and McNemar's exact p (hmm.h), whole and at each cut.
+    // Two classifiers on the same trials, paired: b / c the trials only the first / only the
+    // second gets right, and McNemar's exact p (hmm.h), whole and at each cut; printed as a row.
+    const auto pair_row = [](const std::string& label, const RightIds& first, const RightIds& second) {
+      std::printf("  %-44s", label.c_str());
+      Json jb = Json::array(), jc = Json::array(), jp = Json::array();
+      for (int c = 0; c < 5; ++c) {
+        int b = 0, cc = 0;
+        for (const auto& id : first[c]) b += !second[c].count(id);
+        for (const auto& id : second[c]) cc += !first[c].count(id);
+        const double p = hmm::mcnemar_exact_p(b, cc);
+        std::printf(" %d/%d %.2f", b, cc, p);
+        jb.push(b), jc.push(cc), jp.push(p);
+      }
+      std::printf("\n");
+      Json j = Json::object();
+      j.set("only_first_right_whole_and_cuts", jb);
+      j.set("only_second_right_whole_and_cuts", jc);
+      j.set("mcnemar_exact_p_whole_and_cuts", jp);
+      return j;
+    };
+    // Each STC against its BC on the same trials (the other people's).
     {
       Json rows = Json::array();
       for (std::size_t s = 0; s < sources.size(); ++s) {
-        std::printf("  %-44s", ("STC vs BC, b/c p: " + fs::path(sources[s].file).stem().string()).c_str());
-        Json jb = Json::array(), jc = Json::array(), jp = Json::array();
-        for (int c = 0; c < 5; ++c) {
-          int b = 0, cc = 0;
-          for (const auto& id : single_ids[s][c]) b += !bc_ids[s][c].count(id);
-          for (const auto& id : bc_ids[s][c]) cc += !single_ids[s][c].count(id);
-          const double p = hmm::mcnemar_exact_p(b, cc);
-          std::printf(" %d/%d %.2f", b, cc, p);
-          jb.push(b), jc.push(cc), jp.push(p);
-        }
-        std::printf("\n");
-        Json j = Json::object();
+        Json j = pair_row("STC vs BC, b/c p: " + fs::path(sources[s].file).stem().string(), single_ids[s],
+                          bc_ids[s]);
         j.set("calibration", sources[s].file);
-        j.set("only_stc_right_whole_and_cuts", jb);
-        j.set("only_bc_right_whole_and_cuts", jc);
-        j.set("mcnemar_exact_p_whole_and_cuts", jp);
         rows.push(j);
       }
       jset.set("single_against_bc", rows);
+    }
+    // Two calibrations of one person (the same test trials): which of the two STCs is the better
+    // classifier source, beyond what 18-20 trials leave to chance (sessions 59 and 67 compare a
+    // person's files this way).
+    {
+      Json rows = Json::array();
+      for (std::size_t s = 0; s < sources.size(); ++s)
+        for (std::size_t t = s + 1; t < sources.size(); ++t) {
+          if (sources[s].participant != sources[t].participant) continue;
+          Json j = pair_row(fs::path(sources[s].file).stem().string() + " vs " +
+                                fs::path(sources[t].file).stem().string(),
+                            single_ids[s], single_ids[t]);
+          j.set("first", sources[s].file);
+          j.set("second", sources[t].file);
+          rows.push(j);
+        }
+      jset.set("single_against_single_same_person", rows);
     }
     // The pools: per test person, every calibration of someone else; the same pool cut to one
     // set's size beside it. Models are cached by their pool.
