@@ -48,8 +48,9 @@
 //     interval (hmm.h), because 22 trials leave a few trials' difference inside the noise; two
 //     calibrations of the same person are paired the same way (their STCs face the same trials:
 //     which file is the better source). Prints the table and each simulator's early cue against
-//     the people's and its own person's, writes DIR/pooled.json (plot: tools/plot/pooled_stc.py). With several seeds, each seed's sets go in its own folder and each
-//     simulator trains on the union (N x seeds per height); the file is DIR1/pooled-S1-S2-....json.
+//     the people's and its own person's, writes DIR/pooled.json (plot: tools/plot/pooled_stc.py).
+//     With several seeds, each seed's sets go in its own folder and each simulator trains on the
+//     union (N x seeds per height); the file is DIR1/pooled-S1-S2-....json.
 //   bench_calib_pipeline timing [--gown ...] [--generations G --population N] [--threads T]
 //                               [--arm-compliance ... --fist-shift ... --rim-shift ... --density ...] [--prune K]
 //     Wall time per simulation and of a G x N calibration of participant 4, with the final
@@ -970,8 +971,8 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       jset.set("single_against_bc", rows);
     }
     // Two calibrations of one person (the same test trials): which of the two STCs is the better
-    // classifier source, beyond what 18-20 trials leave to chance (sessions 59 and 67 compare a
-    // person's files this way).
+    // classifier source, beyond what 18-20 trials leave to chance (sessions 59 and 67 ranked a
+    // person's files by their STCs; session 67 found one seed's sets cannot do it alone).
     {
       Json rows = Json::array();
       for (std::size_t s = 0; s < sources.size(); ++s)
