@@ -50,7 +50,9 @@
 //     which file is the better source). Prints the table and each simulator's early cue against
 //     the people's and its own person's, writes DIR/pooled.json (plot: tools/plot/pooled_stc.py).
 //     With several seeds, each seed's sets go in its own folder and each simulator trains on the
-//     union (N x seeds per height); the file is DIR1/pooled-S1-S2-....json.
+//     union (N x seeds per height); each calibration's STC is also trained on each seed's set
+//     alone and the seeds paired, how far one file moves between draws; the file is
+//     DIR1/pooled-S1-S2-....json.
 //   bench_calib_pipeline timing [--gown ...] [--generations G --population N] [--threads T]
 //                               [--arm-compliance ... --fist-shift ... --rim-shift ... --density ...] [--prune K]
 //     Wall time per simulation and of a G x N calibration of participant 4, with the final
@@ -745,6 +747,13 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     for (int c = 0; c < 5; ++c) j.push(n ? static_cast<double>(right[c]) / n : 0.0);
     return j;
   };
+  // The test trials of a classifier built for participant `p`: every measured trial of the others.
+  auto trials_not_of = [&all](const std::string& p) {
+    std::vector<const HapticSequence*> test;
+    for (const auto* t : all)
+      if (t->participant != p) test.push_back(t);
+    return test;
+  };
   auto print_row = [](const char* name, const int right[5], int n) {
     std::printf("  %-44s", name);
     for (int c = 0; c < 5; ++c) std::printf(" %4.0f%%", n ? 100.0 * right[c] / n : 0.0);
@@ -874,9 +883,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       for (const auto& src : sources) {
         const std::vector<HapticSequence> owned = training(src);
         const std::vector<const HapticSequence*> tr = pointers_to(owned);
-        std::vector<const HapticSequence*> test;
-        for (const auto* t : all)
-          if (t->participant != src.participant) test.push_back(t);
+        const std::vector<const HapticSequence*> test = trials_not_of(src.participant);
         int right[5] = {};
         model::OutcomeModel m = train(tr, fs_.second_axis, name(src));
         if (ids) ids->emplace_back();
@@ -913,9 +920,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       Json rows = Json::array();
       for (std::size_t s = 0; s < sources.size(); ++s) {
         const model::OutcomeModel& m = shares[s];
-        std::vector<const HapticSequence*> test;
-        for (const auto* t : all)
-          if (t->participant != sources[s].participant) test.push_back(t);
+        const std::vector<const HapticSequence*> test = trials_not_of(sources[s].participant);
         int right[5] = {};
         count_right(m, test, right, {"good", "missed"});
         for (int c = 0; c < 5; ++c) sum[c] += right[c];
@@ -986,6 +991,44 @@ int run_pooled(const std::map<std::string, std::string>& a) {
           rows.push(j);
         }
       jset.set("single_against_single_same_person", rows);
+    }
+    // With several seeds: each calibration's STC trained on each seed's set alone, and the seeds
+    // paired (one file, the same test trials; only the synthesized draws differ). How far one
+    // file's figures move between draws is the floor under any ranking of two files (session 67:
+    // up to 8 of 18 trials at 40 per height). Seed s's trials are the union's indices
+    // s x per_height .. (s + 1) x per_height - 1 (see the synthesis loop above).
+    if (seeds.size() > 1) {
+      Json rows = Json::array(), pairs = Json::array();
+      for (const auto& src : sources) {
+        const std::string stem = fs::path(src.file).stem().string();
+        const std::vector<const HapticSequence*> test = trials_not_of(src.participant);
+        std::vector<RightIds> by_seed(seeds.size());
+        for (std::size_t s = 0; s < seeds.size(); ++s) {
+          std::vector<const HapticSequence*> tr;
+          for (const auto& t : src.set.trials)
+            if (synthesized_index(t.id) / so.per_height == static_cast<int>(s)) tr.push_back(&t);
+          const std::string label = "seed " + std::to_string(seeds[s]) + " alone: " + stem;
+          int right[5] = {};
+          count_right(train(tr, fs_.second_axis, label), test, right, {}, &by_seed[s]);
+          print_row(label.c_str(), right, static_cast<int>(test.size()));
+          Json j = Json::object();
+          j.set("calibration", src.file);
+          j.set("seed", static_cast<double>(seeds[s]));
+          j.set("accuracy_whole_and_cuts", pct(right, static_cast<int>(test.size())));
+          rows.push(j);
+        }
+        for (std::size_t s = 0; s < seeds.size(); ++s)
+          for (std::size_t t = s + 1; t < seeds.size(); ++t) {
+            Json j = pair_row("seed " + std::to_string(seeds[s]) + " vs " + std::to_string(seeds[t]) + ": " + stem,
+                              by_seed[s], by_seed[t]);
+            j.set("calibration", src.file);
+            j.set("first_seed", static_cast<double>(seeds[s]));
+            j.set("second_seed", static_cast<double>(seeds[t]));
+            pairs.push(j);
+          }
+      }
+      jset.set("single_per_seed", rows);
+      jset.set("single_seed_against_seed", pairs);
     }
     // The pools: per test person, every calibration of someone else; the same pool cut to one
     // set's size beside it. Models are cached by their pool.
