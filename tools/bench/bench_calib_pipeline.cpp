@@ -998,7 +998,8 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     // up to 8 of 18 trials at 40 per height). Seed s's trials are the union's indices
     // s x per_height .. (s + 1) x per_height - 1 (see the synthesis loop above). The same models
     // are also asked "good or missed?" with equal priors: there the caught model, trained on the
-    // few trials the gown's push catches, has no say (session 68's candidate cause of the swing).
+    // few trials the gown's push catches, has no say (session 68: under the paper's three-class
+    // rule that model's draw is most of the swing).
     if (seeds.size() > 1) {
       struct Question {
         const char* prefix;
