@@ -2,6 +2,7 @@
 # on that seed's part of the union, must be the STC a one-seed run trains on the same set (the
 # union renumbers seed s's trials from s x per_height), and the seeds' pairing rows must be there
 # for the paper's three classes and for good or missed; a seed without its folder exits 2.
+# Each STC's pairing with the 1-NN must match the one-member vote's.
 # -DBENCH=<bench_calib_pipeline> -DWORK=<dir> -DSTUDY=<study dir or empty> -DCAL=<a calibration>
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
@@ -65,4 +66,30 @@ foreach(label "seed 1 vs 2" "good\\|missed, seed 1 vs 2")
   if(NOT n EQUAL 3)
     message(FATAL_ERROR "'${label}: ${stem}' (b/c p at the five cuts) found ${n} times, not 3:\n${out_union}")
   endif()
+endforeach()
+# Each STC against the 1-NN on its own test trials (everyone but its person), at the cuts only.
+# With one calibration the vote of "the other people's STCs" is that one STC on the same trials,
+# so its long-standing pairing with the 1-NN must give the same splits, force set by force set.
+set(pair "([0-9]+/[0-9]+)")
+foreach(run s1 s2)
+  string(REGEX MATCHALL "\n  STC vs 1-NN, b/c p: ${stem} +- +${cell} ${cell} ${cell} ${cell}\n" stc_rows
+         "${out_${run}}")
+  string(REGEX MATCHALL "\n  vote vs 1-NN, paired: only vote / only 1-NN +- +${pair} +${pair} +${pair} +${pair}\n"
+         vote_rows "${out_${run}}")
+  list(LENGTH stc_rows n_stc)
+  list(LENGTH vote_rows n_vote)
+  if(NOT n_stc EQUAL 3 OR NOT n_vote EQUAL 3)
+    message(FATAL_ERROR "${run}: 'STC vs 1-NN' rows ${n_stc}, 'vote vs 1-NN' rows ${n_vote}, not 3 each:\n"
+                        "${out_${run}}")
+  endif()
+  foreach(i RANGE 2)
+    list(GET stc_rows ${i} s)
+    list(GET vote_rows ${i} v)
+    string(REGEX MATCHALL "[0-9]+/[0-9]+" s_splits "${s}")
+    string(REGEX MATCHALL "[0-9]+/[0-9]+" v_splits "${v}")
+    if(NOT s_splits STREQUAL v_splits)
+      message(FATAL_ERROR "${run}, force set ${i}: the STC's pairing with the 1-NN (${s_splits}) is not the "
+                          "one-member vote's (${v_splits}):\n${out_${run}}")
+    endif()
+  endforeach()
 endforeach()

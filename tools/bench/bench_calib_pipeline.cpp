@@ -42,13 +42,14 @@
 //     trials of the people other than its own), beside the baseline classifier BC trained on the
 //     2-3 measured sequences each calibration was fitted to (paper VI-B.1); the vote of the
 //     single STCs of the people other than P (hmm::evaluate_vote) and, for comparison, their
-//     mixture (per class the mean likelihood of the raw forces). Each STC and its BC, and the
-//     vote and the 1-NN, are also compared trial by trial at each cut: how many trials only one
-//     of them gets right, McNemar's exact p of that split and each accuracy's 95 % Wilson
-//     interval (hmm.h), because 22 trials leave a few trials' difference inside the noise; two
-//     calibrations of the same person are paired the same way (their STCs face the same trials:
-//     which file is the better source). Prints the table and each simulator's early cue against
-//     the people's and its own person's, writes DIR/pooled.json (plot: tools/plot/pooled_stc.py).
+//     mixture (per class the mean likelihood of the raw forces). Each STC and its BC, each STC
+//     and the 1-NN (on the STC's test trials), and the vote and the 1-NN, are also compared trial
+//     by trial at each cut: how many trials only one of them gets right, McNemar's exact p of
+//     that split and each accuracy's 95 % Wilson interval (hmm.h), because 22 trials leave a few
+//     trials' difference inside the noise; two calibrations of the same person are paired the
+//     same way (their STCs face the same trials: which file is the better source). Prints the
+//     table and each simulator's early cue against the people's and its own person's, writes
+//     DIR/pooled.json (plot: tools/plot/pooled_stc.py).
 //     With several seeds, each seed's sets go in its own folder and each simulator trains on the
 //     union (N x seeds per height); each calibration's STC is also trained on each seed's set
 //     alone and the seeds paired, how far one file moves between draws, under the paper's three
@@ -946,10 +947,18 @@ int run_pooled(const std::map<std::string, std::string>& a) {
                     nullptr, &bc_ids);
     // Two classifiers on the same trials, paired: b / c the trials only the first / only the
     // second gets right, and McNemar's exact p (hmm.h), whole and at each cut; printed as a row.
-    const auto pair_row = [](const std::string& label, const RightIds& first, const RightIds& second) {
+    // Without `whole` the first column is not compared (the 1-NN compares cut curves only): "-"
+    // printed, null in the JSON.
+    const auto pair_row = [](const std::string& label, const RightIds& first, const RightIds& second,
+                             bool whole = true) {
       std::printf("  %-44s", label.c_str());
       Json jb = Json::array(), jc = Json::array(), jp = Json::array();
       for (int c = 0; c < 5; ++c) {
+        if (c == 0 && !whole) {
+          std::printf("    -     ");
+          jb.push(Json()), jc.push(Json()), jp.push(Json());
+          continue;
+        }
         int b = 0, cc = 0;
         for (const auto& id : first[c]) b += !second[c].count(id);
         for (const auto& id : second[c]) cc += !first[c].count(id);
@@ -974,6 +983,30 @@ int run_pooled(const std::map<std::string, std::string>& a) {
         rows.push(j);
       }
       jset.set("single_against_bc", rows);
+    }
+    // The 1-NN on the other people's real curves (leave-one-participant-out), per trial and cut:
+    // paired below with each STC and with the vote. The issue asks an STC, trained on simulation
+    // alone, to match it; each STC faces its own test trials (everyone but its person), so the
+    // 1-NN's answers are taken on those same trials.
+    double nn[4];
+    std::vector<char> nn_right[4];
+    for (int c = 0; c < 4; ++c) {
+      nn_right[c] = one_nn_right(all, kCuts[c], fs_.nn);
+      nn[c] = static_cast<double>(std::count(nn_right[c].begin(), nn_right[c].end(), 1)) / all.size();
+    }
+    {
+      Json rows = Json::array();
+      for (std::size_t s = 0; s < sources.size(); ++s) {
+        RightIds nn_ids;
+        for (int c = 0; c < 4; ++c)
+          for (std::size_t i = 0; i < all.size(); ++i)
+            if (nn_right[c][i] && all[i]->participant != sources[s].participant) nn_ids[c + 1].insert(all[i]->id);
+        Json j = pair_row("STC vs 1-NN, b/c p: " + fs::path(sources[s].file).stem().string(), single_ids[s], nn_ids,
+                          false);
+        j.set("calibration", sources[s].file);
+        rows.push(j);
+      }
+      jset.set("single_against_one_nn", rows);
     }
     // Two calibrations of one person (the same test trials): which of the two STCs is the better
     // classifier source, beyond what 18-20 trials leave to chance (sessions 59 and 67 ranked a
@@ -1137,12 +1170,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       jset.set("vote_training_priors_good_or_missed_accuracy_whole_and_cuts", pct(share2_right, nm));
       jset.set("mixture_accuracy_whole_and_cuts", pct(mix_right, nm));
     }
-    double nn[4];  // the 1-NN compares curves cut at the same travel: scored at the cuts only
-    std::vector<char> nn_right[4];
-    for (int c = 0; c < 4; ++c) {
-      nn_right[c] = one_nn_right(all, kCuts[c], fs_.nn);
-      nn[c] = static_cast<double>(std::count(nn_right[c].begin(), nn_right[c].end(), 1)) / all.size();
-    }
+    // The 1-NN (above) compares curves cut at the same travel: scored at the cuts only.
     std::printf("  %-44s     -", "1-NN on the other people's measured curves");
     for (double v : nn) std::printf(" %4.0f%%", 100.0 * v);
     std::printf("   (%zu trials)\n", all.size());
