@@ -986,8 +986,9 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     }
     // The 1-NN on the other people's real curves (leave-one-participant-out), per trial and cut:
     // paired below with each STC and with the vote. The issue asks an STC, trained on simulation
-    // alone, to match it; each STC faces its own test trials (everyone but its person), so the
-    // 1-NN's answers are taken on those same trials.
+    // alone, to match it (`--discrepancy off`; on, the STC also learns its person's residual);
+    // each STC faces its own test trials (everyone but its person), so the 1-NN's answers are
+    // taken on those same trials.
     double nn[4];
     std::vector<char> nn_right[4];
     for (int c = 0; c < 4; ++c) {
