@@ -2,7 +2,8 @@
 # on that seed's part of the union, must be the STC a one-seed run trains on the same set (the
 # union renumbers seed s's trials from s x per_height), and the seeds' pairing rows must be there
 # for the paper's three classes and for good or missed; a seed without its folder exits 2.
-# Each STC's pairing with the 1-NN must match the one-member vote's.
+# Each STC's pairing with the 1-NN must match the one-member vote's, and its good-or-missed
+# pairing must meet the same 1-NN on the same trials.
 # -DBENCH=<bench_calib_pipeline> -DWORK=<dir> -DSTUDY=<study dir or empty> -DCAL=<a calibration>
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
@@ -54,10 +55,16 @@ if(NOT one STREQUAL union_one OR NOT two STREQUAL union_two)
   message(FATAL_ERROR "a seed's STC in the union is not its one-seed run's:\nseed 1 alone ${one}\nin the union "
                       "${union_one}\nseed 2 alone ${two}\nin the union ${union_two}")
 endif()
-# The good-or-missed rows (equal priors) have no one-seed counterpart (its good|missed rows use
-# the training shares): present, three of each, is what is checked.
-rows("${out_union}" "good\\|missed, seed 1 alone" unused)
-rows("${out_union}" "good\\|missed, seed 2 alone" unused)
+# Likewise each seed's STC asked "good or missed?" with equal priors: the one-seed run's
+# "good|missed" rows.
+rows("${out_s1}" "good\\|missed" gm_one)
+rows("${out_union}" "good\\|missed, seed 1 alone" union_gm_one)
+rows("${out_s2}" "good\\|missed" gm_two)
+rows("${out_union}" "good\\|missed, seed 2 alone" union_gm_two)
+if(NOT gm_one STREQUAL union_gm_one OR NOT gm_two STREQUAL union_gm_two)
+  message(FATAL_ERROR "a seed's good-or-missed STC in the union is not its one-seed run's:\nseed 1 ${gm_one}\n"
+                      "in the union ${union_gm_one}\nseed 2 ${gm_two}\nin the union ${union_gm_two}")
+endif()
 # CMake's regular expressions have no {n}: the five b/c p cells spelled out.
 set(cell "[0-9]+/[0-9]+ [01]\\.[0-9][0-9]")
 foreach(label "seed 1 vs 2" "good\\|missed, seed 1 vs 2")
@@ -91,5 +98,57 @@ foreach(run s1 s2)
       message(FATAL_ERROR "${run}, force set ${i}: the STC's pairing with the 1-NN (${s_splits}) is not the "
                           "one-member vote's (${v_splits}):\n${out_${run}}")
     endif()
+  endforeach()
+endforeach()
+# The same STC asked "good or missed?", paired with the same 1-NN on the same trials: b - c is
+# the STC's count less the 1-NN's, so (b - c) of the good-or-missed row less (b - c) of the
+# three-class row must be the two rows' difference in trials right, cut by cut. It fails when
+# either pairing meets another 1-NN or other trials.
+foreach(run s1 s2)
+  rows("${out_${run}}" "alone" three)
+  rows("${out_${run}}" "good\\|missed" gm)
+  string(REGEX MATCHALL "\n  STC vs 1-NN, b/c p: ${stem} +- +${cell} ${cell} ${cell} ${cell}\n" stc_rows
+         "${out_${run}}")
+  string(REGEX MATCHALL "\n  good\\|missed vs 1-NN, b/c p: ${stem} +- +${cell} ${cell} ${cell} ${cell}\n" gm_rows
+         "${out_${run}}")
+  list(LENGTH gm_rows n_gm)
+  if(NOT n_gm EQUAL 3)
+    message(FATAL_ERROR "${run}: 'good|missed vs 1-NN' rows ${n_gm}, not 3:\n${out_${run}}")
+  endif()
+  foreach(i RANGE 2)
+    foreach(what three gm stc_rows gm_rows)
+      list(GET ${what} ${i} row_${what})
+    endforeach()
+    string(REGEX MATCH "\\(([0-9]+) trials\\)" unused "${row_three}")
+    set(n_trials ${CMAKE_MATCH_1})
+    string(REGEX MATCHALL "[0-9]+%" p_three "${row_three}")
+    string(REGEX MATCHALL "[0-9]+%" p_gm "${row_gm}")
+    string(REGEX MATCHALL "[0-9]+/[0-9]+" s_three "${row_stc_rows}")
+    string(REGEX MATCHALL "[0-9]+/[0-9]+" s_gm "${row_gm_rows}")
+    foreach(c RANGE 1 4)
+      list(GET p_three ${c} a)
+      list(GET p_gm ${c} g)
+      math(EXPR cm1 "${c} - 1")
+      list(GET s_three ${cm1} x)
+      list(GET s_gm ${cm1} y)
+      string(REPLACE "%" "" a "${a}")
+      string(REPLACE "%" "" g "${g}")
+      string(REPLACE "/" ";" x "${x}")
+      string(REPLACE "/" ";" y "${y}")
+      list(GET x 0 xb)
+      list(GET x 1 xc)
+      list(GET y 0 yb)
+      list(GET y 1 yc)
+      # Percentages back to trials: printed to 1 %, so exact for fewer than 100 trials.
+      math(EXPR right_three "(${a} * ${n_trials} + 50) / 100")
+      math(EXPR right_gm "(${g} * ${n_trials} + 50) / 100")
+      math(EXPR lhs "(${yb} - ${yc}) - (${xb} - ${xc})")
+      math(EXPR rhs "${right_gm} - ${right_three}")
+      if(NOT lhs EQUAL rhs)
+        message(FATAL_ERROR "${run}, force set ${i}, cut ${c}: the good-or-missed pairing with the 1-NN "
+                            "(${yb}/${yc}) and the three-class one (${xb}/${xc}) differ by ${lhs}, the rows by "
+                            "${rhs} trials:\n${out_${run}}")
+      endif()
+    endforeach()
   endforeach()
 endforeach()
