@@ -99,16 +99,12 @@ foreach(run s1 s2)
                           "one-member vote's (${v_splits}):\n${out_${run}}")
     endif()
   endforeach()
-endforeach()
-# The same STC asked "good or missed?", paired with the same 1-NN on the same trials: b - c is
-# the STC's count less the 1-NN's, so (b - c) of the good-or-missed row less (b - c) of the
-# three-class row must be the two rows' difference in trials right, cut by cut. It fails when
-# either pairing meets another 1-NN or other trials.
-foreach(run s1 s2)
+  # The same STC asked "good or missed?", paired with the same 1-NN on the same trials: b - c is
+  # the STC's count less the 1-NN's, so (b - c) of the good-or-missed row less (b - c) of the
+  # three-class row must be the two rows' difference in trials right, cut by cut. It fails when
+  # either pairing meets another 1-NN or other trials.
   rows("${out_${run}}" "alone" three)
   rows("${out_${run}}" "good\\|missed" gm)
-  string(REGEX MATCHALL "\n  STC vs 1-NN, b/c p: ${stem} +- +${cell} ${cell} ${cell} ${cell}\n" stc_rows
-         "${out_${run}}")
   string(REGEX MATCHALL "\n  good\\|missed vs 1-NN, b/c p: ${stem} +- +${cell} ${cell} ${cell} ${cell}\n" gm_rows
          "${out_${run}}")
   list(LENGTH gm_rows n_gm)
