@@ -2,8 +2,9 @@
 # on that seed's part of the union, must be the STC a one-seed run trains on the same set (the
 # union renumbers seed s's trials from s x per_height), and the seeds' pairing rows must be there
 # for the paper's three classes and for good or missed; a seed without its folder exits 2.
-# Each STC's pairing with the 1-NN must match the one-member vote's, and its good-or-missed
-# pairing must meet the same 1-NN on the same trials.
+# Each STC's pairing with the 1-NN must match the one-member vote's, asked the three classes and
+# asked "good or missed?", and its good-or-missed pairing must meet the same 1-NN on the same
+# trials.
 # -DBENCH=<bench_calib_pipeline> -DWORK=<dir> -DSTUDY=<study dir or empty> -DCAL=<a calibration>
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
@@ -76,41 +77,42 @@ foreach(label "seed 1 vs 2" "good\\|missed, seed 1 vs 2")
 endforeach()
 # Each STC against the 1-NN on its own test trials (everyone but its person), at the cuts only.
 # With one calibration the vote of "the other people's STCs" is that one STC on the same trials,
-# so its long-standing pairing with the 1-NN must give the same splits, force set by force set.
+# so its pairing with the 1-NN (`vote_label`) must give the STC's splits (`stc_label`), force set
+# by force set. Sets `stc_rows` in the caller: the STC's three rows.
 set(pair "([0-9]+/[0-9]+)")
-foreach(run s1 s2)
-  string(REGEX MATCHALL "\n  STC vs 1-NN, b/c p: ${stem} +- +${cell} ${cell} ${cell} ${cell}\n" stc_rows
-         "${out_${run}}")
-  string(REGEX MATCHALL "\n  vote vs 1-NN, paired: only vote / only 1-NN +- +${pair} +${pair} +${pair} +${pair}\n"
-         vote_rows "${out_${run}}")
-  list(LENGTH stc_rows n_stc)
-  list(LENGTH vote_rows n_vote)
+function(vote_is_stc text run what stc_label vote_label)
+  string(REGEX MATCHALL "\n  ${stc_label}: ${stem} +- +${cell} ${cell} ${cell} ${cell}\n" stc "${text}")
+  string(REGEX MATCHALL "\n  ${vote_label}: only vote / only 1-NN +- +${pair} +${pair} +${pair} +${pair}\n" vote
+         "${text}")
+  list(LENGTH stc n_stc)
+  list(LENGTH vote n_vote)
   if(NOT n_stc EQUAL 3 OR NOT n_vote EQUAL 3)
-    message(FATAL_ERROR "${run}: 'STC vs 1-NN' rows ${n_stc}, 'vote vs 1-NN' rows ${n_vote}, not 3 each:\n"
-                        "${out_${run}}")
+    message(FATAL_ERROR "${run}: '${stc_label}' rows ${n_stc}, '${vote_label}' rows ${n_vote}, not 3 each:\n${text}")
   endif()
   foreach(i RANGE 2)
-    list(GET stc_rows ${i} s)
-    list(GET vote_rows ${i} v)
+    list(GET stc ${i} s)
+    list(GET vote ${i} v)
     string(REGEX MATCHALL "[0-9]+/[0-9]+" s_splits "${s}")
     string(REGEX MATCHALL "[0-9]+/[0-9]+" v_splits "${v}")
     if(NOT s_splits STREQUAL v_splits)
-      message(FATAL_ERROR "${run}, force set ${i}: the STC's pairing with the 1-NN (${s_splits}) is not the "
-                          "one-member vote's (${v_splits}):\n${out_${run}}")
+      message(FATAL_ERROR "${run}, force set ${i}: the STC's ${what} pairing with the 1-NN (${s_splits}) is not "
+                          "the one-member vote's (${v_splits}):\n${text}")
     endif()
   endforeach()
+  set(stc_rows "${stc}" PARENT_SCOPE)
+endfunction()
+foreach(run s1 s2)
+  vote_is_stc("${out_${run}}" ${run} "three-class" "STC vs 1-NN, b/c p" "vote vs 1-NN, paired")
+  set(three_rows "${stc_rows}")
+  vote_is_stc("${out_${run}}" ${run} "good-or-missed" "good\\|missed vs 1-NN, b/c p" "vote good\\|missed vs 1-NN")
+  set(gm_rows "${stc_rows}")
+  set(stc_rows "${three_rows}")
   # The same STC asked "good or missed?", paired with the same 1-NN on the same trials: b - c is
   # the STC's count less the 1-NN's, so (b - c) of the good-or-missed row less (b - c) of the
   # three-class row must be the two rows' difference in trials right, cut by cut. It fails when
   # either pairing meets another 1-NN or other trials.
   rows("${out_${run}}" "alone" three)
   rows("${out_${run}}" "good\\|missed" gm)
-  string(REGEX MATCHALL "\n  good\\|missed vs 1-NN, b/c p: ${stem} +- +${cell} ${cell} ${cell} ${cell}\n" gm_rows
-         "${out_${run}}")
-  list(LENGTH gm_rows n_gm)
-  if(NOT n_gm EQUAL 3)
-    message(FATAL_ERROR "${run}: 'good|missed vs 1-NN' rows ${n_gm}, not 3:\n${out_${run}}")
-  endif()
   foreach(i RANGE 2)
     foreach(what three gm stc_rows gm_rows)
       list(GET ${what} ${i} row_${what})
