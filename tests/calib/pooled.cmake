@@ -4,8 +4,9 @@
 # for the paper's three classes and for good or missed; a seed without its folder exits 2.
 # Each STC's pairing with the 1-NN must match the one-member vote's, asked the three classes and
 # asked "good or missed?", and its good-or-missed pairing must meet the same 1-NN on the same
-# trials.
+# trials. The run's file keeps both votes' pairings and plots.
 # -DBENCH=<bench_calib_pipeline> -DWORK=<dir> -DSTUDY=<study dir or empty> -DCAL=<a calibration>
+# -DPLOT=<tools/plot/pooled_stc.py>
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 if(NOT STUDY)
@@ -150,3 +151,17 @@ foreach(run s1 s2)
     endforeach()
   endforeach()
 endforeach()
+# The file keeps both votes' pairings with the 1-NN (four cuts each), and the accuracy plot
+# (tools/plot/pooled_stc.py) draws it.
+file(READ ${WORK}/s1/pooled.json json)
+foreach(key vote_against_one_nn_at_cuts vote_good_or_missed_against_one_nn_at_cuts)
+  string(JSON n ERROR_VARIABLE json_err LENGTH "${json}" force_sets 0 ${key})
+  if(NOT n EQUAL 4)
+    message(FATAL_ERROR "${WORK}/s1/pooled.json: ${key} holds ${n} cuts, not 4 ${json_err}")
+  endif()
+endforeach()
+execute_process(COMMAND /usr/bin/python3 ${PLOT} ${WORK}/s1/pooled.json ${WORK}/pooled.png
+                RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/pooled.png)
+  message(FATAL_ERROR "pooled_stc.py on ${WORK}/s1/pooled.json (${rc}): ${err}")
+endif()

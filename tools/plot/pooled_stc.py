@@ -10,7 +10,8 @@ usage: pooled_stc.py POOLED.json OUT.png
 POOLED.json is what `bench_calib_pipeline pooled` writes (DIR/pooled.json). One panel per force
 set; "whole" is drawn at the right end, after the cuts. Where the file pairs the vote with the
 1-NN (since session 43), each cut shows both accuracies' 95 % intervals and, at the bottom, the
-trials only the vote / only the 1-NN got right with McNemar's exact p.
+trials only the vote / only the 1-NN got right with McNemar's exact p; above them, in red, the same
+for the vote with each STC asked "good or missed?" (since session 71).
 """
 import json
 import sys
@@ -56,6 +57,9 @@ def main(argv):
         if "vote_accuracy_whole_and_cuts" in s:
             ax.plot(xs, cuts_then_whole(s["vote_accuracy_whole_and_cuts"]), color="tab:red", lw=2.2, marker="D",
                     ms=5, label="vote of the simulators' STCs")
+        if "vote_good_or_missed_against_one_nn_at_cuts" in s:  # files since session 71
+            ax.plot(xs, cuts_then_whole(s["vote_good_or_missed_accuracy_whole_and_cuts"]), color="tab:red", lw=1.4,
+                    ls=":", marker="D", mfc="white", ms=4, label="vote, each asked good or missed")
         if "vote_training_priors_good_or_missed_accuracy_whole_and_cuts" in s:
             ax.plot(xs, cuts_then_whole(s["vote_training_priors_good_or_missed_accuracy_whole_and_cuts"]),
                     color="darkred", lw=2.2, ls="--", marker="D", mfc="white", ms=5,
@@ -75,6 +79,10 @@ def main(argv):
                             fmt="none")
             ax.annotate(f"{pair['only_vote_right']}/{pair['only_one_nn_right']}\np {pair['mcnemar_exact_p']:.2f}",
                         (x, 3), ha="center", fontsize=7, color="0.3")
+        # The vote asked "good or missed?" against the same 1-NN, above the plain vote's numbers.
+        for pair in s.get("vote_good_or_missed_against_one_nn_at_cuts", []):
+            ax.annotate(f"{pair['only_vote_right']}/{pair['only_one_nn_right']}\np {pair['mcnemar_exact_p']:.2f}",
+                        (pair["cut"], 13), ha="center", fontsize=7, color="tab:red")
         ax.set_title(s["forces"], fontsize=10)
         ax.set_xticks(xs)
         ax.set_xticklabels([f"{c:.2f}" for c in CUTS] + ["whole"])
@@ -87,7 +95,8 @@ def main(argv):
     fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, frameon=False)
     if any("vote_against_one_nn_at_cuts" in s for s in sets):
         fig.text(0.01, 0.01, "bars: 95 % Wilson intervals of the vote (left) and the 1-NN (right); numbers at the "
-                 "bottom: trials only the vote / only the 1-NN got right, McNemar's exact p", fontsize=7, color="0.3")
+                 "bottom: trials only the vote / only the 1-NN got right, McNemar's exact p (red, above: the vote asked "
+                 "good or missed)", fontsize=7, color="0.3")
     n = len(d["sources"])
     term = ", each simulator's own error added (--discrepancy)" if d.get("discrepancy") else ""
     # The noise models are on unless the file says otherwise (files from before session 27 do not).
