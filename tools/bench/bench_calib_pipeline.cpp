@@ -1156,6 +1156,9 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       // And both again with the training shares as priors (`shares`, above).
       const hmm::ClassChoice good_or_missed{"good", "missed"};
       int mix_right[5] = {}, vote_right[5] = {}, vote2_right[5] = {}, share_right[5] = {}, share2_right[5] = {}, nm = 0;
+      // How many of the measured trials (none of them caught) the plain vote calls caught: what the
+      // caught model, trained only on the gown push's few catches, takes from the other two.
+      int vote_caught[5] = {};
       for (const auto& p : people) {
         std::vector<const HapticSequence*> test;
         for (const auto* t : all)
@@ -1169,8 +1172,11 @@ int run_pooled(const std::map<std::string, std::string>& a) {
           const double cut = c == 0 ? std::numeric_limits<double>::infinity() : kCuts[c - 1];
           std::vector<hmm::Vote> votes;
           vote_right[c] += hmm::evaluate_vote(members, test, cut, &votes).correct;
-          for (std::size_t i = 0; i < test.size(); ++i)
+          for (std::size_t i = 0; i < test.size(); ++i) {
             vote_right_of[c][test[i]] = hmm::right_or_not(votes[i], *test[i]) == 1;
+            const hmm::Vote& v = votes[i];
+            vote_caught[c] += v.predicted >= 0 && v.classes[v.predicted] == outcome_name(Outcome::Caught);
+          }
           std::vector<hmm::Vote> gm_votes;  // evaluate_vote appends: a vector of its own
           vote2_right[c] += hmm::evaluate_vote(members, test, cut, &gm_votes, good_or_missed).correct;
           for (std::size_t i = 0; i < test.size(); ++i)
@@ -1181,11 +1187,13 @@ int run_pooled(const std::map<std::string, std::string>& a) {
         }
       }
       print_row("vote of the other people's STCs", vote_right, nm);
+      print_row("vote: trials it calls caught", vote_caught, nm);
       print_row("vote, each asked good or missed only", vote2_right, nm);
       print_row("vote, priors the training shares", share_right, nm);
       print_row("vote, training shares, good or missed", share2_right, nm);
       print_row("mixture of the other people's STCs", mix_right, nm);
       jset.set("vote_accuracy_whole_and_cuts", pct(vote_right, nm));
+      jset.set("vote_called_caught_whole_and_cuts", pct(vote_caught, nm));
       jset.set("vote_good_or_missed_accuracy_whole_and_cuts", pct(vote2_right, nm));
       jset.set("vote_training_priors_accuracy_whole_and_cuts", pct(share_right, nm));
       jset.set("vote_training_priors_good_or_missed_accuracy_whole_and_cuts", pct(share2_right, nm));
