@@ -4,7 +4,8 @@
 # for the paper's three classes and for good or missed; a seed without its folder exits 2.
 # Each STC's pairing with the 1-NN must match the one-member vote's, asked the three classes and
 # asked "good or missed?", and its good-or-missed pairing must meet the same 1-NN on the same
-# trials. The run's file keeps both votes' pairings and plots.
+# trials; the good-or-missed vote gains no more trials than the plain vote calls caught. The
+# run's file keeps both votes' pairings and plots.
 # -DBENCH=<bench_calib_pipeline> -DWORK=<dir> -DSTUDY=<study dir or empty> -DCAL=<a calibration>
 # -DPLOT=<tools/plot/pooled_stc.py>
 file(REMOVE_RECURSE ${WORK})
@@ -147,6 +148,42 @@ foreach(run s1 s2)
         message(FATAL_ERROR "${run}, force set ${i}, cut ${c}: the good-or-missed pairing with the 1-NN "
                             "(${yb}/${yc}) and the three-class one (${xb}/${xc}) differ by ${lhs}, the rows by "
                             "${rhs} trials:\n${out_${run}}")
+      endif()
+    endforeach()
+  endforeach()
+endforeach()
+# The vote's trials called caught: a trial the plain vote does not call caught keeps its answer
+# when each STC is asked "good or missed?" (one member: the larger of two is the larger of three),
+# so the good-or-missed vote is right on no fewer trials and on at most as many more as the plain
+# vote calls caught, whole and at each cut.
+foreach(run s1 s2)
+  foreach(what plain caught gm)
+    set(label_plain "vote of the other people's STCs")
+    set(label_caught "vote: trials it calls caught")
+    set(label_gm "vote, each asked good or missed only")
+    string(REGEX MATCHALL "\n  ${label_${what}} +[0-9% ]+\\([0-9]+ trials\\)" ${what} "${out_${run}}")
+    list(LENGTH ${what} n)
+    if(NOT n EQUAL 3)
+      message(FATAL_ERROR "${run}: '${label_${what}}' found ${n} times, not 3:\n${out_${run}}")
+    endif()
+  endforeach()
+  foreach(i RANGE 2)
+    foreach(what plain caught gm)
+      list(GET ${what} ${i} row)
+      string(REGEX MATCH "\\(([0-9]+) trials\\)" unused "${row}")
+      set(n_trials ${CMAKE_MATCH_1})
+      string(REGEX MATCHALL "[0-9]+%" pct_${what} "${row}")
+    endforeach()
+    foreach(c RANGE 4)
+      foreach(what plain caught gm)
+        list(GET pct_${what} ${c} v)
+        string(REPLACE "%" "" v "${v}")
+        math(EXPR k_${what} "(${v} * ${n_trials} + 50) / 100")
+      endforeach()
+      math(EXPR gain "${k_gm} - ${k_plain}")
+      if(gain LESS 0 OR gain GREATER k_caught)
+        message(FATAL_ERROR "${run}, force set ${i}, column ${c}: the good-or-missed vote is right on ${gain} "
+                            "trials more than the plain vote, which calls ${k_caught} caught:\n${out_${run}}")
       endif()
     endforeach()
   endforeach()
