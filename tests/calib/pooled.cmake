@@ -80,9 +80,9 @@ endforeach()
 # Each STC against the 1-NN on its own test trials (everyone but its person), at the cuts only.
 # With one calibration the vote of "the other people's STCs" is that one STC on the same trials,
 # so its pairing with the 1-NN (`vote_label`) must give the STC's splits (`stc_label`), force set
-# by force set. Sets `stc_rows` in the caller: the STC's three rows.
+# by force set. Sets `out_var` in the caller to the STC's three rows.
 set(pair "([0-9]+/[0-9]+)")
-function(vote_is_stc text run what stc_label vote_label)
+function(vote_is_stc text run what stc_label vote_label out_var)
   string(REGEX MATCHALL "\n  ${stc_label}: ${stem} +- +${cell} ${cell} ${cell} ${cell}\n" stc "${text}")
   string(REGEX MATCHALL "\n  ${vote_label}: only vote / only 1-NN +- +${pair} +${pair} +${pair} +${pair}\n" vote
          "${text}")
@@ -101,14 +101,12 @@ function(vote_is_stc text run what stc_label vote_label)
                           "the one-member vote's (${v_splits}):\n${text}")
     endif()
   endforeach()
-  set(stc_rows "${stc}" PARENT_SCOPE)
+  set(${out_var} "${stc}" PARENT_SCOPE)
 endfunction()
 foreach(run s1 s2)
-  vote_is_stc("${out_${run}}" ${run} "three-class" "STC vs 1-NN, b/c p" "vote vs 1-NN, paired")
-  set(three_rows "${stc_rows}")
-  vote_is_stc("${out_${run}}" ${run} "good-or-missed" "good\\|missed vs 1-NN, b/c p" "vote good\\|missed vs 1-NN")
-  set(gm_rows "${stc_rows}")
-  set(stc_rows "${three_rows}")
+  vote_is_stc("${out_${run}}" ${run} "three-class" "STC vs 1-NN, b/c p" "vote vs 1-NN, paired" stc_rows)
+  vote_is_stc("${out_${run}}" ${run} "good-or-missed" "good\\|missed vs 1-NN, b/c p" "vote good\\|missed vs 1-NN"
+              gm_rows)
   # The same STC asked "good or missed?", paired with the same 1-NN on the same trials: b - c is
   # the STC's count less the 1-NN's, so (b - c) of the good-or-missed row less (b - c) of the
   # three-class row must be the two rows' difference in trials right, cut by cut. It fails when
@@ -156,11 +154,11 @@ endforeach()
 # when each STC is asked "good or missed?" (one member: the larger of two is the larger of three),
 # so the good-or-missed vote is right on no fewer trials and on at most as many more as the plain
 # vote calls caught, whole and at each cut.
+set(label_plain "vote of the other people's STCs")
+set(label_caught "vote: trials it calls caught")
+set(label_gm "vote, each asked good or missed only")
 foreach(run s1 s2)
   foreach(what plain caught gm)
-    set(label_plain "vote of the other people's STCs")
-    set(label_caught "vote: trials it calls caught")
-    set(label_gm "vote, each asked good or missed only")
     string(REGEX MATCHALL "\n  ${label_${what}} +[0-9% ]+\\([0-9]+ trials\\)" ${what} "${out_${run}}")
     list(LENGTH ${what} n)
     if(NOT n EQUAL 3)
