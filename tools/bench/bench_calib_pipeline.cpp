@@ -1156,8 +1156,9 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       // And both again with the training shares as priors (`shares`, above).
       const hmm::ClassChoice good_or_missed{"good", "missed"};
       int mix_right[5] = {}, vote_right[5] = {}, vote2_right[5] = {}, share_right[5] = {}, share2_right[5] = {}, nm = 0;
-      // How many of the measured trials (none of them caught) the plain vote calls caught: what the
-      // caught model, trained only on the gown push's few catches, takes from the other two.
+      // How many of the measured trials (none of them caught) the plain vote calls caught. With
+      // several members this is not all the caught models cost: a member's caught vote also
+      // splits the good and missed votes (the good-or-missed vote below may gain more trials).
       int vote_caught[5] = {};
       for (const auto& p : people) {
         std::vector<const HapticSequence*> test;
