@@ -5,7 +5,8 @@
 # Each STC's pairing with the 1-NN must match the one-member vote's, asked the three classes and
 # asked "good or missed?", and its good-or-missed pairing must meet the same 1-NN on the same
 # trials; the good-or-missed vote gains no more trials than the plain vote calls caught. The
-# run's file keeps both votes' pairings and plots.
+# run's file keeps both votes' pairings and plots. Trials 0-1 of a 3-per-height set (--indices)
+# train the STC a 2-per-height set trains.
 # -DBENCH=<bench_calib_pipeline> -DWORK=<dir> -DSTUDY=<study dir or empty> -DCAL=<a calibration>
 # -DPLOT=<tools/plot/pooled_stc.py>
 file(REMOVE_RECURSE ${WORK})
@@ -199,4 +200,35 @@ execute_process(COMMAND /usr/bin/python3 ${PLOT} ${WORK}/s1/pooled.json ${WORK}/
                 RESULT_VARIABLE rc ERROR_VARIABLE err)
 if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/pooled.png)
   message(FATAL_ERROR "pooled_stc.py on ${WORK}/s1/pooled.json (${rc}): ${err}")
+endif()
+# --indices: a synthesized trial is a function of the seed, the height and its index (its speed
+# of index < per_height / 2), so trials 0 and 1 of seed 1's 3-per-height set are a 2-per-height
+# set's, and the STC trained on them alone (--indices 0-1) must be that set's STC, each force set,
+# asked the three classes and good or missed. Six more simulations. A range past the set exits 2.
+execute_process(COMMAND ${BENCH} ${common} --seed 1 --synth ${WORK}/s1 --indices 1-3 RESULT_VARIABLE rc
+                OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "pooled: --indices: '1-3' is not a range A-B with 0 <= A <= B < 3")
+  message(FATAL_ERROR "pooled --indices 1-3 of 3 per height (${rc}):\n${out}\n${err}")
+endif()
+execute_process(COMMAND ${BENCH} pooled --calibrations ${CAL} --per-height 2 --threads 2 --seed 1 --synth ${WORK}/two
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out_two ERROR_VARIABLE err)
+execute_process(COMMAND ${BENCH} ${common} --seed 1 --synth ${WORK}/s1 --indices 0-1 RESULT_VARIABLE rc_sub
+                OUTPUT_VARIABLE out_sub ERROR_VARIABLE err_sub)
+if(NOT rc EQUAL 0 OR NOT rc_sub EQUAL 0)
+  message(FATAL_ERROR "pooled at 2 per height (${rc}) or --indices 0-1 (${rc_sub}):\n${out_two}\n${err}\n${err_sub}")
+endif()
+foreach(label "alone" "good\\|missed")
+  rows("${out_two}" "${label}" whole_set)
+  rows("${out_sub}" "${label}" subset)
+  if(NOT whole_set STREQUAL subset)
+    message(FATAL_ERROR "'${label}': the STC of trials 0-1 of 3 per height (${subset}) is not the 2-per-height "
+                        "set's (${whole_set}):\n${out_sub}")
+  endif()
+endforeach()
+file(READ ${WORK}/s1/pooled-0-1.json json)
+string(JSON n_sub ERROR_VARIABLE json_err GET "${json}" per_height)
+string(JSON range ERROR_VARIABLE json_err GET "${json}" indices 0)
+if(NOT n_sub EQUAL 2 OR NOT range STREQUAL "0-1")
+  message(FATAL_ERROR "${WORK}/s1/pooled-0-1.json: per_height ${n_sub}, indices '${range}' (want 2, '0-1') "
+                      "${json_err}")
 endif()

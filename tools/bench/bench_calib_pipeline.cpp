@@ -30,6 +30,7 @@
 //                               [--seed S1,S2,... --synth DIR1,DIR2,...]
 //                               [--discrepancy on|off] [--arm-noise on|off] [--gown-noise on|off]
 //                               [--high-low paper|repeat-band] [--middle nominal|caught-edge]
+//                               [--indices A-B,C-D,...]
 //     The pooled STC (paper VII: HMMs trained on the simulators of several people and tested on a
 //     person none of them was calibrated on) against each calibration's own STC and the 1-NN on
 //     the people's real trials. Each calibration synthesizes its set into DIR/<file's name>/, as
@@ -53,7 +54,10 @@
 //     With several seeds, each seed's sets go in its own folder and each simulator trains on the
 //     union (N x seeds per height); each calibration's STC is also trained on each seed's set
 //     alone and the seeds paired, how far one file moves between draws, under the paper's three
-//     classes and asked good or missed; the file is DIR1/pooled-S1-S2-....json.
+//     classes and asked good or missed; the file is DIR1/pooled-S1-S2-....json. --indices trains
+//     on those trials of each height of each set only (0-19,50-69 of a 100-per-height set: 40 per
+//     height, half at each speed): a smaller draw from the cached sets; the file's name ends with
+//     the ranges.
 //   bench_calib_pipeline timing [--gown ...] [--generations G --population N] [--threads T]
 //                               [--arm-compliance ... --fist-shift ... --rim-shift ... --density ...] [--prune K]
 //     Wall time per simulation and of a G x N calibration of participant 4, with the final
@@ -633,6 +637,38 @@ int run_pooled(const std::map<std::string, std::string>& a) {
   for (const auto& s : split(get(a, "seed", "1"))) seeds.push_back(std::stoull(s));
   std::vector<fs::path> works;
   for (const auto& d : split(get(a, "synth", "pooled-stc"))) works.emplace_back(d);
+  // --indices A-B,C-D,...: the STCs train on these trials of each height of each seed's set
+  // only (default all). A synthesized trial is a function of the seed, the height and its index,
+  // and its speed of whether the index is under per_height / 2 (synthesis_request), so the
+  // blocks 0-19,50-69 of a 100-per-height set are a 40-per-height draw with the same speeds.
+  std::vector<std::pair<int, int>> index_ranges;
+  for (const auto& r : split(get(a, "indices", ""))) {
+    const auto dash = r.find('-');
+    int lo = -1, hi = -1;
+    try {
+      lo = std::stoi(r.substr(0, dash));
+      hi = dash == std::string::npos ? lo : std::stoi(r.substr(dash + 1));
+    } catch (const std::exception&) {
+      lo = -1;
+    }
+    if (lo < 0 || hi < lo || hi >= so.per_height) {
+      std::fprintf(stderr, "pooled: --indices: '%s' is not a range A-B with 0 <= A <= B < %d (--per-height)\n",
+                   r.c_str(), so.per_height);
+      return 2;
+    }
+    index_ranges.emplace_back(lo, hi);
+  }
+  auto kept = [&index_ranges](int index) {
+    if (index_ranges.empty()) return true;
+    for (const auto& [lo, hi] : index_ranges)
+      if (index >= lo && index <= hi) return true;
+    return false;
+  };
+  int kept_per_height = 0;
+  for (int i = 0; i < so.per_height; ++i) kept_per_height += kept(i);
+  if (!index_ranges.empty())
+    std::printf("the STCs train on %d of the %d trials per height of each set (--indices)\n", kept_per_height,
+                so.per_height);
   if (seeds.empty() || works.size() != seeds.size()) {
     std::fprintf(stderr, "pooled: --synth needs one folder per --seed (%zu seeds, %zu folders)\n", seeds.size(),
                  works.size());
@@ -698,9 +734,9 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       // The s-th seed's trial i of a height is that height's trial s x per_height + i of the
       // union, so that ids stay unique and the equal-size pool below splits the union evenly.
       for (auto& t : load_dataset(dir).trials) {
-        const auto dash = t.id.rfind('-');
-        t.id = t.id.substr(0, dash + 1) +
-               std::to_string(static_cast<int>(s) * so.per_height + std::stoi(t.id.substr(dash + 1)));
+        const int index = synthesized_index(t.id);
+        if (!kept(index)) continue;
+        t.id = t.id.substr(0, t.id.rfind('-') + 1) + std::to_string(static_cast<int>(s) * so.per_height + index);
         src.set.trials.push_back(std::move(t));
       }
     }
@@ -762,7 +798,10 @@ int run_pooled(const std::map<std::string, std::string>& a) {
   };
 
   Json out = Json::object();
-  out.set("per_height", so.per_height * static_cast<int>(seeds.size()));
+  out.set("per_height", kept_per_height * static_cast<int>(seeds.size()));
+  Json jranges = Json::array();
+  for (const auto& [lo, hi] : index_ranges) jranges.push(std::to_string(lo) + "-" + std::to_string(hi));
+  out.set("indices", jranges);
   Json jseeds = Json::array();
   for (auto sd : seeds) jseeds.push(static_cast<double>(sd));
   out.set("seed", seeds.size() == 1 ? Json(static_cast<double>(seeds.front())) : jseeds);
@@ -1285,6 +1324,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
   if (!so.gown_noise) json_name += "-no-gown-noise";
   if (so.high_low != HighLowArm::Paper) json_name += std::string("-") + high_low_arm_name(so.high_low);
   if (so.middle != MiddleArm::Nominal) json_name += std::string("-middle-") + middle_arm_name(so.middle);
+  for (const auto& [lo, hi] : index_ranges) json_name += "-" + std::to_string(lo) + "-" + std::to_string(hi);
   json_name += ".json";
   write_file_atomic(work / json_name, out.dump() + "\n");
   std::printf("wrote %s\n", (work / json_name).string().c_str());
