@@ -6,9 +6,9 @@
 # asked "good or missed?", and its good-or-missed pairing must meet the same 1-NN on the same
 # trials; the good-or-missed vote gains no more trials than the plain vote calls caught. The
 # run's file keeps both votes' pairings and plots. Trials 0-1 of a 3-per-height set (--indices)
-# train the STC a 2-per-height set trains.
+# train the STC a 2-per-height set trains; tools/plot/committee_draws.py draws the runs together.
 # -DBENCH=<bench_calib_pipeline> -DWORK=<dir> -DSTUDY=<study dir or empty> -DCAL=<a calibration>
-# -DPLOT=<tools/plot/pooled_stc.py>
+# -DPLOT=<tools/plot/pooled_stc.py> -DPLOT_DRAWS=<tools/plot/committee_draws.py>
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 if(NOT STUDY)
@@ -231,4 +231,17 @@ string(JSON range ERROR_VARIABLE json_err GET "${json}" indices 0)
 if(NOT n_sub EQUAL 2 OR NOT range STREQUAL "0-1")
   message(FATAL_ERROR "${WORK}/s1/pooled-0-1.json: per_height ${n_sub}, indices '${range}' (want 2, '0-1') "
                       "${json_err}")
+endif()
+# tools/plot/committee_draws.py draws the runs' votes side by side (two seeds and the subset),
+# and names the file that lacks a vote's accuracies.
+execute_process(COMMAND /usr/bin/python3 ${PLOT_DRAWS} ${WORK}/s1/pooled.json ${WORK}/s2/pooled.json
+                        ${WORK}/s1/pooled-0-1.json ${WORK}/draws.png RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/draws.png)
+  message(FATAL_ERROR "committee_draws.py on three runs (${rc}): ${err}")
+endif()
+file(WRITE ${WORK}/no-vote.json "{\"seed\": 1, \"per_height\": 2, \"force_sets\": [{\"forces\": \"F_motion\"}]}")
+execute_process(COMMAND /usr/bin/python3 ${PLOT_DRAWS} ${WORK}/no-vote.json ${WORK}/no-vote.png RESULT_VARIABLE rc
+                ERROR_VARIABLE err)
+if(NOT rc EQUAL 1 OR NOT err MATCHES "no-vote.json: force set 'F_motion' has no vote_accuracy_whole_and_cuts")
+  message(FATAL_ERROR "committee_draws.py on a file without the vote (${rc}): ${err}")
 endif()

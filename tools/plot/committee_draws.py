@@ -1,0 +1,92 @@
+#!/usr/bin/python3
+"""The committee's vote (each simulator's STC votes on the people it was not calibrated on;
+offline/calib/MEASUREMENTS.md, sessions 26 and 71) from several runs of `bench_calib_pipeline
+pooled` side by side: how far the vote moves between synthesis draws and set sizes (another
+seed, or `--indices`, a smaller block of the same cached sets), against the 1-nearest-neighbour
+classifier on the other people's measured curves.
+
+usage: committee_draws.py POOLED.json [POOLED.json ...] OUT.png
+Each POOLED.json is a file the bench wrote; each is labelled by its seeds, the trials per height
+its STCs trained on and its --indices. One panel per force set and per vote (the paper's rule;
+each STC asked "good or missed?"); a line per run, the 1-NN in black with its 95 % interval at
+each cut, from the first file (every run of one set of calibrations faces the same trials).
+The whole sequence is drawn right of the cuts.
+"""
+import json
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+
+CUTS = [0.15, 0.20, 0.25, 0.30]
+WHOLE_X = 0.35
+VOTES = [("vote_accuracy_whole_and_cuts", "vote_against_one_nn_at_cuts", "vote (the paper's rule)"),
+         ("vote_good_or_missed_accuracy_whole_and_cuts", "vote_good_or_missed_against_one_nn_at_cuts",
+          'vote, each STC asked "good or missed?"')]
+
+
+def label_of(d):
+    seed = d["seed"]
+    seeds = ",".join(str(int(s)) for s in seed) if isinstance(seed, list) else str(int(seed))
+    text = f"seed {seeds}, {d['per_height']} per height"
+    if d.get("indices"):
+        text += f" (trials {','.join(d['indices'])})"
+    return text
+
+
+def main(argv):
+    if len(argv) < 3:
+        sys.stderr.write(__doc__)
+        return 2
+    runs = []
+    for path in argv[1:-1]:
+        with open(path) as f:
+            d = json.load(f)
+        if not d.get("force_sets"):
+            sys.stderr.write(f"{path}: no force sets\n")
+            return 1
+        for key, pairing, _ in VOTES:
+            for s in d["force_sets"]:
+                if key not in s or len(s[key]) != 5:
+                    sys.stderr.write(f"{path}: force set '{s.get('forces')}' has no {key} (whole and 4 cuts)\n")
+                    return 1
+        runs.append((label_of(d), d))
+    names = [s["forces"] for s in runs[0][1]["force_sets"]]
+    fig, axes = plt.subplots(len(VOTES), len(names), figsize=(5 * len(names), 4.2 * len(VOTES)), squeeze=False,
+                             sharey=True)
+    xs = CUTS + [WHOLE_X]
+    for row, (key, pairing, title) in enumerate(VOTES):
+        for col, name in enumerate(names):
+            ax = axes[row][col]
+            for label, d in runs:
+                sets = {s["forces"]: s for s in d["force_sets"]}
+                if name not in sets:
+                    continue
+                v = sets[name][key]
+                ax.plot(xs, [100 * a for a in v[1:] + v[:1]], "o-", lw=1.2, ms=4, label=label)
+            ref = {s["forces"]: s for s in runs[0][1]["force_sets"]}[name]
+            nn = ref.get("one_nn_accuracy_at_cuts")
+            if nn:
+                ax.plot(CUTS, [100 * a for a in nn], "ks--", lw=1.5, ms=5, label="1-NN on people's curves")
+            for p in ref.get(pairing, []):
+                lo, hi = p["one_nn_interval"]
+                ax.plot([p["cut"]] * 2, [100 * lo, 100 * hi], "k-", lw=0.8, alpha=0.5)
+            ax.set_xticks(xs)
+            ax.set_xticklabels([f"{c:.2f}" for c in CUTS] + ["whole"])
+            ax.set_ylim(0, 105)
+            ax.grid(alpha=0.3)
+            ax.set_title(f"{name}: {title}", fontsize=9)
+            if col == 0:
+                ax.set_ylabel("right of the measured trials [%]")
+            if row == len(VOTES) - 1:
+                ax.set_xlabel("travel cut [m]")
+    axes[0][0].legend(fontsize=7, loc="lower right")
+    fig.tight_layout()
+    fig.savefig(argv[-1], dpi=110)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
