@@ -7,7 +7,8 @@ classifier on the other people's measured curves.
 
 usage: committee_draws.py POOLED.json [POOLED.json ...] OUT.png
 Each POOLED.json is a file the bench wrote; each is labelled by its seeds, the trials per height
-its STCs trained on and its --indices. One panel per force set and per vote (the paper's rule;
+its STCs trained on, its --indices and, where the runs' members differ, the files it holds beyond
+those every run holds. One panel per force set and per vote (the paper's rule;
 each STC asked "good or missed?"); a line per run, the 1-NN in black with its 95 % interval at
 each cut, from the first file (every run of one set of calibrations faces the same trials).
 The whole sequence is drawn right of the cuts.
@@ -27,12 +28,19 @@ VOTES = [("vote_accuracy_whole_and_cuts", "vote_against_one_nn_at_cuts", "vote (
           'vote, each STC asked "good or missed?"')]
 
 
-def label_of(d):
+def members(d):  # the calibration files' stems, the committee's members
+    return {s["calibration"].replace("\\", "/").split("/")[-1].removesuffix(".json") for s in d.get("sources", [])}
+
+
+def label_of(d, shared):
     seed = d["seed"]
     seeds = ",".join(str(int(s)) for s in seed) if isinstance(seed, list) else str(int(seed))
     text = f"seed {seeds}, {d['per_height']} per height"
     if d.get("indices"):
         text += f" (trials {','.join(d['indices'])})"
+    if shared is not None:  # the runs' members differ: name what this one adds to the shared ones
+        extra = sorted(members(d) - shared)
+        text += ", " + (" + ".join(extra) if extra else f"the {len(shared)} shared only")
     return text
 
 
@@ -52,7 +60,12 @@ def main(argv):
                 if key not in s or len(s[key]) != 5:
                     sys.stderr.write(f"{path}: force set '{s.get('forces')}' has no {key} (whole and 4 cuts)\n")
                     return 1
-        runs.append((label_of(d), d))
+        runs.append(d)
+    # Where the runs' members differ (another file of one person, or one left out), each label
+    # names the files it holds beyond those every run holds.
+    shared = set.intersection(*(members(d) for d in runs))
+    same = all(members(d) == shared for d in runs)
+    runs = [(label_of(d, None if same else shared), d) for d in runs]
     names = [s["forces"] for s in runs[0][1]["force_sets"]]
     fig, axes = plt.subplots(len(VOTES), len(names), figsize=(5 * len(names), 4.2 * len(VOTES)), squeeze=False,
                              sharey=True)
@@ -82,8 +95,11 @@ def main(argv):
                 ax.set_ylabel("right of the measured trials [%]")
             if row == len(VOTES) - 1:
                 ax.set_xlabel("travel cut [m]")
-    axes[0][0].legend(fontsize=7, loc="lower right")
-    fig.tight_layout()
+    # One legend for all panels, under them, so that no line is hidden behind it.
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    rows = (len(labels) + 2) // 3
+    fig.legend(handles, labels, fontsize=8, loc="lower center", ncol=3)
+    fig.tight_layout(rect=(0, 0.035 * rows, 1, 1))
     fig.savefig(argv[-1], dpi=110)
     return 0
 
