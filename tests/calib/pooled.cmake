@@ -7,6 +7,7 @@
 # trials; the good-or-missed vote gains no more trials than the plain vote calls caught. The
 # run's file keeps both votes' pairings and plots. Trials 0-1 of a 3-per-height set (--indices)
 # train the STC a 2-per-height set trains; tools/plot/committee_draws.py draws the runs together.
+# A one-member vote's ballots give that member's answer as the vote.
 # -DBENCH=<bench_calib_pipeline> -DWORK=<dir> -DSTUDY=<study dir or empty> -DCAL=<a calibration>
 # -DPLOT=<tools/plot/pooled_stc.py> -DPLOT_DRAWS=<tools/plot/committee_draws.py>
 file(REMOVE_RECURSE ${WORK})
@@ -245,3 +246,41 @@ execute_process(COMMAND /usr/bin/python3 ${PLOT_DRAWS} ${WORK}/no-vote.json ${WO
 if(NOT rc EQUAL 1 OR NOT err MATCHES "no-vote.json: force set 'F_motion' has no vote_accuracy_whole_and_cuts")
   message(FATAL_ERROR "committee_draws.py on a file without the vote (${rc}): ${err}")
 endif()
+# Each trial's ballot (vote_ballots_whole_and_cuts): with one member the vote is that member's
+# answer, trial by trial, in every column of the first force set; every ballot names its label,
+# and at the cuts as many ballots are right as the vote's pairing with the 1-NN counts.
+file(READ ${WORK}/s1/pooled.json json)
+string(JSON n_cols ERROR_VARIABLE json_err LENGTH "${json}" force_sets 0 vote_ballots_whole_and_cuts)
+if(NOT n_cols EQUAL 5)
+  message(FATAL_ERROR "${WORK}/s1/pooled.json: vote_ballots_whole_and_cuts holds ${n_cols} columns, not 5 ${json_err}")
+endif()
+foreach(c RANGE 4)
+  string(JSON n_ballots LENGTH "${json}" force_sets 0 vote_ballots_whole_and_cuts ${c})
+  if(n_ballots LESS 1)
+    message(FATAL_ERROR "${WORK}/s1/pooled.json: no ballot in column ${c}")
+  endif()
+  math(EXPR last "${n_ballots} - 1")
+  set(right 0)
+  foreach(i RANGE ${last})
+    string(JSON ballot GET "${json}" force_sets 0 vote_ballots_whole_and_cuts ${c} ${i})
+    string(JSON trial GET "${ballot}" trial)
+    string(JSON label GET "${ballot}" label)
+    string(JSON vote GET "${ballot}" vote)
+    string(JSON answer ERROR_VARIABLE json_err GET "${ballot}" members ${stem})
+    if(NOT vote STREQUAL answer OR NOT label MATCHES "^(good|missed)$")
+      message(FATAL_ERROR "${WORK}/s1/pooled.json, column ${c}, ${trial} (${label}): the vote '${vote}' is not its "
+                          "one member's answer '${answer}' ${json_err}")
+    endif()
+    if(vote STREQUAL label)
+      math(EXPR right "${right} + 1")
+    endif()
+  endforeach()
+  if(c GREATER 0)
+    math(EXPR k "${c} - 1")
+    string(JSON counted GET "${json}" force_sets 0 vote_against_one_nn_at_cuts ${k} vote_right)
+    if(NOT right EQUAL counted)
+      message(FATAL_ERROR "${WORK}/s1/pooled.json, cut ${k}: ${right} ballots right, the vote's pairing counts "
+                          "${counted}")
+    endif()
+  endif()
+endforeach()

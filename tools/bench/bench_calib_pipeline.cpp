@@ -50,7 +50,8 @@
 //     interval (hmm.h), because 22 trials leave a few trials' difference inside the noise; two
 //     calibrations of the same person are paired the same way (their STCs face the same trials:
 //     which file is the better source). Prints the table and each simulator's early cue against
-//     the people's and its own person's, writes DIR/pooled.json (plot: tools/plot/pooled_stc.py).
+//     the people's and its own person's, writes DIR/pooled.json (plot: tools/plot/pooled_stc.py;
+//     each trial's ballot, every member's answer beside the vote, in vote_ballots_whole_and_cuts).
 //     With several seeds, each seed's sets go in its own folder and each simulator trains on the
 //     union (N x seeds per height); each calibration's STC is also trained on each seed's set
 //     alone and the seeds paired, how far one file moves between draws, under the paper's three
@@ -1199,13 +1200,21 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       // several members this is not all the caught models cost: a member's caught vote also
       // splits the good and missed votes (the good-or-missed vote below may gain more trials).
       int vote_caught[5] = {};
+      // Each trial's plain vote at each column with every member's own answer, so that two runs
+      // that differ in one member show on which trials and how that member moved the vote.
+      Json jballots[5];
+      for (auto& j : jballots) j = Json::array();
       for (const auto& p : people) {
         std::vector<const HapticSequence*> test;
         for (const auto* t : all)
           if (t->participant == p && t->label && !t->samples.empty()) test.push_back(t);
         std::vector<const model::OutcomeModel*> members, share_members;
+        std::vector<std::string> member_files;
         for (std::size_t s = 0; s < sources.size(); ++s)
-          if (sources[s].participant != p) members.push_back(&singles[s]), share_members.push_back(&shares[s]);
+          if (sources[s].participant != p) {
+            members.push_back(&singles[s]), share_members.push_back(&shares[s]);
+            member_files.push_back(fs::path(sources[s].file).stem().string());
+          }
         if (members.empty() || test.empty()) continue;
         nm += static_cast<int>(test.size());
         for (int c = 0; c < 5; ++c) {
@@ -1216,6 +1225,17 @@ int run_pooled(const std::map<std::string, std::string>& a) {
             vote_right_of[c][test[i]] = hmm::right_or_not(votes[i], *test[i]) == 1;
             const hmm::Vote& v = votes[i];
             vote_caught[c] += v.predicted >= 0 && v.classes[v.predicted] == outcome_name(Outcome::Caught);
+            Json ballot = Json::object(), jm = Json::object();
+            ballot.set("trial", test[i]->id);
+            ballot.set("label", std::string(outcome_name(*test[i]->label)));
+            ballot.set("vote", v.predicted >= 0 ? v.classes[v.predicted] : std::string());
+            for (std::size_t k = 0; k < members.size(); ++k) {  // as hmm::vote asks each member
+              const auto seq = hmm::features_of(*test[i], members[k]->features, cut);
+              const int q = seq.size() ? hmm::classify(*members[k], seq).predicted : -1;
+              jm.set(member_files[k], q >= 0 ? members[k]->classes[q].name : std::string());
+            }
+            ballot.set("members", jm);
+            jballots[c].push(ballot);
           }
           std::vector<hmm::Vote> gm_votes;  // evaluate_vote appends: a vector of its own
           vote2_right[c] += hmm::evaluate_vote(members, test, cut, &gm_votes, good_or_missed).correct;
@@ -1238,6 +1258,9 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       jset.set("vote_training_priors_accuracy_whole_and_cuts", pct(share_right, nm));
       jset.set("vote_training_priors_good_or_missed_accuracy_whole_and_cuts", pct(share2_right, nm));
       jset.set("mixture_accuracy_whole_and_cuts", pct(mix_right, nm));
+      Json jb = Json::array();
+      for (auto& j : jballots) jb.push(j);
+      jset.set("vote_ballots_whole_and_cuts", jb);
     }
     // The 1-NN (above) compares curves cut at the same travel: scored at the cuts only.
     std::printf("  %-50s     -", "1-NN on the other people's measured curves");
