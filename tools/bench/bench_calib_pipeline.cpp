@@ -75,6 +75,7 @@
 // Everything runs through dg_calib's public API (the same code as the commands).
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -643,16 +644,18 @@ int run_pooled(const std::map<std::string, std::string>& a) {
   // and its speed of whether the index is under per_height / 2 (synthesis_request), so the
   // blocks 0-19,50-69 of a 100-per-height set are a 40-per-height draw with the same speeds.
   std::vector<std::pair<int, int>> index_ranges;
+  auto whole_number = [](std::string_view text, int& value) {  // digits only, all of `text`
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+    return !text.empty() && ec == std::errc() && end == text.data() + text.size() && value >= 0;
+  };
   for (const auto& r : split(get(a, "indices", ""))) {
     const auto dash = r.find('-');
     int lo = -1, hi = -1;
-    try {
-      lo = std::stoi(r.substr(0, dash));
-      hi = dash == std::string::npos ? lo : std::stoi(r.substr(dash + 1));
-    } catch (const std::exception&) {
-      lo = -1;
-    }
-    if (lo < 0 || hi < lo || hi >= so.per_height) {
+    const std::string_view text(r);
+    const bool parsed = dash == std::string::npos
+                            ? whole_number(text, lo) && whole_number(text, hi)
+                            : whole_number(text.substr(0, dash), lo) && whole_number(text.substr(dash + 1), hi);
+    if (!parsed || hi < lo || hi >= so.per_height) {
       std::fprintf(stderr, "pooled: --indices: '%s' is not a range A-B with 0 <= A <= B < %d (--per-height)\n",
                    r.c_str(), so.per_height);
       return 2;
