@@ -205,12 +205,15 @@ endif()
 # --indices: a synthesized trial is a function of the seed, the height and its index (its speed
 # of index < per_height / 2), so trials 0 and 1 of seed 1's 3-per-height set are a 2-per-height
 # set's, and the STC trained on them alone (--indices 0-1) must be that set's STC, each force set,
-# asked the three classes and good or missed. Six more simulations. A range past the set exits 2.
-execute_process(COMMAND ${BENCH} ${common} --seed 1 --synth ${WORK}/s1 --indices 1-3 RESULT_VARIABLE rc
-                OUTPUT_VARIABLE out ERROR_VARIABLE err)
-if(NOT rc EQUAL 2 OR NOT err MATCHES "pooled: --indices: '1-3' is not a range A-B with 0 <= A <= B < 3")
-  message(FATAL_ERROR "pooled --indices 1-3 of 3 per height (${rc}):\n${out}\n${err}")
-endif()
+# asked the three classes and good or missed. Six more simulations. A range past the set, or
+# one that is not two whole numbers, exits 2 naming it.
+foreach(bad 1-3 1x-2)
+  execute_process(COMMAND ${BENCH} ${common} --seed 1 --synth ${WORK}/s1 --indices ${bad} RESULT_VARIABLE rc
+                  OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 2 OR NOT err MATCHES "pooled: --indices: '${bad}' is not a range A-B with 0 <= A <= B < 3")
+    message(FATAL_ERROR "pooled --indices ${bad} of 3 per height (${rc}):\n${out}\n${err}")
+  endif()
+endforeach()
 execute_process(COMMAND ${BENCH} pooled --calibrations ${CAL} --per-height 2 --threads 2 --seed 1 --synth ${WORK}/two
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out_two ERROR_VARIABLE err)
 execute_process(COMMAND ${BENCH} ${common} --seed 1 --synth ${WORK}/s1 --indices 0-1 RESULT_VARIABLE rc_sub
