@@ -737,7 +737,8 @@ Vote vote(const std::vector<const model::OutcomeModel*>& models, const HapticSeq
     if (seq.size() == 0) return v;
     const Classification c = classify(*m, seq, among);
     for (size_t k = 0; k < m->classes.size(); ++k) v.posterior_sum[index_of(v.classes, m->classes[k].name)] += c.posterior[k];
-    ++v.votes[index_of(v.classes, m->classes[c.predicted].name)];
+    v.answers.push_back(index_of(v.classes, m->classes[c.predicted].name));
+    ++v.votes[v.answers.back()];
   }
   for (size_t k = 0; k < v.classes.size(); ++k) {
     const int b = v.predicted;

@@ -202,6 +202,8 @@ struct Vote {
   std::vector<std::string> classes;
   std::vector<int> votes;             // per class: how many models predict it
   std::vector<double> posterior_sum;  // per class: the sum of the models' posteriors
+  std::vector<int> answers;           // per model, in order: index into classes of its answer
+                                      // (empty when the cut leaves no sample)
   size_t samples = 0;                 // after the cut
   int predicted = -1;                 // index into classes; -1 when the cut leaves no sample
 };

@@ -516,6 +516,7 @@ TEST(HmmVote, MajorityWinsWithClosedFormPosteriorSums) {
   const auto v = hmm::vote(committee, one_sample(0.5, Outcome::Good));
   ASSERT_EQ(v.classes, (std::vector<std::string>{"good", "missed"}));
   EXPECT_EQ(v.votes, (std::vector<int>{2, 1}));
+  EXPECT_EQ(v.answers, (std::vector<int>{0, 0, 1}));  // each member's own answer, in order: c reversed
   EXPECT_EQ(v.samples, 1u);
   EXPECT_EQ(v.predicted, 0);
   const double pg = posterior_good(0.5, 0, 3) + posterior_good(0.5, 0, 2) + posterior_good(0.5, 3, 0);

@@ -1232,11 +1232,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
             ballot.set("trial", test[i]->id);
             ballot.set("label", std::string(outcome_name(*test[i]->label)));
             ballot.set("vote", v.predicted >= 0 ? v.classes[v.predicted] : std::string());
-            for (std::size_t k = 0; k < members.size(); ++k) {  // as hmm::vote asks each member
-              const auto seq = hmm::features_of(*test[i], members[k]->features, cut);
-              const int q = seq.size() ? hmm::classify(*members[k], seq).predicted : -1;
-              jm.set(member_files[k], q >= 0 ? members[k]->classes[q].name : std::string());
-            }
+            for (std::size_t k = 0; k < v.answers.size(); ++k) jm.set(member_files[k], v.classes[v.answers[k]]);
             ballot.set("members", jm);
             jballots[c].push(ballot);
           }

@@ -21,8 +21,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
-CUTS = [0.15, 0.20, 0.25, 0.30]
-WHOLE_X = 0.35
+from pooled_stc import CUTS, WHOLE_X, cuts_then_whole  # the same axis as the per-run plot
 VOTES = [("vote_accuracy_whole_and_cuts", "vote_against_one_nn_at_cuts", "vote (the paper's rule)"),
          ("vote_good_or_missed_accuracy_whole_and_cuts", "vote_good_or_missed_against_one_nn_at_cuts",
           'vote, each STC asked "good or missed?"')]
@@ -77,8 +76,7 @@ def main(argv):
                 sets = {s["forces"]: s for s in d["force_sets"]}
                 if name not in sets:
                     continue
-                v = sets[name][key]
-                ax.plot(xs, [100 * a for a in v[1:] + v[:1]], "o-", lw=1.2, ms=4, label=label)
+                ax.plot(xs, cuts_then_whole(sets[name][key]), "o-", lw=1.2, ms=4, label=label)
             ref = {s["forces"]: s for s in runs[0][1]["force_sets"]}[name]
             nn = ref.get("one_nn_accuracy_at_cuts")
             if nn:
