@@ -95,7 +95,7 @@ void print_summary(const hmm::Evaluation& ev, size_t models) {
 // voting) at the cut.
 std::vector<int> right_per_trial(const std::vector<const model::OutcomeModel*>& models,
                                  const std::vector<const HapticSequence*>& trials, double cut,
-                                 const hmm::ClassChoice& among) {
+                                 const hmm::ClassChoice& among, const std::vector<double>& weights = {}) {
   std::vector<int> right;
   if (models.size() == 1) {
     std::vector<hmm::TrialResult> per;
@@ -103,7 +103,7 @@ std::vector<int> right_per_trial(const std::vector<const model::OutcomeModel*>& 
     for (const auto& r : per) right.push_back(hmm::right_or_not(r));
   } else {
     std::vector<hmm::Vote> per;
-    hmm::evaluate_vote(models, trials, cut, &per, among);
+    hmm::evaluate_vote(models, trials, cut, &per, among, weights);
     for (size_t i = 0; i < per.size(); ++i) right.push_back(hmm::right_or_not(per[i], *trials[i]));
   }
   return right;
@@ -150,11 +150,17 @@ int run_classify(int argc, char** argv) {
         "  --against B.dgm[,...]   also classify the same trials (same cut, same --among) by another model\n"
         "                          or committee, and pair the two: the trials only one of them gets right\n"
         "                          and McNemar's exact p (is the difference more than these trials' noise?)\n"
+        "  --weigh-on SET[,SET...] with several models: one synthesized dataset per --model, in\n"
+        "                          order, each the set that model was trained on (dressguard\n"
+        "                          synthesize); each member's vote then counts by its log-odds of being\n"
+        "                          right on the other members' sets at the same cut and --among\n"
+        "                          (hmm.h, simulation_weights: learnt from simulation alone; give one\n"
+        "                          model per person). Printed, and in the JSON\n"
         "  --json                  print a machine-readable result");
     return 0;
   }
   args.allow_only({"help", "json", "no-plot", "model", "data", "truncate-at", "sweep", "sweep-out", "participant",
-                    "among", "against"});
+                    "among", "against", "weigh-on"});
   const std::string model_list = args.require("model"), data = args.require("data");
   const double truncate = args.number("truncate-at", std::numeric_limits<double>::infinity());
   if (!(truncate > 0)) throw UsageError("--truncate-at must be positive");
@@ -198,6 +204,25 @@ int run_classify(int argc, char** argv) {
   for (const auto& m : against_models) against_committee.push_back(&m);
   // One model classifies as it always did (its log-likelihoods in the JSON); several vote.
   const model::OutcomeModel* single = models.size() == 1 ? &models[0] : nullptr;
+  // --weigh-on: each member's synthesized set, for its weight at each cut (rule S).
+  const std::vector<std::string> weigh_paths = split_in_order(args.get("weigh-on").value_or(""));
+  if (args.get("weigh-on") && single) throw UsageError("--weigh-on weighs the members of a committee: give several --model");
+  if (args.get("weigh-on") && weigh_paths.size() != models.size())
+    throw UsageError("--weigh-on names " + std::to_string(weigh_paths.size()) + " sets for " +
+                     std::to_string(models.size()) + " models: one set per model, in --model's order");
+  std::vector<Dataset> weigh_sets;
+  for (const auto& path : weigh_paths) {
+    weigh_sets.push_back(load_dataset(path));
+    if (weigh_sets.back().trials.empty()) throw InputError(path + ": no trials to weigh a member on");
+  }
+  std::vector<std::vector<const HapticSequence*>> weigh_on;
+  for (const auto& set : weigh_sets) {
+    weigh_on.emplace_back();
+    for (const auto& t : set.trials) weigh_on.back().push_back(&t);
+  }
+  auto weights_at = [&](double d) {
+    return weigh_on.empty() ? std::vector<double>{} : hmm::simulation_weights(committee, weigh_on, d, among);
+  };
   const Dataset ds = load_dataset(data);
   std::vector<const HapticSequence*> trials;
   for (const auto& t : ds.trials)
@@ -207,7 +232,7 @@ int run_classify(int argc, char** argv) {
   // --against: the pairing, its JSON member and its text line (printed after the summary).
   std::string against_json, against_text;
   if (!against_committee.empty()) {
-    const Against a = pair_against(right_per_trial(committee, trials, truncate, among),
+    const Against a = pair_against(right_per_trial(committee, trials, truncate, among, weights_at(truncate)),
                                    right_per_trial(against_committee, trials, truncate, among));
     std::string paths;
     for (const auto& path : against_paths) paths += (paths.empty() ? "" : ", ") + hmm::json_string(path);
@@ -222,7 +247,8 @@ int run_classify(int argc, char** argv) {
     against_text = line;
   }
   auto evaluate_at = [&](double d) {
-    return single ? hmm::evaluate(*single, trials, d, nullptr, among) : hmm::evaluate_vote(committee, trials, d, nullptr, among);
+    return single ? hmm::evaluate(*single, trials, d, nullptr, among)
+                  : hmm::evaluate_vote(committee, trials, d, nullptr, among, weights_at(d));
   };
 
   if (!sweep.empty()) {
@@ -266,7 +292,12 @@ int run_classify(int argc, char** argv) {
   if (!single) {
     // The committee: per trial the votes and the models' posterior sums.
     std::vector<hmm::Vote> per;
-    const auto ev = hmm::evaluate_vote(committee, trials, truncate, &per, among);
+    const std::vector<double> weights = weights_at(truncate);
+    const auto ev = hmm::evaluate_vote(committee, trials, truncate, &per, among, weights);
+    std::string weights_json;
+    for (size_t k = 0; k < weights.size(); ++k)
+      weights_json += (k ? ", " : "") + hmm::json_number(weights[k]);
+    if (!weights.empty()) weights_json = ", \"weights\": [" + weights_json + "]";
     if (json) {
       std::string rows, paths;
       for (size_t i = 0; i < per.size(); ++i) {
@@ -285,10 +316,15 @@ int run_classify(int argc, char** argv) {
                 "], \"posterior_sum\": [" + sums + "]}";
       }
       for (const auto& path : model_paths) paths += (paths.empty() ? "" : ", ") + hmm::json_string(path);
-      std::printf("{\"models\": [%s], \"data\": %s, \"truncate_at\": %s, \"trials\": [%s], \"evaluation\": %s%s}\n",
-                  paths.c_str(), hmm::json_string(data).c_str(), hmm::json_number(truncate).c_str(), rows.c_str(),
-                  hmm::evaluation_json(ev).c_str(), against_json.c_str());
+      std::printf("{\"models\": [%s]%s, \"data\": %s, \"truncate_at\": %s, \"trials\": [%s], \"evaluation\": %s%s}\n",
+                  paths.c_str(), weights_json.c_str(), hmm::json_string(data).c_str(), hmm::json_number(truncate).c_str(),
+                  rows.c_str(), hmm::evaluation_json(ev).c_str(), against_json.c_str());
       return 0;
+    }
+    if (!weights.empty()) {
+      std::printf("weights (rule S: each member on the other members' synthesized sets):");
+      for (size_t k = 0; k < weights.size(); ++k) std::printf(" %s %.3f", model_paths[k].c_str(), weights[k]);
+      std::printf("\n");
     }
     std::printf("%-24s %-6s %7s %-8s %-8s %6s\n", "trial", "part.", "samples", "truth", "predicted", "votes");
     for (size_t i = 0; i < per.size(); ++i) {

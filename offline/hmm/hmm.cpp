@@ -726,7 +726,10 @@ int index_of(const std::vector<std::string>& names, const std::string& name) {
 }  // namespace
 
 Vote vote(const std::vector<const model::OutcomeModel*>& models, const HapticSequence& trial, double truncate_at,
-          const ClassChoice& among) {
+          const ClassChoice& among, const std::vector<double>& weights) {
+  if (!weights.empty() && weights.size() != models.size())
+    throw std::invalid_argument("vote: " + std::to_string(weights.size()) + " weights for " +
+                                std::to_string(models.size()) + " models");
   Vote v;
   v.classes = committee_classes(models);
   v.votes.assign(v.classes.size(), 0);
@@ -745,18 +748,80 @@ Vote vote(const std::vector<const model::OutcomeModel*>& models, const HapticSeq
     if (b < 0 || v.votes[k] > v.votes[b] || (v.votes[k] == v.votes[b] && v.posterior_sum[k] > v.posterior_sum[b]))
       v.predicted = static_cast<int>(k);
   }
+  if (!weights.empty()) v.predicted = weighted_choice(v, weights);
   return v;
+}
+
+int weighted_choice(const Vote& v, const std::vector<double>& weights) {
+  if (weights.size() != v.answers.size() && !v.answers.empty())
+    throw std::invalid_argument("weighted_choice: " + std::to_string(weights.size()) + " weights for " +
+                                std::to_string(v.answers.size()) + " members");
+  for (double w : weights)
+    if (!std::isfinite(w) || w < 0) throw std::invalid_argument("weighted_choice: a weight is negative or not finite");
+  if (v.answers.empty()) return -1;
+  std::vector<double> sum(v.classes.size(), 0.0);
+  for (size_t m = 0; m < v.answers.size(); ++m) sum[v.answers[m]] += weights[m];
+  int best = -1;
+  for (size_t k = 0; k < v.classes.size(); ++k)
+    if (best < 0 || sum[k] > sum[best] || (sum[k] == sum[best] && v.posterior_sum[k] > v.posterior_sum[best]))
+      best = static_cast<int>(k);
+  return best;
+}
+
+double member_weight(int right, int n, int classes) {
+  if (n <= 0 || right < 0 || right > n || classes < 2)
+    throw std::invalid_argument("member_weight: needs 0 <= right <= n, n > 0 and at least two classes (right " +
+                                std::to_string(right) + ", n " + std::to_string(n) + ", classes " +
+                                std::to_string(classes) + ")");
+  const double floor = 0.5 / n;
+  const double a = std::clamp(static_cast<double>(right) / n, floor, 1.0 - floor);
+  return std::max(0.0, std::log(a / (1.0 - a)) + std::log(static_cast<double>(classes - 1)));
+}
+
+LabelScore score_labels(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials,
+                        double truncate_at, const ClassChoice& among) {
+  LabelScore s;
+  for (const auto* t : trials) {
+    if (!t->label) continue;
+    const std::string label(outcome_name(*t->label));
+    if (!among.empty() && std::find(among.begin(), among.end(), label) == among.end()) continue;
+    const FeatureSequence seq = features_of(*t, m.features, truncate_at);
+    if (seq.size() == 0) continue;
+    ++s.scored;
+    s.right += m.classes[classify(m, seq, among).predicted].name == label;
+  }
+  return s;
+}
+
+std::vector<double> simulation_weights(const std::vector<const model::OutcomeModel*>& models,
+                                       const std::vector<std::vector<const HapticSequence*>>& sets, double truncate_at,
+                                       const ClassChoice& among) {
+  if (sets.size() != models.size())
+    throw std::invalid_argument("simulation_weights: " + std::to_string(sets.size()) + " sets for " +
+                                std::to_string(models.size()) + " models");
+  const int classes = static_cast<int>(among.empty() ? committee_classes(models).size() : among.size());
+  std::vector<double> w;
+  for (size_t i = 0; i < models.size(); ++i) {
+    LabelScore sum;
+    for (size_t j = 0; j < sets.size(); ++j) {
+      if (j == i) continue;
+      const LabelScore s = score_labels(*models[i], sets[j], truncate_at, among);
+      sum.right += s.right, sum.scored += s.scored;
+    }
+    w.push_back(sum.scored > 0 ? member_weight(sum.right, sum.scored, classes) : 0.0);
+  }
+  return w;
 }
 
 Evaluation evaluate_vote(const std::vector<const model::OutcomeModel*>& models,
                          const std::vector<const HapticSequence*>& trials, double truncate_at,
-                         std::vector<Vote>* per_trial, const ClassChoice& among) {
+                         std::vector<Vote>* per_trial, const ClassChoice& among, const std::vector<double>& weights) {
   Evaluation ev;
   ev.classes = committee_classes(models);
   ev.confusion.assign(ev.classes.size(), std::vector<int>(ev.classes.size(), 0));
   for (const auto* t : trials) {
     const int truth = t->label ? index_of(ev.classes, std::string(outcome_name(*t->label))) : -1;
-    Vote v = truth >= 0 ? vote(models, *t, truncate_at, among) : Vote{};
+    Vote v = truth >= 0 ? vote(models, *t, truncate_at, among, weights) : Vote{};
     if (truth < 0 || v.predicted < 0) {
       ++ev.skipped;
     } else {

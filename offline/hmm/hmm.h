@@ -207,17 +207,68 @@ struct Vote {
   size_t samples = 0;                 // after the cut
   int predicted = -1;                 // index into classes; -1 when the cut leaves no sample
 };
-// With `among`, each model decides among those classes only (classify()).
+// With `among`, each model decides among those classes only (classify()); with `weights` (one
+// per model), the weighted sums decide (weighted_choice(), below) instead of the counts.
 Vote vote(const std::vector<const model::OutcomeModel*>& models, const HapticSequence& trial,
-          double truncate_at = std::numeric_limits<double>::infinity(), const ClassChoice& among = {});
+          double truncate_at = std::numeric_limits<double>::infinity(), const ClassChoice& among = {},
+          const std::vector<double>& weights = {});
+
+// The committee's decision with a weight per member (`weights`, in the order of the vote's
+// models): per class the sum of the weights of the members that answer it wins, a tie goes to the
+// larger posterior sum and then to the class named first, as vote() decides with every weight 1.
+// -1 when the cut left no sample. Why weights: a plain vote counts a member that is right one
+// time in four as much as one right three times in four (offline/calib/MEASUREMENTS.md, session
+// 72: at 0.15 m the committee's figure is a balance of the members' leanings). Throws
+// std::invalid_argument unless there is one finite weight >= 0 per member.
+int weighted_choice(const Vote& v, const std::vector<double>& weights);
+
+// The weight of a committee member that is right `right` of `n` times on trials of a K-class
+// question: the log-odds of its accuracy a = right / n above chance,
+//
+//   w = max(0, ln(a / (1 - a)) + ln(K - 1)),
+//
+// SAMME's member weight (Zhu, Zou, Rosset and Hastie 2009, multi-class AdaBoost). For K = 2 it is
+// ln(a / (1 - a)), the weight under which a vote of independent members is the most likely class
+// (Nitzan and Paroush 1982); a member at or below chance (a <= 1 / K) gets none. a is held inside
+// [1 / (2n), 1 - 1 / (2n)], so that a member right every time has a finite weight that grows with
+// the evidence. Throws std::invalid_argument unless 0 <= right <= n, n > 0 and classes >= 2.
+double member_weight(int right, int n, int classes);
+
+// How often a model names the label of `trials` cut at `truncate_at`, deciding `among` some
+// classes (classify()): `scored` counts every labelled trial with a sample before the cut, also
+// one whose label the model does not know (a simulator that never catches, facing a caught
+// trial: in a vote such a member is wrong there, so its weight must count it wrong; evaluate()
+// skips such trials instead), `right` those whose MAP class is the label.
+struct LabelScore {
+  int right = 0, scored = 0;
+};
+LabelScore score_labels(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials,
+                        double truncate_at = std::numeric_limits<double>::infinity(), const ClassChoice& among = {});
+
+// The members' weights learnt from simulation alone (rule S; offline/calib/MEASUREMENTS.md,
+// session 73): member i is scored (score_labels) on every set but its own, `sets[j]` being the
+// synthesized trials that member j was trained on, at the cut and question it will vote at,
+// and weighted by member_weight() with K = the classes decided among (`among`, else the union of
+// the models' classes). With `among`, a trial whose label is not among them is not scored. Why
+// the other members' sets: a member whose simulator agrees with the others' on what a good and
+// a missed trial look like at that cut is more likely to be right on a person none of them was
+// fitted to than one whose simulator stands alone; its own set would only say how well it
+// learnt itself. Give one set per person: two simulators of one person would score each other
+// as if they were another person's. Throws std::invalid_argument unless there is one set per
+// model; a member with no scored trial gets weight 0.
+std::vector<double> simulation_weights(const std::vector<const model::OutcomeModel*>& models,
+                                       const std::vector<std::vector<const HapticSequence*>>& sets,
+                                       double truncate_at = std::numeric_limits<double>::infinity(),
+                                       const ClassChoice& among = {});
 
 // evaluate() for a committee: the confusion matrix over the union of the models' classes, every
 // labelled trial whose label one of the models knows. `per_trial` (may be null) gets every trial's
-// vote, skipped trials included (predicted -1).
+// vote, skipped trials included (predicted -1). `weights` as vote()'s.
 Evaluation evaluate_vote(const std::vector<const model::OutcomeModel*>& models,
                          const std::vector<const HapticSequence*>& trials,
                          double truncate_at = std::numeric_limits<double>::infinity(),
-                         std::vector<Vote>* per_trial = nullptr, const ClassChoice& among = {});
+                         std::vector<Vote>* per_trial = nullptr, const ClassChoice& among = {},
+                         const std::vector<double>& weights = {});
 
 // ---- two classifiers on the same trials ------------------------------------------------------
 

@@ -7,9 +7,11 @@
 # trials; the good-or-missed vote gains no more trials than the plain vote calls caught. The
 # run's file keeps both votes' pairings and plots. Trials 0-1 of a 3-per-height set (--indices)
 # train the STC a 2-per-height set trains; tools/plot/committee_draws.py draws the runs together.
-# A one-member vote's ballots give that member's answer as the vote.
+# A one-member vote's ballots give that member's answer as the vote, and so do its votes weighted
+# by rule S or R; tools/plot/member_weights.py draws what the weights see.
 # -DBENCH=<bench_calib_pipeline> -DWORK=<dir> -DSTUDY=<study dir or empty> -DCAL=<a calibration>
 # -DPLOT=<tools/plot/pooled_stc.py> -DPLOT_DRAWS=<tools/plot/committee_draws.py>
+# -DPLOT_WEIGHTS=<tools/plot/member_weights.py>
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 if(NOT STUDY)
@@ -287,3 +289,45 @@ foreach(c RANGE 4)
     endif()
   endif()
 endforeach()
+# The weighted votes (rules S and R, session 73): with one member, whatever its weight (rule S
+# gives it none, there being no other simulator; rule R its log-odds on the measured trials), the
+# decision is that member's answer, so each weighted vote is right on the same trials as the
+# plain vote of its question, in every column of every force set.
+string(JSON n_sets LENGTH "${json}" force_sets)
+math(EXPR last_set "${n_sets} - 1")
+foreach(f RANGE ${last_set})
+  foreach(rule simulated measured)
+    foreach(q "" "_good_or_missed")
+      string(JSON weighted ERROR_VARIABLE json_err GET "${json}" force_sets ${f}
+             vote_weighted_${rule}${q}_accuracy_whole_and_cuts)
+      string(JSON plain GET "${json}" force_sets ${f} vote${q}_accuracy_whole_and_cuts)
+      string(JSON b ERROR_VARIABLE json_err2 GET "${json}" force_sets ${f} vote_weighted_${rule}${q}_against_vote
+             only_first_right_whole_and_cuts)
+      string(JSON c GET "${json}" force_sets ${f} vote_weighted_${rule}${q}_against_vote only_second_right_whole_and_cuts)
+      string(REGEX REPLACE "[ \n]" "" b "${b}")
+      string(REGEX REPLACE "[ \n]" "" c "${c}")
+      if(NOT weighted STREQUAL plain OR NOT b STREQUAL "[0,0,0,0,0]" OR NOT c STREQUAL "[0,0,0,0,0]")
+        message(FATAL_ERROR "${WORK}/s1/pooled.json, force set ${f}: the one-member vote weighted by rule "
+                            "'${rule}${q}' (${weighted}; only it / only the plain vote right ${b} ${c}) is not the "
+                            "plain vote (${plain}) ${json_err} ${json_err2}")
+      endif()
+    endforeach()
+  endforeach()
+  string(JSON w GET "${json}" force_sets ${f} vote_weights 0 simulated_three_classes 0 whole_and_cuts)
+  string(REGEX REPLACE "[ \n]" "" w "${w}")
+  if(NOT w STREQUAL "[0,0,0,0,0]")
+    message(FATAL_ERROR "${WORK}/s1/pooled.json, force set ${f}: a lone member's rule-S weights are ${w}, not 0")
+  endif()
+endforeach()
+# What the weights see, drawn; a file from before session 73 (no member on other simulators) is
+# named.
+execute_process(COMMAND /usr/bin/python3 ${PLOT_WEIGHTS} ${WORK}/s1/pooled.json ${WORK}/weights.png
+                RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/weights.png)
+  message(FATAL_ERROR "member_weights.py (${rc}): ${err}")
+endif()
+execute_process(COMMAND /usr/bin/python3 ${PLOT_WEIGHTS} ${WORK}/no-vote.json ${WORK}/no-weights.png
+                RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 1 OR NOT err MATCHES "no-vote.json: force set 'F_motion' has no single_on_other_simulators")
+  message(FATAL_ERROR "member_weights.py on a file without the members' rows (${rc}): ${err}")
+endif()

@@ -4,7 +4,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 
@@ -55,7 +57,22 @@ class CliTest : public ::testing::Test {
     fs::create_directories(dir);
   }
   void TearDown() override { fs::remove_all(dir); }
+  // The committee tests' models: m trained on `train` (synthesized from known HMMs), the liar on
+  // `swapped` (another draw with good and missed labels swapped), and the `test` set to classify.
+  bool train_right_and_liar() {
+    save_dataset(fx::synthetic_dataset(12, 300, 500, 55, 5, "a"), dir / "train");
+    Dataset swapped = fx::synthetic_dataset(12, 300, 500, 56, 5, "s");
+    for (auto& t : swapped.trials)
+      if (t.label == Outcome::Good || t.label == Outcome::Missed)
+        t.label = t.label == Outcome::Good ? Outcome::Missed : Outcome::Good;
+    save_dataset(swapped, dir / "swapped");
+    save_dataset(fx::synthetic_dataset(6, 300, 500, 57, 5, "b"), dir / "test");
+    m = (dir / "m.dgm").string(), liar = (dir / "liar.dgm").string(), test = (dir / "test").string();
+    return run("train --data " + (dir / "train").string() + " --out " + m + " --states 5").code == 0 &&
+           run("train --data " + (dir / "swapped").string() + " --out " + liar + " --states 5").code == 0;
+  }
   fs::path dir;
+  std::string m, liar, test;
 };
 
 }  // namespace
@@ -105,16 +122,7 @@ TEST_F(CliTest, TrainClassifyShowOnSyntheticData) {
 // missed labels, the majority is right on every trial; with the liar twice, the good and missed
 // trials go the liar's way and only the caught ones stay right. A bad file in the list is named.
 TEST_F(CliTest, CommitteeOfModelsVotes) {
-  save_dataset(fx::synthetic_dataset(12, 300, 500, 55, 5, "a"), dir / "train");
-  Dataset swapped = fx::synthetic_dataset(12, 300, 500, 56, 5, "s");
-  for (auto& t : swapped.trials)
-    if (t.label == Outcome::Good || t.label == Outcome::Missed)
-      t.label = t.label == Outcome::Good ? Outcome::Missed : Outcome::Good;
-  save_dataset(swapped, dir / "swapped");
-  save_dataset(fx::synthetic_dataset(6, 300, 500, 57, 5, "b"), dir / "test");
-  const std::string m = (dir / "m.dgm").string(), liar = (dir / "liar.dgm").string(), test = (dir / "test").string();
-  ASSERT_EQ(run("train --data " + (dir / "train").string() + " --out " + m + " --states 5").code, 0);
-  ASSERT_EQ(run("train --data " + (dir / "swapped").string() + " --out " + liar + " --states 5").code, 0);
+  ASSERT_TRUE(train_right_and_liar());
 
   const auto two_right = run("classify --model " + m + "," + m + "," + liar + " --data " + test + " --json");
   ASSERT_EQ(two_right.code, 0) << two_right.err;
@@ -172,6 +180,63 @@ TEST_F(CliTest, CommitteeOfModelsVotes) {
   const auto torn = run("classify --model " + m + "," + liar + " --data " + test + " --among good,torn");
   EXPECT_EQ(torn.code, 2);
   EXPECT_NE(torn.err.find("'torn' is not a class of " + m), std::string::npos) << torn.err;
+}
+
+// --weigh-on (rule S, hmm::simulation_weights): each member counts by its log-odds on the other
+// members' sets. Weighed on their own training sets, the two liars agree with each other's set
+// and m with neither: m gets 0 (right on the 24 caught of 72 trials: chance for three classes),
+// each liar ln 4 (48 of 72: ln(2/3 / 1/3) + ln 2), and the committee is the liars' (6/18). Weighed
+// on three sets that tell the truth, m is right on all 72 of the others' (a held at 1 - 1/144:
+// ln 143 + ln 2) and the liars on 24 (0): the committee is m's (18/18), where the plain vote
+// goes the liars' way.
+TEST_F(CliTest, CommitteeWeighedOnTheMembersSets) {
+  ASSERT_TRUE(train_right_and_liar());
+  save_dataset(fx::synthetic_dataset(12, 300, 500, 58, 5, "c"), dir / "train2");
+  save_dataset(fx::synthetic_dataset(12, 300, 500, 59, 5, "d"), dir / "train3");
+  const std::string committee = "classify --model " + m + "," + liar + "," + liar + " --data " + test;
+  const std::string train = (dir / "train").string(), sw = (dir / "swapped").string();
+
+  const auto own = run(committee + " --weigh-on " + train + "," + sw + "," + sw + " --json");
+  ASSERT_EQ(own.code, 0) << own.err;
+  const size_t w = own.out.find("\"weights\": [");
+  ASSERT_NE(w, std::string::npos) << own.out;
+  EXPECT_EQ(std::strtod(own.out.c_str() + w + 12, nullptr), 0.0) << own.out;
+  EXPECT_NEAR(json_field(own.out, "accuracy"), 6.0 / 18, 1e-12) << own.out;
+  const auto own_text = run(committee + " --weigh-on " + train + "," + sw + "," + sw);
+  ASSERT_EQ(own_text.code, 0) << own_text.err;
+  char line[128];
+  std::snprintf(line, sizeof line, "%s %.3f %s %.3f", m.c_str(), 0.0, liar.c_str(), std::log(4.0));
+  EXPECT_NE(own_text.out.find(line), std::string::npos) << own_text.out;
+
+  const auto truth = run(committee + " --weigh-on " + train + "," + (dir / "train2").string() + "," +
+                         (dir / "train3").string() + " --json");
+  ASSERT_EQ(truth.code, 0) << truth.err;
+  EXPECT_EQ(json_field(truth.out, "accuracy"), 1.0) << truth.out;
+  const size_t tw = truth.out.find("\"weights\": [");
+  ASSERT_NE(tw, std::string::npos) << truth.out;
+  EXPECT_NEAR(std::strtod(truth.out.c_str() + tw + 12, nullptr), std::log(286.0), 1e-9) << truth.out;
+  // The sweep weighs at every distance: m's committee there too.
+  const auto sweep = run(committee + " --weigh-on " + train + "," + (dir / "train2").string() + "," +
+                         (dir / "train3").string() + " --sweep 0.05:0.15:0.05 --sweep-out " + (dir / "ws").string() +
+                         " --no-plot");
+  ASSERT_EQ(sweep.code, 0) << sweep.err;
+  std::ifstream csv(dir / "ws.csv");
+  std::string row;
+  std::getline(csv, row);
+  for (const char* d : {"0.05", "0.1", "0.15"}) {
+    ASSERT_TRUE(std::getline(csv, row));
+    EXPECT_EQ(row, std::string(d) + ",1.000000,18,18");
+  }
+
+  const auto count = run(committee + " --weigh-on " + train + "," + sw);
+  EXPECT_EQ(count.code, 2);
+  EXPECT_NE(count.err.find("--weigh-on names 2 sets for 3 models"), std::string::npos) << count.err;
+  const auto one = run("classify --model " + m + " --data " + test + " --weigh-on " + train);
+  EXPECT_EQ(one.code, 2);
+  EXPECT_NE(one.err.find("--weigh-on weighs the members of a committee"), std::string::npos) << one.err;
+  const auto missing = run(committee + " --weigh-on " + train + "," + sw + "," + (dir / "none").string());
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_NE(missing.err.find("none"), std::string::npos) << missing.err;
 }
 
 // The sweep writes accuracy against travel as CSV (one row per distance) and a PNG.

@@ -655,6 +655,114 @@ TEST(HmmVote, CommitteeOfOneIsTheModel) {
   }
 }
 
+// With every weight 1 the weighted decision is the vote's: three models trained on different
+// draws, on trials drawn from known HMMs, whole and cut.
+TEST(HmmVote, EqualWeightsDecideAsTheVote) {
+  const auto a = five_state_model(41), b = five_state_model(43), c = five_state_model(47);
+  const Dataset test = fx::synthetic_dataset(10, 300, 500, 42);
+  int decided = 0;
+  for (double cut : {std::numeric_limits<double>::infinity(), 0.05, 0.02}) {
+    std::vector<hmm::Vote> votes;
+    hmm::evaluate_vote({&a, &b, &c}, fx::pointers(test), cut, &votes);
+    for (const auto& v : votes) {
+      EXPECT_EQ(hmm::weighted_choice(v, {1.0, 1.0, 1.0}), v.predicted);
+      EXPECT_EQ(hmm::weighted_choice(v, {2.5, 2.5, 2.5}), v.predicted);  // only the ratios count
+      decided += v.predicted >= 0;
+    }
+  }
+  EXPECT_GT(decided, 0);
+}
+
+// One heavy member outweighs two light ones; equal sums go to the larger posterior sum, as in
+// the plain vote; a member of weight 0 has no say. The committee of MajorityWins: a and b answer
+// good at x = 0.5, the reversed c missed.
+TEST(HmmVote, WeightsDecideAndTiesGoToThePosteriorSum) {
+  const auto a = one_state_model(0, 3), b = one_state_model(0, 2), c = one_state_model(3, 0);
+  const auto v = hmm::vote({&a, &b, &c}, one_sample(0.5, Outcome::Good));
+  ASSERT_EQ(v.answers, (std::vector<int>{0, 0, 1}));
+  EXPECT_EQ(hmm::weighted_choice(v, {0.4, 0.5, 1.0}), 1);   // 0.9 against 1.0
+  EXPECT_EQ(hmm::weighted_choice(v, {0.6, 0.5, 1.0}), 0);   // 1.1 against 1.0
+  EXPECT_EQ(hmm::weighted_choice(v, {0.0, 0.0, 0.1}), 1);   // c alone has a say
+  // 0.5 + 0.5 = 1.0: the tie goes to good, whose posterior sum is the larger (closed form).
+  const double pg = posterior_good(0.5, 0, 3) + posterior_good(0.5, 0, 2) + posterior_good(0.5, 3, 0);
+  ASSERT_GT(pg, 3.0 - pg);
+  EXPECT_EQ(hmm::weighted_choice(v, {0.5, 0.5, 1.0}), 0);
+  EXPECT_EQ(hmm::weighted_choice(v, {0.0, 0.0, 0.0}), 0);
+  EXPECT_THROW(hmm::weighted_choice(v, {1.0, 1.0}), std::invalid_argument);
+  EXPECT_THROW(hmm::weighted_choice(v, {1.0, -1.0, 1.0}), std::invalid_argument);
+  EXPECT_THROW(hmm::weighted_choice(v, {1.0, std::nan(""), 1.0}), std::invalid_argument);
+}
+
+// SAMME's weight against the closed form: ln(a / (1 - a)) + ln(K - 1), none at or below chance,
+// the accuracy held inside [1 / 2n, 1 - 1 / 2n].
+TEST(HmmVote, MemberWeightIsTheLogOddsAboveChance) {
+  EXPECT_NEAR(hmm::member_weight(3, 4, 2), std::log(3.0), 1e-15);        // a = 3/4
+  EXPECT_EQ(hmm::member_weight(2, 4, 2), 0.0);                            // chance
+  EXPECT_EQ(hmm::member_weight(1, 4, 2), 0.0);                            // below it
+  EXPECT_NEAR(hmm::member_weight(2, 3, 3), std::log(4.0), 1e-15);        // ln 2 + ln 2
+  EXPECT_NEAR(hmm::member_weight(1, 2, 3), std::log(2.0), 1e-15);        // 1/2 beats 1/3 chance
+  EXPECT_EQ(hmm::member_weight(1, 3, 3), 0.0);                            // ln(1/2) + ln 2
+  EXPECT_NEAR(hmm::member_weight(4, 4, 2), std::log(7.0), 1e-15);        // a = 1 - 1/8
+  EXPECT_NEAR(hmm::member_weight(40, 40, 2), std::log(79.0), 1e-13);     // more evidence, more weight
+  EXPECT_THROW(hmm::member_weight(5, 4, 2), std::invalid_argument);
+  EXPECT_THROW(hmm::member_weight(0, 0, 2), std::invalid_argument);
+  EXPECT_THROW(hmm::member_weight(1, 2, 1), std::invalid_argument);
+}
+
+// score_labels counts a trial whose label the model does not know as scored and wrong (a member
+// that never catches, facing a caught trial), skips unlabelled ones, and with `among` skips the
+// labels outside it. Model (good 0, missed 3) on x = 0 good, x = 3 missed, x = 3 good, x = 10
+// caught and an unlabelled one.
+TEST(HmmVote, ScoreLabelsCountsUnknownLabelsAsWrong) {
+  const auto m = one_state_model(0, 3);
+  std::vector<HapticSequence> owned = {one_sample(0, Outcome::Good), one_sample(3, Outcome::Missed),
+                                       one_sample(3, Outcome::Good), one_sample(10, Outcome::Caught),
+                                       one_sample(0, Outcome::Good)};
+  owned.back().label.reset();
+  std::vector<const HapticSequence*> trials;
+  for (const auto& t : owned) trials.push_back(&t);
+  const auto all = hmm::score_labels(m, trials);
+  EXPECT_EQ(all.scored, 4);
+  EXPECT_EQ(all.right, 2);
+  const auto gm = hmm::score_labels(m, trials, std::numeric_limits<double>::infinity(), {"good", "missed"});
+  EXPECT_EQ(gm.scored, 3);
+  EXPECT_EQ(gm.right, 2);
+}
+
+// Rule S by hand. Members a and b learnt that good pulls at 0 and missed at 3, c the reverse;
+// a's set holds 2 trials of a's world, b's set 4, c's set 2 of c's. a on b's and c's sets: 4 of
+// 6 right, weight ln(2); b on a's and c's: 2 of 4, chance, 0; c on a's and b's: 0 of 6, 0. So
+// the committee decides as a does, even where b and c outvote it.
+TEST(HmmVote, SimulationWeightsScoreEachMemberOnTheOthersSets) {
+  const auto a = one_state_model(0, 3), b = one_state_model(0, 3), c = one_state_model(3, 0);
+  auto world = [](int n, double good_at, double missed_at) {
+    std::vector<HapticSequence> v;
+    for (int i = 0; i < n; ++i)
+      v.push_back(i % 2 ? one_sample(missed_at, Outcome::Missed) : one_sample(good_at, Outcome::Good));
+    return v;
+  };
+  const auto set_a = world(2, 0, 3), set_b = world(4, 0, 3), set_c = world(2, 3, 0);
+  auto ptrs = [](const std::vector<HapticSequence>& v) {
+    std::vector<const HapticSequence*> p;
+    for (const auto& t : v) p.push_back(&t);
+    return p;
+  };
+  const std::vector<const model::OutcomeModel*> committee = {&a, &b, &c};
+  const auto w = hmm::simulation_weights(committee, {ptrs(set_a), ptrs(set_b), ptrs(set_c)});
+  ASSERT_EQ(w.size(), 3u);
+  EXPECT_NEAR(w[0], std::log(2.0), 1e-15);
+  EXPECT_EQ(w[1], 0.0);
+  EXPECT_EQ(w[2], 0.0);
+  // With the same weights, a trial that two reversed members outvote a on: at x = 1.4, a answers
+  // good, b2 and c missed.
+  const auto b2 = one_state_model(3, 0);
+  const auto v = hmm::vote({&a, &b2, &c}, one_sample(1.4, Outcome::Good));
+  ASSERT_EQ(v.answers, (std::vector<int>{0, 1, 1}));
+  EXPECT_EQ(v.predicted, 1);                           // the plain vote: missed, 2 to 1
+  EXPECT_EQ(hmm::weighted_choice(v, w), 0);            // weighted: a's good
+  EXPECT_THROW(hmm::simulation_weights(committee, {ptrs(set_a)}), std::invalid_argument);
+}
+
 // Determinism: the same data trains the same bits.
 TEST(HmmTrain, Deterministic) {
   const auto truth = fx::known_left_right(5, 0.95);

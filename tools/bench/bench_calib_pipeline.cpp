@@ -552,6 +552,16 @@ int synthesized_index(const std::string& id) {
 }
 
 
+// hmm::score_labels whole and at each cut ([0] whole), added into `right` and `scored`.
+void right_of_labels(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials,
+                     const hmm::ClassChoice& among, int right[5], int scored[5]) {
+  for (int c = 0; c < 5; ++c) {
+    const hmm::LabelScore s =
+        hmm::score_labels(m, trials, c == 0 ? std::numeric_limits<double>::infinity() : kCuts[c - 1], among);
+    right[c] += s.right, scored[c] += s.scored;
+  }
+}
+
 // The early cue a classifier of cut sequences can learn: the mean force over a window of travel,
 // good trials minus missed ones (each trial's mean over its samples in [lo, hi), then the mean
 // over the trials of each label). NaN when either label has no sample there.
@@ -916,6 +926,8 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     // vote with each STC asked "good or missed?": each paired with the 1-NN's answers at the end.
     using RightOf = std::array<std::map<const HapticSequence*, bool>, 5>;
     RightOf vote_right_of, vote_good_or_missed_right_of;
+    // The same votes weighted by rule S or R ([0] / [1], below), each question ([q]).
+    std::array<std::array<RightOf, 2>, 2> weighted_right_of;
     // One classifier per calibration, each on the trials of everyone but the calibration's person:
     // its row, and the sums over all of them into `key` (rows) and `key`_accuracy_whole_and_cuts.
     auto per_calibration = [&](const char* key, const char* all_name,
@@ -1193,6 +1205,57 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     // The same people's simulators as a committee of their own STCs rather than one STC of their
     // pooled trials: the vote of the simulators' answers (hmm::evaluate_vote, what `dressguard
     // classify --model A.dgm,B.dgm,...` does), and for comparison their mixture (mixture_correct).
+    // Weights for the vote (hmm::member_weight), fixed before the votes below were looked at
+    // (session 73). Rule S, simulation alone: a member's accuracy on the other members'
+    // synthesized trials, every other simulator of a person other than its own; for a test
+    // person p, only the simulators of people other than p count, so nothing of p (whose
+    // simulator was fitted to p's measured trials) enters. Rule R, not simulation alone: its
+    // accuracy on the measured trials of people other than p and other than its own person (as
+    // the 1-NN learns from the other people's trials). Both at the same cut and question:
+    // q = 0 the paper's three classes on all trials, q = 1 "good or missed?" on the good and
+    // missed ones. sim_right[q][i][j][c]: member i on simulator j's set, scored once for every
+    // test person's committee: hmm::simulation_weights (what `dressguard classify --weigh-on`
+    // uses) from counts kept, two files of one person not scoring each other.
+    const std::size_t k_src = sources.size();
+    std::vector<std::vector<std::array<std::array<int, 5>, 2>>> sim_right(
+        k_src, std::vector<std::array<std::array<int, 5>, 2>>(k_src)),
+        sim_scored = sim_right;
+    {
+      const hmm::ClassChoice questions[2] = {{}, {"good", "missed"}};
+      std::vector<std::vector<const HapticSequence*>> set_of(k_src);
+      for (std::size_t j = 0; j < k_src; ++j) set_of[j] = pointers_to(sources[j].set.trials);
+      std::printf("  each STC on the other people's simulators' trials (the weights of rule S), three classes | "
+                  "good or missed:\n");
+      Json rows = Json::array();
+      for (std::size_t i = 0; i < k_src; ++i) {
+        int all_right[2][5] = {}, all_scored[2][5] = {};
+        for (std::size_t j = 0; j < k_src; ++j) {
+          if (sources[j].participant == sources[i].participant) continue;
+          for (int q = 0; q < 2; ++q) {
+            right_of_labels(singles[i], set_of[j], questions[q],
+                            sim_right[i][j][q].data(), sim_scored[i][j][q].data());
+            for (int c = 0; c < 5; ++c) all_right[q][c] += sim_right[i][j][q][c], all_scored[q][c] += sim_scored[i][j][q][c];
+          }
+        }
+        std::printf("  %-50s", ("on other simulators: " + fs::path(sources[i].file).stem().string()).c_str());
+        for (int q = 0; q < 2; ++q) {
+          for (int c = 0; c < 5; ++c)
+            std::printf(" %4.0f%%", all_scored[q][c] ? 100.0 * all_right[q][c] / all_scored[q][c] : 0.0);
+          if (q == 0) std::printf("  |");
+        }
+        std::printf("   (%d trials)\n", all_scored[0][0]);
+        Json j = Json::object();
+        j.set("calibration", sources[i].file);
+        j.set("trials", all_scored[0][0]);
+        for (int q = 0; q < 2; ++q) {
+          Json acc = Json::array();
+          for (int c = 0; c < 5; ++c) acc.push(all_scored[q][c] ? static_cast<double>(all_right[q][c]) / all_scored[q][c] : 0.0);
+          j.set(q == 0 ? "accuracy_whole_and_cuts" : "good_or_missed_accuracy_whole_and_cuts", acc);
+        }
+        rows.push(j);
+      }
+      jset.set("single_on_other_simulators", rows);
+    }
     {
       // The vote once more with each STC asked "good or missed?" (hmm::classify's `among`): the
       // only question the 1-NN below, trained on recordings without a caught trial, can answer.
@@ -1207,6 +1270,9 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       // that differ in one member show on which trials and how that member moved the vote.
       Json jballots[5];
       for (auto& j : jballots) j = Json::array();
+      // The weighted votes (rules S and R above, each question): right counts and per trial.
+      int weighted_right[2][2][5] = {};
+      Json jweights = Json::array();
       for (const auto& p : people) {
         std::vector<const HapticSequence*> test;
         for (const auto* t : all)
@@ -1220,6 +1286,47 @@ int run_pooled(const std::map<std::string, std::string>& a) {
           }
         if (members.empty() || test.empty()) continue;
         nm += static_cast<int>(test.size());
+        // The member sources, and the measured trials rule R may learn from: no trial of p.
+        std::vector<std::size_t> member_src;
+        for (std::size_t s = 0; s < sources.size(); ++s)
+          if (sources[s].participant != p) member_src.push_back(s);
+        // weights[rule][q][c][member]
+        std::array<std::array<std::array<std::vector<double>, 5>, 2>, 2> weights;
+        Json jw = Json::object();
+        jw.set("participant", p);
+        for (int q = 0; q < 2; ++q) {
+          const hmm::ClassChoice among = q == 0 ? hmm::ClassChoice{} : good_or_missed;
+          const int classes = q == 0 ? 3 : 2;
+          Json jq[2] = {Json::array(), Json::array()};
+          for (std::size_t k = 0; k < member_src.size(); ++k) {
+            const std::size_t i = member_src[k];
+            std::array<int, 5> sr{}, sn{}, rr{}, rn{};
+            for (std::size_t j : member_src)
+              if (sources[j].participant != sources[i].participant)
+                for (int c = 0; c < 5; ++c) sr[c] += sim_right[i][j][q][c], sn[c] += sim_scored[i][j][q][c];
+            std::vector<const HapticSequence*> others;
+            for (const auto* t : all)
+              if (t->participant != p && t->participant != sources[i].participant) others.push_back(t);
+            right_of_labels(singles[i], others, among, rr.data(), rn.data());
+            Json js = Json::array(), jr = Json::array();
+            for (int c = 0; c < 5; ++c) {
+              weights[0][q][c].push_back(sn[c] ? hmm::member_weight(sr[c], sn[c], classes) : 0.0);
+              weights[1][q][c].push_back(rn[c] ? hmm::member_weight(rr[c], rn[c], classes) : 0.0);
+              js.push(weights[0][q][c].back()), jr.push(weights[1][q][c].back());
+            }
+            Json jm = Json::object();
+            jm.set("member", member_files[k]);
+            jm.set("whole_and_cuts", js);
+            jq[0].push(jm);
+            Json jm2 = Json::object();
+            jm2.set("member", member_files[k]);
+            jm2.set("whole_and_cuts", jr);
+            jq[1].push(jm2);
+          }
+          jw.set(q == 0 ? "simulated_three_classes" : "simulated_good_or_missed", jq[0]);
+          jw.set(q == 0 ? "measured_three_classes" : "measured_good_or_missed", jq[1]);
+        }
+        jweights.push(jw);
         for (int c = 0; c < 5; ++c) {
           const double cut = c == 0 ? std::numeric_limits<double>::infinity() : kCuts[c - 1];
           std::vector<hmm::Vote> votes;
@@ -1240,6 +1347,18 @@ int run_pooled(const std::map<std::string, std::string>& a) {
           vote2_right[c] += hmm::evaluate_vote(members, test, cut, &gm_votes, good_or_missed).correct;
           for (std::size_t i = 0; i < test.size(); ++i)
             vote_good_or_missed_right_of[c][test[i]] = hmm::right_or_not(gm_votes[i], *test[i]) == 1;
+          // The same ballots, decided by the weights (a trial the plain vote skips is skipped).
+          for (int rule = 0; rule < 2; ++rule)
+            for (int q = 0; q < 2; ++q) {
+              const std::vector<hmm::Vote>& vs = q == 0 ? votes : gm_votes;
+              for (std::size_t i = 0; i < test.size(); ++i) {
+                if (hmm::right_or_not(vs[i], *test[i]) < 0) continue;
+                const int choice = hmm::weighted_choice(vs[i], weights[rule][q][c]);
+                const bool right = choice >= 0 && vs[i].classes[choice] == outcome_name(*test[i]->label);
+                weighted_right[rule][q][c] += right;
+                weighted_right_of[rule][q][c][test[i]] = right;
+              }
+            }
           share_right[c] += hmm::evaluate_vote(share_members, test, cut).correct;
           share2_right[c] += hmm::evaluate_vote(share_members, test, cut, nullptr, good_or_missed).correct;
           mix_right[c] += mixture_correct(members, test, cut);
@@ -1251,6 +1370,33 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       print_row("vote, priors the training shares", share_right, nm);
       print_row("vote, training shares, good or missed", share2_right, nm);
       print_row("mixture of the other people's STCs", mix_right, nm);
+      const char* weighted_names[2][2] = {
+          {"vote weighted by the simulators (rule S)", "vote weighted by the simulators, good|missed"},
+          {"vote weighted by measured trials (rule R)", "vote weighted by measured trials, good|missed"}};
+      const char* weighted_keys[2][2] = {{"vote_weighted_simulated", "vote_weighted_simulated_good_or_missed"},
+                                         {"vote_weighted_measured", "vote_weighted_measured_good_or_missed"}};
+      for (int rule = 0; rule < 2; ++rule)
+        for (int q = 0; q < 2; ++q) {
+          print_row(weighted_names[rule][q], weighted_right[rule][q], nm);
+          jset.set(std::string(weighted_keys[rule][q]) + "_accuracy_whole_and_cuts", pct(weighted_right[rule][q], nm));
+        }
+      jset.set("vote_weights", jweights);
+      // Each weighted vote against the plain vote of the same question, trial by trial.
+      auto ids_of = [](const RightOf& r) {
+        RightIds ids;
+        for (int c = 0; c < 5; ++c)
+          for (const auto& [t, right] : r[c])
+            if (right) ids[c].insert(t->id);
+        return ids;
+      };
+      for (int rule = 0; rule < 2; ++rule)
+        for (int q = 0; q < 2; ++q) {
+          Json j = pair_row(std::string(rule == 0 ? "S" : "R") + (q == 0 ? "" : " good|missed") +
+                                " vs plain vote, b/c p",
+                            ids_of(weighted_right_of[rule][q]),
+                            ids_of(q == 0 ? vote_right_of : vote_good_or_missed_right_of));
+          jset.set(std::string(weighted_keys[rule][q]) + "_against_vote", j);
+        }
       jset.set("vote_accuracy_whole_and_cuts", pct(vote_right, nm));
       jset.set("vote_called_caught_whole_and_cuts", pct(vote_caught, nm));
       jset.set("vote_good_or_missed_accuracy_whole_and_cuts", pct(vote2_right, nm));
@@ -1328,6 +1474,12 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     vote_against_one_nn("vote vs 1-NN, paired", "vote_against_one_nn_at_cuts", vote_right_of);
     vote_against_one_nn("vote good|missed vs 1-NN", "vote_good_or_missed_against_one_nn_at_cuts",
                         vote_good_or_missed_right_of);
+    vote_against_one_nn("S vs 1-NN", "vote_weighted_simulated_against_one_nn_at_cuts", weighted_right_of[0][0]);
+    vote_against_one_nn("S good|missed vs 1-NN", "vote_weighted_simulated_good_or_missed_against_one_nn_at_cuts",
+                        weighted_right_of[0][1]);
+    vote_against_one_nn("R vs 1-NN", "vote_weighted_measured_against_one_nn_at_cuts", weighted_right_of[1][0]);
+    vote_against_one_nn("R good|missed vs 1-NN", "vote_weighted_measured_good_or_missed_against_one_nn_at_cuts",
+                        weighted_right_of[1][1]);
     jset.set("per_participant", jper);
     jset.set("pooled_accuracy_whole_and_cuts", pct(pooled_right, n));
     jset.set("pooled_equal_size_accuracy_whole_and_cuts", pct(equal_right, n));

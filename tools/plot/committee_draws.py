@@ -9,7 +9,9 @@ usage: committee_draws.py POOLED.json [POOLED.json ...] OUT.png
 Each POOLED.json is a file the bench wrote; each is labelled by its seeds, the trials per height
 its STCs trained on, its --indices and, where the runs' members differ, the files it holds beyond
 those every run holds. One panel per force set and per vote (the paper's rule;
-each STC asked "good or missed?"); a line per run, the 1-NN in black with its 95 % interval at
+each STC asked "good or missed?"; where every run has them, the same question decided by the
+members' weights, rule S from the simulators alone and rule R from the other people's measured
+trials, session 73); a line per run, the 1-NN in black with its 95 % interval at
 each cut, from the first file (every run of one set of calibrations faces the same trials).
 The whole sequence is drawn right of the cuts.
 """
@@ -25,6 +27,13 @@ from pooled_stc import CUTS, WHOLE_X, cuts_then_whole  # the same axis as the pe
 VOTES = [("vote_accuracy_whole_and_cuts", "vote_against_one_nn_at_cuts", "vote (the paper's rule)"),
          ("vote_good_or_missed_accuracy_whole_and_cuts", "vote_good_or_missed_against_one_nn_at_cuts",
           'vote, each STC asked "good or missed?"')]
+# Drawn when every run has them (runs before session 73 do not): the weighted votes, same question.
+WEIGHTED = [("vote_weighted_simulated_good_or_missed_accuracy_whole_and_cuts",
+             "vote_weighted_simulated_good_or_missed_against_one_nn_at_cuts",
+             'good or missed, weighted by the simulators (rule S)'),
+            ("vote_weighted_measured_good_or_missed_accuracy_whole_and_cuts",
+             "vote_weighted_measured_good_or_missed_against_one_nn_at_cuts",
+             'good or missed, weighted by measured trials (rule R)')]
 
 
 def members(d):  # the calibration files' stems, the committee's members
@@ -65,11 +74,13 @@ def main(argv):
     shared = set.intersection(*(members(d) for d in runs))
     same = all(members(d) == shared for d in runs)
     runs = [(label_of(d, None if same else shared), d) for d in runs]
+    votes = VOTES + [w for w in WEIGHTED
+                     if all(w[0] in s and len(s[w[0]]) == 5 for _, d in runs for s in d["force_sets"])]
     names = [s["forces"] for s in runs[0][1]["force_sets"]]
-    fig, axes = plt.subplots(len(VOTES), len(names), figsize=(5 * len(names), 4.2 * len(VOTES)), squeeze=False,
+    fig, axes = plt.subplots(len(votes), len(names), figsize=(5 * len(names), 4.2 * len(votes)), squeeze=False,
                              sharey=True)
     xs = CUTS + [WHOLE_X]
-    for row, (key, pairing, title) in enumerate(VOTES):
+    for row, (key, pairing, title) in enumerate(votes):
         for col, name in enumerate(names):
             ax = axes[row][col]
             for label, d in runs:
@@ -91,13 +102,13 @@ def main(argv):
             ax.set_title(f"{name}: {title}", fontsize=9)
             if col == 0:
                 ax.set_ylabel("right of the measured trials [%]")
-            if row == len(VOTES) - 1:
+            if row == len(votes) - 1:
                 ax.set_xlabel("travel cut [m]")
     # One legend for all panels, under them, so that no line is hidden behind it.
     handles, labels = axes[0][0].get_legend_handles_labels()
     rows = (len(labels) + 2) // 3
     fig.legend(handles, labels, fontsize=8, loc="lower center", ncol=3)
-    fig.tight_layout(rect=(0, 0.035 * rows, 1, 1))
+    fig.tight_layout(rect=(0, 0.035 * rows * 2 / len(votes), 1, 1))
     fig.savefig(argv[-1], dpi=110)
     return 0
 

@@ -1,0 +1,70 @@
+#!/usr/bin/python3
+"""What the committee's weights see (offline/calib/MEASUREMENTS.md, session 73): each member's
+STC asked "good or missed?" on the other simulators' synthesized trials (what rule S weighs it by:
+the simulators alone) above the same STC on the other people's measured trials (what rule R
+weighs it by, and what the vote is judged on), whole and at each cut. Where the two rows rank the
+members alike, weights learnt from simulation alone help the vote on people.
+
+usage: member_weights.py POOLED.json OUT.png
+POOLED.json is what `bench_calib_pipeline pooled` writes (since session 73). One column of two
+heat maps per force set, a row per member, the accuracy in % in each cell.
+"""
+import json
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+
+from pooled_stc import CUTS  # the same cuts as the per-run plot
+
+COLUMNS = ["whole"] + [f"{c:.2f} m" for c in CUTS]
+
+
+def stem(path):
+    return path.replace("\\", "/").split("/")[-1].removesuffix(".json")
+
+
+def main(argv):
+    if len(argv) != 3:
+        sys.stderr.write(__doc__)
+        return 2
+    with open(argv[1]) as f:
+        d = json.load(f)
+    sets = d.get("force_sets") or []
+    if not sets:
+        sys.stderr.write(f"{argv[1]}: no force sets\n")
+        return 1
+    for s in sets:
+        for key in ("single_on_other_simulators", "single_good_or_missed"):
+            if key not in s:
+                sys.stderr.write(f"{argv[1]}: force set '{s.get('forces')}' has no {key}\n")
+                return 1
+    rows = [stem(r["calibration"]) for r in sets[0]["single_on_other_simulators"]]
+    fig, axes = plt.subplots(2, len(sets), figsize=(4.6 * len(sets), 0.45 * len(rows) * 2 + 2.6), squeeze=False)
+    image = None
+    for col, s in enumerate(sets):
+        simulated = {stem(r["calibration"]): r["good_or_missed_accuracy_whole_and_cuts"]
+                     for r in s["single_on_other_simulators"]}
+        measured = {stem(r["calibration"]): r["accuracy_whole_and_cuts"] for r in s["single_good_or_missed"]}
+        for row, (what, acc) in enumerate([("on the other simulators' trials (rule S)", simulated),
+                                           ("on the other people's measured trials", measured)]):
+            ax = axes[row][col]
+            grid = [[100 * a for a in acc[m]] for m in rows]
+            image = ax.imshow(grid, cmap="RdYlGn", vmin=0, vmax=100, aspect="auto")
+            for i, line in enumerate(grid):
+                for j, v in enumerate(line):
+                    ax.text(j, i, f"{v:.0f}", ha="center", va="center", fontsize=8)
+            ax.set_xticks(range(len(COLUMNS)))
+            ax.set_xticklabels(COLUMNS, fontsize=8)
+            ax.set_yticks(range(len(rows)))
+            ax.set_yticklabels(rows if col == 0 else [], fontsize=8)
+            ax.set_title(f"{s['forces']}\n{what}", fontsize=9)
+    fig.colorbar(image, ax=axes, shrink=0.6, label='right, asked "good or missed?" [%]')
+    fig.savefig(argv[2], dpi=110, bbox_inches="tight")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
