@@ -155,7 +155,9 @@ int run_classify(int argc, char** argv) {
         "                          synthesize); each member's vote then counts by its log-odds of being\n"
         "                          right on the other members' sets at the same cut and --among\n"
         "                          (hmm.h, simulation_weights: learnt from simulation alone; give one\n"
-        "                          model per person). Printed, and in the JSON\n"
+        "                          model per person). Printed, and in the JSON. The sets are scored\n"
+        "                          as written: a model built with --discrepancy learnt its set\n"
+        "                          corrected, and is weighed here on the set without the correction\n"
         "  --json                  print a machine-readable result");
     return 0;
   }
@@ -331,9 +333,18 @@ int run_classify(int argc, char** argv) {
       const auto& v = per[i];
       if (v.predicted < 0) continue;
       const std::string truth(outcome_name(*trials[i]->label));
-      std::printf("%-24s %-6s %7zu %-8s %-8s %3d/%-2zu%s\n", trials[i]->id.c_str(), trials[i]->participant.c_str(),
+      // Weighted, the votes alone may look like the loser's: the winner's share of the weight too.
+      std::string share;
+      if (!weights.empty()) {
+        double won = 0, all = 0;
+        for (size_t k = 0; k < v.answers.size(); ++k) all += weights[k], won += v.answers[k] == v.predicted ? weights[k] : 0;
+        char text[32];
+        std::snprintf(text, sizeof text, " (weight %.2f)", all > 0 ? won / all : 0.0);
+        share = text;
+      }
+      std::printf("%-24s %-6s %7zu %-8s %-8s %3d/%-2zu%s%s\n", trials[i]->id.c_str(), trials[i]->participant.c_str(),
                   v.samples, truth.c_str(), v.classes[v.predicted].c_str(), v.votes[v.predicted], committee.size(),
-                  truth == v.classes[v.predicted] ? "" : "   WRONG");
+                  share.c_str(), truth == v.classes[v.predicted] ? "" : "   WRONG");
     }
     print_late_starts(trials);
     print_summary(ev, committee.size());

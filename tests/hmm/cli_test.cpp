@@ -215,6 +215,12 @@ TEST_F(CliTest, CommitteeWeighedOnTheMembersSets) {
   const size_t tw = truth.out.find("\"weights\": [");
   ASSERT_NE(tw, std::string::npos) << truth.out;
   EXPECT_NEAR(std::strtod(truth.out.c_str() + tw + 12, nullptr), std::log(286.0), 1e-9) << truth.out;
+  // In the text, such a trial is won by 1 vote of 3 that holds all the weight.
+  const auto truth_text = run(committee + " --weigh-on " + train + "," + (dir / "train2").string() + "," +
+                              (dir / "train3").string());
+  ASSERT_EQ(truth_text.code, 0) << truth_text.err;
+  EXPECT_NE(truth_text.out.find("1/3  (weight 1.00)"), std::string::npos) << truth_text.out;
+  EXPECT_EQ(truth_text.out.find("WRONG"), std::string::npos) << truth_text.out;
   // The sweep weighs at every distance: m's committee there too.
   const auto sweep = run(committee + " --weigh-on " + train + "," + (dir / "train2").string() + "," +
                          (dir / "train3").string() + " --sweep 0.05:0.15:0.05 --sweep-out " + (dir / "ws").string() +
