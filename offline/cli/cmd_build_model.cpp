@@ -62,6 +62,10 @@ int run_build_model(int argc, char** argv) {
         "               7 cm decides by less than M metres (a stopped trial with max(d_behind,\n"
         "               d_ahead) within M of 7 cm, from each set's labels.csv): a label that the\n"
         "               noise models flip at random teaches a class the other's forces. Default 0\n"
+        "  --training-out DIR   also write the trials the HMMs learnt, as a dataset: after\n"
+        "               --label-margin and with --discrepancy's correction added, which the\n"
+        "               synthesized set on disk does not hold. What `classify --weigh-on` weighs\n"
+        "               this model's fellow members on. One training set only\n"
         "  --priors P   uniform (default: the paper's highest likelihood, and a caught arm's HMM\n"
         "               as likely as the others before any force is read) | training: each\n"
         "               class's share of the training trials (the Bayes decision for trials\n"
@@ -72,7 +76,7 @@ int run_build_model(int argc, char** argv) {
   }
   args.allow_only({"help", "json", "no-gown-noise", "no-arm-noise", "calibration", "data", "out", "synth-dir",
                    "states", "per-height", "seed", "gown", "threads", "forces", "middle", "high-low", "created", "discrepancy", "label-margin",
-                   "priors"});
+                   "priors", "training-out"});
   const std::string out = args.require("out");
   if (args.has("calibration") == args.has("data")) throw UsageError("give exactly one of --calibration and --data");
   const int states = static_cast<int>(args.integer("states", 10));
@@ -85,6 +89,11 @@ int run_build_model(int argc, char** argv) {
   const double label_margin = args.number("label-margin", 0.0);
   if (!(label_margin >= 0.0 && label_margin < kGoodLabelDistance))
     throw UsageError("--label-margin must be in [0, 0.07) metres");
+  if (args.has("training-out") && args.has("calibration") &&
+      split_in_order(*args.get("calibration")).size() > 1)
+    throw UsageError("--training-out writes one training set: give one --calibration (several pool their sets)");
+  if (args.has("training-out") && args.has("data") && split_in_order(*args.get("data")).size() > 1)
+    throw UsageError("--training-out writes one training set: give one --data (several pool their sets)");
   if (args.has("discrepancy") && !args.has("calibration"))
     throw UsageError("--discrepancy needs --calibration: it is a calibrated simulator's error on its own sequences");
   // The training sets: one per calibration (synthesized here) or the datasets given.
@@ -160,6 +169,7 @@ int run_build_model(int argc, char** argv) {
       for (auto& t : one.trials) apply_discrepancy(discrepancies[i].second, t);
     std::move(one.trials.begin(), one.trials.end(), std::back_inserter(ds.trials));
   }
+  if (auto dir = args.get("training-out")) save_dataset(ds, *dir);
   if (!discrepancies.empty()) {
     write_file_atomic(out + ".discrepancy.csv", discrepancy_csv(discrepancies));
     data += " + discrepancy from " + *args.get("discrepancy");

@@ -150,14 +150,13 @@ int run_classify(int argc, char** argv) {
         "  --against B.dgm[,...]   also classify the same trials (same cut, same --among) by another model\n"
         "                          or committee, and pair the two: the trials only one of them gets right\n"
         "                          and McNemar's exact p (is the difference more than these trials' noise?)\n"
-        "  --weigh-on SET[,SET...] with several models: one synthesized dataset per --model, in\n"
-        "                          order, each the set that model was trained on (dressguard\n"
-        "                          synthesize); each member's vote then counts by its log-odds of being\n"
+        "  --weigh-on SET[,SET...] with several models: one dataset per --model, in order, each\n"
+        "                          the set that model was trained on; each member's vote then counts by its log-odds of being\n"
         "                          right on the other members' sets at the same cut and --among\n"
         "                          (hmm.h, simulation_weights: learnt from simulation alone; give one\n"
-        "                          model per person). Printed, and in the JSON. The sets are scored\n"
-        "                          as written: a model built with --discrepancy learnt its set\n"
-        "                          corrected, and is weighed here on the set without the correction\n"
+        "                          model per person). Printed, and in the JSON. For a model built\n"
+        "                          with --discrepancy give its build-model --training-out set: the\n"
+        "                          synthesized set on disk lacks the correction it learnt\n"
         "  --json                  print a machine-readable result");
     return 0;
   }

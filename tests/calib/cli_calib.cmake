@@ -93,6 +93,8 @@ if(HMM)
               build-model --calibration ${WORK}/cal4.json,${WORK}/twin/cal4.json --out ${WORK}/p.dgm)
   expect_fail("build-model with no calibration in the list" "--calibration names no file"
               build-model --calibration , --out ${WORK}/p.dgm)
+  expect_fail("build-model --training-out of two calibrations" "--training-out writes one training set"
+              build-model --calibration ${WORK}/cal4.json,${WORK}/calB.json --training-out ${WORK}/t --out ${WORK}/p.dgm)
   set(synth_opts --per-height 2 --seed 3 --threads 2)
   execute_process(COMMAND ${DG} build-model --calibration ${WORK}/cal4.json,${WORK}/calB.json --out ${WORK}/pooled.dgm
                           ${synth_opts} --states 3 --forces motion --created 2026-01-02T03:04:05Z --json
@@ -512,6 +514,7 @@ if(STUDY)
     set(d_opts --calibration ${WORK}/c1.json --synth-dir ${WORK}/d.synth --per-height 2 --seed 3 --threads 2
                --states 3 --created 2026-01-02T03:04:05Z)
     execute_process(COMMAND ${DG} build-model ${d_opts} --discrepancy ${WORK}/study --out ${WORK}/d.dgm --json
+                            --training-out ${WORK}/d.train
                     RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
     if(EXISTS ${WORK}/d.dgm.discrepancy.csv)
       file(STRINGS ${WORK}/d.dgm.discrepancy.csv table)
@@ -535,6 +538,17 @@ if(STUDY)
     string(REGEX REPLACE "source:[^\n]*" "" without "${without}")
     if(NOT rc EQUAL 0 OR with STREQUAL without)
       message(FATAL_ERROR "build-model --discrepancy trained the uncorrected model (${rc}):\n${with}")
+    endif()
+    # --training-out wrote the corrected trials the HMMs learnt (what classify --weigh-on weighs
+    # the model's fellow members on): a model trained on them is the corrected model.
+    execute_process(COMMAND ${DG} build-model --data ${WORK}/d.train --states 3 --forces both
+                            --created 2026-01-02T03:04:05Z --out ${WORK}/d2.dgm RESULT_VARIABLE rc OUTPUT_QUIET
+                    ERROR_VARIABLE err)
+    execute_process(COMMAND ${DG} model show ${WORK}/d2.dgm OUTPUT_VARIABLE again)
+    string(REGEX REPLACE "source:[^\n]*" "" again "${again}")
+    if(NOT rc EQUAL 0 OR NOT again STREQUAL with)
+      message(FATAL_ERROR "build-model --training-out: the model of its trials is not the corrected one (${rc}) "
+                          "${err}:\n${again}\n---\n${with}")
     endif()
     # A dataset without the calibration's sequences: named, with the missing trial.
     expect_fail("build-model --discrepancy on the wrong data" "holds no trial 's4-good-3'"
