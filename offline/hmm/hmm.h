@@ -252,8 +252,9 @@ LabelScore score_labels(const model::OutcomeModel& m, const std::vector<const Ha
 // the models' classes). With `among`, a trial whose label is not among them is not scored. Why
 // the other members' sets: a member whose simulator agrees with the others' on what a good and
 // a missed trial look like at that cut is more likely to be right on a person none of them was
-// fitted to than one whose simulator stands alone; its own set would only say how well it
-// learnt itself. Give one set per person: two simulators of one person would score each other
+// fitted to than one whose simulator stands alone (session 73 measured it: over seven people's
+// simulators, the two accuracies rank the members alike at every cut, Spearman median 0.82); its
+// own set would only say how well it learnt itself. Give one set per person: two simulators of one person would score each other
 // as if they were another person's. Throws std::invalid_argument unless there is one set per
 // model; a member with no scored trial gets weight 0.
 std::vector<double> simulation_weights(const std::vector<const model::OutcomeModel*>& models,
