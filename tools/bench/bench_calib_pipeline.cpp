@@ -1202,9 +1202,6 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       std::snprintf(name, sizeof name, "pooled (%d to %d simulators)", fewest, most);
     print_row(name, pooled_right, n);
     print_row("pooled, cut to one set's size", equal_right, n);
-    // The same people's simulators as a committee of their own STCs rather than one STC of their
-    // pooled trials: the vote of the simulators' answers (hmm::evaluate_vote, what `dressguard
-    // classify --model A.dgm,B.dgm,...` does), and for comparison their mixture (mixture_correct).
     // Weights for the vote (hmm::member_weight), fixed before the votes below were looked at
     // (session 73). Rule S, simulation alone: a member's accuracy on the other members'
     // synthesized trials, every other simulator of a person other than its own; for a test
@@ -1256,6 +1253,9 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       }
       jset.set("single_on_other_simulators", rows);
     }
+    // The same people's simulators as a committee of their own STCs rather than one STC of their
+    // pooled trials: the vote of the simulators' answers (hmm::evaluate_vote, what `dressguard
+    // classify --model A.dgm,B.dgm,...` does), and for comparison their mixture (mixture_correct).
     {
       // The vote once more with each STC asked "good or missed?" (hmm::classify's `among`): the
       // only question the 1-NN below, trained on recordings without a caught trial, can answer.
@@ -1286,17 +1286,22 @@ int run_pooled(const std::map<std::string, std::string>& a) {
           }
         if (members.empty() || test.empty()) continue;
         nm += static_cast<int>(test.size());
-        // The member sources, and the measured trials rule R may learn from: no trial of p.
+        // The members' sources (in the order of `members`) and their classes' union, K of the
+        // three-class question as hmm::simulation_weights counts it.
         std::vector<std::size_t> member_src;
+        std::set<std::string> union_classes;
         for (std::size_t s = 0; s < sources.size(); ++s)
-          if (sources[s].participant != p) member_src.push_back(s);
+          if (sources[s].participant != p) {
+            member_src.push_back(s);
+            for (const auto& h : singles[s].classes) union_classes.insert(h.name);
+          }
         // weights[rule][q][c][member]
         std::array<std::array<std::array<std::vector<double>, 5>, 2>, 2> weights;
         Json jw = Json::object();
         jw.set("participant", p);
         for (int q = 0; q < 2; ++q) {
           const hmm::ClassChoice among = q == 0 ? hmm::ClassChoice{} : good_or_missed;
-          const int classes = q == 0 ? 3 : 2;
+          const int classes = q == 0 ? static_cast<int>(union_classes.size()) : 2;
           Json jq[2] = {Json::array(), Json::array()};
           for (std::size_t k = 0; k < member_src.size(); ++k) {
             const std::size_t i = member_src[k];
@@ -1304,6 +1309,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
             for (std::size_t j : member_src)
               if (sources[j].participant != sources[i].participant)
                 for (int c = 0; c < 5; ++c) sr[c] += sim_right[i][j][q][c], sn[c] += sim_scored[i][j][q][c];
+            // Rule R's trials: the measured ones of neither p nor this member's person.
             std::vector<const HapticSequence*> others;
             for (const auto* t : all)
               if (t->participant != p && t->participant != sources[i].participant) others.push_back(t);
