@@ -150,13 +150,13 @@ int run_classify(int argc, char** argv) {
         "  --against B.dgm[,...]   also classify the same trials (same cut, same --among) by another model\n"
         "                          or committee, and pair the two: the trials only one of them gets right\n"
         "                          and McNemar's exact p (is the difference more than these trials' noise?)\n"
-        "  --weigh-on SET[,SET...] with several models: one dataset per --model, in order, each\n"
-        "                          the set that model was trained on; each member's vote then counts by its log-odds of being\n"
-        "                          right on the other members' sets at the same cut and --among\n"
-        "                          (hmm.h, simulation_weights: learnt from simulation alone; give one\n"
-        "                          model per person). Printed, and in the JSON. For a model built\n"
-        "                          with --discrepancy give its build-model --training-out set: the\n"
-        "                          synthesized set on disk lacks the correction it learnt\n"
+        "  --weigh-on SET[,SET...] with several models: one dataset per --model, in order, each the\n"
+        "                          set that model was trained on; each member's vote then counts by\n"
+        "                          its log-odds of being right on the other members' sets at the same\n"
+        "                          cut and --among (hmm.h, simulation_weights: learnt from simulation\n"
+        "                          alone; give one model per person). Printed, and in the JSON. For a\n"
+        "                          model built with --discrepancy give its build-model --training-out\n"
+        "                          set: the synthesized set on disk lacks the correction it learnt\n"
         "  --json                  print a machine-readable result");
     return 0;
   }
@@ -205,7 +205,7 @@ int run_classify(int argc, char** argv) {
   for (const auto& m : against_models) against_committee.push_back(&m);
   // One model classifies as it always did (its log-likelihoods in the JSON); several vote.
   const model::OutcomeModel* single = models.size() == 1 ? &models[0] : nullptr;
-  // --weigh-on: each member's synthesized set, for its weight at each cut (rule S).
+  // --weigh-on: each member's training set, for the weights at each cut (rule S).
   const std::vector<std::string> weigh_paths = split_in_order(args.get("weigh-on").value_or(""));
   if (args.get("weigh-on") && single) throw UsageError("--weigh-on weighs the members of a committee: give several --model");
   if (args.get("weigh-on") && weigh_paths.size() != models.size())
@@ -323,7 +323,7 @@ int run_classify(int argc, char** argv) {
       return 0;
     }
     if (!weights.empty()) {
-      std::printf("weights (rule S: each member on the other members' synthesized sets):");
+      std::printf("weights (rule S: each member on the other members' training sets):");
       for (size_t k = 0; k < weights.size(); ++k) std::printf(" %s %.3f", model_paths[k].c_str(), weights[k]);
       std::printf("\n");
     }
