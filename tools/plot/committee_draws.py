@@ -15,7 +15,6 @@ trials, session 73); a line per run, the 1-NN in black with its 95 % interval at
 each cut, from the first file (every run of one set of calibrations faces the same trials).
 The whole sequence is drawn right of the cuts.
 """
-import json
 import sys
 
 import matplotlib
@@ -23,7 +22,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
-from pooled_stc import CUTS, WHOLE_X, cuts_then_whole  # the same axis as the per-run plot
+from pooled_stc import CUTS, WHOLE_X, cuts_then_whole, read_run  # as the per-run plot
 VOTES = [("vote_accuracy_whole_and_cuts", "vote_against_one_nn_at_cuts", "vote (the paper's rule)"),
          ("vote_good_or_missed_accuracy_whole_and_cuts", "vote_good_or_missed_against_one_nn_at_cuts",
           'vote, each STC asked "good or missed?"')]
@@ -58,10 +57,8 @@ def main(argv):
         return 2
     runs = []
     for path in argv[1:-1]:
-        with open(path) as f:
-            d = json.load(f)
-        if not d.get("force_sets"):
-            sys.stderr.write(f"{path}: no force sets\n")
+        d = read_run(path)
+        if d is None:
             return 1
         for key, pairing, _ in VOTES:
             for s in d["force_sets"]:

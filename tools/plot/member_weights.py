@@ -11,7 +11,6 @@ usage: member_weights.py POOLED.json OUT.png
 POOLED.json is what `bench_calib_pipeline pooled` writes (since session 73). One column of two
 heat maps per force set, a row per member, the accuracy in % in each cell.
 """
-import json
 import sys
 
 import matplotlib
@@ -19,7 +18,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
-from pooled_stc import CUTS  # the same cuts as the per-run plot
+from pooled_stc import CUTS, read_run  # the same cuts and reading as the per-run plot
 
 COLUMNS = ["whole"] + [f"{c:.2f} m" for c in CUTS]
 
@@ -54,12 +53,10 @@ def main(argv):
     if len(argv) != 3:
         sys.stderr.write(__doc__)
         return 2
-    with open(argv[1]) as f:
-        d = json.load(f)
-    sets = d.get("force_sets") or []
-    if not sets:
-        sys.stderr.write(f"{argv[1]}: no force sets\n")
+    d = read_run(argv[1])
+    if d is None:
         return 1
+    sets = d["force_sets"]
     for s in sets:
         for key in ("single_on_other_simulators", "single_good_or_missed"):
             if key not in s:

@@ -29,16 +29,25 @@ def cuts_then_whole(v):  # the file holds whole first, then the cuts
     return [100 * a for a in v[1:] + v[:1]]
 
 
+def read_run(path):
+    """A file `bench_calib_pipeline pooled` wrote; None, the reason on stderr, when it has no
+    force sets (every plot of such runs reads them this way)."""
+    with open(path) as f:
+        d = json.load(f)
+    if not d.get("force_sets"):
+        sys.stderr.write(f"{path}: no force sets\n")
+        return None
+    return d
+
+
 def main(argv):
     if len(argv) != 3:
         sys.stderr.write(__doc__)
         return 2
-    with open(argv[1]) as f:
-        d = json.load(f)
-    sets = d["force_sets"]
-    if not sets:
-        sys.stderr.write(f"{argv[1]}: no force sets\n")
+    d = read_run(argv[1])
+    if d is None:
         return 1
+    sets = d["force_sets"]
     xs = CUTS + [WHOLE_X]
     fig, axes = plt.subplots(1, len(sets), figsize=(5.2 * len(sets), 4.6), sharey=True, squeeze=False)
     for ax, s in zip(axes[0], sets):
