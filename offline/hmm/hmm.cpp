@@ -813,6 +813,91 @@ std::vector<double> simulation_weights(const std::vector<const model::OutcomeMod
   return w;
 }
 
+AnswerModel answer_model(const std::vector<std::string>& classes, const std::vector<std::vector<int>>& counts) {
+  const size_t k = classes.size();
+  if (k < 2 || counts.size() != k)
+    throw std::invalid_argument("answer_model: needs at least two classes and one row of counts per class (" +
+                                std::to_string(k) + " classes, " + std::to_string(counts.size()) + " rows)");
+  AnswerModel a;
+  a.classes = classes;
+  for (size_t t = 0; t < k; ++t) {
+    if (counts[t].size() != k)
+      throw std::invalid_argument("answer_model: row " + std::to_string(t) + " has " +
+                                  std::to_string(counts[t].size()) + " counts for " + std::to_string(k) + " classes");
+    double n = 0;
+    for (int c : counts[t]) {
+      if (c < 0) throw std::invalid_argument("answer_model: a count is negative");
+      n += c;
+    }
+    std::vector<double> row;
+    for (int c : counts[t]) row.push_back(std::log((c + 0.5) / (n + 0.5 * static_cast<double>(k))));
+    a.log_p.push_back(std::move(row));
+  }
+  return a;
+}
+
+std::vector<std::vector<int>> answer_counts(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials,
+                                            const std::vector<std::string>& classes, double truncate_at,
+                                            const ClassChoice& among) {
+  std::vector<std::vector<int>> counts(classes.size(), std::vector<int>(classes.size(), 0));
+  for (const auto* t : trials) {
+    if (!t->label) continue;
+    const std::string label(outcome_name(*t->label));
+    const int truth = index_of(classes, label);
+    if (truth < 0 || (!among.empty() && std::find(among.begin(), among.end(), label) == among.end())) continue;
+    const FeatureSequence seq = features_of(*t, m.features, truncate_at);
+    if (seq.size() == 0) continue;
+    const std::string& said = m.classes[classify(m, seq, among).predicted].name;
+    const int answer = index_of(classes, said);
+    if (answer < 0) throw std::invalid_argument("answer_counts: the model answers '" + said + "', not one of the classes counted");
+    ++counts[truth][answer];
+  }
+  return counts;
+}
+
+int answer_model_choice(const Vote& v, const std::vector<AnswerModel>& models, const ClassChoice& among) {
+  if (v.answers.empty()) return -1;
+  if (models.size() != v.answers.size())
+    throw std::invalid_argument("answer_model_choice: " + std::to_string(models.size()) + " answer models for " +
+                                std::to_string(v.answers.size()) + " members");
+  int best = -1;
+  double best_score = 0;
+  for (size_t t = 0; t < v.classes.size(); ++t) {
+    if (!among.empty() && std::find(among.begin(), among.end(), v.classes[t]) == among.end()) continue;
+    double score = 0;  // sum_m ln P_m(a_m | t); a member that knows neither t nor its answer adds nothing
+    for (size_t m = 0; m < models.size(); ++m) {
+      const int row = index_of(models[m].classes, v.classes[t]);
+      const int col = index_of(models[m].classes, v.classes[v.answers[m]]);
+      if (row >= 0 && col >= 0) score += models[m].log_p[row][col];
+    }
+    if (best < 0 || score > best_score ||
+        (score == best_score && v.posterior_sum[t] > v.posterior_sum[best]))
+      best = static_cast<int>(t), best_score = score;
+  }
+  return best;
+}
+
+std::vector<AnswerModel> simulation_answer_models(const std::vector<const model::OutcomeModel*>& models,
+                                                  const std::vector<std::vector<const HapticSequence*>>& sets,
+                                                  double truncate_at, const ClassChoice& among) {
+  if (sets.size() != models.size())
+    throw std::invalid_argument("simulation_answer_models: " + std::to_string(sets.size()) + " sets for " +
+                                std::to_string(models.size()) + " models");
+  const std::vector<std::string> classes = among.empty() ? committee_classes(models) : among;
+  std::vector<AnswerModel> out;
+  for (size_t i = 0; i < models.size(); ++i) {
+    std::vector<std::vector<int>> sum(classes.size(), std::vector<int>(classes.size(), 0));
+    for (size_t j = 0; j < sets.size(); ++j) {
+      if (j == i) continue;
+      const auto c = answer_counts(*models[i], sets[j], classes, truncate_at, among);
+      for (size_t t = 0; t < classes.size(); ++t)
+        for (size_t a = 0; a < classes.size(); ++a) sum[t][a] += c[t][a];
+    }
+    out.push_back(answer_model(classes, sum));
+  }
+  return out;
+}
+
 Evaluation evaluate_vote(const std::vector<const model::OutcomeModel*>& models,
                          const std::vector<const HapticSequence*>& trials, double truncate_at,
                          std::vector<Vote>* per_trial, const ClassChoice& among, const std::vector<double>& weights) {

@@ -262,6 +262,61 @@ std::vector<double> simulation_weights(const std::vector<const model::OutcomeMod
                                        double truncate_at = std::numeric_limits<double>::infinity(),
                                        const ClassChoice& among = {});
 
+// What one member's answer says about the truth: ln P(answer | truth) over `classes` (rows the
+// truth, columns the answer), learnt from how often it gave each answer on trials of each label.
+// Why more than rule S's one weight per member: a member that calls most trials good is right on
+// the good ones and wrong on the missed ones, so its "good" says little and its "missed" much;
+// one accuracy cannot tell the two answers apart (offline/calib/MEASUREMENTS.md, session 72: at
+// 0.15 m three of seven members call most missed trials good).
+struct AnswerModel {
+  std::vector<std::string> classes;
+  std::vector<std::vector<double>> log_p;  // log_p[truth][answer]
+};
+
+// The answer model of counts[truth][answer] (over `classes`): each row's counts plus 1/2 per cell
+// (Jeffreys' prior, so that an answer never seen for a truth is unlikely, not impossible),
+//
+//   P(a | t) = (n_ta + 1/2) / (n_t + K/2),   K = classes.size(),
+//
+// and a row without counts 1/K for every answer (it tells nothing). Throws std::invalid_argument
+// unless counts is K x K with counts >= 0 and K >= 2.
+AnswerModel answer_model(const std::vector<std::string>& classes, const std::vector<std::vector<int>>& counts);
+
+// How often model `m` gave each answer on `trials` of each label, cut at `truncate_at` and
+// deciding `among` some classes (classify()), as counts[truth][answer] over `classes`: trials
+// whose label is not in `classes` (or not among) are not counted, nor those with no sample before
+// the cut; an answer not in `classes` throws std::invalid_argument. The confusion matrix of
+// evaluate(), but over classes the model may not know (a simulator that never catches, facing
+// caught trials: every answer it gives them counts).
+std::vector<std::vector<int>> answer_counts(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials,
+                                            const std::vector<std::string>& classes,
+                                            double truncate_at = std::numeric_limits<double>::infinity(),
+                                            const ClassChoice& among = {});
+
+// The committee's decision by its members' answer models (rule C; Kuncheva 2004, "Combining
+// Pattern Classifiers", the naive Bayes combination; Dawid and Skene 1979): if the members err
+// independently given the truth, the most likely truth t given their answers a_m is
+//
+//   argmax_t  sum_m ln P_m(a_m | t)          (equal priors, as classify() with its defaults),
+//
+// over `among` (empty: the vote's classes); a tie goes to the larger posterior sum and then to
+// the class named first, as vote(). Each model gives its classes by name; a class the vote holds
+// and a member's model does not is a truth that member says nothing about. For two classes and a
+// member whose two kinds of error are equally likely, its term is rule S's weight ln(a/(1-a))
+// for its answer, without member_weight()'s floor at 0: a member under chance counts against its
+// own answer. -1 when the cut left no sample. Throws std::invalid_argument unless there is one
+// model per member.
+int answer_model_choice(const Vote& v, const std::vector<AnswerModel>& models, const ClassChoice& among = {});
+
+// The members' answer models learnt from simulation alone (rule C), where simulation_weights()
+// learns rule S's weights: member i's answer_counts() summed over every set but its own, over
+// the union of the models' classes (`among`: those only), then answer_model(). The same
+// arguments and the same caveat: one set per person.
+std::vector<AnswerModel> simulation_answer_models(const std::vector<const model::OutcomeModel*>& models,
+                                                  const std::vector<std::vector<const HapticSequence*>>& sets,
+                                                  double truncate_at = std::numeric_limits<double>::infinity(),
+                                                  const ClassChoice& among = {});
+
 // evaluate() for a committee: the confusion matrix over the union of the models' classes, every
 // labelled trial whose label one of the models knows. `per_trial` (may be null) gets every trial's
 // vote, skipped trials included (predicted -1). `weights` as vote()'s.

@@ -8,7 +8,7 @@
 # run's file keeps both votes' pairings and plots. Trials 0-1 of a 3-per-height set (--indices)
 # train the STC a 2-per-height set trains; tools/plot/committee_draws.py draws the runs together.
 # A one-member vote's ballots give that member's answer as the vote, and so do its votes weighted
-# by rule S or R; tools/plot/member_weights.py draws what the weights see.
+# by rule S or R and read by rule C; tools/plot/member_weights.py draws what the weights see.
 # -DBENCH=<bench_calib_pipeline> -DWORK=<dir> -DSTUDY=<study dir or empty> -DCAL=<a calibration>
 # -DPLOT=<tools/plot/pooled_stc.py> -DPLOT_DRAWS=<tools/plot/committee_draws.py>
 # -DPLOT_WEIGHTS=<tools/plot/member_weights.py>
@@ -292,18 +292,20 @@ endforeach()
 # The weighted votes (rules S and R, session 73): with one member, whatever its weight (rule S
 # gives it none, there being no other simulator; rule R its log-odds on the measured trials), the
 # decision is that member's answer, so each weighted vote is right on the same trials as the
-# plain vote of its question, in every column of every force set.
+# plain vote of its question, in every column of every force set. So is rule C's (session 74):
+# with no other simulator to count its answers on, its answer model says nothing and the tie
+# goes to the larger posterior sum, the member's own answer.
 string(JSON n_sets LENGTH "${json}" force_sets)
 math(EXPR last_set "${n_sets} - 1")
 foreach(f RANGE ${last_set})
-  foreach(rule simulated measured)
+  foreach(rule weighted_simulated weighted_measured answer_models_simulated)
     foreach(q "" "_good_or_missed")
       string(JSON weighted ERROR_VARIABLE json_err GET "${json}" force_sets ${f}
-             vote_weighted_${rule}${q}_accuracy_whole_and_cuts)
+             vote_${rule}${q}_accuracy_whole_and_cuts)
       string(JSON plain GET "${json}" force_sets ${f} vote${q}_accuracy_whole_and_cuts)
-      string(JSON b ERROR_VARIABLE json_err2 GET "${json}" force_sets ${f} vote_weighted_${rule}${q}_against_vote
+      string(JSON b ERROR_VARIABLE json_err2 GET "${json}" force_sets ${f} vote_${rule}${q}_against_vote
              only_first_right_whole_and_cuts)
-      string(JSON c GET "${json}" force_sets ${f} vote_weighted_${rule}${q}_against_vote only_second_right_whole_and_cuts)
+      string(JSON c GET "${json}" force_sets ${f} vote_${rule}${q}_against_vote only_second_right_whole_and_cuts)
       string(REGEX REPLACE "[ \n]" "" b "${b}")
       string(REGEX REPLACE "[ \n]" "" c "${c}")
       if(NOT weighted STREQUAL plain OR NOT b STREQUAL "[0,0,0,0,0]" OR NOT c STREQUAL "[0,0,0,0,0]")
@@ -317,6 +319,12 @@ foreach(f RANGE ${last_set})
   string(REGEX REPLACE "[ \n]" "" w "${w}")
   if(NOT w STREQUAL "[0,0,0,0,0]")
     message(FATAL_ERROR "${WORK}/s1/pooled.json, force set ${f}: a lone member's rule-S weights are ${w}, not 0")
+  endif()
+  string(JSON n GET "${json}" force_sets ${f} vote_weights 0 answer_models_good_or_missed 0
+         answer_counts_whole_and_cuts)
+  string(REGEX REPLACE "[ \n]" "" n "${n}")
+  if(NOT n STREQUAL "[[[0,0],[0,0]],[[0,0],[0,0]],[[0,0],[0,0]],[[0,0],[0,0]],[[0,0],[0,0]]]")
+    message(FATAL_ERROR "${WORK}/s1/pooled.json, force set ${f}: a lone member's rule-C counts are ${n}, not 0")
   endif()
 endforeach()
 # What the weights see, drawn; a file from before session 73 (no member on other simulators) is

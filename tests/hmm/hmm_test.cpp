@@ -505,6 +505,30 @@ HapticSequence one_sample(double f_motion, Outcome label) {
   return t;
 }
 
+// n one-sample trials, alternately good at `good_at` and missed at `missed_at`: one simulator's
+// world as a one_state_model sees it.
+std::vector<HapticSequence> one_sample_world(int n, double good_at, double missed_at) {
+  std::vector<HapticSequence> v;
+  for (int i = 0; i < n; ++i)
+    v.push_back(i % 2 ? one_sample(missed_at, Outcome::Missed) : one_sample(good_at, Outcome::Good));
+  return v;
+}
+
+std::vector<const HapticSequence*> pointers_to(const std::vector<HapticSequence>& v) {
+  std::vector<const HapticSequence*> p;
+  for (const auto& t : v) p.push_back(&t);
+  return p;
+}
+
+// x = 0 good, x = 3 missed, x = 3 good, x = 10 caught and an unlabelled x = 0.
+std::vector<HapticSequence> mixed_labels() {
+  std::vector<HapticSequence> v = {one_sample(0, Outcome::Good), one_sample(3, Outcome::Missed),
+                                   one_sample(3, Outcome::Good), one_sample(10, Outcome::Caught),
+                                   one_sample(0, Outcome::Good)};
+  v.back().label.reset();
+  return v;
+}
+
 double posterior_good(double x, double good_mean, double missed_mean) {
   return 1.0 / (1.0 + std::exp(((x - good_mean) * (x - good_mean) - (x - missed_mean) * (x - missed_mean)) / 2));
 }
@@ -715,12 +739,8 @@ TEST(HmmVote, MemberWeightIsTheLogOddsAboveChance) {
 // caught and an unlabelled one.
 TEST(HmmVote, ScoreLabelsCountsUnknownLabelsAsWrong) {
   const auto m = one_state_model(0, 3);
-  std::vector<HapticSequence> owned = {one_sample(0, Outcome::Good), one_sample(3, Outcome::Missed),
-                                       one_sample(3, Outcome::Good), one_sample(10, Outcome::Caught),
-                                       one_sample(0, Outcome::Good)};
-  owned.back().label.reset();
-  std::vector<const HapticSequence*> trials;
-  for (const auto& t : owned) trials.push_back(&t);
+  const std::vector<HapticSequence> owned = mixed_labels();
+  const std::vector<const HapticSequence*> trials = pointers_to(owned);
   const auto all = hmm::score_labels(m, trials);
   EXPECT_EQ(all.scored, 4);
   EXPECT_EQ(all.right, 2);
@@ -729,26 +749,27 @@ TEST(HmmVote, ScoreLabelsCountsUnknownLabelsAsWrong) {
   EXPECT_EQ(gm.right, 2);
 }
 
+// Three simulators' STCs and the sets they learnt from: a and b learnt that good pulls at 0 and
+// missed at 3, c the reverse; a's set holds 2 trials of a's world, b's set 4, c's set 2 of c's.
+struct ThreeSimulators {
+  std::array<model::OutcomeModel, 3> models = {one_state_model(0, 3), one_state_model(0, 3), one_state_model(3, 0)};
+  std::array<std::vector<HapticSequence>, 3> worlds = {one_sample_world(2, 0, 3), one_sample_world(4, 0, 3),
+                                                       one_sample_world(2, 3, 0)};
+  std::vector<const model::OutcomeModel*> committee() const { return {&models[0], &models[1], &models[2]}; }
+  std::vector<std::vector<const HapticSequence*>> sets() const {
+    return {pointers_to(worlds[0]), pointers_to(worlds[1]), pointers_to(worlds[2])};
+  }
+};
+
 // Rule S by hand. Members a and b learnt that good pulls at 0 and missed at 3, c the reverse;
 // a's set holds 2 trials of a's world, b's set 4, c's set 2 of c's. a on b's and c's sets: 4 of
 // 6 right, weight ln(2); b on a's and c's: 2 of 4, chance, 0; c on a's and b's: 0 of 6, 0. So
 // the committee decides as a does, even where b and c outvote it.
 TEST(HmmVote, SimulationWeightsScoreEachMemberOnTheOthersSets) {
-  const auto a = one_state_model(0, 3), b = one_state_model(0, 3), c = one_state_model(3, 0);
-  auto world = [](int n, double good_at, double missed_at) {
-    std::vector<HapticSequence> v;
-    for (int i = 0; i < n; ++i)
-      v.push_back(i % 2 ? one_sample(missed_at, Outcome::Missed) : one_sample(good_at, Outcome::Good));
-    return v;
-  };
-  const auto set_a = world(2, 0, 3), set_b = world(4, 0, 3), set_c = world(2, 3, 0);
-  auto ptrs = [](const std::vector<HapticSequence>& v) {
-    std::vector<const HapticSequence*> p;
-    for (const auto& t : v) p.push_back(&t);
-    return p;
-  };
-  const std::vector<const model::OutcomeModel*> committee = {&a, &b, &c};
-  const auto w = hmm::simulation_weights(committee, {ptrs(set_a), ptrs(set_b), ptrs(set_c)});
+  const ThreeSimulators sims;
+  const auto& [a, b, c] = sims.models;
+  const auto committee = sims.committee();
+  const auto w = hmm::simulation_weights(committee, sims.sets());
   ASSERT_EQ(w.size(), 3u);
   EXPECT_NEAR(w[0], std::log(2.0), 1e-15);
   EXPECT_EQ(w[1], 0.0);
@@ -760,7 +781,124 @@ TEST(HmmVote, SimulationWeightsScoreEachMemberOnTheOthersSets) {
   ASSERT_EQ(v.answers, (std::vector<int>{0, 1, 1}));
   EXPECT_EQ(v.predicted, 1);                           // the plain vote: missed, 2 to 1
   EXPECT_EQ(hmm::weighted_choice(v, w), 0);            // weighted: a's good
-  EXPECT_THROW(hmm::simulation_weights(committee, {ptrs(set_a)}), std::invalid_argument);
+  EXPECT_THROW(hmm::simulation_weights(committee, {sims.sets()[0]}), std::invalid_argument);
+}
+
+// The answer model is each row's frequency with 1/2 added per cell (Jeffreys), a row without
+// counts 1/K; bad shapes and negative counts are refused.
+TEST(HmmVote, AnswerModelIsTheSmoothedFrequency) {
+  const std::vector<std::string> gm = {"good", "missed"};
+  const auto a = hmm::answer_model(gm, {{3, 1}, {0, 4}});
+  EXPECT_EQ(a.classes, gm);
+  EXPECT_NEAR(a.log_p[0][0], std::log(3.5 / 5), 1e-15);
+  EXPECT_NEAR(a.log_p[0][1], std::log(1.5 / 5), 1e-15);
+  EXPECT_NEAR(a.log_p[1][0], std::log(0.5 / 5), 1e-15);  // never seen: unlikely, not impossible
+  EXPECT_NEAR(a.log_p[1][1], std::log(4.5 / 5), 1e-15);
+  const auto three = hmm::answer_model({"good", "missed", "caught"}, {{2, 0, 0}, {0, 0, 0}, {1, 1, 0}});
+  EXPECT_NEAR(three.log_p[0][0], std::log(2.5 / 3.5), 1e-15);
+  for (double lp : three.log_p[1]) EXPECT_NEAR(lp, std::log(1.0 / 3), 1e-15);  // says nothing
+  EXPECT_NEAR(three.log_p[2][2], std::log(0.5 / 3.5), 1e-15);
+  EXPECT_THROW(hmm::answer_model(gm, {{1, 1}}), std::invalid_argument);
+  EXPECT_THROW(hmm::answer_model(gm, {{1, 1}, {1}}), std::invalid_argument);
+  EXPECT_THROW(hmm::answer_model(gm, {{1, -1}, {1, 1}}), std::invalid_argument);
+  EXPECT_THROW(hmm::answer_model({"good"}, {{1}}), std::invalid_argument);
+}
+
+// A ballot by hand: member x answers good, member y missed (classes good, missed).
+hmm::Vote two_member_ballot(double posterior_good_sum) {
+  hmm::Vote v;
+  v.classes = {"good", "missed"};
+  v.votes = {1, 1};
+  v.posterior_sum = {posterior_good_sum, 2.0 - posterior_good_sum};
+  v.answers = {0, 1};
+  v.samples = 1;
+  v.predicted = posterior_good_sum > 1.0 ? 0 : 1;
+  return v;
+}
+
+// Where one weight per member and an answer model part: x is right on 24 of 30 trials (rule S's
+// weight ln 4) but calls 6 of 10 missed trials good, y is right 7 times of 10 either way (ln(7/3)).
+// By weight x's good wins; by answers, good scores ln(20.5/21) + ln(3.5/11) = -1.169 and missed
+// ln(6.5/11) + ln(7.5/11) = -0.909: x's good is weak evidence, y's missed wins.
+TEST(HmmVote, AnswerModelsWeighEachAnswerNotEachMember) {
+  const std::vector<std::string> gm = {"good", "missed"};
+  const auto v = two_member_ballot(1.0);
+  EXPECT_EQ(hmm::weighted_choice(v, {hmm::member_weight(24, 30, 2), hmm::member_weight(14, 20, 2)}), 0);
+  const std::vector<hmm::AnswerModel> models = {hmm::answer_model(gm, {{20, 0}, {6, 4}}),
+                                                hmm::answer_model(gm, {{7, 3}, {3, 7}})};
+  EXPECT_NEAR(models[0].log_p[0][0] + models[1].log_p[0][1], -1.169, 1e-3);
+  EXPECT_NEAR(models[0].log_p[1][0] + models[1].log_p[1][1], -0.909, 1e-3);
+  EXPECT_EQ(hmm::answer_model_choice(v, models), 1);
+  // Errors alike both ways: the answers' terms are the weights ln(a/(1-a)) (a = 0.7 and 0.6, up
+  // to the +1/2) and the decision is the weighted one, either member heavier.
+  for (auto [nx, ny] : {std::pair{7, 6}, std::pair{6, 7}}) {
+    const std::vector<hmm::AnswerModel> sym = {hmm::answer_model(gm, {{nx, 10 - nx}, {10 - nx, nx}}),
+                                               hmm::answer_model(gm, {{ny, 10 - ny}, {10 - ny, ny}})};
+    EXPECT_EQ(hmm::answer_model_choice(v, sym),
+              hmm::weighted_choice(v, {hmm::member_weight(nx, 10, 2), hmm::member_weight(ny, 10, 2)}));
+  }
+  // A member under chance counts against its answer (rule S would give it 0): x alone, wrong 3
+  // times in 4, answers good; the committee says missed.
+  hmm::Vote alone = v;
+  alone.answers = {0};
+  alone.votes = {1, 0};
+  EXPECT_EQ(hmm::answer_model_choice(alone, {hmm::answer_model(gm, {{1, 3}, {3, 1}})}), 1);
+  // Equal scores go to the larger posterior sum; `among` limits the classes; a cut with no sample
+  // decides nothing; one answer model per member.
+  const std::vector<hmm::AnswerModel> none = {hmm::answer_model(gm, {{0, 0}, {0, 0}}),
+                                              hmm::answer_model(gm, {{0, 0}, {0, 0}})};
+  EXPECT_EQ(hmm::answer_model_choice(two_member_ballot(1.2), none), 0);
+  EXPECT_EQ(hmm::answer_model_choice(two_member_ballot(0.8), none), 1);
+  EXPECT_EQ(hmm::answer_model_choice(v, models, {"good"}), 0);
+  EXPECT_EQ(hmm::answer_model_choice(hmm::Vote{}, models), -1);
+  EXPECT_THROW(hmm::answer_model_choice(v, {models[0]}), std::invalid_argument);
+}
+
+// answer_counts counts every answer of a model on trials of labels it may not know (a member
+// that never catches, facing a caught trial, answers missed), skips unlabelled trials and the
+// labels outside the classes or `among`, and refuses an answer it was not told to count.
+TEST(HmmVote, AnswerCountsKeepTheLabelsTheModelDoesNotKnow) {
+  const auto m = one_state_model(0, 3);
+  const std::vector<HapticSequence> owned = mixed_labels();
+  const std::vector<const HapticSequence*> trials = pointers_to(owned);
+  const std::vector<std::string> three = {"good", "missed", "caught"};
+  EXPECT_EQ(hmm::answer_counts(m, trials, three),
+            (std::vector<std::vector<int>>{{1, 1, 0}, {0, 1, 0}, {0, 1, 0}}));
+  const double all = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(hmm::answer_counts(m, trials, {"good", "missed"}, all, {"good", "missed"}),
+            (std::vector<std::vector<int>>{{1, 1}, {0, 1}}));
+  EXPECT_THROW(hmm::answer_counts(m, trials, {"good", "caught"}), std::invalid_argument);
+}
+
+// Rule C by hand on SimulationWeights' worlds (a and b learnt good at 0 and missed at 3, c the
+// reverse). a on b's and c's sets: good answered good 2, missed 1; missed answered good 1, missed
+// 2. b on a's and c's: one of each everywhere, so b tells nothing. c on a's and b's: every answer
+// the wrong one, so c's answer is read the other way round. On x = 1.6 (a and b missed, c good)
+// every term says missed; on a ballot where only c answers missed, its missed is evidence for good.
+TEST(HmmVote, SimulationAnswerModelsCountEachMemberOnTheOthersSets) {
+  const ThreeSimulators sims;
+  const auto committee = sims.committee();
+  const auto am = hmm::simulation_answer_models(committee, sims.sets());
+  ASSERT_EQ(am.size(), 3u);
+  const double l = std::log(2.5 / 4), s = std::log(1.5 / 4), h = std::log(0.5);
+  EXPECT_EQ(am[0].classes, (std::vector<std::string>{"good", "missed"}));
+  EXPECT_NEAR(am[0].log_p[0][0], l, 1e-15);
+  EXPECT_NEAR(am[0].log_p[0][1], s, 1e-15);
+  EXPECT_NEAR(am[0].log_p[1][0], s, 1e-15);
+  EXPECT_NEAR(am[0].log_p[1][1], l, 1e-15);
+  for (const auto& row : am[1].log_p)
+    for (double lp : row) EXPECT_NEAR(lp, h, 1e-15);
+  EXPECT_NEAR(am[2].log_p[0][1], std::log(3.5 / 4), 1e-15);  // c on a good trial answers missed
+  EXPECT_NEAR(am[2].log_p[0][0], std::log(0.5 / 4), 1e-15);
+  const auto v = hmm::vote(committee, one_sample(1.6, Outcome::Missed));
+  ASSERT_EQ(v.answers, (std::vector<int>{1, 1, 0}));
+  EXPECT_EQ(hmm::answer_model_choice(v, am), 1);
+  hmm::Vote w = v;
+  w.answers = {0, 0, 1};  // a and b good, c missed: every term now says good
+  EXPECT_EQ(hmm::answer_model_choice(w, am), 0);
+  w.answers = {1, 1, 1};  // all say missed: a's missed (ln(2.5/1.5)) against c's (ln(3.5/0.5))
+  EXPECT_EQ(hmm::answer_model_choice(w, am), 0);
+  EXPECT_THROW(hmm::simulation_answer_models(committee, {sims.sets()[0]}), std::invalid_argument);
 }
 
 // Determinism: the same data trains the same bits.

@@ -52,6 +52,10 @@
 //     which file is the better source). Prints the table and each simulator's early cue against
 //     the people's and its own person's, writes DIR/pooled.json (plot: tools/plot/pooled_stc.py;
 //     each trial's ballot, every member's answer beside the vote, in vote_ballots_whole_and_cuts).
+//     The same ballots are also decided by the members' weights, learnt on the other simulators'
+//     trials (rule S, hmm::simulation_weights) or on the other people's (rule R), and by each
+//     member's answer model learnt on the other simulators' trials (rule C,
+//     hmm::simulation_answer_models), each paired with the plain vote and with the 1-NN.
 //     With several seeds, each seed's sets go in its own folder and each simulator trains on the
 //     union (N x seeds per height); each calibration's STC is also trained on each seed's set
 //     alone and the seeds paired, how far one file moves between draws, under the paper's three
@@ -926,8 +930,9 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     // vote with each STC asked "good or missed?": each paired with the 1-NN's answers at the end.
     using RightOf = std::array<std::map<const HapticSequence*, bool>, 5>;
     RightOf vote_right_of, vote_good_or_missed_right_of;
-    // The same votes weighted by rule S or R ([0] / [1], below), each question ([q]).
-    std::array<std::array<RightOf, 2>, 2> weighted_right_of;
+    // The same ballots decided by rule S or R's weights or by rule C's answer models ([0] / [1] /
+    // [2], below), each question ([q]).
+    std::array<std::array<RightOf, 2>, 3> weighted_right_of;
     // One classifier per calibration, each on the trials of everyone but the calibration's person:
     // its row, and the sums over all of them into `key` (rows) and `key`_accuracy_whole_and_cuts.
     auto per_calibration = [&](const char* key, const char* all_name,
@@ -1210,10 +1215,17 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     // accuracy on the measured trials of people other than p and other than its own person (as
     // the 1-NN learns from the other people's trials). Both at the same cut and question:
     // q = 0 the paper's three classes on all trials, q = 1 "good or missed?" on the good and
-    // missed ones. sim_right[q][i][j][c]: member i on simulator j's set, scored once for every
-    // test person's committee: hmm::simulation_weights (what `dressguard classify --weigh-on`
-    // uses) from counts kept, two files of one person not scoring each other.
+    // missed ones. sim_answers[i][j][q][c]: member i's answers on simulator j's set
+    // (hmm::answer_counts over kOutcomes; q = 1 over good and missed), counted once for every
+    // test person's committee; rule S's right and scored are their diagonal and their sum, as
+    // hmm::simulation_weights (what `dressguard classify --weigh-on` uses) counts them, and rule C
+    // (session 74, fixed before its votes were looked at) learns each member's answer model from
+    // them as hmm::simulation_answer_models does. Two files of one person do not score each other.
     const std::size_t k_src = sources.size();
+    using AnswerCounts = std::vector<std::vector<int>>;
+    std::vector<std::vector<std::array<std::array<AnswerCounts, 5>, 2>>> sim_answers(
+        k_src, std::vector<std::array<std::array<AnswerCounts, 5>, 2>>(k_src));
+    const std::vector<std::string> kOutcomes = {"good", "missed", "caught"};
     std::vector<std::vector<std::array<std::array<int, 5>, 2>>> sim_right(
         k_src, std::vector<std::array<std::array<int, 5>, 2>>(k_src)),
         sim_scored = sim_right;
@@ -1229,8 +1241,14 @@ int run_pooled(const std::map<std::string, std::string>& a) {
         for (std::size_t j = 0; j < k_src; ++j) {
           if (sources[j].participant == sources[i].participant) continue;
           for (int q = 0; q < 2; ++q) {
-            right_of_labels(singles[i], set_of[j], questions[q],
-                            sim_right[i][j][q].data(), sim_scored[i][j][q].data());
+            for (int c = 0; c < 5; ++c) {
+              const double cut = c == 0 ? std::numeric_limits<double>::infinity() : kCuts[c - 1];
+              const AnswerCounts& n = sim_answers[i][j][q][c] =
+                  hmm::answer_counts(singles[i], set_of[j], q == 0 ? kOutcomes : questions[q], cut, questions[q]);
+              for (std::size_t t = 0; t < n.size(); ++t)
+                for (std::size_t a = 0; a < n.size(); ++a)
+                  sim_scored[i][j][q][c] += n[t][a], sim_right[i][j][q][c] += t == a ? n[t][a] : 0;
+            }
             for (int c = 0; c < 5; ++c) all_right[q][c] += sim_right[i][j][q][c], all_scored[q][c] += sim_scored[i][j][q][c];
           }
         }
@@ -1270,8 +1288,9 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       // that differ in one member show on which trials and how that member moved the vote.
       Json jballots[5];
       for (auto& j : jballots) j = Json::array();
-      // The weighted votes (rules S and R above, each question): right counts and per trial.
-      int weighted_right[2][2][5] = {};
+      // The weighted votes (rules S and R above) and rule C's (each member's answer model, learnt
+      // where rule S learns its weight), each question: right counts and per trial.
+      int weighted_right[3][2][5] = {};
       Json jweights = Json::array();
       for (const auto& p : people) {
         std::vector<const HapticSequence*> test;
@@ -1295,20 +1314,51 @@ int run_pooled(const std::map<std::string, std::string>& a) {
             member_src.push_back(s);
             for (const auto& h : singles[s].classes) union_classes.insert(h.name);
           }
-        // weights[rule][q][c][member]
+        // weights[rule][q][c][member]; rule C's answer models answer_models[q][c][member].
         std::array<std::array<std::array<std::vector<double>, 5>, 2>, 2> weights;
+        std::array<std::array<std::vector<hmm::AnswerModel>, 5>, 2> answer_models;
         Json jw = Json::object();
         jw.set("participant", p);
         for (int q = 0; q < 2; ++q) {
           const hmm::ClassChoice among = q == 0 ? hmm::ClassChoice{} : good_or_missed;
           const int classes = q == 0 ? static_cast<int>(union_classes.size()) : 2;
-          Json jq[2] = {Json::array(), Json::array()};
+          Json jq[3] = {Json::array(), Json::array(), Json::array()};
           for (std::size_t k = 0; k < member_src.size(); ++k) {
             const std::size_t i = member_src[k];
             std::array<int, 5> sr{}, sn{}, rr{}, rn{};
+            // Rule C's classes: the question's, of the three-class question those of the union.
+            std::vector<std::size_t> kept;
+            for (std::size_t t = 0; t < (q == 0 ? kOutcomes.size() : 2); ++t)
+              if (q == 1 || union_classes.count(kOutcomes[t])) kept.push_back(t);
+            std::vector<std::string> kept_names;
+            for (std::size_t t : kept) kept_names.push_back(kOutcomes[t]);
+            std::array<AnswerCounts, 5> ac;
+            for (auto& n : ac) n.assign(kept.size(), std::vector<int>(kept.size(), 0));
             for (std::size_t j : member_src)
               if (sources[j].participant != sources[i].participant)
-                for (int c = 0; c < 5; ++c) sr[c] += sim_right[i][j][q][c], sn[c] += sim_scored[i][j][q][c];
+                for (int c = 0; c < 5; ++c) {
+                  sr[c] += sim_right[i][j][q][c], sn[c] += sim_scored[i][j][q][c];
+                  for (std::size_t t = 0; t < kept.size(); ++t)
+                    for (std::size_t a = 0; a < kept.size(); ++a) ac[c][t][a] += sim_answers[i][j][q][c][kept[t]][kept[a]];
+                }
+            Json jc = Json::array();  // rule C's counts[truth][answer] over `classes`, whole and at each cut
+            for (int c = 0; c < 5; ++c) {
+              answer_models[q][c].push_back(hmm::answer_model(kept_names, ac[c]));
+              Json rows = Json::array();
+              for (const auto& row : ac[c]) {
+                Json r = Json::array();
+                for (int n : row) r.push(n);
+                rows.push(r);
+              }
+              jc.push(rows);
+            }
+            Json jn = Json::array();
+            for (const auto& name : kept_names) jn.push(name);
+            Json ja = Json::object();
+            ja.set("member", member_files[k]);
+            ja.set("classes", jn);
+            ja.set("answer_counts_whole_and_cuts", jc);
+            jq[2].push(ja);
             // Rule R's trials: the measured ones of neither p nor this member's person.
             std::vector<const HapticSequence*> others;
             for (const auto* t : all)
@@ -1331,6 +1381,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
           }
           jw.set(q == 0 ? "simulated_three_classes" : "simulated_good_or_missed", jq[0]);
           jw.set(q == 0 ? "measured_three_classes" : "measured_good_or_missed", jq[1]);
+          jw.set(q == 0 ? "answer_models_three_classes" : "answer_models_good_or_missed", jq[2]);
         }
         jweights.push(jw);
         for (int c = 0; c < 5; ++c) {
@@ -1354,12 +1405,14 @@ int run_pooled(const std::map<std::string, std::string>& a) {
           for (std::size_t i = 0; i < test.size(); ++i)
             vote_good_or_missed_right_of[c][test[i]] = hmm::right_or_not(gm_votes[i], *test[i]) == 1;
           // The same ballots, decided by the weights (a trial the plain vote skips is skipped).
-          for (int rule = 0; rule < 2; ++rule)
+          for (int rule = 0; rule < 3; ++rule)
             for (int q = 0; q < 2; ++q) {
               const std::vector<hmm::Vote>& vs = q == 0 ? votes : gm_votes;
               for (std::size_t i = 0; i < test.size(); ++i) {
                 if (hmm::right_or_not(vs[i], *test[i]) < 0) continue;
-                const int choice = hmm::weighted_choice(vs[i], weights[rule][q][c]);
+                const int choice = rule < 2 ? hmm::weighted_choice(vs[i], weights[rule][q][c])
+                                            : hmm::answer_model_choice(vs[i], answer_models[q][c],
+                                                                       q == 0 ? hmm::ClassChoice{} : good_or_missed);
                 const bool right = choice >= 0 && vs[i].classes[choice] == outcome_name(*test[i]->label);
                 weighted_right[rule][q][c] += right;
                 weighted_right_of[rule][q][c][test[i]] = right;
@@ -1376,12 +1429,14 @@ int run_pooled(const std::map<std::string, std::string>& a) {
       print_row("vote, priors the training shares", share_right, nm);
       print_row("vote, training shares, good or missed", share2_right, nm);
       print_row("mixture of the other people's STCs", mix_right, nm);
-      const char* weighted_names[2][2] = {
+      const char* weighted_names[3][2] = {
           {"vote weighted by the simulators (rule S)", "vote weighted by the simulators, good|missed"},
-          {"vote weighted by measured trials (rule R)", "vote weighted by measured trials, good|missed"}};
-      const char* weighted_keys[2][2] = {{"vote_weighted_simulated", "vote_weighted_simulated_good_or_missed"},
-                                         {"vote_weighted_measured", "vote_weighted_measured_good_or_missed"}};
-      for (int rule = 0; rule < 2; ++rule)
+          {"vote weighted by measured trials (rule R)", "vote weighted by measured trials, good|missed"},
+          {"answers read by the simulators (rule C)", "answers read by the simulators, good|missed"}};
+      const char* weighted_keys[3][2] = {{"vote_weighted_simulated", "vote_weighted_simulated_good_or_missed"},
+                                         {"vote_weighted_measured", "vote_weighted_measured_good_or_missed"},
+                                         {"vote_answer_models_simulated", "vote_answer_models_simulated_good_or_missed"}};
+      for (int rule = 0; rule < 3; ++rule)
         for (int q = 0; q < 2; ++q) {
           print_row(weighted_names[rule][q], weighted_right[rule][q], nm);
           jset.set(std::string(weighted_keys[rule][q]) + "_accuracy_whole_and_cuts", pct(weighted_right[rule][q], nm));
@@ -1395,9 +1450,9 @@ int run_pooled(const std::map<std::string, std::string>& a) {
             if (right) ids[c].insert(t->id);
         return ids;
       };
-      for (int rule = 0; rule < 2; ++rule)
+      for (int rule = 0; rule < 3; ++rule)
         for (int q = 0; q < 2; ++q) {
-          Json j = pair_row(std::string(rule == 0 ? "S" : "R") + (q == 0 ? "" : " good|missed") +
+          Json j = pair_row(std::string("SRC"[rule], 1) + (q == 0 ? "" : " good|missed") +
                                 " vs plain vote, b/c p",
                             ids_of(weighted_right_of[rule][q]),
                             ids_of(q == 0 ? vote_right_of : vote_good_or_missed_right_of));
@@ -1486,6 +1541,9 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     vote_against_one_nn("R vs 1-NN", "vote_weighted_measured_against_one_nn_at_cuts", weighted_right_of[1][0]);
     vote_against_one_nn("R good|missed vs 1-NN", "vote_weighted_measured_good_or_missed_against_one_nn_at_cuts",
                         weighted_right_of[1][1]);
+    vote_against_one_nn("C vs 1-NN", "vote_answer_models_simulated_against_one_nn_at_cuts", weighted_right_of[2][0]);
+    vote_against_one_nn("C good|missed vs 1-NN", "vote_answer_models_simulated_good_or_missed_against_one_nn_at_cuts",
+                        weighted_right_of[2][1]);
     jset.set("per_participant", jper);
     jset.set("pooled_accuracy_whole_and_cuts", pct(pooled_right, n));
     jset.set("pooled_equal_size_accuracy_whole_and_cuts", pct(equal_right, n));

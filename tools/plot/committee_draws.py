@@ -11,7 +11,7 @@ its STCs trained on, its --indices and, where the runs' members differ, the file
 those every run holds. One panel per force set and per vote (the paper's rule;
 each STC asked "good or missed?"; where every run has them, the same question decided by the
 members' weights, rule S from the simulators alone and rule R from the other people's measured
-trials, session 73); a line per run, the 1-NN in black with its 95 % interval at
+trials, session 73, and by the members' answer models, rule C, session 74); a line per run, the 1-NN in black with its 95 % interval at
 each cut, from the first file (every run of one set of calibrations faces the same trials).
 The whole sequence is drawn right of the cuts.
 """
@@ -26,13 +26,17 @@ from pooled_stc import CUTS, WHOLE_X, cuts_then_whole, read_run  # as the per-ru
 VOTES = [("vote_accuracy_whole_and_cuts", "vote_against_one_nn_at_cuts", "vote (the paper's rule)"),
          ("vote_good_or_missed_accuracy_whole_and_cuts", "vote_good_or_missed_against_one_nn_at_cuts",
           'vote, each STC asked "good or missed?"')]
-# Drawn when every run has them (runs before session 73 do not): the weighted votes, same question.
+# Drawn when every run has them (runs before session 73 do not; rule C's, before session 74): the
+# weighted votes and rule C's, same question.
 WEIGHTED = [("vote_weighted_simulated_good_or_missed_accuracy_whole_and_cuts",
              "vote_weighted_simulated_good_or_missed_against_one_nn_at_cuts",
              'good or missed, weighted by the simulators (rule S)'),
             ("vote_weighted_measured_good_or_missed_accuracy_whole_and_cuts",
              "vote_weighted_measured_good_or_missed_against_one_nn_at_cuts",
-             'good or missed, weighted by measured trials (rule R)')]
+             'good or missed, weighted by measured trials (rule R)'),
+            ("vote_answer_models_simulated_good_or_missed_accuracy_whole_and_cuts",
+             "vote_answer_models_simulated_good_or_missed_against_one_nn_at_cuts",
+             "good or missed, answers read by the simulators (rule C)")]
 
 
 def members(d):  # the calibration files' stems, the committee's members
