@@ -836,7 +836,8 @@ AnswerModel answer_model(const std::vector<std::string>& classes, const std::vec
   return a;
 }
 
-std::vector<std::vector<int>> answer_counts(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials,
+std::vector<std::vector<int>> answer_counts(const model::OutcomeModel& m,
+                                            const std::vector<const HapticSequence*>& trials,
                                             const std::vector<std::string>& classes, double truncate_at,
                                             const ClassChoice& among) {
   std::vector<std::vector<int>> counts(classes.size(), std::vector<int>(classes.size(), 0));
@@ -849,7 +850,8 @@ std::vector<std::vector<int>> answer_counts(const model::OutcomeModel& m, const 
     if (seq.size() == 0) continue;
     const std::string& said = m.classes[classify(m, seq, among).predicted].name;
     const int answer = index_of(classes, said);
-    if (answer < 0) throw std::invalid_argument("answer_counts: the model answers '" + said + "', not one of the classes counted");
+    if (answer < 0)
+      throw std::invalid_argument("answer_counts: the model answers '" + said + "', not one of the classes counted");
     ++counts[truth][answer];
   }
   return counts;

@@ -288,7 +288,8 @@ AnswerModel answer_model(const std::vector<std::string>& classes, const std::vec
 // the cut; an answer not in `classes` throws std::invalid_argument. The confusion matrix of
 // evaluate(), but over classes the model may not know (a simulator that never catches, facing
 // caught trials: every answer it gives them counts).
-std::vector<std::vector<int>> answer_counts(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials,
+std::vector<std::vector<int>> answer_counts(const model::OutcomeModel& m,
+                                            const std::vector<const HapticSequence*>& trials,
                                             const std::vector<std::string>& classes,
                                             double truncate_at = std::numeric_limits<double>::infinity(),
                                             const ClassChoice& among = {});

@@ -1339,7 +1339,8 @@ int run_pooled(const std::map<std::string, std::string>& a) {
                 for (int c = 0; c < 5; ++c) {
                   sr[c] += sim_right[i][j][q][c], sn[c] += sim_scored[i][j][q][c];
                   for (std::size_t t = 0; t < kept.size(); ++t)
-                    for (std::size_t a = 0; a < kept.size(); ++a) ac[c][t][a] += sim_answers[i][j][q][c][kept[t]][kept[a]];
+                    for (std::size_t a = 0; a < kept.size(); ++a)
+                      ac[c][t][a] += sim_answers[i][j][q][c][kept[t]][kept[a]];
                 }
             Json jc = Json::array();  // rule C's counts[truth][answer] over `classes`, whole and at each cut
             for (int c = 0; c < 5; ++c) {

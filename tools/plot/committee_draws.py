@@ -8,12 +8,12 @@ classifier on the other people's measured curves.
 usage: committee_draws.py POOLED.json [POOLED.json ...] OUT.png
 Each POOLED.json is a file the bench wrote; each is labelled by its seeds, the trials per height
 its STCs trained on, its --indices and, where the runs' members differ, the files it holds beyond
-those every run holds. One panel per force set and per vote (the paper's rule;
-each STC asked "good or missed?"; where every run has them, the same question decided by the
-members' weights, rule S from the simulators alone and rule R from the other people's measured
-trials, session 73, and by the members' answer models, rule C, session 74); a line per run, the 1-NN in black with its 95 % interval at
-each cut, from the first file (every run of one set of calibrations faces the same trials).
-The whole sequence is drawn right of the cuts.
+those every run holds. One panel per force set and per vote (the paper's rule; each STC asked
+"good or missed?"; where every run has them, the same question decided by the members' weights,
+rule S from the simulators alone and rule R from the other people's measured trials, session 73,
+and by the members' answer models, rule C, session 74); a line per run, the 1-NN in black with
+its 95 % interval at each cut, from the first file (every run of one set of calibrations faces
+the same trials). The whole sequence is drawn right of the cuts.
 """
 import sys
 
@@ -36,7 +36,7 @@ WEIGHTED = [("vote_weighted_simulated_good_or_missed_accuracy_whole_and_cuts",
              'good or missed, weighted by measured trials (rule R)'),
             ("vote_answer_models_simulated_good_or_missed_accuracy_whole_and_cuts",
              "vote_answer_models_simulated_good_or_missed_against_one_nn_at_cuts",
-             "good or missed, answers read by the simulators (rule C)")]
+             "good or missed, answer models (rule C)")]
 
 
 def members(d):  # the calibration files' stems, the committee's members
