@@ -866,7 +866,7 @@ int answer_model_choice(const Vote& v, const std::vector<AnswerModel>& models, c
   double best_score = 0;
   for (size_t t = 0; t < v.classes.size(); ++t) {
     if (!among.empty() && std::find(among.begin(), among.end(), v.classes[t]) == among.end()) continue;
-    double score = 0;  // sum_m ln P_m(a_m | t); a member that knows neither t nor its answer adds nothing
+    double score = 0;  // sum_m ln P_m(a_m | t); a member whose model lacks t or its answer adds nothing
     for (size_t m = 0; m < models.size(); ++m) {
       const int row = index_of(models[m].classes, v.classes[t]);
       const int col = index_of(models[m].classes, v.classes[v.answers[m]]);

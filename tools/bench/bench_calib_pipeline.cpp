@@ -88,6 +88,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <set>
 #include <sstream>
 #include <string>
@@ -1226,9 +1227,17 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     std::vector<std::vector<std::array<std::array<AnswerCounts, 5>, 2>>> sim_answers(
         k_src, std::vector<std::array<std::array<AnswerCounts, 5>, 2>>(k_src));
     const std::vector<std::string> kOutcomes = {"good", "missed", "caught"};
-    std::vector<std::vector<std::array<std::array<int, 5>, 2>>> sim_right(
-        k_src, std::vector<std::array<std::array<int, 5>, 2>>(k_src)),
-        sim_scored = sim_right;
+    // Rule S's counts of one member on one set: right the diagonal, scored every answer.
+    auto right_in = [](const AnswerCounts& n) {
+      int k = 0;
+      for (std::size_t t = 0; t < n.size(); ++t) k += n[t][t];
+      return k;
+    };
+    auto scored_in = [](const AnswerCounts& n) {
+      int k = 0;
+      for (const auto& row : n) k += std::accumulate(row.begin(), row.end(), 0);
+      return k;
+    };
     {
       const hmm::ClassChoice questions[2] = {{}, {"good", "missed"}};
       std::vector<std::vector<const HapticSequence*>> set_of(k_src);
@@ -1245,11 +1254,8 @@ int run_pooled(const std::map<std::string, std::string>& a) {
               const double cut = c == 0 ? std::numeric_limits<double>::infinity() : kCuts[c - 1];
               const AnswerCounts& n = sim_answers[i][j][q][c] =
                   hmm::answer_counts(singles[i], set_of[j], q == 0 ? kOutcomes : questions[q], cut, questions[q]);
-              for (std::size_t t = 0; t < n.size(); ++t)
-                for (std::size_t a = 0; a < n.size(); ++a)
-                  sim_scored[i][j][q][c] += n[t][a], sim_right[i][j][q][c] += t == a ? n[t][a] : 0;
+              all_right[q][c] += right_in(n), all_scored[q][c] += scored_in(n);
             }
-            for (int c = 0; c < 5; ++c) all_right[q][c] += sim_right[i][j][q][c], all_scored[q][c] += sim_scored[i][j][q][c];
           }
         }
         std::printf("  %-50s", ("on other simulators: " + fs::path(sources[i].file).stem().string()).c_str());
@@ -1337,7 +1343,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
             for (std::size_t j : member_src)
               if (sources[j].participant != sources[i].participant)
                 for (int c = 0; c < 5; ++c) {
-                  sr[c] += sim_right[i][j][q][c], sn[c] += sim_scored[i][j][q][c];
+                  sr[c] += right_in(sim_answers[i][j][q][c]), sn[c] += scored_in(sim_answers[i][j][q][c]);
                   for (std::size_t t = 0; t < kept.size(); ++t)
                     for (std::size_t a = 0; a < kept.size(); ++a)
                       ac[c][t][a] += sim_answers[i][j][q][c][kept[t]][kept[a]];
