@@ -780,16 +780,21 @@ double member_weight(int right, int n, int classes) {
 
 LabelScore score_labels(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials,
                         double truncate_at, const ClassChoice& among) {
-  LabelScore s;
-  for (const auto* t : trials) {
-    if (!t->label) continue;
-    const std::string label(outcome_name(*t->label));
-    if (!among.empty() && std::find(among.begin(), among.end(), label) == among.end()) continue;
-    const FeatureSequence seq = features_of(*t, m.features, truncate_at);
-    if (seq.size() == 0) continue;
-    ++s.scored;
-    s.right += m.classes[classify(m, seq, among).predicted].name == label;
+  // Every label a trial can carry and every answer the model can give, so that answer_counts()
+  // counts each labelled trial (among: those labels only).
+  std::vector<std::string> classes = among;
+  if (classes.empty()) {
+    for (Outcome o : {Outcome::Good, Outcome::Missed, Outcome::Caught}) classes.emplace_back(outcome_name(o));
+    for (const auto& h : m.classes)
+      if (index_of(classes, h.name) < 0) classes.push_back(h.name);
   }
+  return label_score(answer_counts(m, trials, classes, truncate_at, among));
+}
+
+LabelScore label_score(const std::vector<std::vector<int>>& counts) {
+  LabelScore s;
+  for (size_t t = 0; t < counts.size(); ++t)
+    for (size_t a = 0; a < counts[t].size(); ++a) s.scored += counts[t][a], s.right += t == a ? counts[t][a] : 0;
   return s;
 }
 

@@ -244,6 +244,9 @@ struct LabelScore {
 };
 LabelScore score_labels(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials,
                         double truncate_at = std::numeric_limits<double>::infinity(), const ClassChoice& among = {});
+// The same score of counts[truth][answer] (answer_counts(), below): right the diagonal, scored
+// every count.
+LabelScore label_score(const std::vector<std::vector<int>>& counts);
 
 // The members' weights learnt from simulation alone (rule S; offline/calib/MEASUREMENTS.md,
 // session 73): member i is scored (score_labels) on every set but its own, `sets[j]` being the

@@ -88,7 +88,6 @@
 #include <functional>
 #include <limits>
 #include <map>
-#include <numeric>
 #include <set>
 #include <sstream>
 #include <string>
@@ -1227,17 +1226,6 @@ int run_pooled(const std::map<std::string, std::string>& a) {
     std::vector<std::vector<std::array<std::array<AnswerCounts, 5>, 2>>> sim_answers(
         k_src, std::vector<std::array<std::array<AnswerCounts, 5>, 2>>(k_src));
     const std::vector<std::string> kOutcomes = {"good", "missed", "caught"};
-    // Rule S's counts of one member on one set: right the diagonal, scored every answer.
-    auto right_in = [](const AnswerCounts& n) {
-      int k = 0;
-      for (std::size_t t = 0; t < n.size(); ++t) k += n[t][t];
-      return k;
-    };
-    auto scored_in = [](const AnswerCounts& n) {
-      int k = 0;
-      for (const auto& row : n) k += std::accumulate(row.begin(), row.end(), 0);
-      return k;
-    };
     {
       const hmm::ClassChoice questions[2] = {{}, {"good", "missed"}};
       std::vector<std::vector<const HapticSequence*>> set_of(k_src);
@@ -1254,7 +1242,8 @@ int run_pooled(const std::map<std::string, std::string>& a) {
               const double cut = c == 0 ? std::numeric_limits<double>::infinity() : kCuts[c - 1];
               const AnswerCounts& n = sim_answers[i][j][q][c] =
                   hmm::answer_counts(singles[i], set_of[j], q == 0 ? kOutcomes : questions[q], cut, questions[q]);
-              all_right[q][c] += right_in(n), all_scored[q][c] += scored_in(n);
+              const hmm::LabelScore ls = hmm::label_score(n);
+              all_right[q][c] += ls.right, all_scored[q][c] += ls.scored;
             }
           }
         }
@@ -1343,7 +1332,8 @@ int run_pooled(const std::map<std::string, std::string>& a) {
             for (std::size_t j : member_src)
               if (sources[j].participant != sources[i].participant)
                 for (int c = 0; c < 5; ++c) {
-                  sr[c] += right_in(sim_answers[i][j][q][c]), sn[c] += scored_in(sim_answers[i][j][q][c]);
+                  const hmm::LabelScore ls = hmm::label_score(sim_answers[i][j][q][c]);
+                  sr[c] += ls.right, sn[c] += ls.scored;
                   for (std::size_t t = 0; t < kept.size(); ++t)
                     for (std::size_t a = 0; a < kept.size(); ++a)
                       ac[c][t][a] += sim_answers[i][j][q][c][kept[t]][kept[a]];
