@@ -27,6 +27,9 @@ void write_file_atomic(const std::filesystem::path& path, std::string_view conte
 
 // The study's shared/ folder: $DRESSGUARD_SHARED_DIR, else the build-time default, else
 // ../shared relative to the working directory. Empty when none of them holds data/.
+// A non-empty $DRESSGUARD_SHARED_DIR is taken at its word: one without data/ means the data is
+// absent, not "look elsewhere", so that a run (or a test) can be made as on a machine without
+// ../shared, e.g. DRESSGUARD_SHARED_DIR=/nonexistent.
 std::filesystem::path shared_dir();
 
 }  // namespace dressguard

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <unistd.h>
 #include <fstream>
@@ -166,4 +167,30 @@ TEST(Pull, TimeAtTravelAndUnrecordedStart) {
   for (auto& smp : s.samples) smp.t *= 3.0;       // the same start at a 30 ms period
   EXPECT_EQ(unrecorded_samples(s), 36u);          // 1.09 / 0.03 = 36.3
   EXPECT_EQ(unrecorded_samples(HapticSequence{}), 0u);
+}
+
+// Where the study's data is looked for: an explicit $DRESSGUARD_SHARED_DIR with data/ in it is
+// used; one without data/ means "absent" even when the build's default holds the data, which is
+// how tests run the project as on a machine without ../shared. Unset, the build's default (or
+// ../shared) is used, so that result does not depend on this test's own environment.
+TEST(SharedDir, AnExplicitFolderIsTakenAtItsWord) {
+  const char* before = std::getenv("DRESSGUARD_SHARED_DIR");
+  const std::string saved = before ? before : "";
+  TempDir with("shared_with"), without("shared_without");
+  fs::create_directories(with.path / "data");
+
+  ASSERT_EQ(::setenv("DRESSGUARD_SHARED_DIR", with.path.c_str(), 1), 0);
+  EXPECT_EQ(shared_dir(), with.path);
+  ASSERT_EQ(::setenv("DRESSGUARD_SHARED_DIR", without.path.c_str(), 1), 0);
+  EXPECT_TRUE(shared_dir().empty()) << shared_dir();
+  ASSERT_EQ(::setenv("DRESSGUARD_SHARED_DIR", (without.path / "nonexistent").c_str(), 1), 0);
+  EXPECT_TRUE(shared_dir().empty()) << shared_dir();
+  // Set but empty is as if unset: whatever the build's default or ../shared gives.
+  ASSERT_EQ(::unsetenv("DRESSGUARD_SHARED_DIR"), 0);
+  const fs::path unset = shared_dir();
+  ASSERT_EQ(::setenv("DRESSGUARD_SHARED_DIR", "", 1), 0);
+  EXPECT_EQ(shared_dir(), unset);
+
+  if (before) ::setenv("DRESSGUARD_SHARED_DIR", saved.c_str(), 1);
+  else ::unsetenv("DRESSGUARD_SHARED_DIR");
 }

@@ -82,6 +82,10 @@ if(NOT rc EQUAL 0 OR NOT gown_json MATCHES "\"grasped\": ([0-9]+)")
   message(FATAL_ERROR "gown --rim-ahead 0.5 --json: rc=${rc} ${gown_json} ${err}")
 endif()
 set(grasped_far ${CMAKE_MATCH_1})
+# -DEXPECT_GOWN=parametric: the run is meant to be as without shared/data (cli_simulate_without_shared).
+if(DEFINED EXPECT_GOWN AND NOT gown_json MATCHES "\"source\": \"${EXPECT_GOWN}\"")
+  message(FATAL_ERROR "expected the ${EXPECT_GOWN} gown: ${gown_json}")
+endif()
 execute_process(COMMAND ${DG} simulate --height high --gown coarse --rim-ahead 0.5 --out ${TMP}/dg_grip_off.csv
                 RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
 if(gown_json MATCHES "\"source\": \"parametric\"")
