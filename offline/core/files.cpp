@@ -59,7 +59,8 @@ void write_file_atomic(const fs::path& path, std::string_view content) {
 
 fs::path shared_dir() {
   auto holds_data = [](const fs::path& p) { return !p.empty() && fs::is_directory(p / "data"); };
-  if (const char* env = std::getenv("DRESSGUARD_SHARED_DIR"); env && *env) return holds_data(env) ? fs::path(env) : fs::path{};
+  if (const char* env = std::getenv("DRESSGUARD_SHARED_DIR"); env && *env)
+    return holds_data(env) ? fs::path(env) : fs::path{};  // taken at its word (files.h)
   if (holds_data(DRESSGUARD_DEFAULT_SHARED_DIR)) return fs::path(DRESSGUARD_DEFAULT_SHARED_DIR);
   if (holds_data("../shared")) return fs::path("../shared");
   return {};

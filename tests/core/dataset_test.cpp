@@ -1,4 +1,5 @@
-// Datasets: round trip, errors that name the file and line, atomic writes, the study import.
+// Datasets: round trip, errors that name the file and line, atomic writes, the study import;
+// where the study's data is looked for (shared_dir).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -174,8 +175,16 @@ TEST(Pull, TimeAtTravelAndUnrecordedStart) {
 // how tests run the project as on a machine without ../shared. Unset, the build's default (or
 // ../shared) is used, so that result does not depend on this test's own environment.
 TEST(SharedDir, AnExplicitFolderIsTakenAtItsWord) {
-  const char* before = std::getenv("DRESSGUARD_SHARED_DIR");
-  const std::string saved = before ? before : "";
+  // Puts the variable back as it was however the test ends (an ASSERT returns early), so that
+  // the tests after it in the same process see the environment ctest gave them.
+  struct RestoreSharedDir {
+    const char* before = std::getenv("DRESSGUARD_SHARED_DIR");
+    const std::string saved = before ? before : "";
+    ~RestoreSharedDir() {
+      if (before) ::setenv("DRESSGUARD_SHARED_DIR", saved.c_str(), 1);
+      else ::unsetenv("DRESSGUARD_SHARED_DIR");
+    }
+  } restore;
   TempDir with("shared_with"), without("shared_without");
   fs::create_directories(with.path / "data");
 
@@ -190,7 +199,4 @@ TEST(SharedDir, AnExplicitFolderIsTakenAtItsWord) {
   const fs::path unset = shared_dir();
   ASSERT_EQ(::setenv("DRESSGUARD_SHARED_DIR", "", 1), 0);
   EXPECT_EQ(shared_dir(), unset);
-
-  if (before) ::setenv("DRESSGUARD_SHARED_DIR", saved.c_str(), 1);
-  else ::unsetenv("DRESSGUARD_SHARED_DIR");
 }
