@@ -27,12 +27,12 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <random>
 #include <vector>
 
 #include "constraints.h"
 #include "model.h"
+#include "sim_kernel_setup.h"
 #include "trial.h"
 
 using namespace dressguard::sim;
@@ -85,28 +85,14 @@ enum Variant { kEdges, kShear, kEdgesAndShear, kElementInTurn, kElementAtOnce, k
 }  // namespace
 
 int main(int argc, char** argv) {
-  int reps = 5;
-  for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--reps") == 0 && i + 1 < argc) {
-      reps = std::atoi(argv[++i]);
-    } else {
-      std::fprintf(stderr, "usage: bench_sim_elements [--reps N]\n");
-      return 2;
-    }
-  }
-  if (reps < 1) {
-    std::fprintf(stderr, "bench_sim_elements: --reps must be at least 1\n");
-    return 2;
-  }
+  const int reps = dressguard::bench::parse_reps(argc, argv, "bench_sim_elements");
+  if (reps == 0) return 2;
   constexpr int kSubsteps = 600;  // per timing: 0.1 s of simulated time
   for (const GownResolution res : {GownResolution::Reduced, GownResolution::Full}) {
-    const Scene scene = make_default_scene(res);
-    const SceneData& s = scene.data();
-    ClothParams p;  // participant 4's paper-budget cloth
-    p.stretch = 0.19266707117227413;
-    p.shear = 0.52909917993358069;
-    p.bend = 0.73316639164263386;
-    const GownModel m = make_model(s, p, FrictionScheme::Improved, true, 0.0);
+    const dressguard::bench::KernelSetup k = dressguard::bench::kernel_setup(res);
+    const SceneData& s = k.scene.data();
+    const GownModel& m = k.model;
+    const std::vector<V3>& start = k.start;
     const double h2 = m.h * m.h;
 
     std::vector<double> r;  // bending: h^2 sum w k^2 / alpha per stencil
@@ -116,10 +102,6 @@ int main(int argc, char** argv) {
       if (sw > 0) r.push_back(sw * h2 / m.alpha_bend);
     }
 
-    std::mt19937_64 rng(1);
-    std::normal_distribution<double> jitter(0, 1e-3);
-    std::vector<V3> start(s.rest.size());
-    for (std::size_t i = 0; i < start.size(); ++i) start[i] = s.rest[i] + V3{jitter(rng), jitter(rng), jitter(rng)};
     const double at = m.alpha_stretch / h2, ac = m.alpha_compress / h2;
     double best[kVariants];
     std::fill(best, best + kVariants, 1e30);

@@ -7,3 +7,7 @@ target_link_libraries(bench_sim PRIVATE dg_sim)
 add_executable(bench_sim_elements ${CMAKE_CURRENT_LIST_DIR}/bench_sim_elements.cpp)
 target_link_libraries(bench_sim_elements PRIVATE dg_sim)
 target_compile_options(bench_sim_elements PRIVATE $<$<CXX_COMPILER_ID:GNU,Clang>:-ffp-contract=off>)
+# bench_sim_kernels: whether the constraint stream's size or moving vertices into lanes sets the
+# AVX2 kernels' pace, and the floor that leaves against the speed goals (MEASUREMENTS.md, session 76).
+add_executable(bench_sim_kernels ${CMAKE_CURRENT_LIST_DIR}/bench_sim_kernels.cpp)
+target_link_libraries(bench_sim_kernels PRIVATE dg_sim)
