@@ -26,8 +26,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
-#include <random>
 #include <vector>
 
 #include "constraints.h"
