@@ -11,3 +11,7 @@ target_compile_options(bench_sim_elements PRIVATE $<$<CXX_COMPILER_ID:GNU,Clang>
 # AVX2 kernels' pace, and the floor that leaves against the speed goals (MEASUREMENTS.md, session 76).
 add_executable(bench_sim_kernels ${CMAKE_CURRENT_LIST_DIR}/bench_sim_kernels.cpp)
 target_link_libraries(bench_sim_kernels PRIVATE dg_sim)
+# bench_sim_vertex_pass: a vertex-centric pass (Vertex Block Descent) against the tree's
+# constraint pass, its cost and its work per pass (MEASUREMENTS.md, session 77).
+add_executable(bench_sim_vertex_pass ${CMAKE_CURRENT_LIST_DIR}/bench_sim_vertex_pass.cpp)
+target_link_libraries(bench_sim_vertex_pass PRIVATE dg_sim)
