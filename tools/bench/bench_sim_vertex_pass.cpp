@@ -9,7 +9,8 @@
 // no element, each free vertex i takes one Newton step on the incremental potential with its
 // neighbours held:
 //   G(x) = sum_i m_i / (2 h^2) |x_i - y_i|^2 + sum_c E_c(x),
-//   H_i dx_i = -g_i,   H_i = m_i / h^2 I + sum_{c ∋ i} d2E_c / dx_i^2,   g_i = m_i / h^2 (x_i - y_i) + sum dE_c / dx_i,
+//   H_i dx_i = -g_i,   H_i = m_i / h^2 I + sum_{c at i} d2E_c / dx_i^2,
+//                      g_i = m_i / h^2 (x_i - y_i) + sum_{c at i} dE_c / dx_i,
 // with the XPBD constraints' own energies E_c = C^2 / (2 alpha) (constraints.h):
 //   stretch edge  C = |x_i - x_j| - L:  dE = k C n,  d2E = k n n^T + k max(C, 0) / |d| (I - n n^T)
 //                 (k = 1 / alpha, the compressive compliance below the rest length; the second
@@ -25,10 +26,10 @@
 //    each vertex's terms stored in its order) against the tree's pass (the three AVX2 kernels, free
 //    and careful blocks) and against the same pass through the scalar constraint functions, timed
 //    in the same run, the three alternating.
-// 2. Work per pass: from x = y = the jittered start, how much of G's excess over its minimum
-//    (G* from 400 vertex passes, and how much 400 more lower it) one tree pass and 1, 2, 5 and 20 vertex passes remove. Each
-//    substep of the tree starts its multipliers at 0 ("small steps"), so one pass of each is the
-//    like-for-like comparison.
+// 2. Work per pass: from x = y = the jittered start, how much of G's excess over its minimum one
+//    tree pass and 1, 2, 5 and 20 vertex passes remove (G* from 400 vertex passes; printed: how
+//    much 400 more lower it). Each substep of the tree starts its multipliers at 0 ("small
+//    steps"), so one pass of each is the like-for-like comparison.
 // 3. What the 8x and 1x goals would leave: vertex passes per 1/300 s output step if the whole
 //    budget went to them (no integration, collision or output).
 //
@@ -305,7 +306,8 @@ int main(int argc, char** argv) {
   const int reps = dressguard::bench::parse_reps(argc, argv, "bench_sim_vertex_pass");
   if (reps == 0) return 2;
   if (!cpu_has_avx2()) {
-    std::fprintf(stderr, "bench_sim_vertex_pass: this CPU has no AVX2; the tree's kernels it compares with do not run\n");
+    std::fprintf(stderr, "bench_sim_vertex_pass: this CPU has no AVX2; the tree's kernels it compares with do not "
+                         "run\n");
     return 1;
   }
   constexpr double kPassesPerSimSecond = 300.0 * 20.0;
