@@ -79,7 +79,7 @@ struct BendTerm {
 // The vertex-centric form of a GownModel: free vertices in colour order, each with its terms.
 struct VertexSolver {
   std::vector<int32_t> order;                     // free vertices, colour group after colour group
-  std::vector<int32_t> colour_start;              // group g is order[colour_start[g], colour_start[g + 1])
+  int colours = 0;                                // vertex colours (groups of `order`, one after another)
   std::vector<int32_t> edge_off, tri_off, bend_off;  // per position in `order`: [off[k], off[k + 1])
   std::vector<EdgeTerm> edges;
   std::vector<TriTerm> tris;
@@ -132,7 +132,6 @@ VertexSolver make_vertex_solver(const GownModel& m) {
   VertexSolver v;
   const double inv_h2 = 1.0 / (m.h * m.h);
   for (int c = 0; c < colours; ++c) {
-    v.colour_start.push_back(static_cast<int32_t>(v.order.size()));
     for (int i = 0; i < n; ++i)
       if (colour[i] == c && m.w[i] > 0) {
         v.order.push_back(i);
@@ -145,7 +144,7 @@ VertexSolver make_vertex_solver(const GownModel& m) {
         v.m_h2.push_back(m.mass[i] * inv_h2);
       }
   }
-  v.colour_start.push_back(static_cast<int32_t>(v.order.size()));
+  v.colours = colours;
   v.edge_off.push_back(static_cast<int32_t>(v.edges.size()));
   v.tri_off.push_back(static_cast<int32_t>(v.tris.size()));
   v.bend_off.push_back(static_cast<int32_t>(v.bends.size()));
@@ -351,13 +350,12 @@ int main(int argc, char** argv) {
     const GownModel& m = ks.model;
     const std::vector<V3>& y = ks.start;  // the inertial target: x = y at the pass's start
     const VertexSolver v = make_vertex_solver(m);
-    const int colours = static_cast<int>(v.colour_start.size()) - 1;
     const double free_vertices = static_cast<double>(v.order.size());
     double edge_sum = 0;
     for (const DistanceLink& l : m.scene->stretch) edge_sum += l.rest;
     std::printf("%s gown: %zu vertices (%zu free), %d vertex colours, mean edge %.1f mm; terms per free vertex: "
                 "%.2f edges, %.2f triangles, %.2f hinge stencils (%.2f MB of terms a pass)\n",
-                reduced ? "reduced" : "full", y.size(), v.order.size(), colours,
+                reduced ? "reduced" : "full", y.size(), v.order.size(), v.colours,
                 1e3 * edge_sum / static_cast<double>(m.scene->stretch.size()), v.edges.size() / free_vertices,
                 v.tris.size() / free_vertices, v.bends.size() / free_vertices,
                 (v.edges.size() * sizeof(EdgeTerm) + v.tris.size() * sizeof(TriTerm) +
