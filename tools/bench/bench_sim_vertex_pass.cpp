@@ -383,9 +383,14 @@ int main(int argc, char** argv) {
     // 2. Work per pass, from the 1 mm start and from the same displacements x 10 (1 cm).
     std::vector<V3> wide(y.size());
     for (std::size_t i = 0; i < y.size(); ++i) wide[i] = m.scene->rest[i] + 10.0 * (y[i] - m.scene->rest[i]);
-    if (!work_per_pass(m, v, y, "1 mm") || !work_per_pass(m, v, wide, "1 cm")) {
-      std::fprintf(stderr, "bench_sim_vertex_pass: %s gown: the vertex passes did not lower G at every count\n",
-                   reduced ? "reduced" : "full");
+    // Both starts run and print before either is judged, so a failure names its start.
+    const bool descends_1mm = work_per_pass(m, v, y, "1 mm");
+    const bool descends_1cm = work_per_pass(m, v, wide, "1 cm");
+    if (!descends_1mm || !descends_1cm) {
+      const char* which = !descends_1mm && !descends_1cm ? "1 mm and 1 cm" : descends_1mm ? "1 cm" : "1 mm";
+      std::fprintf(stderr,
+                   "bench_sim_vertex_pass: %s gown, %s start: the vertex passes did not lower G at every count\n",
+                   reduced ? "reduced" : "full", which);
       return 1;
     }
   }
