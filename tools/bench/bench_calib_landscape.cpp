@@ -2,7 +2,7 @@
 // two L values cannot be told apart by a search.
 //
 //   bench_calib_landscape --calibration CAL.json --data DATASET [--scales 0.0001,0.001,0.01]
-//                         [--samples 16] [--seed 1] [--threads T]
+//                         [--samples 16] [--seed 1] [--threads T] [--points FILE.csv]
 //
 // The file's point is simulated again on the sequences it was fitted to (the baseline of the run:
 // it must give the recorded L of each sequence, to the bit). Then, for each scale s, `samples`
@@ -15,12 +15,16 @@
 // file's. A smooth objective moves in proportion to s (quadratically at a minimum); one ruled by
 // the chaos of the catch (which vertex slips first past the fist) jumps even at the smallest s.
 // Deterministic for one seed on one machine (std::normal_distribution is the library's).
+// --points writes every point: its scale, the step of each parameter as a share of its box (after
+// clamping) and each sequence's L and the combined one, for fitting models of the objective (a
+// surrogate's ranking: offline/calib/MEASUREMENTS.md, session 79).
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <optional>
 #include <random>
 #include <stdexcept>
@@ -29,6 +33,7 @@
 
 #include "calibration.h"
 #include "dataset.h"
+#include "files.h"
 #include "objective.h"
 #include "runner.h"
 #include "sim_bridge.h"
@@ -82,7 +87,7 @@ double median(std::vector<double> v) {
 }
 
 int run(int argc, char** argv) {
-  std::string cal_path, data, scales_arg = "0.0001,0.001,0.01";
+  std::string cal_path, data, points_path, scales_arg = "0.0001,0.001,0.01";
   int samples = 16, threads = 0;
   std::uint64_t seed = 1;
   for (int i = 1; i < argc; i += 2) {
@@ -94,10 +99,13 @@ int run(int argc, char** argv) {
     else if (k == "--samples") samples = std::stoi(v);
     else if (k == "--seed") seed = std::stoull(v);
     else if (k == "--threads") threads = std::stoi(v);
+    else if (k == "--points") points_path = v;
     else throw std::runtime_error("unknown option '" + k + "'");
   }
   if (cal_path.empty() || data.empty()) throw std::runtime_error("need --calibration CAL.json and --data DATASET");
   if (samples < 1) throw std::runtime_error("--samples must be at least 1");
+  if (!points_path.empty() && std::filesystem::is_directory(points_path))  // said now, not after the run
+    throw std::runtime_error("--points " + points_path + " is a folder; give a file name");
   std::vector<double> scales;
   for (std::size_t from = 0; from <= scales_arg.size();) {
     const std::size_t comma = std::min(scales_arg.find(',', from), scales_arg.size());
@@ -141,19 +149,20 @@ int run(int argc, char** argv) {
     std::printf("  %-16s %10.6g in [%g, %g]\n", p.name.c_str(), param_value(p.ref, cal.cloth, cal.offsets),
                 p.box.lower, p.box.upper);
   const auto t0 = std::chrono::steady_clock::now();
+  // Parameter p's value at task t (t = 0: the file's point), clamped to its box (or to the file's
+  // value, where that lies outside it).
+  auto value_at = [&](int t, int p) {
+    const double v0 = param_value(params[p].ref, cal.cloth, cal.offsets);
+    if (t == 0) return v0;
+    const int s = (t - 1) / samples, i = (t - 1) % samples;
+    const ParamBound& box = params[p].box;
+    const double lo = std::min(box.lower, v0), hi = std::max(box.upper, v0);
+    return std::clamp(v0 + scales[s] * (box.upper - box.lower) * z[static_cast<std::size_t>(i) * P + p], lo, hi);
+  };
   const std::vector<double> L = run_batch(tasks, K, threads, Comm::world(), [&](int t, double* out) {
     ClothValues c = cal.cloth;
     std::array<double, 3> off = cal.offsets;
-    if (t > 0) {
-      const int s = (t - 1) / samples, i = (t - 1) % samples;
-      for (int p = 0; p < P; ++p) {
-        const ParamBound& box = params[p].box;
-        const double v0 = param_value(params[p].ref, cal.cloth, cal.offsets);
-        const double lo = std::min(box.lower, v0), hi = std::max(box.upper, v0);
-        const double v = v0 + scales[s] * (box.upper - box.lower) * z[static_cast<std::size_t>(i) * P + p];
-        set_param_value(params[p].ref, c, off, std::clamp(v, lo, hi));
-      }
-    }
+    for (int p = 0; p < P; ++p) set_param_value(params[p].ref, c, off, value_at(t, p));
     const std::vector<SimulatedTrial> sts = simulate_inputs(sim.trials, c, off, inputs);
     for (int k = 0; k < K; ++k) out[k] = area_objective(sts[k].samples, inputs[k].samples);
   });
@@ -195,6 +204,32 @@ int run(int argc, char** argv) {
                 median(comb), *mx, *mx - *mn, below, samples, base);
   }
   std::printf("\n%d simulations of %d sequences in %.1f s\n", tasks, K, elapsed);
+  if (!points_path.empty()) {
+    std::string csv = "scale,sample";
+    for (const Searched& p : params) csv += ",d_" + p.name;
+    for (int k = 0; k < K; ++k) csv += ",L_" + inputs[k].id;
+    csv += ",L_combined\n";
+    char cell[64];
+    for (int t = 0; t < tasks; ++t) {
+      const int s = t == 0 ? -1 : (t - 1) / samples, i = t == 0 ? 0 : (t - 1) % samples;
+      std::snprintf(cell, sizeof cell, "%.17g,%d", s < 0 ? 0.0 : scales[s], i);
+      csv += cell;
+      for (int p = 0; p < P; ++p) {
+        const double v0 = param_value(params[p].ref, cal.cloth, cal.offsets);
+        std::snprintf(cell, sizeof cell, ",%.17g", (value_at(t, p) - v0) / (params[p].box.upper - params[p].box.lower));
+        csv += cell;
+      }
+      const double* l = L.data() + static_cast<std::size_t>(t) * K;
+      for (int k = 0; k < K; ++k) {
+        std::snprintf(cell, sizeof cell, ",%.17g", l[k]);
+        csv += cell;
+      }
+      std::snprintf(cell, sizeof cell, ",%.17g\n", combined(l));
+      csv += cell;
+    }
+    write_file_atomic(points_path, csv);
+    std::printf("wrote %s (%d points)\n", points_path.c_str(), tasks);
+  }
   return same ? 0 : 1;  // the baseline must reproduce the file
 }
 

@@ -1,0 +1,239 @@
+#!/usr/bin/python3
+"""Would a surrogate model rank a CMA-ES generation of the calibration objective?
+(offline/calib/MEASUREMENTS.md, session 79)
+
+Surrogate-assisted CMA-ES (lq-CMA-ES, Hansen 2019; GP-based DTS-CMA-ES, Bajer et al. 2019) skips
+simulating a generation's candidates when a model fitted to earlier evaluations ranks them as the
+true objective does: lq-CMA-ES trusts its model once Kendall's tau between the model's and the
+true values of the candidates it did evaluate reaches 0.85. Until then it evaluates more, up to
+all of them. So the saving of such a search is bounded by how well a model ranks a generation.
+
+This reads the points of `bench_calib_landscape --points` (one scale: a generation drawn
+N(x_file, (s * box)^2), as CMA-ES draws before its covariance has learnt anything) and, per
+scale, in folds of one generation (32 points held out, the rest to fit on), ranks the held-out
+points with each model and prints Kendall's tau against the simulated combined L, how many of the
+true best 16 (CMA-ES's mu) the model's best 16 hold (8 by chance), and tau among the model's best
+16 (the ones lq-CMA-ES evaluates first). Models, all on log L unless named:
+  linear, diagonal quadratic, full quadratic (ridge chosen on the fitting points alone), the full
+  quadratic on L itself (as lq-CMA-ES fits), one full quadratic per sequence summed (the combined
+  L sums sequences whose landscapes differ) and a Gaussian process (squared-exponential kernel,
+  length scale and nugget chosen on the fitting points alone).
+
+usage: surrogate_rank.py POINTS.csv [OUT.png]      the table, and with OUT.png a picture
+       surrogate_rank.py --self-test               known objectives: a quadratic must be ranked
+                                                   (tau >= 0.9), noise must not (|tau| < 0.3);
+                                                   exit 1 if one is not
+"""
+import itertools
+import sys
+
+import numpy as np
+
+GENERATION = 32  # the paper's population
+MU = 16
+TRUST = 0.85  # lq-CMA-ES's threshold on Kendall's tau
+
+
+def kendall_tau(a, b):
+    """Kendall's tau-a of two equal-length sequences (ties count as neither)."""
+    a, b = np.asarray(a), np.asarray(b)
+    s = np.sign(a[:, None] - a[None, :]) * np.sign(b[:, None] - b[None, :])
+    n = len(a)
+    return np.triu(s, 1).sum() / (n * (n - 1) / 2)
+
+
+def features(X, kind):
+    cols = [np.ones(len(X))] + list(X.T)
+    if kind in ("diag", "full"):
+        cols += [x**2 for x in X.T]
+    if kind == "full":
+        cols += [X[:, i] * X[:, j] for i, j in itertools.combinations(range(X.shape[1]), 2)]
+    return np.stack(cols, 1)
+
+
+def ridge_fit(Xtr, ytr, Xte, kind, ridge):
+    A, B = features(Xtr, kind), features(Xte, kind)
+    mu, sd = A[:, 1:].mean(0), A[:, 1:].std(0) + 1e-300
+    A[:, 1:] = (A[:, 1:] - mu) / sd
+    B[:, 1:] = (B[:, 1:] - mu) / sd
+    R = ridge * np.eye(A.shape[1])
+    R[0, 0] = 0  # the constant is not shrunk
+    return B @ np.linalg.lstsq(A.T @ A + R, A.T @ ytr, rcond=None)[0]
+
+
+def inner_folds(n, k=3):
+    idx = np.arange(n)
+    return [(np.setdiff1d(idx, f), f) for f in np.array_split(idx, k)]
+
+
+def quadratic(Xtr, ytr, Xte, kind):
+    """Ridge-regressed polynomial, the ridge picked by a 3-fold error on the fitting points."""
+    best = min((sum(((ridge_fit(Xtr[a], ytr[a], Xtr[b], kind, r) - ytr[b]) ** 2).sum()
+                    for a, b in inner_folds(len(ytr))), r) for r in (1e-6, 0.1, 1.0, 10.0, 100.0))
+    return ridge_fit(Xtr, ytr, Xte, kind, best[1])
+
+
+def gp_predict(Xtr, ytr, Xte, ell, nugget):
+    m, s = ytr.mean(), ytr.std() + 1e-300
+    d2 = lambda A, B: ((A[:, None, :] - B[None, :, :]) ** 2).sum(-1)
+    K = np.exp(-0.5 * d2(Xtr, Xtr) / ell**2) + nugget * np.eye(len(Xtr))
+    return m + s * (np.exp(-0.5 * d2(Xte, Xtr) / ell**2) @ np.linalg.solve(K, (ytr - m) / s))
+
+
+def gaussian_process(Xtr, ytr, Xte):
+    best = min((sum(((gp_predict(Xtr[a], ytr[a], Xtr[b], ell, g) - ytr[b]) ** 2).sum()
+                    for a, b in inner_folds(len(ytr))), ell, g)
+               for ell in (0.5, 1, 2, 3, 5, 8) for g in (1e-4, 1e-2, 0.1, 0.3, 1.0))
+    return gp_predict(Xtr, ytr, Xte, best[1], best[2])
+
+
+# name -> predict(X_fit, per-sequence L of the fit rows (n x K), X_held) -> predicted combined L
+# (any monotone transform of it: only the ranking counts)
+MODELS = {
+    "linear": lambda X, Ls, Xt: quadratic(X, np.log(Ls.sum(1)), Xt, "lin"),
+    "diagonal quadratic": lambda X, Ls, Xt: quadratic(X, np.log(Ls.sum(1)), Xt, "diag"),
+    "full quadratic": lambda X, Ls, Xt: quadratic(X, np.log(Ls.sum(1)), Xt, "full"),
+    "full quadratic on L": lambda X, Ls, Xt: quadratic(X, Ls.sum(1), Xt, "full"),
+    "full quadratic per sequence": lambda X, Ls, Xt: sum(
+        np.exp(quadratic(X, np.log(Ls[:, k]), Xt, "full")) for k in range(Ls.shape[1])),
+    "Gaussian process": lambda X, Ls, Xt: gaussian_process(X, np.log(Ls.sum(1)), Xt),
+}
+
+
+def rank_scale(X, Ls):
+    """Per model: (tau per fold, best-16 overlap per fold, tau among the model's best 16 per fold),
+    and the held-out predictions of every fold for the picture."""
+    y = Ls.sum(1)
+    n = len(y)
+    folds = n // GENERATION
+    out = {}
+    for name, model in MODELS.items():
+        taus, overlaps, taus_best, pairs = [], [], [], []
+        for f in range(folds):
+            held = np.arange(f * GENERATION, (f + 1) * GENERATION)
+            fit = np.setdiff1d(np.arange(n), held)
+            p = model(X[fit], Ls[fit], X[held])
+            best = np.argsort(p)[:MU]
+            taus.append(kendall_tau(p, y[held]))
+            overlaps.append(len(set(best) & set(np.argsort(y[held])[:MU])))
+            taus_best.append(kendall_tau(p[best], y[held][best]))
+            pairs.append((p, y[held]))
+        out[name] = (np.array(taus), np.array(overlaps), np.array(taus_best), pairs)
+    return out
+
+
+def read_points(path):
+    data = np.genfromtxt(path, delimiter=",", names=True)
+    names = data.dtype.names
+    steps = [c for c in names if c.startswith("d_")]
+    seqs = [c for c in names if c.startswith("L_") and c != "L_combined"]
+    if not steps or not seqs or "scale" not in names:
+        raise SystemExit(f"{path}: not a bench_calib_landscape --points file (columns {names})")
+    by_scale = {}
+    for s in sorted(set(data["scale"]) - {0.0}, reverse=True):
+        rows = data[data["scale"] == s]
+        if len(rows) < 2 * GENERATION:
+            raise SystemExit(f"{path}: scale {s} has {len(rows)} points; need at least {2 * GENERATION}")
+        X = np.stack([rows[c] for c in steps], 1) / s  # each step in units of the scale: N(0, 1)
+        by_scale[s] = (X, np.stack([rows[c] for c in seqs], 1))
+    return by_scale
+
+
+def report(by_scale):
+    results = {}
+    print(f"{'scale':>6}  {'model':28s} {'tau: min / median / max':>24}  {'best 16 held':>12}"
+          f"  {'tau in model best 16':>20}")
+    for s, (X, Ls) in by_scale.items():
+        y = Ls.sum(1)
+        print(f"{s:6g}  {len(y)} points, combined L min {y.min():.3f} median {np.median(y):.3f} max {y.max():.3f}")
+        results[s] = rank_scale(X, Ls)
+        for name, (t, o, tb, _) in results[s].items():
+            print(f"{'':6}  {name:28s} {t.min():7.3f} / {np.median(t):6.3f} / {t.max():6.3f}"
+                  f"  {np.median(o):8.1f} / {MU}  {np.median(tb):20.3f}")
+    best = max(np.median(t) for r in results.values() for t, *_ in r.values())
+    print(f"\nthe highest median tau of any model at any scale: {best:.3f} "
+          f"(lq-CMA-ES trusts a model from {TRUST})")
+    return results
+
+
+def plot(results, out):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    scales = list(results)
+    fig, axes = plt.subplots(2, len(scales), figsize=(4 * len(scales), 7.5), squeeze=False)
+    for j, s in enumerate(scales):
+        ax = axes[0][j]
+        names = list(results[s])
+        for i, name in enumerate(names):
+            t = results[s][name][0]
+            ax.plot([i] * len(t), t, "o", color="C0", alpha=0.6)
+            ax.plot(i, np.median(t), "_", color="k", markersize=18)
+        ax.axhline(TRUST, color="C3", ls="--", label=f"lq-CMA-ES trusts from {TRUST}")
+        ax.axhline(0, color="0.6", lw=0.8)
+        ax.set_xticks(range(len(names)), [n.replace(" ", "\n", 1) for n in names], fontsize=7, rotation=60)
+        ax.set_ylim(-0.4, 1.05)
+        ax.set_title(f"step {s:g} of each box: Kendall tau per fold")
+        if j == 0:
+            ax.set_ylabel("tau, model vs simulated (32 held out)")
+            ax.legend(fontsize=8, loc="lower left")
+        ax = axes[1][j]
+        name = max(results[s], key=lambda k: np.median(results[s][k][0]))
+        for p, y in results[s][name][3]:
+            ax.plot(np.argsort(np.argsort(p)) + 1, np.argsort(np.argsort(y)) + 1, ".", alpha=0.7)
+        ax.plot([1, GENERATION], [1, GENERATION], color="0.5", lw=0.8)
+        ax.set_xlabel(f"rank by the model ({name})", fontsize=8)
+        if j == 0:
+            ax.set_ylabel("rank by the simulator (1 = best)")
+        ax.set_title("its held-out generations, one colour each", fontsize=9)
+    fig.suptitle("Can a surrogate rank a CMA-ES generation of the calibration objective?")
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    print(f"wrote {out}")
+
+
+def self_test():
+    """Known objectives, drawn as the bench draws (N(0, 1) steps): a quadratic bowl seen from off its
+    minimum is ranked by the quadratic on L (tau >= 0.9); exp of a bowl, by the quadratics on log L
+    (tau >= 0.9) and, smooth as it is, by the Gaussian process well above chance (tau >= 0.8);
+    independent noise by no model (|median tau| < 0.3)."""
+    rng = np.random.default_rng(1)
+    P, n = 10, 4 * GENERATION
+    X = rng.normal(size=(n, P))
+    H = rng.normal(size=(P, P))
+    H = H @ H.T / P + np.eye(P)
+    c = rng.normal(size=P)
+    bowl = np.einsum("ni,ij,nj->n", X - c, H, X - c)[:, None] + 0.1
+    cases = (
+        ("quadratic bowl", bowl, {"full quadratic on L": 0.9}),
+        ("exp of a bowl", np.exp(0.05 * bowl),
+         {"full quadratic": 0.9, "full quadratic per sequence": 0.9, "Gaussian process": 0.8}),
+        ("noise", rng.uniform(0.5, 1.5, size=(n, 1)), {name: None for name in MODELS}),
+    )
+    ok = True
+    for label, Ls, wants in cases:
+        r = rank_scale(X, Ls)
+        for name, floor in wants.items():
+            t = np.median(r[name][0])
+            good = abs(t) < 0.3 if floor is None else t >= floor
+            ok = ok and good
+            want = "|tau| < 0.3" if floor is None else f"tau >= {floor}"
+            print(f"{label:15s} {name:28s} median tau {t:6.3f} (want {want}) {'ok' if good else 'FAILED'}")
+    return 0 if ok else 1
+
+
+def main(argv):
+    if argv[1:] == ["--self-test"]:
+        return self_test()
+    if len(argv) not in (2, 3):
+        print(__doc__, file=sys.stderr)
+        return 2
+    results = report(read_points(argv[1]))
+    if len(argv) == 3:
+        plot(results, argv[2])
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
