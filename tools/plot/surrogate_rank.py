@@ -19,7 +19,11 @@ true best 16 (CMA-ES's mu) the model's best 16 hold (8 by chance), and tau among
   L sums sequences whose landscapes differ) and a Gaussian process (squared-exponential kernel,
   length scale and nugget chosen on the fitting points alone).
 
-usage: surrogate_rank.py POINTS.csv [OUT.png]      the table, and with OUT.png a picture
+usage: surrogate_rank.py POINTS.csv [OUT.png] [--low-fidelity LOW.csv]
+                                                   the table, and with OUT.png a picture;
+                                                   LOW.csv: the same points on a cheaper
+                                                   simulator (the calibration file copied with
+                                                   "gown": "coarse"), its L as a model
        surrogate_rank.py --self-test               known objectives: a quadratic must be ranked
                                                    (tau >= 0.9), noise must not (|tau| < 0.3);
                                                    exit 1 if one is not
@@ -100,19 +104,26 @@ MODELS = {
 }
 
 
-def rank_scale(X, Ls):
+LOW_FIDELITY = "low fidelity (its own L)"
+
+
+def rank_scale(X, Ls, low=None):
     """Per model: (tau per fold, best-16 overlap per fold, tau among the model's best 16 per fold),
-    and the held-out predictions of every fold for the picture."""
+    and the held-out predictions of every fold for the picture. `low`: the combined L of the same
+    points from another simulator (a coarser gown), ranked as it is, with no fitting."""
     y = Ls.sum(1)
     n = len(y)
     folds = n // GENERATION
     out = {}
-    for name, model in MODELS.items():
+    models = dict(MODELS)
+    if low is not None:
+        models[LOW_FIDELITY] = None
+    for name, model in models.items():
         taus, overlaps, taus_best, pairs = [], [], [], []
         for f in range(folds):
             held = np.arange(f * GENERATION, (f + 1) * GENERATION)
             fit = np.setdiff1d(np.arange(n), held)
-            p = model(X[fit], Ls[fit], X[held])
+            p = low[held] if model is None else model(X[fit], Ls[fit], X[held])
             best = np.argsort(p)[:MU]
             taus.append(kendall_tau(p, y[held]))
             overlaps.append(len(set(best) & set(np.argsort(y[held])[:MU])))
@@ -139,14 +150,20 @@ def read_points(path):
     return by_scale
 
 
-def report(by_scale):
+def report(by_scale, low_by_scale=None):
     results = {}
     print(f"{'scale':>6}  {'model':28s} {'tau: min / median / max':>24}  {'best 16 held':>12}"
           f"  {'tau in model best 16':>20}")
     for s, (X, Ls) in by_scale.items():
         y = Ls.sum(1)
         print(f"{s:6g}  {len(y)} points, combined L min {y.min():.3f} median {np.median(y):.3f} max {y.max():.3f}")
-        results[s] = rank_scale(X, Ls)
+        low = None
+        if low_by_scale is not None:
+            if s not in low_by_scale or not np.array_equal(low_by_scale[s][0], X):
+                raise SystemExit(f"--low-fidelity: its points at scale {s} are not this file's (the same "
+                                 "calibration's values, --scales, --samples and --seed draw the same points)")
+            low = low_by_scale[s][1].sum(1)
+        results[s] = rank_scale(X, Ls, low)
         for name, (t, o, tb, _) in results[s].items():
             print(f"{'':6}  {name:28s} {t.min():7.3f} / {np.median(t):6.3f} / {t.max():6.3f}"
                   f"  {np.median(o):8.1f} / {MU}  {np.median(tb):20.3f}")
@@ -197,7 +214,8 @@ def self_test():
     """Known objectives, drawn as the bench draws (N(0, 1) steps): a quadratic bowl seen from off its
     minimum is ranked by the quadratic on L (tau >= 0.9); exp of a bowl, by the quadratics on log L
     (tau >= 0.9) and, smooth as it is, by the Gaussian process well above chance (tau >= 0.8);
-    independent noise by no model (|median tau| < 0.3)."""
+    independent noise by no model (|median tau| < 0.3). A low fidelity that is a monotone map of
+    the bowl ranks it exactly; one that is noise does not."""
     rng = np.random.default_rng(1)
     P, n = 10, 4 * GENERATION
     X = rng.normal(size=(n, P))
@@ -212,8 +230,11 @@ def self_test():
         ("noise", rng.uniform(0.5, 1.5, size=(n, 1)), {name: None for name in MODELS}),
     )
     ok = True
+    lows = {"quadratic bowl": 2 * bowl[:, 0] + 1, "noise": rng.uniform(size=n)}  # a monotone map, noise
     for label, Ls, wants in cases:
-        r = rank_scale(X, Ls)
+        r = rank_scale(X, Ls, lows.get(label))
+        if label in lows:
+            wants = dict(wants, **{LOW_FIDELITY: 0.99 if label == "quadratic bowl" else None})
         for name, floor in wants.items():
             t = np.median(r[name][0])
             good = abs(t) < 0.3 if floor is None else t >= floor
@@ -226,12 +247,21 @@ def self_test():
 def main(argv):
     if argv[1:] == ["--self-test"]:
         return self_test()
-    if len(argv) not in (2, 3):
+    args = argv[1:]
+    low = None
+    if "--low-fidelity" in args:
+        i = args.index("--low-fidelity")
+        if i + 1 >= len(args):
+            print("--low-fidelity needs a points file", file=sys.stderr)
+            return 2
+        low = read_points(args[i + 1])
+        del args[i:i + 2]
+    if len(args) not in (1, 2):
         print(__doc__, file=sys.stderr)
         return 2
-    results = report(read_points(argv[1]))
-    if len(argv) == 3:
-        plot(results, argv[2])
+    results = report(read_points(args[0]), low)
+    if len(args) == 2:
+        plot(results, args[1])
     return 0
 
 
