@@ -1,13 +1,23 @@
-// dg_fuzz_seeds DIR: writes the seed corpus of fuzz_dgm at test time: valid models of several
-// shapes (1 class x 1 state, 2 x 5, 3 x 10, a general topology), each with mode byte 0 (as is)
-// and 1 (size and CRC repaired by the harness), plus a truncated and a bit-flipped file.
+// dg_fuzz_seeds KIND DIR: writes a fuzz target's seed corpus at test time.
+//   dgm        fuzz_dgm: valid models of several shapes (1 class x 1 state, 2 x 5, 3 x 10, a
+//              general topology), each with mode byte 0 (as is) and 1 (size and CRC repaired by
+//              the harness), plus a truncated and a bit-flipped file;
+//   predictor  fuzz_predictor: trials as the bus carries them (predictor_traffic.h): a good
+//              trial, a caught one confirmed by its echo, the hard limit, a sensor timeout whose
+//              stop must be resent, a burst of corrupted frames, no model, SIGTERM in a trial.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
 
 #include "dgm.h"
+#include "predictor_traffic.h"
 
 using namespace dressguard::model;
 
@@ -51,33 +61,136 @@ OutcomeModel make(int classes, int states, bool general) {
   return m;
 }
 
-void put(const std::filesystem::path& p, uint8_t mode, const std::vector<uint8_t>& b) {
+bool write_file(const std::filesystem::path& p, const std::vector<uint8_t>& b) {
   std::ofstream o(p, std::ios::binary);
-  o.put(static_cast<char>(mode));
   o.write(reinterpret_cast<const char*>(b.data()), static_cast<std::streamsize>(b.size()));
+  o.close();
+  if (!o) std::fprintf(stderr, "dg_fuzz_seeds: cannot write %s\n", p.c_str());
+  return static_cast<bool>(o);
+}
+
+bool put(const std::filesystem::path& p, uint8_t mode, const std::vector<uint8_t>& b) {
+  std::vector<uint8_t> m{mode};
+  m.insert(m.end(), b.begin(), b.end());
+  return write_file(p, m);
+}
+
+int dgm_seeds(const std::filesystem::path& dir) {
+  int k = 0;
+  bool ok = true;
+  for (auto [c, s, g] : {std::tuple{1, 1, false}, std::tuple{2, 5, false}, std::tuple{3, 10, false}, std::tuple{2, 4, true}}) {
+    const auto b = encode_model(make(c, s, g));
+    ok &= put(dir / ("valid" + std::to_string(k) + "_raw"), 0, b);
+    ok &= put(dir / ("valid" + std::to_string(k) + "_fixed"), 1, b);
+    auto t = b;
+    t.resize(t.size() / 2);
+    ok &= put(dir / ("truncated" + std::to_string(k)), 0, t);
+    auto f = b;
+    f[f.size() / 3] ^= 0x40;
+    ok &= put(dir / ("flipped" + std::to_string(k)), 1, f);
+    ++k;
+  }
+  if (!ok) return 1;
+  std::printf("wrote %d seeds into %s\n", 4 * k, dir.c_str());
+  return 0;
+}
+
+int predictor_seeds(const std::filesystem::path& dir) {
+  using dressguard::fuzz::TrafficOp;
+  using dressguard::fuzz::TrafficWriter;
+  // The daemon's defaults (predictor_core.h), "caught" at class index 1: hard limit 10 N, budget
+  // 5 x 20, E2E max delta 3, timeout 50 ms, stop retry 2 ms, periodic frames every 100 ms.
+  const uint8_t defaults[dressguard::fuzz::kTrafficHeader] = {8, 0, 0, 0, 0, 0, 8, 4, 19, 2, 40, 1, 95};
+  uint8_t no_model[dressguard::fuzz::kTrafficHeader];
+  std::copy(std::begin(defaults), std::end(defaults), no_model);
+  no_model[0] = 0;
+  const auto samples = [](TrafficWriter& w, int n, double motion, double vertical) {
+    for (int i = 0; i < n; ++i) {
+      w.force(motion, 0.0, vertical);
+      w.tick();
+    }
+  };
+  std::vector<std::pair<std::string, TrafficWriter>> seeds;
+  {
+    TrafficWriter w(defaults);  // good: light drag throughout, then the trial's end
+    w.start(1);
+    samples(w, 60, -2.0, 0.0);
+    w.end();
+    seeds.emplace_back("good", w);
+  }
+  {
+    TrafficWriter w(defaults);  // caught: the drag rises to the caught class's; the echo confirms
+    w.start(2);
+    samples(w, 20, -2.0, 0.0);
+    samples(w, 20, -6.0, -1.0);
+    w.op(TrafficOp::StopEcho, 0, {0});
+    w.end();
+    w.start(3);
+    samples(w, 5, -2.0, 0.0);
+    seeds.emplace_back("caught", w);
+  }
+  {
+    TrafficWriter w(defaults);  // the hard limit on the vertical axis
+    w.start(4);
+    for (int i = 0; i <= 12; ++i) w.force(-2.0, 0.0, -1.0 * i);
+    seeds.emplace_back("hard_limit", w);
+  }
+  {
+    TrafficWriter w(defaults);  // the sensor goes quiet; the stop fails twice and is resent
+    w.start(5);
+    samples(w, 5, -2.0, 0.0);
+    w.op(TrafficOp::TxFail, 0, {2});
+    w.op(TrafficOp::Wait, 0, {60});
+    for (int i = 0; i < 5; ++i) w.tick(1);
+    w.op(TrafficOp::StopEcho, 0, {0});
+    seeds.emplace_back("timeout", w);
+  }
+  {
+    TrafficWriter w(defaults);  // a burst of corrupted frames between good ones
+    w.start(6);
+    samples(w, 5, -2.0, 0.0);
+    for (int i = 0; i < 8; ++i) w.op(TrafficOp::Force, 5, {0x20, 0xEC, 0, 0, 0, 0, 0});
+    seeds.emplace_back("bad_frames", w);
+  }
+  {
+    TrafficWriter w(no_model);  // no model: every trial refused
+    w.start(7);
+    samples(w, 3, -2.0, 0.0);
+    w.op(TrafficOp::StopEcho, 0, {0});
+    w.end();
+    seeds.emplace_back("no_model", w);
+  }
+  {
+    TrafficWriter w(defaults);  // SIGTERM in a trial, then bus errors and kernel drops
+    w.start(8);
+    samples(w, 3, -2.0, 0.0);
+    w.op(TrafficOp::KernelDrops, 0, {3});
+    w.op(TrafficOp::BusError, 0, {4});
+    w.op(TrafficOp::Heartbeat, 0);
+    w.op(TrafficOp::Shutdown, 0);
+    w.tick(2);
+    seeds.emplace_back("shutdown", w);
+  }
+  bool ok = true;
+  for (const auto& [name, w] : seeds) ok &= write_file(dir / name, w.bytes);
+  if (!ok) return 1;
+  std::printf("wrote %zu seeds into %s\n", seeds.size(), dir.c_str());
+  return 0;
 }
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 2) {
-    std::fprintf(stderr, "usage: dg_fuzz_seeds DIR\n");
+  const std::string kind = argc == 3 ? argv[1] : "";
+  if (kind != "dgm" && kind != "predictor") {
+    std::fprintf(stderr, "usage: dg_fuzz_seeds dgm|predictor DIR\n");
     return 2;
   }
-  const std::filesystem::path dir = argv[1];
-  std::filesystem::create_directories(dir);
-  int k = 0;
-  for (auto [c, s, g] : {std::tuple{1, 1, false}, std::tuple{2, 5, false}, std::tuple{3, 10, false}, std::tuple{2, 4, true}}) {
-    const auto b = encode_model(make(c, s, g));
-    put(dir / ("valid" + std::to_string(k) + "_raw"), 0, b);
-    put(dir / ("valid" + std::to_string(k) + "_fixed"), 1, b);
-    auto t = b;
-    t.resize(t.size() / 2);
-    put(dir / ("truncated" + std::to_string(k)), 0, t);
-    auto f = b;
-    f[f.size() / 3] ^= 0x40;
-    put(dir / ("flipped" + std::to_string(k)), 1, f);
-    ++k;
+  const std::filesystem::path dir = argv[2];
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) {
+    std::fprintf(stderr, "dg_fuzz_seeds: cannot create %s: %s\n", dir.c_str(), ec.message().c_str());
+    return 1;
   }
-  std::printf("wrote %d seeds into %s\n", 4 * k, dir.c_str());
-  return 0;
+  return kind == "dgm" ? dgm_seeds(dir) : predictor_seeds(dir);
 }

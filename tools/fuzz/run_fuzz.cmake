@@ -1,7 +1,8 @@
-# ctest fuzz_dgm_loader: fresh seed corpus, then a bounded libFuzzer run; any crash fails.
+# ctest fuzz_dgm_loader / fuzz_predictor_traffic: a fresh seed corpus of KIND (dg_fuzz_seeds
+# dgm|predictor), then a bounded libFuzzer run; any crash, report, leak or broken rule fails.
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK}/corpus)
-execute_process(COMMAND ${SEEDS} ${WORK}/corpus RESULT_VARIABLE rc)
+execute_process(COMMAND ${SEEDS} ${KIND} ${WORK}/corpus RESULT_VARIABLE rc)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "seed generation failed (${rc})")
 endif()
@@ -9,7 +10,7 @@ execute_process(COMMAND ${FUZZER} -runs=200000 -max_total_time=120 -seed=1 -max_
                         -artifact_prefix=${WORK}/ ${WORK}/corpus
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 string(REGEX MATCH "stat::number_of_executed_units: *[0-9]+" units "${err}")
-message(STATUS "fuzz_dgm: ${units}")
+message(STATUS "${KIND}: ${units}")
 if(NOT rc EQUAL 0)
-  message(FATAL_ERROR "fuzz_dgm found a failure (exit ${rc}); artifacts in ${WORK}\n${err}")
+  message(FATAL_ERROR "the ${KIND} fuzz target found a failure (exit ${rc}); artifacts in ${WORK}\n${err}")
 endif()

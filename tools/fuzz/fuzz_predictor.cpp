@@ -1,0 +1,470 @@
+// libFuzzer target for the predictor's logic (predictor/core): arbitrary bus traffic, timer ticks,
+// echoes, bus errors and failed transmissions (the byte format: predictor_traffic.h), under
+// -fsanitize=fuzzer,address,undefined. Besides faults, it checks after every call the rules of
+// predictor_core.h against a shadow of them written from that header, not from the code:
+//
+//   stop policy   an accepted sample beyond the hard limit on the motion or vertical axis
+//                 stops in the same call; otherwise the robot stops on "caught" exactly when
+//                 P(caught) > threshold for k consecutive samples; a tick stops exactly when
+//                 no sample was accepted for longer than the sensor timeout; SIGTERM in a trial
+//                 stops;
+//   in a trial    no stop outside a trial, except a trial refused for want of a model;
+//   latch         a stop stays (state and reason) until a trial start, or a trial end once its
+//                 stop frame is confirmed;
+//   stop frame    every stop hands a stop frame to the sink in the same call, E2E-protected,
+//                 with the decision's reason, trial and sample; an unconfirmed stop is resent
+//                 by every tick at least stop_retry after the last send;
+//   outputs       every other frame the predictor sends is E2E-protected and 8 bytes long;
+//   logical time  a sample's index counts the lost frames (the protocol's E2E checker, run
+//                 beside it, says how many); a timeout's is the sample that never came;
+//   filter        posteriors in [0, 1], summing to 1;
+//   real time     on_frame, on_tick, on_stop_echo, on_kernel_drops, on_bus_error and on_shutdown
+//                 allocate nothing (every malloc and operator new, counted by the sanitizer's
+//                 allocation hook).
+//
+// A broken rule prints which and aborts, which libFuzzer reports with the input that did it.
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+
+#include <sanitizer/allocator_interface.h>
+
+#include "dg_protocol.h"
+#include "predictor_core.h"
+#include "predictor_traffic.h"
+#include "test_model.h"
+
+using namespace dressguard;
+using fuzz::TrafficOp;
+using predictor::Predictor;
+using protocol::Frame;
+using protocol::MsgId;
+using protocol::PredictorState;
+using protocol::StatusCounter;
+using protocol::StopReason;
+
+namespace {
+
+[[noreturn]] void broken(const char* rule, long op) {
+  std::fprintf(stderr, "fuzz_predictor: rule broken at operation %ld: %s\n", op, rule);
+  std::abort();
+}
+
+// The sink: records what the predictor sends, in fixed storage (the hot path must not see a
+// sink that allocates either).
+struct RecordingSink final : predictor::PredictorSink {
+  int stop_sends = 0;       // transmit_stop calls in the current operation
+  Frame last_stop;          // the last stop frame handed over
+  int64_t last_stop_ns = 0;  // when (the harness's clock)
+  int64_t now_ns = 0;
+  int fail_next = 0;        // the next n stop transmissions fail
+  bool bad_output = false;  // a frame that is not E2E-protected or not 8 bytes
+
+  static bool protected_as(const Frame& f, MsgId m) {
+    protocol::E2EChecker chk(m);
+    uint32_t lost = 0;
+    return protocol::accepted(chk.check(f, lost));
+  }
+  uint8_t transmit_stop(const Frame& f) noexcept override {
+    ++stop_sends;
+    last_stop = f;
+    last_stop_ns = now_ns;
+    if (f.id != protocol::id_of(MsgId::Stop) || !protected_as(f, MsgId::Stop)) bad_output = true;
+    if (fail_next > 0) {
+      --fail_next;
+      return 1;
+    }
+    return 0;
+  }
+  uint8_t transmit(const Frame& f) noexcept override {
+    MsgId m;
+    switch (f.id) {
+      case protocol::id_of(MsgId::PredictorStatus): m = MsgId::PredictorStatus; break;
+      case protocol::id_of(MsgId::Posteriors): m = MsgId::Posteriors; break;
+      case protocol::id_of(MsgId::HeartbeatPredictor): m = MsgId::HeartbeatPredictor; break;
+      default: bad_output = true; return 0;
+    }
+    if (!protected_as(f, m)) bad_output = true;
+    return 0;
+  }
+  void event(const predictor::Event&) noexcept override {}
+};
+
+// Allocations while a CountAllocations is open. The sanitizer's hook sees malloc and operator
+// new alike (replacing operator new, as tests/predictor/alloc_counter.cpp does under GCC, trips
+// ASan's start-up under libFuzzer). The harness is single-threaded.
+long g_allocations = 0;
+bool g_counting = false;
+void on_malloc(const volatile void*, size_t) {
+  if (g_counting) ++g_allocations;
+}
+void on_free(const volatile void*) {}
+
+struct CountAllocations {
+  long start = g_allocations;
+  CountAllocations() { g_counting = true; }
+  ~CountAllocations() { g_counting = false; }
+  long count() const { return g_allocations - start; }
+};
+
+struct Reader {
+  const uint8_t* p;
+  size_t n;
+  bool take(size_t k) const { return n >= k; }
+  uint8_t u8() { return --n, *p++; }
+  int16_t i16() {
+    const uint8_t lo = u8();
+    return static_cast<int16_t>(lo | (u8() << 8));
+  }
+};
+
+predictor::PredictorConfig config_from(const uint8_t* h) {
+  predictor::PredictorConfig c;
+  static constexpr int kPerm[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  for (int k = 0; k < 3; ++k) {
+    c.mount.axis[k] = kPerm[h[1] % 6][k];
+    c.mount.sign[k] = (h[1] >> (3 + k)) & 1 ? -1.0 : 1.0;
+  }
+  c.mount.bias[0] = static_cast<int8_t>(h[2]) * 0.05;
+  c.mount.bias[2] = static_cast<int8_t>(h[3]) * 0.05;
+  c.stop_threshold = h[4] == 0 ? -1.0 : 0.50 + (h[4] % 50) / 100.0;
+  c.stop_consecutive = h[5] % 9;
+  c.hard_limit_n = 2.0 + h[6] % 19;
+  c.bad_frame_budget = 1 + h[7] % 8;
+  c.bad_frame_weight = 1 + h[8] % 40;
+  c.max_delta_counter = static_cast<uint8_t>(1 + h[9] % 5);
+  c.sensor_timeout_ns = (10 + h[10] % 91) * 1'000'000LL;
+  c.stop_retry_ns = (1 + h[11] % 10) * 1'000'000LL;
+  c.status_period_ns = c.heartbeat_period_ns = c.posteriors_period_ns = (5 + h[12]) * 1'000'000LL;
+  return c;
+}
+
+// The test model with "caught" moved to class index `caught_at`.
+model::OutcomeModel model_with_caught_at(int caught_at) {
+  model::OutcomeModel m = testkit::test_model();
+  std::swap(m.classes[2], m.classes[caught_at]);
+  return m;
+}
+
+// A frame's counter byte per the ctl bits of TrafficOp::Force / TrialStart / TrialEnd.
+uint8_t counter_for(uint8_t ctl, uint8_t& running, uint8_t raw) {
+  switch (ctl & 3) {
+    case 0: return ++running;
+    case 1: return running;
+    case 2: return running = static_cast<uint8_t>(running + 2 + ((ctl >> 2) & 3));
+    default: return running = raw;
+  }
+}
+
+void damage(Frame& f, uint8_t ctl) {
+  if (ctl & 0x20) f.data[2] ^= 0x5A;  // after the CRC: the checker must see it
+  if (ctl & 0x40) f.len = 7;
+}
+
+bool is(const Frame& f, MsgId m) { return f.id == protocol::id_of(m); }
+
+// What the rules are judged against: the configuration as the predictor took it.
+struct Rules {
+  predictor::PredictorConfig cfg;
+  bool has_model = false;
+  double threshold = 0;
+  int k = 0;
+};
+
+// The bridge's and the robot's alive counters, and the shadow of the predictor's state that the
+// rules need, kept from the header's description alone.
+struct Shadow {
+  uint8_t c_force = 0, c_start = 0, c_end = 0, c_hb = 0;
+  int64_t now = 1'000'000'000;
+  int64_t last_accept_ns = 0;  // trial start or the last accepted sample in a trial
+  int run = 0;                 // consecutive samples with P(caught) > threshold
+  // Logical time: sample 0 is the trial's first accepted sample, and lost frames count (the
+  // protocol's own E2E checker, fed the same force frames, says how many were lost).
+  protocol::E2EChecker e2e;
+  uint32_t sample = 0;
+  bool started = false;
+  explicit Shadow(uint8_t max_delta) : e2e(MsgId::FtForce, max_delta) {}
+};
+
+// One operation: what was done, and the predictor's state just before.
+struct Call {
+  TrafficOp kind = TrafficOp::Tick;
+  bool frame_sent = false, ticked = false, shut_down = false;
+  Frame sent{};
+  uint8_t echo_mode = 0;
+  uint32_t e2e_lost = 0;   // the shadow checker's verdict on a force frame
+  bool e2e_ok = false;
+  predictor::Decision before;
+  uint32_t samples_before = 0, starts_before = 0;
+  long steps_before = 0;
+  bool pending_before = false;
+};
+
+// Reads one operation's frame or arguments, then makes the one predictor call (allocations
+// counted). False when the input ends inside the operation.
+bool run_one(Reader& in, Predictor& p, RecordingSink& sink, Shadow& sh, Call& c, long op) {
+  const uint8_t opbyte = in.u8();
+  c.kind = static_cast<TrafficOp>(opbyte & 0x0F);
+  sh.now += (opbyte >> 4) * fuzz::kTrafficTimeUnitNs;
+  sink.now_ns = sh.now;
+  sink.stop_sends = 0;
+  c.before = p.decision();
+  c.samples_before = p.counter(StatusCounter::Samples);
+  c.starts_before = p.trials_started();
+  c.steps_before = p.filter() ? p.filter()->samples() : 0;
+  c.pending_before = p.stop_pending();
+
+  switch (c.kind) {
+    case TrafficOp::Force: {
+      if (!in.take(7)) return false;
+      const uint8_t ctl = in.u8();
+      int16_t v[3];
+      for (auto& x : v) x = in.i16();
+      if (!(ctl & 0x10))
+        for (auto& x : v) x = static_cast<int16_t>(static_cast<int8_t>(x & 0xFF) * 10);
+      const uint8_t ctr = counter_for(ctl, sh.c_force, static_cast<uint8_t>(v[0]));
+      if (ctl & 0x80) {  // the torque frame of the same sample, first
+        const CountAllocations a;
+        p.on_frame(protocol::encode(protocol::FtTorque{ctr, 0, 0, 0}), sh.now);
+        if (a.count() != 0) broken("on_frame allocated (torque)", op);
+      }
+      c.sent = protocol::encode(protocol::FtForce{ctr, v[0], v[1], v[2]});
+      damage(c.sent, ctl);
+      c.frame_sent = true;
+      break;
+    }
+    case TrafficOp::TrialStart: {
+      if (!in.take(3)) return false;
+      const uint8_t ctl = in.u8(), id = in.u8(), speed = in.u8();
+      c.sent = protocol::encode(protocol::TrialStart{counter_for(ctl, sh.c_start, id), id,
+                                                     static_cast<uint16_t>(50 + speed), protocol::HeightClass::Middle});
+      damage(c.sent, ctl);
+      c.frame_sent = true;
+      break;
+    }
+    case TrafficOp::TrialEnd: {
+      if (!in.take(2)) return false;
+      const uint8_t ctl = in.u8(), id = in.u8();
+      const uint16_t trial = id == 0 ? c.before.trial : id;
+      c.sent = protocol::encode(protocol::TrialEnd{counter_for(ctl, sh.c_end, id), trial, 0,
+                                                   protocol::TrialEndReason::Completed});
+      damage(c.sent, ctl);
+      c.frame_sent = true;
+      break;
+    }
+    case TrafficOp::RawFrame: {
+      if (!in.take(11)) return false;
+      static constexpr MsgId kIds[] = {MsgId::FtForce, MsgId::FtTorque, MsgId::TrialStart, MsgId::TrialEnd,
+                                       MsgId::HeartbeatBridge, MsgId::Stop, MsgId::PredictorStatus};
+      const uint8_t sel = in.u8();
+      c.sent.id = sel < 224 ? protocol::id_of(kIds[sel % 7]) : (sel * 37u) & 0x7FF;
+      c.sent.len = in.u8() % 9;
+      for (auto& b : c.sent.data) b = in.u8();
+      if (in.u8() & 1) {
+        for (MsgId m : kIds)
+          if (is(c.sent, m)) protocol::protect(c.sent, m);
+      }
+      c.frame_sent = true;
+      break;
+    }
+    case TrafficOp::Heartbeat:
+      c.sent = protocol::encode(protocol::HeartbeatBridge{++sh.c_hb, protocol::BridgeState::Ok, 0, 0, 0});
+      c.frame_sent = true;
+      break;
+    case TrafficOp::StopEcho:
+    case TrafficOp::KernelDrops:
+    case TrafficOp::BusError:
+    case TrafficOp::Wait:
+    case TrafficOp::TxFail:
+      if (!in.take(1)) return false;
+      break;
+    default: break;
+  }
+  if (c.frame_sent && is(c.sent, MsgId::FtForce)) c.e2e_ok = protocol::accepted(sh.e2e.check(c.sent, c.e2e_lost));
+
+  const CountAllocations a;
+  switch (c.kind) {
+    case TrafficOp::Force:
+    case TrafficOp::TrialStart:
+    case TrafficOp::TrialEnd:
+    case TrafficOp::RawFrame:
+    case TrafficOp::Heartbeat: p.on_frame(c.sent, sh.now); break;
+    case TrafficOp::StopEcho: {
+      c.echo_mode = in.u8() % 3;
+      Frame echo = sink.last_stop;
+      if (c.echo_mode == 1) echo.data[1] ^= 0x01;
+      if (c.echo_mode == 2) echo = protocol::encode(protocol::FtForce{0, 0, 0, 0});
+      p.on_stop_echo(echo, sh.now);
+      break;
+    }
+    case TrafficOp::KernelDrops: p.on_kernel_drops(p.counter(StatusCounter::KernelDrops) + in.u8(), sh.now); break;
+    case TrafficOp::BusError: p.on_bus_error(in.u8(), sh.now); break;
+    case TrafficOp::Shutdown: p.on_shutdown(sh.now), c.shut_down = true; break;
+    case TrafficOp::Wait:
+      sh.now += in.u8() * 1'000'000LL;
+      sink.now_ns = sh.now;
+      p.on_tick(sh.now), c.ticked = true;
+      break;
+    case TrafficOp::TxFail: sink.fail_next = in.u8() % 8; break;
+    default: p.on_tick(sh.now), c.ticked = true; break;
+  }
+  if (a.count() != 0) broken("a real-time call allocated", op);
+  return true;
+}
+
+// Outputs and filter: every frame protected; the posteriors a distribution over the classes.
+void check_outputs(const Predictor& p, const RecordingSink& sink, long op) {
+  if (sink.bad_output) broken("a frame sent without E2E protection or of the wrong length or identifier", op);
+  if (const auto* f = p.filter()) {
+    double s = 0;
+    for (int c = 0; c < f->classes(); ++c) {
+      const double q = f->posterior(c);
+      if (!(q >= 0.0 && q <= 1.0)) broken("a posterior outside [0, 1]", op);
+      s += q;
+    }
+    if (std::fabs(s - 1.0) > 1e-9) broken("the posteriors do not sum to 1", op);
+  }
+}
+
+// Trial start: the shadow restarts; with a model the trial runs, without one it is refused.
+void check_trial_start(const Call& c, const Predictor& p, const Rules& r, Shadow& sh, long op) {
+  protocol::TrialStart m;
+  if (!protocol::decode(c.sent, m) || p.decision().trial != m.trial_id) broken("the decision's trial is not the start frame's", op);
+  sh.last_accept_ns = sh.now;
+  sh.run = 0;
+  sh.e2e.reset();
+  sh.sample = 0;
+  sh.started = false;
+  const predictor::Decision& d = p.decision();
+  if (r.has_model && d.state != PredictorState::InTrial) broken("a trial start with a model did not run the trial", op);
+  if (!r.has_model && (d.state != PredictorState::Stopped || d.reason != StopReason::ModelError))
+    broken("a trial start without a model was not refused", op);
+}
+
+// No stop outside a trial; the latch; and the stop frame of a new stop.
+void check_stop_state(const Call& c, const Predictor& p, const RecordingSink& sink, bool started, long op) {
+  const predictor::Decision& d = p.decision();
+  const bool stopped_now = c.before.state != PredictorState::Stopped && d.state == PredictorState::Stopped;
+  if (stopped_now && c.before.state != PredictorState::InTrial && !started) broken("a stop outside a trial", op);
+  // Latch: out of Stopped only by a trial start, or a trial end after the stop was confirmed.
+  if (c.before.state == PredictorState::Stopped && !started) {
+    const bool ended_clean = c.frame_sent && is(c.sent, MsgId::TrialEnd) && d.state == PredictorState::Idle && !p.stop_pending();
+    if (d.state != PredictorState::Stopped && !ended_clean) broken("a stop was released without a trial start or end", op);
+    if (d.state == PredictorState::Stopped && d.reason != c.before.reason) broken("a latched stop changed its reason", op);
+  }
+  // The stop frame: handed over in the same call, saying what the decision says.
+  if (stopped_now) {
+    if (sink.stop_sends == 0) broken("a stop with no stop frame", op);
+    protocol::Stop m;
+    if (!protocol::decode(sink.last_stop, m)) broken("the stop frame does not decode", op);
+    if (m.reason != d.reason || m.trial_id != d.trial || m.sample != static_cast<uint16_t>(d.stop_sample))
+      broken("the stop frame does not carry the decision's reason, trial and sample", op);
+    if (d.reason == StopReason::None) broken("a stop without a reason", op);
+  }
+}
+
+// A force frame in a trial: E2E as the protocol says, logical time, the hard limit, then the
+// k-sample rule.
+void check_sample(const Call& c, const Predictor& p, const Rules& r, Shadow& sh, long op) {
+  const predictor::Decision& d = p.decision();
+  const bool bad_frame_stop = d.state == PredictorState::Stopped && d.reason == StopReason::BadFrames;
+  const bool accepted = p.counter(StatusCounter::Samples) != c.samples_before;
+  const bool stepped = p.filter() && p.filter()->samples() != c.steps_before;
+  if (accepted && !stepped && !bad_frame_stop) broken("an accepted sample in a trial did not reach the filter", op);
+  if (!accepted && d.state != PredictorState::InTrial && !bad_frame_stop)
+    broken("a rejected frame changed the trial's state other than by the bad-frame budget", op);
+  if (accepted != c.e2e_ok) broken("the sample's E2E verdict is not the protocol's", op);
+  if (accepted) sh.last_accept_ns = sh.now;
+  if (!stepped) return;
+
+  if (sh.started) sh.sample += 1 + c.e2e_lost;
+  sh.started = true;
+  if (d.sample != sh.sample) broken("the sample index is not the trial's logical time", op);
+  protocol::FtForce m;
+  protocol::decode(c.sent, m);
+  const double fs[3] = {protocol::force_newtons(m.fx), protocol::force_newtons(m.fy), protocol::force_newtons(m.fz)};
+  double rig[3];
+  for (int k = 0; k < 3; ++k) rig[k] = r.cfg.mount.sign[k] * fs[r.cfg.mount.axis[k]] - r.cfg.mount.bias[k];
+  if (std::fabs(rig[0]) > r.cfg.hard_limit_n || std::fabs(rig[2]) > r.cfg.hard_limit_n) {
+    if (d.state != PredictorState::Stopped || d.reason != StopReason::HardLimit)
+      broken("a sample beyond the hard limit did not stop with reason hard_limit", op);
+    return;
+  }
+  sh.run = p.filter()->posterior(p.caught_class()) > r.threshold ? sh.run + 1 : 0;
+  const bool should = sh.run >= r.k;
+  const bool did = d.state == PredictorState::Stopped && d.reason == StopReason::Caught;
+  if (should != did) broken(should ? "k samples over the threshold did not stop" : "a caught stop before k samples over the threshold", op);
+}
+
+// A tick: the sensor deadline, exactly; an unconfirmed stop resent on time; nothing else.
+void check_tick(const Call& c, const Predictor& p, const RecordingSink& sink, const Rules& r, const Shadow& sh, long op) {
+  const predictor::Decision& d = p.decision();
+  if (c.before.state == PredictorState::InTrial) {
+    const bool late = sh.now - sh.last_accept_ns > r.cfg.sensor_timeout_ns;
+    const bool did = d.state == PredictorState::Stopped && d.reason == StopReason::SensorTimeout;
+    if (late != did) broken(late ? "no sample for longer than the timeout did not stop" : "a timeout stop before the deadline", op);
+    // The deciding "sample" of a timeout is the one that never came.
+    if (did && d.stop_sample != sh.sample + (sh.started ? 1 : 0)) broken("a timeout stop's sample is not the one that never came", op);
+  }
+  if (p.stop_pending() && sh.now - sink.last_stop_ns >= r.cfg.stop_retry_ns) broken("an unconfirmed stop was not resent", op);
+  if (d.state != c.before.state && d.reason != StopReason::SensorTimeout)
+    broken("a tick changed the state other than by the sensor timeout", op);
+}
+
+// The calls that carry no frame and no tick: the echo, SIGTERM, drops, bus errors.
+void check_quiet_call(const Call& c, const Predictor& p, long op) {
+  const predictor::Decision& d = p.decision();
+  // The echo of the stop frame last sent confirms it; nothing else does.
+  if (c.kind == TrafficOp::StopEcho && c.pending_before) {
+    if (c.echo_mode == 0 && p.stop_pending()) broken("the stop frame's own echo did not confirm it", op);
+    if (c.echo_mode != 0 && !p.stop_pending()) broken("another frame confirmed the stop", op);
+  }
+  const bool was_in = c.before.state == PredictorState::InTrial;
+  if (c.shut_down && was_in && (d.state != PredictorState::Stopped || d.reason != StopReason::Shutdown))
+    broken("SIGTERM in a trial did not stop with reason shutdown", op);
+  if (!(c.shut_down && was_in) && d.state != c.before.state) broken("a call that carries no frame changed the state", op);
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  __sanitizer_install_malloc_and_free_hooks(on_malloc, on_free);
+  return 0;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  if (size < static_cast<size_t>(fuzz::kTrafficHeader)) return 0;
+  const uint8_t* h = data;
+  Reader in{data + fuzz::kTrafficHeader, size - fuzz::kTrafficHeader};
+
+  Rules r;
+  r.cfg = config_from(h);
+  r.has_model = h[0] % 8 != 0;
+  const int caught_at = (h[0] / 8) % 3;
+  const model::OutcomeModel model = model_with_caught_at(caught_at);
+  RecordingSink sink;
+  Predictor p(r.has_model ? &model : nullptr, r.cfg, sink);
+  if (r.has_model && p.caught_class() != caught_at) broken("the caught class is not the model's 'caught'", -1);
+  r.threshold = p.threshold();
+  r.k = p.consecutive();
+  if (r.cfg.stop_threshold > 0 && r.threshold != r.cfg.stop_threshold) broken("the config's threshold is not used", -1);
+  if (r.cfg.stop_consecutive > 0 && r.k != r.cfg.stop_consecutive) broken("the config's k is not used", -1);
+
+  Shadow sh(r.cfg.max_delta_counter);
+  for (long op = 0; in.take(1); ++op) {
+    Call c;
+    if (!run_one(in, p, sink, sh, c, op)) break;
+    const bool started = p.trials_started() != c.starts_before;
+    check_outputs(p, sink, op);
+    if (started) check_trial_start(c, p, r, sh, op);
+    check_stop_state(c, p, sink, started, op);
+    const bool force = c.frame_sent && is(c.sent, MsgId::FtForce);
+    if (force && !started && c.before.state == PredictorState::InTrial) check_sample(c, p, r, sh, op);
+    if (force && c.before.state != PredictorState::InTrial && p.decision().state != c.before.state)
+      broken("a force frame outside a trial changed the state", op);
+    if (c.ticked) check_tick(c, p, sink, r, sh, op);
+    if (!c.frame_sent && !c.ticked) check_quiet_call(c, p, op);
+  }
+  return 0;
+}

@@ -1,0 +1,142 @@
+#!/usr/bin/python3
+"""Checks that fuzz_predictor's rules can fail: puts one fault at a time into a copy of
+predictor/core/predictor_core.cpp (a line of the stop policy changed, as a slip in review would
+change it), builds the fuzz target against the copy and runs it from the seed corpus. Every
+fault must be reported (a broken rule or a sanitizer report) within the time given; the
+unchanged source must run clean for as long.
+
+usage: tools/fuzz/predictor_mutants.py BUILD_DIR [--seconds S] [--only NAME]
+  BUILD_DIR   a configured build with dg_fuzz_seeds built (e.g. build/release)
+Needs clang++ with libFuzzer (Debian: clang, libclang-rt-14-dev). About 30 s of compiling per
+fault on one core of a 2-core VM. Exit 0 when every fault is caught and the clean run is clean.
+"""
+import argparse
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+
+SRC = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
+CORE = "predictor/core/predictor_core.cpp"
+
+# name, the line as it is, the line with the fault.
+FAULTS = [
+    ("hard limit ignored",
+     "if (std::fabs(rig[0]) > cfg_.hard_limit_n || std::fabs(rig[2]) > cfg_.hard_limit_n) {",
+     "if (false && (std::fabs(rig[0]) > cfg_.hard_limit_n || std::fabs(rig[2]) > cfg_.hard_limit_n)) {"),
+    ("bias not removed",
+     "rig[k] = cfg_.mount.sign[k] * fs[cfg_.mount.axis[k]] - cfg_.mount.bias[k];",
+     "rig[k] = cfg_.mount.sign[k] * fs[cfg_.mount.axis[k]];"),
+    ("mount axes ignored",
+     "rig[k] = cfg_.mount.sign[k] * fs[cfg_.mount.axis[k]] - cfg_.mount.bias[k];",
+     "rig[k] = cfg_.mount.sign[k] * fs[k] - cfg_.mount.bias[k];"),
+    ("timeout at >= instead of >",
+     "now_ns - last_sample_ns_ > cfg_.sensor_timeout_ns",
+     "now_ns - last_sample_ns_ >= cfg_.sensor_timeout_ns"),
+    ("k + 1 samples needed",
+     "if (++consecutive_ >= consecutive_needed_)",
+     "if (++consecutive_ > consecutive_needed_)"),
+    ("latch released before the echo",
+     "if (decision_.state == PredictorState::Stopped && !stop_pending_) decision_.state = PredictorState::Idle;",
+     "if (decision_.state == PredictorState::Stopped) decision_.state = PredictorState::Idle;"),
+    ("retry one period late",
+     "if (stop_pending_ && now_ns - stop_sent_ns_ >= cfg_.stop_retry_ns) {",
+     "if (stop_pending_ && now_ns - stop_sent_ns_ > cfg_.stop_retry_ns) {"),
+    ("echo matched without its counter",
+     "if (!stop_pending_ || f.id != stop_frame_.id || f.data[1] != stop_frame_.data[1]) return;",
+     "if (!stop_pending_ || f.id != stop_frame_.id) return;"),
+    ("SIGTERM does not stop",
+     "if (decision_.state == PredictorState::InTrial) stop(StopReason::Shutdown, now_ns);",
+     "(void)now_ns;"),
+    ("stop frame with a fixed reason",
+     "stop_frame_ = protocol::encode(protocol::Stop{0, r,",
+     "stop_frame_ = protocol::encode(protocol::Stop{0, StopReason::Caught,"),
+    ("lost frames not counted in the sample index",
+     "if (samples_started_) decision_.sample += 1 + lost;",
+     "if (samples_started_) decision_.sample += 1;"),
+    ("an allocation per sample",
+     "void Predictor::on_force(const Frame& f, int64_t now_ns) noexcept {\n  uint32_t lost = 0;",
+     "void Predictor::on_force(const Frame& f, int64_t now_ns) noexcept {\n  uint32_t lost = 0;\n"
+     "  { std::vector<int> v(100); asm volatile(\"\" :: \"r\"(v.data()) : \"memory\"); }"),
+]
+
+SOURCES = ["tools/fuzz/fuzz_predictor.cpp", "firmware-bridge/protocol/dg_protocol.cpp", "models/dgm.cpp",
+           "predictor/filter/forward_filter.cpp", "predictor/filter/emission_update.cpp"]
+INCLUDES = ["tools/fuzz", "tests/predictor", "predictor/core", "firmware-bridge/protocol", "models", "predictor/filter"]
+
+
+def build(core_path, out):
+    cmd = ["clang++", "-std=c++20", "-g", "-O1", "-fno-omit-frame-pointer", "-fsanitize=fuzzer,address,undefined",
+           "-fno-sanitize-recover=undefined"] + ["-I" + os.path.join(SRC, d) for d in INCLUDES] + \
+          [os.path.join(SRC, s) for s in SOURCES] + [core_path, "-o", out]
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode != 0:
+        sys.stderr.write(f"predictor_mutants: clang++ failed for {core_path}:\n{r.stderr}\n")
+        return False
+    return True
+
+
+def fuzz(binary, seeds_tool, work, seconds):
+    corpus = os.path.join(work, "corpus")
+    r = subprocess.run([seeds_tool, "predictor", corpus], capture_output=True, text=True)
+    if r.returncode != 0:
+        sys.stderr.write(f"predictor_mutants: {seeds_tool} failed: {r.stderr}\n")
+        return None, 0.0
+    t0 = time.monotonic()
+    r = subprocess.run([binary, "-seed=1", "-max_len=8192", f"-max_total_time={seconds}", "-runs=100000000",
+                        "-artifact_prefix=" + work + "/", corpus], capture_output=True, text=True)
+    dt = time.monotonic() - t0
+    m = re.search(r"rule broken at operation \d+: (.*)", r.stderr) or \
+        re.search(r"ERROR: (\w+Sanitizer: [^\n]*)", r.stderr)
+    if r.returncode == 0:
+        return "", dt
+    return (m.group(1) if m else f"exit {r.returncode}"), dt
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("build_dir")
+    ap.add_argument("--seconds", type=int, default=60)
+    ap.add_argument("--only")
+    a = ap.parse_args()
+    seeds_tool = os.path.join(a.build_dir, "tools", "fuzz", "dg_fuzz_seeds")
+    if not os.access(seeds_tool, os.X_OK):
+        sys.stderr.write(f"predictor_mutants: {seeds_tool} not found: build dg_fuzz_seeds first\n")
+        return 2
+    original = open(os.path.join(SRC, CORE)).read()
+    runs = [("none (the source as it is)", None, None)] + FAULTS
+    if a.only:
+        runs = [r for r in runs if a.only in r[0]]
+    failures = 0
+    with tempfile.TemporaryDirectory(prefix="dg-mutants-") as tmp:
+        for i, (name, old, new) in enumerate(runs):
+            work = os.path.join(tmp, str(i))
+            os.makedirs(work)
+            text = original
+            if old is not None:
+                if original.count(old) != 1:
+                    sys.stderr.write(f"predictor_mutants: '{name}': the line is not once in {CORE}: {old!r}\n")
+                    return 2
+                text = original.replace(old, new)
+            core = os.path.join(work, "predictor_core.cpp")
+            with open(core, "w") as f:
+                f.write(text)
+            binary = os.path.join(work, "fuzz_predictor")
+            if not build(core, binary):
+                return 2
+            found, dt = fuzz(binary, seeds_tool, work, a.seconds)
+            if found is None:
+                return 2
+            ok = (found == "") if old is None else (found != "")
+            failures += not ok
+            verdict = "ok" if ok else "FAILED"
+            what = found if found else f"clean for {dt:.0f} s"
+            print(f"{verdict:6} {name:45} {dt:6.1f} s  {what}", flush=True)
+    print(f"{len(runs) - failures} of {len(runs)} as expected")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
