@@ -3,6 +3,16 @@
 
 namespace dressguard::bridge {
 
+namespace {
+// The one place the reported state is derived (bridge_core.h, BridgeCore::state): a released
+// latch must report the sensor as it is, not Ok.
+void update_state(BridgeCore& c) {
+  c.state = c.stop_cause != StopCause::None ? protocol::BridgeState::StopLatched
+            : c.sensor_ok                   ? protocol::BridgeState::Ok
+                                            : protocol::BridgeState::SensorLost;
+}
+}  // namespace
+
 void bridge_init(BridgeCore& c, const BridgeConfig& cfg, uint32_t now_ms) {
   c = BridgeCore{};
   c.cfg = cfg;
@@ -16,14 +26,15 @@ int bridge_on_reading(BridgeCore& c, const FtReading& r, uint32_t, Frame out[2])
   out[0] = protocol::encode(protocol::FtForce{n, r.force[0], r.force[1], r.force[2]});
   out[1] = protocol::encode(protocol::FtTorque{n, r.torque[0], r.torque[1], r.torque[2]});
   ++c.readings;
-  if (c.state == protocol::BridgeState::SensorLost) c.state = protocol::BridgeState::Ok;
-  if (c.stop_cause != StopCause::None) c.state = protocol::BridgeState::StopLatched;
+  c.sensor_ok = true;
+  update_state(c);
   return 2;
 }
 
 void bridge_on_sensor_error(BridgeCore& c, uint32_t) {
   if (c.sensor_errors < 255) ++c.sensor_errors;
-  if (c.stop_cause == StopCause::None) c.state = protocol::BridgeState::SensorLost;
+  c.sensor_ok = false;
+  update_state(c);
 }
 
 void bridge_on_reconnect(BridgeCore& c) {
@@ -47,7 +58,7 @@ BridgeAction bridge_on_frame(BridgeCore& c, const Frame& f, uint32_t now_ms) {
       c.last_stop_reason = s.reason;
       if (c.stop_cause != StopCause::None) return BridgeAction::None;  // already latched
       c.stop_cause = StopCause::StopFrame;
-      c.state = protocol::BridgeState::StopLatched;
+      update_state(c);
       return BridgeAction::StopRobot;
     }
     case protocol::id_of(protocol::MsgId::TrialStart):
@@ -58,7 +69,7 @@ BridgeAction bridge_on_frame(BridgeCore& c, const Frame& f, uint32_t now_ms) {
       // A new trial releases the latch (the robot controller restarts the motion itself).
       c.stop_cause = StopCause::None;
       c.last_stop_reason = protocol::StopReason::None;
-      if (c.state == protocol::BridgeState::StopLatched) c.state = protocol::BridgeState::Ok;
+      update_state(c);
       return BridgeAction::None;
     case protocol::id_of(protocol::MsgId::HeartbeatPredictor):
       if (!protocol::accepted(c.predictor_hb_checker.check(f, lost))) {
@@ -77,7 +88,7 @@ int bridge_on_tick(BridgeCore& c, uint32_t now_ms, Frame* out, BridgeAction* act
   if (c.cfg.predictor_timeout_ms > 0 && c.stop_cause == StopCause::None &&
       static_cast<uint32_t>(now_ms - c.last_predictor_ms) > c.cfg.predictor_timeout_ms) {
     c.stop_cause = StopCause::PredictorSilent;
-    c.state = protocol::BridgeState::StopLatched;
+    update_state(c);
     *action = BridgeAction::StopRobot;
   }
   // Wrap-safe comparison of millisecond ticks.

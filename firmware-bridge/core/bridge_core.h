@@ -47,7 +47,10 @@ struct BridgeCore {
   protocol::E2EChecker stop_checker{protocol::MsgId::Stop, 255};
   protocol::E2EChecker trial_checker{protocol::MsgId::TrialStart, 255};
   protocol::E2EChecker predictor_hb_checker{protocol::MsgId::HeartbeatPredictor, 255};
-  protocol::BridgeState state = protocol::BridgeState::SensorLost;  // until the first reading
+  // What the heartbeat reports: StopLatched while a stop is latched, else SensorLost from a
+  // failed read (and before the first reading) until the next reading, else Ok.
+  protocol::BridgeState state = protocol::BridgeState::SensorLost;
+  bool sensor_ok = false;        // the last read succeeded
   StopCause stop_cause = StopCause::None;
   protocol::StopReason last_stop_reason = protocol::StopReason::None;
   uint8_t sensor_errors = 0;     // saturating

@@ -103,6 +103,34 @@ TEST(BridgeCore, HeartbeatCarriesSensorState) {
   EXPECT_EQ(bridge_on_tick(c, 50, &hb, &a), 0) << "next heartbeat only after 100 ms";
 }
 
+// Found by fuzz_bridge (session 80): a trial start used to report Ok when it released the latch,
+// even with no reading since a failed one (or none at all).
+TEST(BridgeCore, ReleasedLatchReportsTheSensorAsItIs) {
+  BridgeCore c;
+  bridge_init(c, {}, 0);
+  const auto heartbeat_state = [&c](uint32_t t) {
+    Frame hb;
+    BridgeAction a;
+    EXPECT_EQ(bridge_on_tick(c, t, &hb, &a), 1);
+    protocol::HeartbeatBridge m;
+    EXPECT_TRUE(protocol::decode(hb, m));
+    return m.state;
+  };
+  EXPECT_EQ(bridge_on_frame(c, protocol::encode(protocol::Stop{0, protocol::StopReason::Caught, 250, 1, 100}), 1),
+            BridgeAction::StopRobot);
+  EXPECT_EQ(heartbeat_state(2), protocol::BridgeState::StopLatched);
+  bridge_on_frame(c, protocol::encode(protocol::TrialStart{0, 2, 100, protocol::HeightClass::High}), 3);
+  EXPECT_FALSE(bridge_stop_latched(c));
+  EXPECT_EQ(heartbeat_state(200), protocol::BridgeState::SensorLost) << "no reading yet";
+  Frame out[2];
+  bridge_on_reading(c, FtReading{{1, 2, 3}, {4, 5, 6}}, 201, out);
+  EXPECT_EQ(heartbeat_state(400), protocol::BridgeState::Ok);
+  bridge_on_sensor_error(c, 401);
+  bridge_on_frame(c, protocol::encode(protocol::Stop{1, protocol::StopReason::HardLimit, 0, 2, 5}), 402);
+  bridge_on_frame(c, protocol::encode(protocol::TrialStart{1, 3, 100, protocol::HeightClass::High}), 403);
+  EXPECT_EQ(heartbeat_state(600), protocol::BridgeState::SensorLost) << "the last read failed";
+}
+
 // ---- Linux port against Modbus TCP peers ------------------------------------------------------
 
 class Emulator {

@@ -1,5 +1,5 @@
 // libFuzzer target for the predictor's logic (predictor/core): arbitrary bus traffic, timer ticks,
-// echoes, bus errors and failed transmissions (the byte format: predictor_traffic.h), under
+// echoes, bus errors and failed transmissions (the byte format: traffic.h), under
 // -fsanitize=fuzzer,address,undefined. Besides faults, it checks after every call the rules of
 // predictor_core.h against a shadow of them written from that header, not from the code:
 //
@@ -25,17 +25,21 @@
 // A broken rule prints which and aborts, which libFuzzer reports with the input that did it.
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
-#include <cstdlib>
 
 #include <sanitizer/allocator_interface.h>
 
 #include "dg_protocol.h"
 #include "predictor_core.h"
-#include "predictor_traffic.h"
+#include "traffic.h"
 #include "test_model.h"
 
 using namespace dressguard;
+using fuzz::broken;
+using fuzz::counter_for;
+using fuzz::damage;
+using fuzz::is;
+using fuzz::protected_as;
+using fuzz::Reader;
 using fuzz::TrafficOp;
 using predictor::Predictor;
 using protocol::Frame;
@@ -45,11 +49,6 @@ using protocol::StatusCounter;
 using protocol::StopReason;
 
 namespace {
-
-[[noreturn]] void broken(const char* rule, long op) {
-  std::fprintf(stderr, "fuzz_predictor: rule broken at operation %ld: %s\n", op, rule);
-  std::abort();
-}
 
 // The sink: records what the predictor sends, in fixed storage (the hot path must not see a
 // sink that allocates either).
@@ -61,11 +60,6 @@ struct RecordingSink final : predictor::PredictorSink {
   int fail_next = 0;        // the next n stop transmissions fail
   bool bad_output = false;  // a frame that is not E2E-protected or not 8 bytes
 
-  static bool protected_as(const Frame& f, MsgId m) {
-    protocol::E2EChecker chk(m);
-    uint32_t lost = 0;
-    return protocol::accepted(chk.check(f, lost));
-  }
   uint8_t transmit_stop(const Frame& f) noexcept override {
     ++stop_sends;
     last_stop = f;
@@ -108,17 +102,6 @@ struct CountAllocations {
   long count() const { return g_allocations - start; }
 };
 
-struct Reader {
-  const uint8_t* p;
-  size_t n;
-  bool take(size_t k) const { return n >= k; }
-  uint8_t u8() { return --n, *p++; }
-  int16_t i16() {
-    const uint8_t lo = u8();
-    return static_cast<int16_t>(lo | (u8() << 8));
-  }
-};
-
 predictor::PredictorConfig config_from(const uint8_t* h) {
   predictor::PredictorConfig c;
   static constexpr int kPerm[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
@@ -146,23 +129,6 @@ model::OutcomeModel model_with_caught_at(int caught_at) {
   std::swap(m.classes[2], m.classes[caught_at]);
   return m;
 }
-
-// A frame's counter byte per the ctl bits of TrafficOp::Force / TrialStart / TrialEnd.
-uint8_t counter_for(uint8_t ctl, uint8_t& running, uint8_t raw) {
-  switch (ctl & 3) {
-    case 0: return ++running;
-    case 1: return running;
-    case 2: return running = static_cast<uint8_t>(running + 2 + ((ctl >> 2) & 3));
-    default: return running = raw;
-  }
-}
-
-void damage(Frame& f, uint8_t ctl) {
-  if (ctl & 0x20) f.data[2] ^= 0x5A;  // after the CRC: the checker must see it
-  if (ctl & 0x40) f.len = 7;
-}
-
-bool is(const Frame& f, MsgId m) { return f.id == protocol::id_of(m); }
 
 // What the rules are judged against: the configuration as the predictor took it.
 struct Rules {
@@ -254,17 +220,8 @@ bool run_one(Reader& in, Predictor& p, RecordingSink& sink, Shadow& sh, Call& c,
       break;
     }
     case TrafficOp::RawFrame: {
-      if (!in.take(11)) return false;
-      static constexpr MsgId kIds[] = {MsgId::FtForce, MsgId::FtTorque, MsgId::TrialStart, MsgId::TrialEnd,
-                                       MsgId::HeartbeatBridge, MsgId::Stop, MsgId::PredictorStatus};
-      const uint8_t sel = in.u8();
-      c.sent.id = sel < 224 ? protocol::id_of(kIds[sel % 7]) : (sel * 37u) & 0x7FF;
-      c.sent.len = in.u8() % 9;
-      for (auto& b : c.sent.data) b = in.u8();
-      if (in.u8() & 1) {
-        for (MsgId m : kIds)
-          if (is(c.sent, m)) protocol::protect(c.sent, m);
-      }
+      if (!in.take(fuzz::kRawFrameBytes)) return false;
+      c.sent = fuzz::raw_frame(in);
       c.frame_sent = true;
       break;
     }

@@ -2,9 +2,12 @@
 //   dgm        fuzz_dgm: valid models of several shapes (1 class x 1 state, 2 x 5, 3 x 10, a
 //              general topology), each with mode byte 0 (as is) and 1 (size and CRC repaired by
 //              the harness), plus a truncated and a bit-flipped file;
-//   predictor  fuzz_predictor: trials as the bus carries them (predictor_traffic.h): a good
+//   predictor  fuzz_predictor: trials as the bus carries them (traffic.h): a good
 //              trial, a caught one confirmed by its echo, the hard limit, a sensor timeout whose
-//              stop must be resent, a burst of corrupted frames, no model, SIGTERM in a trial.
+//              stop must be resent, a burst of corrupted frames, no model, SIGTERM in a trial;
+//   bridge     fuzz_bridge: readings and heartbeats across the millisecond clock's wrap, a stop
+//              latched and released by a trial start, a predictor that falls silent, failed
+//              reads around a stop.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -17,7 +20,7 @@
 #include <vector>
 
 #include "dgm.h"
-#include "predictor_traffic.h"
+#include "traffic.h"
 
 using namespace dressguard::model;
 
@@ -73,6 +76,15 @@ bool put(const std::filesystem::path& p, uint8_t mode, const std::vector<uint8_t
   std::vector<uint8_t> m{mode};
   m.insert(m.end(), b.begin(), b.end());
   return write_file(p, m);
+}
+
+template <typename Writer>
+int write_seeds(const std::filesystem::path& dir, const std::vector<std::pair<std::string, Writer>>& seeds) {
+  bool ok = true;
+  for (const auto& [name, w] : seeds) ok &= write_file(dir / name, w.bytes);
+  if (!ok) return 1;
+  std::printf("wrote %zu seeds into %s\n", seeds.size(), dir.c_str());
+  return 0;
 }
 
 int dgm_seeds(const std::filesystem::path& dir) {
@@ -171,18 +183,73 @@ int predictor_seeds(const std::filesystem::path& dir) {
     w.tick(2);
     seeds.emplace_back("shutdown", w);
   }
-  bool ok = true;
-  for (const auto& [name, w] : seeds) ok &= write_file(dir / name, w.bytes);
-  if (!ok) return 1;
-  std::printf("wrote %zu seeds into %s\n", seeds.size(), dir.c_str());
-  return 0;
+  return write_seeds(dir, seeds);
+}
+int bridge_seeds(const std::filesystem::path& dir) {
+  using dressguard::fuzz::BridgeOp;
+  using dressguard::fuzz::BridgeWriter;
+  // No predictor timeout, 100 ms heartbeats, the clock 2 s before it wraps; and with a 152 ms
+  // predictor timeout (a multiple of the 4 ms steps, so that a tick lands on it exactly).
+  const uint8_t plain[dressguard::fuzz::kBridgeHeader] = {0, 99, 0x30, 0xF8, 0xFF, 0xFF};
+  const uint8_t guarded[dressguard::fuzz::kBridgeHeader] = {142, 99, 0x30, 0xF8, 0xFF, 0xFF};
+  const auto readings = [](BridgeWriter& w, int n, double fx) {
+    for (int i = 0; i < n; ++i) {
+      w.reading(fx, 0.1, -0.5, 0.01);
+      w.tick();
+    }
+  };
+  std::vector<std::pair<std::string, BridgeWriter>> seeds;
+  {
+    BridgeWriter w(plain);  // readings every 8 ms for 4 s: the clock wraps half-way
+    readings(w, 500, -2.0);
+    seeds.emplace_back("wrap", w);
+  }
+  {
+    BridgeWriter w(plain);  // a stop, repeated, a corrupted one, then a trial start releases it
+    readings(w, 20, -2.0);
+    w.op(BridgeOp::Stop, 1, {0, 1, 7});
+    w.op(BridgeOp::Stop, 1, {1, 1, 7});
+    w.op(BridgeOp::Stop, 1, {0x20, 1, 7});
+    readings(w, 20, -6.0);
+    w.op(BridgeOp::TrialStart, 1, {0, 8});
+    readings(w, 20, -2.0);
+    seeds.emplace_back("stop_release", w);
+  }
+  {
+    BridgeWriter w(guarded);  // the predictor's heartbeat every 40 ms, then silence, a tick every 4 ms
+    for (int i = 0; i < 20; ++i) {
+      w.op(BridgeOp::PredictorHeartbeat, 10, {0});
+      w.tick();
+    }
+    for (int i = 0; i < 45; ++i) w.tick(1);
+    w.op(BridgeOp::TrialStart, 1, {0, 2});
+    w.op(BridgeOp::PredictorHeartbeat, 1, {0});
+    w.tick(1);
+    seeds.emplace_back("silent_predictor", w);
+  }
+  {
+    BridgeWriter w(plain);  // failed reads, a reconnect, a stop while the sensor is lost
+    w.op(BridgeOp::SensorError, 5);
+    w.tick(10);
+    w.op(BridgeOp::Reconnect, 1);
+    readings(w, 5, -1.0);
+    w.op(BridgeOp::SensorError, 5);
+    w.op(BridgeOp::Stop, 1, {0, 2, 3});
+    w.tick(10);
+    w.op(BridgeOp::TrialStart, 1, {0, 4});
+    w.op(BridgeOp::Wait, 0, {30});
+    readings(w, 3, -1.0);
+    w.op(BridgeOp::Wait, 0, {30});
+    seeds.emplace_back("sensor_lost", w);
+  }
+  return write_seeds(dir, seeds);
 }
 }  // namespace
 
 int main(int argc, char** argv) {
   const std::string kind = argc == 3 ? argv[1] : "";
-  if (kind != "dgm" && kind != "predictor") {
-    std::fprintf(stderr, "usage: dg_fuzz_seeds dgm|predictor DIR\n");
+  if (kind != "dgm" && kind != "predictor" && kind != "bridge") {
+    std::fprintf(stderr, "usage: dg_fuzz_seeds dgm|predictor|bridge DIR\n");
     return 2;
   }
   const std::filesystem::path dir = argv[2];
@@ -192,5 +259,6 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "dg_fuzz_seeds: cannot create %s: %s\n", dir.c_str(), ec.message().c_str());
     return 1;
   }
-  return kind == "dgm" ? dgm_seeds(dir) : predictor_seeds(dir);
+  if (kind == "dgm") return dgm_seeds(dir);
+  return kind == "predictor" ? predictor_seeds(dir) : bridge_seeds(dir);
 }

@@ -1,14 +1,16 @@
 #!/usr/bin/python3
-"""Checks that fuzz_predictor's rules can fail: puts one fault at a time into a copy of
-predictor/core/predictor_core.cpp (a line of the stop policy changed, as a slip in review would
-change it), builds the fuzz target against the copy and runs it from the seed corpus. Every
-fault must be reported (a broken rule or a sanitizer report) within the time given; the
-unchanged source must run clean for as long.
+"""Checks that the robot side's fuzz targets can fail: puts one fault at a time into a copy of
+the core they drive (predictor/core/predictor_core.cpp for fuzz_predictor,
+firmware-bridge/core/bridge_core.cpp for fuzz_bridge): a line of a rule changed, as a slip in
+review would change it. It builds the fuzz target against the copy and runs it from the seed
+corpus. Every fault must be reported (a broken rule or a sanitizer report) within the time
+given; the unchanged source must run clean for as long.
 
-usage: tools/fuzz/predictor_mutants.py BUILD_DIR [--seconds S] [--only NAME]
+usage: tools/fuzz/mutants.py predictor|bridge BUILD_DIR [--seconds S] [--only NAME]
   BUILD_DIR   a configured build with dg_fuzz_seeds built (e.g. build/release)
 Needs clang++ with libFuzzer (Debian: clang, libclang-rt-14-dev). About 30 s of compiling per
-fault on one core of a 2-core VM. Exit 0 when every fault is caught and the clean run is clean.
+fault on one core of a 2-core VM (fuzz_bridge's sources: a few seconds). Exit 0 when every
+fault is caught and the clean run is clean.
 """
 import argparse
 import os
@@ -19,10 +21,8 @@ import tempfile
 import time
 
 SRC = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
-CORE = "predictor/core/predictor_core.cpp"
-
 # name, the line as it is, the line with the fault.
-FAULTS = [
+PREDICTOR_FAULTS = [
     ("hard limit ignored",
      "if (std::fabs(rig[0]) > cfg_.hard_limit_n || std::fabs(rig[2]) > cfg_.hard_limit_n) {",
      "if (false && (std::fabs(rig[0]) > cfg_.hard_limit_n || std::fabs(rig[2]) > cfg_.hard_limit_n)) {"),
@@ -62,27 +62,70 @@ FAULTS = [
      "  { std::vector<int> v(100); asm volatile(\"\" :: \"r\"(v.data()) : \"memory\"); }"),
 ]
 
-SOURCES = ["tools/fuzz/fuzz_predictor.cpp", "firmware-bridge/protocol/dg_protocol.cpp", "models/dgm.cpp",
-           "predictor/filter/forward_filter.cpp", "predictor/filter/emission_update.cpp"]
-INCLUDES = ["tools/fuzz", "tests/predictor", "predictor/core", "firmware-bridge/protocol", "models", "predictor/filter"]
+BRIDGE_FAULTS = [
+    ("a repeated stop dropped",
+     "if (protocol::e2e_crc(protocol::data_id_of(protocol::MsgId::Stop), f.data) != f.data[0] || !protocol::decode(f, s)) {",
+     "if (true) {"),
+    ("asked to stop again while latched",
+     "if (c.stop_cause != StopCause::None) return BridgeAction::None;  // already latched",
+     ""),
+    ("released by a trial start that fails E2E",
+     "if (!protocol::accepted(c.trial_checker.check(f, lost))) {",
+     "if (false) {"),
+    ("released to Ok with the sensor lost",
+     "c.last_stop_reason = protocol::StopReason::None;\n      update_state(c);",
+     "c.last_stop_reason = protocol::StopReason::None;\n      c.state = protocol::BridgeState::Ok;"),
+    ("silence at >= instead of >",
+     "> c.cfg.predictor_timeout_ms) {",
+     ">= c.cfg.predictor_timeout_ms) {"),
+    ("silence stops again while latched",
+     "if (c.cfg.predictor_timeout_ms > 0 && c.stop_cause == StopCause::None &&",
+     "if (c.cfg.predictor_timeout_ms > 0 &&"),
+    ("heartbeat due compared without the wrap",
+     "if (static_cast<int32_t>(now_ms - c.next_heartbeat_ms) < 0) return 0;",
+     "if (now_ms < c.next_heartbeat_ms) return 0;"),
+    ("the torque frame with a counter of its own",
+     "out[1] = protocol::encode(protocol::FtTorque{n,",
+     "out[1] = protocol::encode(protocol::FtTorque{c.sample_counter.next(),"),
+    ("a reading reports Ok while latched",
+     "c.sensor_ok = true;\n  update_state(c);",
+     "c.sensor_ok = true;\n  c.state = protocol::BridgeState::Ok;"),
+    ("a corrupted predictor heartbeat heard",
+     "if (!protocol::accepted(c.predictor_hb_checker.check(f, lost))) {",
+     "if (false) {"),
+]
+
+# target: (the core the faults go into, the other sources, include folders, the faults)
+TARGETS = {
+    "predictor": ("predictor/core/predictor_core.cpp",
+                  ["tools/fuzz/fuzz_predictor.cpp", "firmware-bridge/protocol/dg_protocol.cpp", "models/dgm.cpp",
+                   "predictor/filter/forward_filter.cpp", "predictor/filter/emission_update.cpp"],
+                  ["tools/fuzz", "tests/predictor", "predictor/core", "firmware-bridge/protocol", "models",
+                   "predictor/filter"],
+                  PREDICTOR_FAULTS),
+    "bridge": ("firmware-bridge/core/bridge_core.cpp",
+               ["tools/fuzz/fuzz_bridge.cpp", "firmware-bridge/protocol/dg_protocol.cpp"],
+               ["tools/fuzz", "firmware-bridge/core", "firmware-bridge/protocol"],
+               BRIDGE_FAULTS),
+}
 
 
-def build(core_path, out):
+def build(core_path, sources, includes, out):
     cmd = ["clang++", "-std=c++20", "-g", "-O1", "-fno-omit-frame-pointer", "-fsanitize=fuzzer,address,undefined",
-           "-fno-sanitize-recover=undefined"] + ["-I" + os.path.join(SRC, d) for d in INCLUDES] + \
-          [os.path.join(SRC, s) for s in SOURCES] + [core_path, "-o", out]
+           "-fno-sanitize-recover=undefined"] + ["-I" + os.path.join(SRC, d) for d in includes] + \
+          [os.path.join(SRC, s) for s in sources] + [core_path, "-o", out]
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode != 0:
-        sys.stderr.write(f"predictor_mutants: clang++ failed for {core_path}:\n{r.stderr}\n")
+        sys.stderr.write(f"mutants: clang++ failed for {core_path}:\n{r.stderr}\n")
         return False
     return True
 
 
-def fuzz(binary, seeds_tool, work, seconds):
+def fuzz(binary, kind, seeds_tool, work, seconds):
     corpus = os.path.join(work, "corpus")
-    r = subprocess.run([seeds_tool, "predictor", corpus], capture_output=True, text=True)
+    r = subprocess.run([seeds_tool, kind, corpus], capture_output=True, text=True)
     if r.returncode != 0:
-        sys.stderr.write(f"predictor_mutants: {seeds_tool} failed: {r.stderr}\n")
+        sys.stderr.write(f"mutants: {seeds_tool} failed: {r.stderr}\n")
         return None, 0.0
     t0 = time.monotonic()
     r = subprocess.run([binary, "-seed=1", "-max_len=8192", f"-max_total_time={seconds}", "-runs=100000000",
@@ -97,16 +140,18 @@ def fuzz(binary, seeds_tool, work, seconds):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("target", choices=sorted(TARGETS))
     ap.add_argument("build_dir")
     ap.add_argument("--seconds", type=int, default=60)
     ap.add_argument("--only")
     a = ap.parse_args()
     seeds_tool = os.path.join(a.build_dir, "tools", "fuzz", "dg_fuzz_seeds")
     if not os.access(seeds_tool, os.X_OK):
-        sys.stderr.write(f"predictor_mutants: {seeds_tool} not found: build dg_fuzz_seeds first\n")
+        sys.stderr.write(f"mutants: {seeds_tool} not found: build dg_fuzz_seeds first\n")
         return 2
-    original = open(os.path.join(SRC, CORE)).read()
-    runs = [("none (the source as it is)", None, None)] + FAULTS
+    core_file, sources, includes, faults = TARGETS[a.target]
+    original = open(os.path.join(SRC, core_file)).read()
+    runs = [("none (the source as it is)", None, None)] + faults
     if a.only:
         runs = [r for r in runs if a.only in r[0]]
     failures = 0
@@ -117,16 +162,16 @@ def main():
             text = original
             if old is not None:
                 if original.count(old) != 1:
-                    sys.stderr.write(f"predictor_mutants: '{name}': the line is not once in {CORE}: {old!r}\n")
+                    sys.stderr.write(f"mutants: '{name}': the line is not once in {core_file}: {old!r}\n")
                     return 2
                 text = original.replace(old, new)
-            core = os.path.join(work, "predictor_core.cpp")
+            core = os.path.join(work, os.path.basename(core_file))
             with open(core, "w") as f:
                 f.write(text)
-            binary = os.path.join(work, "fuzz_predictor")
-            if not build(core, binary):
+            binary = os.path.join(work, "fuzz_" + a.target)
+            if not build(core, sources, includes, binary):
                 return 2
-            found, dt = fuzz(binary, seeds_tool, work, a.seconds)
+            found, dt = fuzz(binary, a.target, seeds_tool, work, a.seconds)
             if found is None:
                 return 2
             ok = (found == "") if old is None else (found != "")

@@ -1,0 +1,196 @@
+// libFuzzer target for the firmware bridge's portable core (firmware-bridge/core): arbitrary
+// sensor readings and read errors, bus frames and ticks of a millisecond clock that may wrap
+// (the byte format: traffic.h), under -fsanitize=fuzzer,address,undefined. After every call it
+// checks the rules of bridge_core.h against a shadow of them written from that header:
+//
+//   samples     a reading becomes one FtForce and one FtTorque frame, E2E-protected, with the
+//               reading's counts and one alive counter that advances by one per reading;
+//   stop        a Stop frame with a valid CRC latches the stop (a repeated one too: a stop is
+//               never dropped for its counter), and asks the robot to stop exactly when it
+//               was not latched; a corrupted or short one changes nothing;
+//   release     only a TrialStart that its E2E check accepts releases the latch;
+//   silence     with a predictor timeout, a tick latches the stop exactly when the predictor's
+//               heartbeat (E2E-accepted) is older than the timeout, wrap-safe;
+//   heartbeat   sent on the tick when due (period from the last one, wrap-safe), E2E-protected,
+//               carrying the state: StopLatched while latched, else SensorLost after a failed
+//               read until the next reading, else Ok.
+//
+// A broken rule prints which and aborts, which libFuzzer reports with the input that did it.
+#include <cstdint>
+
+#include "bridge_core.h"
+#include "dg_protocol.h"
+#include "traffic.h"
+
+using namespace dressguard;
+using bridge::BridgeAction;
+using bridge::BridgeCore;
+using fuzz::BridgeOp;
+using fuzz::broken;
+using fuzz::counter_for;
+using fuzz::damage;
+using fuzz::is;
+using fuzz::protected_as;
+using fuzz::Reader;
+using protocol::BridgeState;
+using protocol::Frame;
+using protocol::MsgId;
+
+namespace {
+
+// The shadow: the senders' counters and what the header's rules need to know.
+struct Shadow {
+  uint32_t now = 0;
+  uint8_t c_stop = 0, c_trial = 0, c_phb = 0;  // the predictor's and the robot's senders
+  uint8_t c_hb = 0;                            // the bridge's heartbeat, as last received
+  bool latched = false;
+  bool sensor_lost = true;  // until the first reading
+  uint8_t sample_counter = 0;
+  bool sampled = false;
+  uint32_t last_predictor = 0;
+  uint32_t next_heartbeat = 0;
+  protocol::E2EChecker trial_e2e{MsgId::TrialStart, 255};
+  protocol::E2EChecker hb_e2e{MsgId::HeartbeatPredictor, 255};
+};
+
+BridgeState expected_state(const Shadow& sh) {
+  return sh.latched ? BridgeState::StopLatched : sh.sensor_lost ? BridgeState::SensorLost : BridgeState::Ok;
+}
+
+// A reading: two frames with the reading's counts and one counter, advancing by one.
+void reading(Reader& in, BridgeCore& c, Shadow& sh, long op) {
+  bridge::FtReading r;
+  for (auto& v : r.force) v = in.i16();
+  for (auto& v : r.torque) v = in.i16();
+  Frame out[2];
+  if (bridge::bridge_on_reading(c, r, sh.now, out) != 2) broken("a reading did not give two frames", op);
+  protocol::FtForce f;
+  protocol::FtTorque t;
+  if (!protected_as(out[0], MsgId::FtForce) || !protected_as(out[1], MsgId::FtTorque) || !protocol::decode(out[0], f) ||
+      !protocol::decode(out[1], t))
+    broken("a sample frame is not an E2E-protected FtForce / FtTorque", op);
+  if (f.fx != r.force[0] || f.fy != r.force[1] || f.fz != r.force[2] || t.mx != r.torque[0] || t.my != r.torque[1] ||
+      t.mz != r.torque[2])
+    broken("a sample frame does not carry the reading's counts", op);
+  if (f.counter != t.counter) broken("the force and torque frames of one reading carry different counters", op);
+  if (sh.sampled && f.counter != static_cast<uint8_t>(sh.sample_counter + 1)) broken("the sample counter did not advance by one", op);
+  sh.sample_counter = f.counter;
+  sh.sampled = true;
+  sh.sensor_lost = false;
+}
+
+// A Stop frame: a valid CRC latches; the robot is asked to stop when it was not latched before.
+void stop_frame(const Frame& f, BridgeCore& c, Shadow& sh, long op) {
+  const bool valid = f.len == protocol::kFrameLength && f.data[0] == protocol::e2e_crc(protocol::data_id_of(MsgId::Stop), f.data);
+  const BridgeAction a = bridge::bridge_on_frame(c, f, sh.now);
+  const bool asks = a == BridgeAction::StopRobot;
+  if (valid && asks != !sh.latched) broken(sh.latched ? "a stop asked again while latched" : "a valid stop frame did not stop the robot", op);
+  if (!valid && asks) broken("a corrupted or short stop frame stopped the robot", op);
+  if (valid) sh.latched = true;
+  if (bridge::bridge_stop_latched(c) != sh.latched) broken(valid ? "a valid stop frame did not latch" : "a corrupted or short stop frame changed the latch", op);
+}
+
+// Any other frame: a TrialStart accepted by its E2E check releases the latch; a predictor
+// heartbeat accepted by its check restarts the silence clock; nothing asks for a stop.
+void other_frame(const Frame& f, BridgeCore& c, Shadow& sh, long op) {
+  uint32_t lost = 0;
+  const bool trial_ok = is(f, MsgId::TrialStart) && protocol::accepted(sh.trial_e2e.check(f, lost));
+  const bool hb_ok = is(f, MsgId::HeartbeatPredictor) && protocol::accepted(sh.hb_e2e.check(f, lost));
+  if (bridge::bridge_on_frame(c, f, sh.now) != BridgeAction::None) broken("a frame other than a stop stopped the robot", op);
+  if (trial_ok) sh.latched = false;
+  if (hb_ok) sh.last_predictor = sh.now;
+  if (bridge::bridge_stop_latched(c) != sh.latched)
+    broken(trial_ok ? "an accepted trial start did not release the latch" : "a frame other than a stop or a trial start changed the latch", op);
+}
+
+// A tick: the predictor's silence, then the heartbeat when due.
+void tick(BridgeCore& c, Shadow& sh, long op) {
+  const bool silent = c.cfg.predictor_timeout_ms > 0 && !sh.latched &&
+                      static_cast<uint32_t>(sh.now - sh.last_predictor) > c.cfg.predictor_timeout_ms;
+  const bool due = static_cast<int32_t>(sh.now - sh.next_heartbeat) >= 0;
+  Frame hb;
+  BridgeAction a = BridgeAction::None;
+  const int n = bridge::bridge_on_tick(c, sh.now, &hb, &a);
+  if ((a == BridgeAction::StopRobot) != silent) broken(silent ? "a silent predictor did not stop the robot" : "a tick stopped the robot with the predictor heard", op);
+  if (silent) sh.latched = true;
+  if (bridge::bridge_stop_latched(c) != sh.latched) broken("a tick changed the latch other than for the predictor's silence", op);
+  if ((n == 1) != due) broken(due ? "a heartbeat due was not sent" : "a heartbeat before it was due", op);
+  if (n != 1) return;
+  sh.next_heartbeat = sh.now + c.cfg.heartbeat_period_ms;
+  protocol::HeartbeatBridge m;
+  if (!protected_as(hb, MsgId::HeartbeatBridge) || !protocol::decode(hb, m)) broken("the heartbeat is not an E2E-protected HeartbeatBridge", op);
+  if (m.counter != ++sh.c_hb) broken("the heartbeat counter did not advance by one", op);
+  if (m.state != expected_state(sh)) broken("the heartbeat's state is not the bridge's", op);
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  if (size < static_cast<size_t>(fuzz::kBridgeHeader)) return 0;
+  const uint8_t* h = data;
+  Reader in{data + fuzz::kBridgeHeader, size - fuzz::kBridgeHeader};
+  bridge::BridgeConfig cfg;
+  cfg.predictor_timeout_ms = h[0] < 64 ? 0 : 10 + h[0] % 200;
+  cfg.heartbeat_period_ms = 1 + h[1];
+  Shadow sh;
+  sh.now = static_cast<uint32_t>(h[2] | h[3] << 8 | h[4] << 16 | static_cast<uint32_t>(h[5]) << 24);
+  sh.last_predictor = sh.next_heartbeat = sh.now;
+  sh.c_hb = 0xFF;  // one before the first heartbeat's counter (protocol::AliveCounter starts at 0)
+  BridgeCore c;
+  bridge::bridge_init(c, cfg, sh.now);
+
+  for (long op = 0; in.take(1); ++op) {
+    const uint8_t opbyte = in.u8();
+    const auto kind = static_cast<BridgeOp>(opbyte & 0x0F);
+    sh.now += (opbyte >> 4) * fuzz::kBridgeTimeUnitMs;
+    switch (kind) {
+      case BridgeOp::Reading:
+        if (!in.take(12)) return 0;
+        reading(in, c, sh, op);
+        break;
+      case BridgeOp::SensorError:
+        bridge::bridge_on_sensor_error(c, sh.now);
+        sh.sensor_lost = true;
+        break;
+      case BridgeOp::Reconnect: bridge::bridge_on_reconnect(c); break;
+      case BridgeOp::Stop: {
+        if (!in.take(3)) return 0;
+        const uint8_t ctl = in.u8(), reason = in.u8(), trial = in.u8();
+        Frame f = protocol::encode(protocol::Stop{counter_for(ctl, sh.c_stop, trial), static_cast<protocol::StopReason>(reason % 7),
+                                                  static_cast<uint8_t>(reason), trial, 0});
+        damage(f, ctl);
+        stop_frame(f, c, sh, op);
+        break;
+      }
+      case BridgeOp::TrialStart: {
+        if (!in.take(2)) return 0;
+        const uint8_t ctl = in.u8(), trial = in.u8();
+        Frame f = protocol::encode(protocol::TrialStart{counter_for(ctl, sh.c_trial, trial), trial, 100, protocol::HeightClass::Middle});
+        damage(f, ctl);
+        other_frame(f, c, sh, op);
+        break;
+      }
+      case BridgeOp::PredictorHeartbeat: {
+        if (!in.take(1)) return 0;
+        const uint8_t ctl = in.u8();
+        Frame f = protocol::encode(protocol::HeartbeatPredictor{counter_for(ctl, sh.c_phb, ctl), protocol::PredictorState::Idle, 1, 0, 0});
+        damage(f, ctl);
+        other_frame(f, c, sh, op);
+        break;
+      }
+      case BridgeOp::RawFrame: {
+        if (!in.take(fuzz::kRawFrameBytes)) return 0;
+        const Frame f = fuzz::raw_frame(in);
+        if (is(f, MsgId::Stop)) stop_frame(f, c, sh, op); else other_frame(f, c, sh, op);
+        break;
+      }
+      case BridgeOp::Wait:
+        if (!in.take(1)) return 0;
+        sh.now += in.u8() * fuzz::kBridgeTimeUnitMs;
+        tick(c, sh, op);
+        break;
+      default: tick(c, sh, op); break;
+    }
+  }
+  return 0;
+}
