@@ -17,12 +17,17 @@ int hex_value(char c) {
 }  // namespace
 
 std::string format_candump_line(int64_t time_us, std::string_view iface, const Frame& f) {
-  char buf[96];
-  int n = std::snprintf(buf, sizeof buf, "(%lld.%06lld) %.*s %03X#", static_cast<long long>(time_us / 1000000),
-                        static_cast<long long>(time_us % 1000000), static_cast<int>(iface.size()), iface.data(),
-                        static_cast<unsigned>(f.id & 0x7FF));
-  for (int i = 0; i < f.len && i < 8; ++i) n += std::snprintf(buf + n, sizeof buf - n, "%02X", f.data[i]);
-  return std::string(buf, n);
+  // The timestamp and the frame in fixed buffers of known size; the interface name as given.
+  char ts[48];
+  const int nt = std::snprintf(ts, sizeof ts, "(%lld.%06lld) ", static_cast<long long>(time_us / 1000000),
+                               static_cast<long long>(time_us % 1000000));
+  char fr[4 + 1 + 16 + 1];
+  int nf = std::snprintf(fr, sizeof fr, " %03X#", static_cast<unsigned>(f.id & 0x7FF));
+  for (int i = 0; i < f.len && i < 8; ++i) nf += std::snprintf(fr + nf, sizeof fr - nf, "%02X", f.data[i]);
+  std::string line(ts, nt);
+  line.append(iface);
+  line.append(fr, nf);
+  return line;
 }
 
 bool parse_candump_line(std::string_view line, LoggedFrame& out, std::string& why) {
@@ -34,6 +39,8 @@ bool parse_candump_line(std::string_view line, LoggedFrame& out, std::string& wh
   const size_t dot = ts.find('.');
   if (dot == std::string_view::npos || dot == 0 || ts.size() - dot - 1 != 6)
     return why = "timestamp is not seconds.microseconds (6 digits)", false;
+  // Microseconds since the epoch must fit an int64_t: 12 digits of seconds (31,000 years) do.
+  if (dot > 12) return why = "timestamp has more than 12 digits of seconds", false;
   int64_t sec = 0, usec = 0;
   for (size_t i = 0; i < ts.size(); ++i) {
     if (i == dot) continue;
@@ -45,6 +52,7 @@ bool parse_candump_line(std::string_view line, LoggedFrame& out, std::string& wh
   rest.remove_prefix(1);
   const size_t sp = rest.find(' ');
   if (sp == std::string_view::npos || sp == 0) return why = "expected an interface name", false;
+  if (sp > kMaxInterfaceName) return why = "interface name longer than 15 characters (IFNAMSIZ)", false;
   out.iface = std::string(rest.substr(0, sp));
   std::string_view fr = rest.substr(sp + 1);
   const size_t hash = fr.find('#');

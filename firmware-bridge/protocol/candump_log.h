@@ -4,9 +4,11 @@
 //   (1700000000.012345) vcan0 100#A5010A00F6FF3200
 //   (seconds.microseconds) interface id#data-in-hex
 //
-// Classic frames only (3 hex digits of identifier, 0..8 data bytes). Host side: allocates.
+// Classic frames only (3 hex digits of identifier, 0..8 data bytes), timestamps of at most 12
+// digits of seconds, interface names of at most 15 characters. Host side: allocates.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -16,6 +18,9 @@
 #include "dg_protocol.h"
 
 namespace dressguard::protocol {
+
+// Linux interface names are at most IFNAMSIZ - 1 characters; a longer one is not a log line.
+inline constexpr size_t kMaxInterfaceName = 15;
 
 struct LoggedFrame {
   int64_t time_us = 0;  // timestamp in microseconds

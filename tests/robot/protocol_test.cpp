@@ -229,6 +229,26 @@ TEST(CandumpLog, BadLinesNameFileAndLine) {
   EXPECT_FALSE(parse_candump_line("(1.000000) vcan0 100##100", lf, why));
 }
 
+// Found by fuzz_candump (session 80): 13 or more digits of seconds overflowed the microseconds
+// (undefined behaviour), and a long interface name written back overran the line's buffer.
+TEST(CandumpLog, TimestampAndInterfaceNameHaveBounds) {
+  LoggedFrame lf;
+  std::string why;
+  ASSERT_TRUE(parse_candump_line("(999999999999.999999) vcan0 100#00", lf, why)) << why;
+  EXPECT_EQ(lf.time_us, 999999999999999999LL);
+  EXPECT_FALSE(parse_candump_line("(17000000000000.000000) vcan0 100#00", lf, why));
+  EXPECT_NE(why.find("12 digits"), std::string::npos) << why;
+  const std::string longest(kMaxInterfaceName, 'c');
+  ASSERT_TRUE(parse_candump_line("(1.000000) " + longest + " 100#00", lf, why)) << why;
+  EXPECT_FALSE(parse_candump_line("(1.000000) " + longest + "c 100#00", lf, why));
+  EXPECT_NE(why.find("IFNAMSIZ"), std::string::npos) << why;
+  // Writing never depends on the name's length: any name comes back whole.
+  const std::string name(200, 'n');
+  const std::string line = format_candump_line(1000001, name, encode(FtForce{1, 2, 3, 4}));
+  EXPECT_EQ(line, "(1.000001) " + name + " 100#" + line.substr(line.size() - 16));
+  EXPECT_EQ(line.size(), std::string("(1.000001) ").size() + name.size() + 5 + 16);
+}
+
 // ---- in-process bus ------------------------------------------------------------------------------
 
 TEST(InProcBus, FiltersEchoesAndDrops) {

@@ -7,7 +7,9 @@
 //              stop must be resent, a burst of corrupted frames, no model, SIGTERM in a trial;
 //   bridge     fuzz_bridge: readings and heartbeats across the millisecond clock's wrap, a stop
 //              latched and released by a trial start, a predictor that falls silent, failed
-//              reads around a stop.
+//              reads around a stop;
+//   candump    fuzz_candump: `candump -l` logs of each message of the protocol, with blank
+//              lines, CRLF endings and a short frame.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -19,6 +21,7 @@
 #include <utility>
 #include <vector>
 
+#include "candump_log.h"
 #include "dgm.h"
 #include "traffic.h"
 
@@ -244,12 +247,39 @@ int bridge_seeds(const std::filesystem::path& dir) {
   }
   return write_seeds(dir, seeds);
 }
+int candump_seeds(const std::filesystem::path& dir) {
+  namespace p = dressguard::protocol;
+  const p::Frame frames[] = {
+      p::encode(p::TrialStart{0, 1, 100, p::HeightClass::High}), p::encode(p::FtForce{0, -200, 10, -50}),
+      p::encode(p::FtTorque{0, 1, -2, 3}), p::encode(p::Stop{0, p::StopReason::Caught, 240, 1, 57}),
+      p::encode(p::HeartbeatBridge{3, p::BridgeState::Ok, 0, 1, 12}),
+      p::encode(p::HeartbeatPredictor{4, p::PredictorState::InTrial, 1, 1, 12}),
+      p::encode(p::Posteriors{5, 57, {10, 5, 240}, p::PredictorState::Stopped}),
+      p::encode(p::TrialEnd{0, 1, 58, p::TrialEndReason::StoppedByPredictor})};
+  std::string all, crlf;
+  int64_t t = 1700000000000100;
+  for (const auto& f : frames) {
+    const std::string line = p::format_candump_line(t, "vcan0", f);
+    all += line + "\n";
+    crlf += line + "\r\n\n";
+    t += 10000;
+  }
+  p::Frame shorty;
+  shorty.id = 0x080;
+  all += p::format_candump_line(t, "can0", shorty) + "\n";
+  const std::vector<std::pair<std::string, std::string>> seeds = {{"trial.log", all}, {"crlf.log", crlf}};
+  bool ok = true;
+  for (const auto& [name, text] : seeds) ok &= write_file(dir / name, std::vector<uint8_t>(text.begin(), text.end()));
+  if (!ok) return 1;
+  std::printf("wrote %zu seeds into %s\n", seeds.size(), dir.c_str());
+  return 0;
+}
 }  // namespace
 
 int main(int argc, char** argv) {
   const std::string kind = argc == 3 ? argv[1] : "";
-  if (kind != "dgm" && kind != "predictor" && kind != "bridge") {
-    std::fprintf(stderr, "usage: dg_fuzz_seeds dgm|predictor|bridge DIR\n");
+  if (kind != "dgm" && kind != "predictor" && kind != "bridge" && kind != "candump") {
+    std::fprintf(stderr, "usage: dg_fuzz_seeds dgm|predictor|bridge|candump DIR\n");
     return 2;
   }
   const std::filesystem::path dir = argv[2];
@@ -260,5 +290,6 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (kind == "dgm") return dgm_seeds(dir);
+  if (kind == "candump") return candump_seeds(dir);
   return kind == "predictor" ? predictor_seeds(dir) : bridge_seeds(dir);
 }

@@ -1,0 +1,48 @@
+// libFuzzer target for the can-utils log reader (firmware-bridge/protocol/candump_log.h), which
+// `dressguard replay` and the tests feed with recorded traffic, under
+// -fsanitize=fuzzer,address,undefined. The input is the log's text. Rules:
+//
+//   errors      a log that does not parse throws std::runtime_error "NAME:LINE: what", LINE a
+//               line of the text (1-based), naming what is wrong;
+//   round trip  every frame of a log that parses, written back by format_candump_line, parses
+//               to the same time, interface, identifier, length and data.
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "candump_log.h"
+#include "traffic.h"
+
+using namespace dressguard;
+using fuzz::broken;
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  const std::string_view text(reinterpret_cast<const char*>(data), size);
+  std::vector<protocol::LoggedFrame> frames;
+  try {
+    frames = protocol::parse_candump_log(text, "trial.log");
+  } catch (const std::runtime_error& e) {
+    const std::string_view m = e.what();
+    const std::string_view prefix = "trial.log:";
+    if (m.substr(0, prefix.size()) != prefix) broken("an error that does not name the file", 0);
+    size_t i = prefix.size();
+    long line = 0;
+    while (i < m.size() && m[i] >= '0' && m[i] <= '9' && line < 1'000'000'000) line = line * 10 + (m[i++] - '0');
+    long lines = 1;
+    for (char ch : text) lines += ch == '\n';
+    if (line < 1 || line > lines || m.substr(i, 2) != ": " || m.size() <= i + 2) broken("an error that does not name the line and what", line);
+    return 0;
+  }
+  for (const auto& lf : frames) {
+    const std::string again = protocol::format_candump_line(lf.time_us, lf.iface, lf.frame);
+    protocol::LoggedFrame back;
+    std::string why;
+    if (!protocol::parse_candump_line(again, back, why)) broken("a parsed frame written back does not parse", lf.line);
+    bool same = back.time_us == lf.time_us && back.iface == lf.iface && back.frame.id == lf.frame.id &&
+                back.frame.len == lf.frame.len;
+    for (int k = 0; k < lf.frame.len; ++k) same = same && back.frame.data[k] == lf.frame.data[k];
+    if (!same) broken("a parsed frame written back parses to another frame", lf.line);
+  }
+  return 0;
+}
