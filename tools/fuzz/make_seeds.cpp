@@ -9,7 +9,9 @@
 //              latched and released by a trial start, a predictor that falls silent, failed
 //              reads around a stop;
 //   candump    fuzz_candump: `candump -l` logs of each message of the protocol, with blank
-//              lines, CRLF endings and a short frame.
+//              lines, CRLF endings and a short frame;
+//   inputs     fuzz_inputs: a dataset trial CSV, a study trial, an OBJ with every face form,
+//              and each with a value that is not finite or an index out of range.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -85,6 +87,14 @@ template <typename Writer>
 int write_seeds(const std::filesystem::path& dir, const std::vector<std::pair<std::string, Writer>>& seeds) {
   bool ok = true;
   for (const auto& [name, w] : seeds) ok &= write_file(dir / name, w.bytes);
+  if (!ok) return 1;
+  std::printf("wrote %zu seeds into %s\n", seeds.size(), dir.c_str());
+  return 0;
+}
+
+int write_texts(const std::filesystem::path& dir, const std::vector<std::pair<std::string, std::string>>& seeds) {
+  bool ok = true;
+  for (const auto& [name, text] : seeds) ok &= write_file(dir / name, std::vector<uint8_t>(text.begin(), text.end()));
   if (!ok) return 1;
   std::printf("wrote %zu seeds into %s\n", seeds.size(), dir.c_str());
   return 0;
@@ -268,18 +278,28 @@ int candump_seeds(const std::filesystem::path& dir) {
   shorty.id = 0x080;
   all += p::format_candump_line(t, "can0", shorty) + "\n";
   const std::vector<std::pair<std::string, std::string>> seeds = {{"trial.log", all}, {"crlf.log", crlf}};
-  bool ok = true;
-  for (const auto& [name, text] : seeds) ok &= write_file(dir / name, std::vector<uint8_t>(text.begin(), text.end()));
-  if (!ok) return 1;
-  std::printf("wrote %zu seeds into %s\n", seeds.size(), dir.c_str());
-  return 0;
+  return write_texts(dir, seeds);
+}
+int input_seeds(const std::filesystem::path& dir) {
+  // The first byte chooses the reader (fuzz_inputs.cpp): 0 trial CSV, 1 study trial, 2 OBJ.
+  const std::vector<std::pair<std::string, std::string>> seeds = {
+      {"trial.csv", std::string(1, '\0') + "t,travel,f_motion,f_lateral,f_vertical\n0.00,0.000,-0.10,0.01,0.02\n"
+                                          "0.01,0.001,-0.20,0.00,0.05\n0.02,0.002,-0.31,-0.01,0.08\n"},
+      {"study.txt", "\x01" "0.00 0.000 -0.10 0.01 0.02\n0.01 0.001 -0.2 0.0 0.05\n0.02 0.002 -0.3 0.0 0.07\n"},
+      {"gown.obj", "\x02" "# a square and its fan\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nvn 0 0 1\n"
+                   "f 1 2 3\nf 2/1 4/1 3/1\nf 1//1 2//1 4//1\nf -1 -2 -3\nf 1 2 4 3\n"},
+      // Values the readers must refuse, as strtod and from_chars would otherwise take them.
+      {"nan.csv", std::string(1, '\0') + "t,travel,f_motion,f_lateral,f_vertical\n0.00,0.000,nan,0.01,0.02\n"},
+      {"inf.txt", "\x01" "0.00 0.000 -0.10 inf 0.02\n"},
+      {"nan.obj", "\x02" "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n"}};
+  return write_texts(dir, seeds);
 }
 }  // namespace
 
 int main(int argc, char** argv) {
   const std::string kind = argc == 3 ? argv[1] : "";
-  if (kind != "dgm" && kind != "predictor" && kind != "bridge" && kind != "candump") {
-    std::fprintf(stderr, "usage: dg_fuzz_seeds dgm|predictor|bridge|candump DIR\n");
+  if (kind != "dgm" && kind != "predictor" && kind != "bridge" && kind != "candump" && kind != "inputs") {
+    std::fprintf(stderr, "usage: dg_fuzz_seeds dgm|predictor|bridge|candump|inputs DIR\n");
     return 2;
   }
   const std::filesystem::path dir = argv[2];
@@ -291,5 +311,6 @@ int main(int argc, char** argv) {
   }
   if (kind == "dgm") return dgm_seeds(dir);
   if (kind == "candump") return candump_seeds(dir);
+  if (kind == "inputs") return input_seeds(dir);
   return kind == "predictor" ? predictor_seeds(dir) : bridge_seeds(dir);
 }
