@@ -3,15 +3,10 @@
 
 namespace dressguard::bridge {
 
-namespace {
-// The one place the reported state is derived (bridge_core.h, BridgeCore::state): a released
-// latch must report the sensor as it is, not Ok.
-void update_state(BridgeCore& c) {
-  c.state = c.stop_cause != StopCause::None ? protocol::BridgeState::StopLatched
-            : c.sensor_ok                   ? protocol::BridgeState::Ok
-                                            : protocol::BridgeState::SensorLost;
+protocol::BridgeState bridge_state(const BridgeCore& c) {
+  if (bridge_stop_latched(c)) return protocol::BridgeState::StopLatched;
+  return c.sensor_ok ? protocol::BridgeState::Ok : protocol::BridgeState::SensorLost;
 }
-}  // namespace
 
 void bridge_init(BridgeCore& c, const BridgeConfig& cfg, uint32_t now_ms) {
   c = BridgeCore{};
@@ -27,14 +22,12 @@ int bridge_on_reading(BridgeCore& c, const FtReading& r, uint32_t, Frame out[2])
   out[1] = protocol::encode(protocol::FtTorque{n, r.torque[0], r.torque[1], r.torque[2]});
   ++c.readings;
   c.sensor_ok = true;
-  update_state(c);
   return 2;
 }
 
 void bridge_on_sensor_error(BridgeCore& c, uint32_t) {
   if (c.sensor_errors < 255) ++c.sensor_errors;
   c.sensor_ok = false;
-  update_state(c);
 }
 
 void bridge_on_reconnect(BridgeCore& c) {
@@ -58,7 +51,6 @@ BridgeAction bridge_on_frame(BridgeCore& c, const Frame& f, uint32_t now_ms) {
       c.last_stop_reason = s.reason;
       if (c.stop_cause != StopCause::None) return BridgeAction::None;  // already latched
       c.stop_cause = StopCause::StopFrame;
-      update_state(c);
       return BridgeAction::StopRobot;
     }
     case protocol::id_of(protocol::MsgId::TrialStart):
@@ -69,7 +61,6 @@ BridgeAction bridge_on_frame(BridgeCore& c, const Frame& f, uint32_t now_ms) {
       // A new trial releases the latch (the robot controller restarts the motion itself).
       c.stop_cause = StopCause::None;
       c.last_stop_reason = protocol::StopReason::None;
-      update_state(c);
       return BridgeAction::None;
     case protocol::id_of(protocol::MsgId::HeartbeatPredictor):
       if (!protocol::accepted(c.predictor_hb_checker.check(f, lost))) {
@@ -88,14 +79,13 @@ int bridge_on_tick(BridgeCore& c, uint32_t now_ms, Frame* out, BridgeAction* act
   if (c.cfg.predictor_timeout_ms > 0 && c.stop_cause == StopCause::None &&
       static_cast<uint32_t>(now_ms - c.last_predictor_ms) > c.cfg.predictor_timeout_ms) {
     c.stop_cause = StopCause::PredictorSilent;
-    update_state(c);
     *action = BridgeAction::StopRobot;
   }
   // Wrap-safe comparison of millisecond ticks.
   if (static_cast<int32_t>(now_ms - c.next_heartbeat_ms) < 0) return 0;
   c.next_heartbeat_ms = now_ms + c.cfg.heartbeat_period_ms;
   const uint32_t up = (now_ms - c.start_ms) / 1000;
-  *out = protocol::encode(protocol::HeartbeatBridge{c.heartbeat_counter.next(), c.state, c.sensor_errors, c.reconnects,
+  *out = protocol::encode(protocol::HeartbeatBridge{c.heartbeat_counter.next(), bridge_state(c), c.sensor_errors, c.reconnects,
                                                     static_cast<uint16_t>(up > 0xFFFF ? 0xFFFF : up)});
   return 1;
 }

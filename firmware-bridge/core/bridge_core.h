@@ -47,10 +47,7 @@ struct BridgeCore {
   protocol::E2EChecker stop_checker{protocol::MsgId::Stop, 255};
   protocol::E2EChecker trial_checker{protocol::MsgId::TrialStart, 255};
   protocol::E2EChecker predictor_hb_checker{protocol::MsgId::HeartbeatPredictor, 255};
-  // What the heartbeat reports: StopLatched while a stop is latched, else SensorLost from a
-  // failed read (and before the first reading) until the next reading, else Ok.
-  protocol::BridgeState state = protocol::BridgeState::SensorLost;
-  bool sensor_ok = false;        // the last read succeeded
+  bool sensor_ok = false;        // the last read succeeded (false before the first reading)
   StopCause stop_cause = StopCause::None;
   protocol::StopReason last_stop_reason = protocol::StopReason::None;
   uint8_t sensor_errors = 0;     // saturating
@@ -81,5 +78,9 @@ BridgeAction bridge_on_frame(BridgeCore& c, const Frame& f, uint32_t now_ms);
 int bridge_on_tick(BridgeCore& c, uint32_t now_ms, Frame* out, BridgeAction* action);
 
 inline bool bridge_stop_latched(const BridgeCore& c) { return c.stop_cause != StopCause::None; }
+
+// What the heartbeat reports: StopLatched while a stop is latched, else SensorLost from a failed
+// read (and before the first reading) until the next reading, else Ok.
+protocol::BridgeState bridge_state(const BridgeCore& c);
 
 }  // namespace dressguard::bridge

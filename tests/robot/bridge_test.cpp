@@ -47,7 +47,7 @@ TEST(BridgeCore, ReadingBecomesTwoFramesWithOneCounter) {
     EXPECT_EQ(force.fz, -1000);
     EXPECT_EQ(torque.my, -2);
   }
-  EXPECT_EQ(c.state, protocol::BridgeState::Ok);
+  EXPECT_EQ(bridge_state(c), protocol::BridgeState::Ok);
 }
 
 TEST(BridgeCore, StopLatchesUntilTheNextTrialAndIgnoresCorruptStops) {
@@ -61,7 +61,7 @@ TEST(BridgeCore, StopLatchesUntilTheNextTrialAndIgnoresCorruptStops) {
   const Frame stop = protocol::encode(protocol::Stop{1, protocol::StopReason::Caught, 250, 1, 100});
   EXPECT_EQ(bridge_on_frame(c, stop, 2), BridgeAction::StopRobot);
   EXPECT_EQ(bridge_on_frame(c, stop, 3), BridgeAction::None) << "already latched";
-  EXPECT_EQ(c.state, protocol::BridgeState::StopLatched);
+  EXPECT_EQ(bridge_state(c), protocol::BridgeState::StopLatched);
   bridge_on_frame(c, protocol::encode(protocol::TrialStart{0, 2, 100, protocol::HeightClass::High}), 4);
   EXPECT_FALSE(bridge_stop_latched(c));
   EXPECT_EQ(bridge_on_frame(c, protocol::encode(protocol::Stop{2, protocol::StopReason::HardLimit, 0, 2, 5}), 5),
