@@ -30,6 +30,7 @@ const char* stop_reason_name(StopReason r) {
     case StopReason::BadFrames: return "bad_frames";
     case StopReason::ModelError: return "model_error";
     case StopReason::Shutdown: return "shutdown";
+    case StopReason::StopUnconfirmed: return "stop_unconfirmed";
   }
   return "unknown";
 }

@@ -260,6 +260,13 @@ void Predictor::on_trial_start(const Frame& f, int64_t now_ns) noexcept {
   chk_torque_.reset();
   protocol::TrialStart m;
   protocol::decode(f, m);
+  // A pending stop names a trial that is over: it is not resent into this one (the robot would
+  // be latched with another trial's reason and id). If it has waited a whole retry period or
+  // more for its echo, the stop socket cannot send, and this trial is refused: a guard that
+  // cannot send a stop cannot guard it. A younger one (decided moments ago, e.g. by this very
+  // frame's lost counter) is simply dropped; its echo, if it comes, is ignored.
+  const bool unconfirmed = stop_pending_ && now_ns - stop_decided_ns_ >= cfg_.stop_retry_ns;
+  stop_pending_ = false;
   decision_ = Decision{};
   ++trials_started_;
   decision_.trial = m.trial_id;
@@ -273,6 +280,7 @@ void Predictor::on_trial_start(const Frame& f, int64_t now_ns) noexcept {
   emit(make_event(EventKind::TrialStarted, now_ns));
   if (filter_) {
     filter_->reset();
+    if (unconfirmed) stop(StopReason::StopUnconfirmed, now_ns);
   } else {
     emit(make_event(EventKind::ModelMissing, now_ns));
     stop(StopReason::ModelError, now_ns);
@@ -339,6 +347,7 @@ void Predictor::stop(StopReason r, int64_t now_ns) noexcept {
   stop_frame_ = protocol::encode(protocol::Stop{0, r, static_cast<uint8_t>(std::lround(pc * 255.0)), decision_.trial,
                                                 static_cast<uint16_t>(decision_.sample)});
   stop_pending_ = true;
+  stop_decided_ns_ = now_ns;
   stop_retries_ = 0;
   send_stop_frame(now_ns);
   Event e = make_event(EventKind::StopSent, now_ns);

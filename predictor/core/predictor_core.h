@@ -16,7 +16,10 @@
 //          (a model that did not load refuses every trial).
 //   6. if it fires: the stop frame, handed to the sink in the same call.
 // The stop is latched until the next TrialStart; its transmission is confirmed by the stop
-// socket's own echo and retried on every tick until then.
+// socket's own echo and retried on every tick until then. A stop still pending at the next
+// TrialStart is dropped (it names a trial that is over); if it had waited stop_retry_ns or more
+// for its echo, the stop socket cannot send, and that trial is refused with a stop_unconfirmed
+// stop of its own.
 //
 // Real-time contract: the constructor allocates (the filter's storage); on_frame, on_tick,
 // on_stop_echo, on_kernel_drops and on_bus_error allocate nothing, lock nothing, log nothing and
@@ -197,7 +200,8 @@ class Predictor {
   // Stop transmission.
   bool stop_pending_ = false;
   Frame stop_frame_;
-  int64_t stop_sent_ns_ = 0;
+  int64_t stop_decided_ns_ = 0;  // first transmission
+  int64_t stop_sent_ns_ = 0;     // latest transmission
   uint32_t stop_retries_ = 0;
   // Periodic traffic.
   protocol::AliveCounter ctr_stop_, ctr_status_, ctr_post_, ctr_hb_;

@@ -260,6 +260,60 @@ TEST(StopTransmission, BusOffIsCountedAndTheStopKeepsRetrying) {
   EXPECT_TRUE(logged);
 }
 
+// A stop that never reached the bus (its echo never came) belongs to a trial that is over once
+// the next TrialStart arrives. Resending it would latch the new trial's robot with the old
+// trial's reason and id; dropping it would run the new trial with a guard that cannot stop it.
+// So the new trial is refused: a stop of its own, reason stop_unconfirmed, retried as any stop.
+TEST(StopTransmission, AStopNeverConfirmedRefusesTheNextTrial) {
+  Harness h;
+  h.sink.fail_next = 1000;  // the stop socket's sends fail (ENOBUFS) between the trials
+  h.start(1);
+  h.sample(-20.0, 0.0);
+  for (int i = 0; i < 1500; ++i) h.p->on_tick(h.now += kMs);
+  ASSERT_TRUE(h.p->stop_pending());
+  h.start(2);
+  EXPECT_EQ(h.p->decision().state, PredictorState::Stopped);
+  EXPECT_EQ(h.p->decision().reason, protocol::StopReason::StopUnconfirmed);
+  EXPECT_EQ(h.p->decision().trial, 2);
+  EXPECT_TRUE(h.p->stop_pending());
+  const size_t at_start = h.sink.stops.size();
+  h.sink.fail_next = 0;  // the bus recovers
+  for (int i = 0; i < 10; ++i) h.p->on_tick(h.now += kMs);
+  ASSERT_GT(h.sink.stops.size(), at_start);
+  for (size_t i = at_start - 1; i < h.sink.stops.size(); ++i) {
+    protocol::Stop s;
+    ASSERT_TRUE(protocol::decode(h.sink.stops[i], s));
+    EXPECT_EQ(s.trial_id, 2) << "the finished trial's stop was sent into the next one (send " << i << ")";
+    EXPECT_EQ(s.reason, protocol::StopReason::StopUnconfirmed);
+  }
+  // Once confirmed, the trial after runs normally.
+  h.p->on_stop_echo(h.sink.stops.back(), h.now);
+  EXPECT_FALSE(h.p->stop_pending());
+  const size_t confirmed = h.sink.stops.size();
+  h.start(3);
+  h.sample(1.0, 0.0);
+  EXPECT_EQ(h.p->decision().state, PredictorState::InTrial);
+  EXPECT_EQ(h.sink.stops.size(), confirmed);
+}
+
+// A stop decided less than a retry period before the next TrialStart may simply not have been
+// echoed yet: it is dropped (not resent into the new trial), and the new trial runs.
+TEST(StopTransmission, AStopJustSentIsDroppedAtTheNextTrialStart) {
+  Harness h;
+  h.start(1);
+  h.sample(-20.0, 0.0);
+  ASSERT_TRUE(h.p->stop_pending());
+  const size_t sent = h.sink.stops.size();
+  h.p->on_frame(h.src.trial_start(2), h.now + kMs);  // within stop_retry_ns (2 ms)
+  EXPECT_EQ(h.p->decision().state, PredictorState::InTrial);
+  EXPECT_FALSE(h.p->stop_pending());
+  h.now += kMs;
+  h.sample(1.0, 0.0);
+  EXPECT_EQ(h.sink.stops.size(), sent) << "the finished trial's stop was resent into the next one";
+  h.p->on_stop_echo(h.sink.stops.back(), h.now);  // its late echo changes nothing
+  EXPECT_EQ(h.p->decision().state, PredictorState::InTrial);
+}
+
 TEST(Status, PagesCarryEveryCounter) {
   Harness h;
   h.start();
@@ -337,10 +391,14 @@ TEST(RealTime, NoHeapAllocationPerSampleTickOrStop) {
   if (!testkit::malloc_intercepted()) GTEST_LOG_(INFO) << "malloc not intercepted (sanitizer build): counting operator new only";
   // Sink that stores into fixed arrays (as the daemon's does: a lock-free ring).
   struct FixedSink : PredictorSink {
-    uint8_t transmit_stop(const Frame&) noexcept override { return 0; }
+    uint8_t transmit_stop(const Frame& f) noexcept override {
+      last_stop = f;
+      return 0;
+    }
     uint8_t transmit(const Frame&) noexcept override { return 0; }
     void event(const Event& e) noexcept override { last = e; }
     Event last;
+    Frame last_stop{};
   } sink;
   model::OutcomeModel m = testkit::test_model();
   Predictor p(&m, PredictorConfig{}, sink);
@@ -372,7 +430,8 @@ TEST(RealTime, NoHeapAllocationPerSampleTickOrStop) {
     for (const Frame& f : frames) {
       p.on_frame(f, now += 5 * kMs);
       p.on_tick(now);
-      p.on_stop_echo(f, now);
+      p.on_stop_echo(f, now);               // not the stop frame: ignored
+      p.on_stop_echo(sink.last_stop, now);  // the echo confirms: the next trial runs
     }
     p.on_shutdown(now);
     allocations = count.count();
@@ -380,6 +439,7 @@ TEST(RealTime, NoHeapAllocationPerSampleTickOrStop) {
   EXPECT_EQ(allocations, 0u) << "the predictor allocated on its hot path";
   EXPECT_GE(p.counter(StatusCounter::Samples), 9000u);
   EXPECT_GE(p.counter(StatusCounter::Stops), 5u) << "the caught trials stopped (so the stop path was counted too)";
+  EXPECT_EQ(p.trials_started(), 10u);
 }
 
 }  // namespace

@@ -156,7 +156,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       case BridgeOp::Stop: {
         if (!in.take(3)) return 0;
         const uint8_t ctl = in.u8(), reason = in.u8(), trial = in.u8();
-        Frame f = protocol::encode(protocol::Stop{counter_for(ctl, sh.c_stop, trial), static_cast<protocol::StopReason>(reason % 7),
+        Frame f = protocol::encode(protocol::Stop{counter_for(ctl, sh.c_stop, trial), static_cast<protocol::StopReason>(reason % 8),
                                                   static_cast<uint8_t>(reason), trial, 0});
         damage(f, ctl);
         stop_frame(f, c, sh, op);

@@ -144,6 +144,7 @@ struct Shadow {
   uint8_t c_force = 0, c_start = 0, c_end = 0, c_hb = 0;
   int64_t now = 1'000'000'000;
   int64_t last_accept_ns = 0;  // trial start or the last accepted sample in a trial
+  int64_t stop_decided_ns = 0; // the latest stop's first transmission
   int run = 0;                 // consecutive samples with P(caught) > threshold
   // Logical time: sample 0 is the trial's first accepted sample, and lost frames count (the
   // protocol's own E2E checker, fed the same force frames, says how many were lost).
@@ -284,7 +285,8 @@ void check_outputs(const Predictor& p, const RecordingSink& sink, long op) {
   }
 }
 
-// Trial start: the shadow restarts; with a model the trial runs, without one it is refused.
+// Trial start: the shadow restarts; with a model the trial runs, unless the last stop was never
+// confirmed; without a model it is refused.
 void check_trial_start(const Call& c, const Predictor& p, const Rules& r, Shadow& sh, long op) {
   protocol::TrialStart m;
   if (!protocol::decode(c.sent, m) || p.decision().trial != m.trial_id) broken("the decision's trial is not the start frame's", op);
@@ -294,7 +296,12 @@ void check_trial_start(const Call& c, const Predictor& p, const Rules& r, Shadow
   sh.sample = 0;
   sh.started = false;
   const predictor::Decision& d = p.decision();
-  if (r.has_model && d.state != PredictorState::InTrial) broken("a trial start with a model did not run the trial", op);
+  // The last stop unconfirmed for a retry period or more: the stop socket cannot send.
+  const bool unconfirmed = c.pending_before && sh.now - sh.stop_decided_ns >= r.cfg.stop_retry_ns;
+  if (r.has_model && !unconfirmed && d.state != PredictorState::InTrial)
+    broken("a trial start with a model did not run the trial", op);
+  if (r.has_model && unconfirmed && (d.state != PredictorState::Stopped || d.reason != StopReason::StopUnconfirmed))
+    broken("a trial start with the last stop unconfirmed was not refused with stop_unconfirmed", op);
   if (!r.has_model && (d.state != PredictorState::Stopped || d.reason != StopReason::ModelError))
     broken("a trial start without a model was not refused", op);
 }
@@ -365,6 +372,12 @@ void check_tick(const Call& c, const Predictor& p, const RecordingSink& sink, co
     if (did && d.stop_sample != sh.sample + (sh.started ? 1 : 0)) broken("a timeout stop's sample is not the one that never came", op);
   }
   if (p.stop_pending() && sh.now - sink.last_stop_ns >= r.cfg.stop_retry_ns) broken("an unconfirmed stop was not resent", op);
+  // A retry says what the decision says: a stop never confirmed is not carried into the next trial.
+  if (sink.stop_sends > 0) {
+    protocol::Stop m;
+    protocol::decode(sink.last_stop, m);
+    if (m.trial_id != d.trial || m.reason != d.reason) broken("a stop resent that is not the decision's (another trial's?)", op);
+  }
   if (d.state != c.before.state && d.reason != StopReason::SensorTimeout)
     broken("a tick changed the state other than by the sensor timeout", op);
 }
@@ -421,6 +434,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (force && c.before.state != PredictorState::InTrial && p.decision().state != c.before.state)
       broken("a force frame outside a trial changed the state", op);
     if (c.ticked) check_tick(c, p, sink, r, sh, op);
+    const bool new_stop = p.decision().state == PredictorState::Stopped && (c.before.state != PredictorState::Stopped || started);
+    if (new_stop) sh.stop_decided_ns = sh.now;
     if (!c.frame_sent && !c.ticked) check_quiet_call(c, p, op);
   }
   return 0;

@@ -171,6 +171,21 @@ int predictor_seeds(const std::filesystem::path& dir) {
     seeds.emplace_back("timeout", w);
   }
   {
+    TrafficWriter w(defaults);  // a hard-limit stop never confirmed; the next trial refused
+    w.start(9);
+    samples(w, 3, -2.0, 0.0);
+    w.op(TrafficOp::TxFail, 0, {7});
+    w.force(-12.0, 0.0, 0.0);
+    w.tick(1);
+    w.start(10);
+    w.tick(1);
+    w.op(TrafficOp::StopEcho, 0, {0});
+    w.end();
+    w.start(11);
+    samples(w, 3, -2.0, 0.0);
+    seeds.emplace_back("unconfirmed", w);
+  }
+  {
     TrafficWriter w(defaults);  // a burst of corrupted frames between good ones
     w.start(6);
     samples(w, 5, -2.0, 0.0);

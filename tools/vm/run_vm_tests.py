@@ -64,7 +64,8 @@ def u16(d, o):
     return int.from_bytes(d[o:o + 2], "little")
 
 
-STOP_REASONS = {1: "caught", 2: "hard_limit", 3: "sensor_timeout", 4: "bad_frames", 5: "model_error", 6: "shutdown"}
+STOP_REASONS = {1: "caught", 2: "hard_limit", 3: "sensor_timeout", 4: "bad_frames", 5: "model_error", 6: "shutdown",
+                7: "stop_unconfirmed"}
 COUNTERS = ["corrupted", "repeated", "wrong_sequence", "lost_frames", "late", "bad_length", "kernel_drops",
             "timeouts", "tx_retries", "tx_errors", "samples", "stops"]
 
