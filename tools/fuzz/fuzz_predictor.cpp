@@ -7,13 +7,17 @@
 //                 stops in the same call; otherwise the robot stops on "caught" exactly when
 //                 P(caught) > threshold for k consecutive samples; a tick stops exactly when
 //                 no sample was accepted for longer than the sensor timeout; SIGTERM in a trial
-//                 stops;
-//   in a trial    no stop outside a trial, except a trial refused for want of a model;
+//                 stops; a frame stops exactly when the bad-frame bucket (weight per corrupted,
+//                 short or lost frame, minus 1 per accepted sample, empty at a trial start)
+//                 holds more than budget * weight;
+//   in a trial    no stop outside a trial, except a trial refused for want of a model or
+//                 because the last stop waited stop_retry or more for its echo;
 //   latch         a stop stays (state and reason) until a trial start, or a trial end once its
 //                 stop frame is confirmed;
 //   stop frame    every stop hands a stop frame to the sink in the same call, E2E-protected,
 //                 with the decision's reason, trial and sample; an unconfirmed stop is resent
-//                 by every tick at least stop_retry after the last send;
+//                 by every tick at least stop_retry after the last send, and only within its
+//                 own trial;
 //   outputs       every other frame the predictor sends is E2E-protected and 8 bytes long;
 //   logical time  a sample's index counts the lost frames (the protocol's E2E checker, run
 //                 beside it, says how many); a timeout's is the sample that never came;
@@ -145,6 +149,7 @@ struct Shadow {
   int64_t now = 1'000'000'000;
   int64_t last_accept_ns = 0;  // trial start or the last accepted sample in a trial
   int64_t stop_decided_ns = 0; // the latest stop's first transmission
+  int64_t bucket = 0;          // the bad-frame budget's leaky bucket, from the trial start
   int run = 0;                 // consecutive samples with P(caught) > threshold
   // Logical time: sample 0 is the trial's first accepted sample, and lost frames count (the
   // protocol's own E2E checker, fed the same force frames, says how many were lost).
@@ -166,7 +171,14 @@ struct Call {
   uint32_t samples_before = 0, starts_before = 0;
   long steps_before = 0;
   bool pending_before = false;
+  uint32_t bad_before = 0;  // frames the bucket is charged for, so far
 };
+
+// What the bad-frame budget charges: corrupted frames, frames of a bad length and lost frames, of
+// any stream the predictor checks (the predictor's own counters say how many).
+uint32_t bad_frames(const Predictor& p) {
+  return p.counter(StatusCounter::Corrupted) + p.counter(StatusCounter::BadLength) + p.counter(StatusCounter::LostFrames);
+}
 
 // Reads one operation's frame or arguments, then makes the one predictor call (allocations
 // counted). False when the input ends inside the operation.
@@ -181,6 +193,7 @@ bool run_one(Reader& in, Predictor& p, RecordingSink& sink, Shadow& sh, Call& c,
   c.starts_before = p.trials_started();
   c.steps_before = p.filter() ? p.filter()->samples() : 0;
   c.pending_before = p.stop_pending();
+  c.bad_before = bad_frames(p);
 
   switch (c.kind) {
     case TrafficOp::Force: {
@@ -361,6 +374,24 @@ void check_sample(const Call& c, const Predictor& p, const Rules& r, Shadow& sh,
   if (should != did) broken(should ? "k samples over the threshold did not stop" : "a caught stop before k samples over the threshold", op);
 }
 
+// The bad-frame budget (a leaky bucket): every charged frame adds the weight, every sample
+// accepted in a running trial drains 1, and a running trial stops the moment the bucket holds
+// more than budget * weight; a trial start empties it.
+void check_bucket(const Call& c, const Predictor& p, const Rules& r, Shadow& sh, bool started, long op) {
+  sh.bucket += static_cast<int64_t>(bad_frames(p) - c.bad_before) * r.cfg.bad_frame_weight;
+  if (started) {
+    sh.bucket = 0;
+    return;
+  }
+  const predictor::Decision& d = p.decision();
+  const bool running = c.before.state == PredictorState::InTrial;
+  const bool over = running && sh.bucket > static_cast<int64_t>(r.cfg.bad_frame_budget) * r.cfg.bad_frame_weight;
+  const bool did = running && d.state == PredictorState::Stopped && d.reason == StopReason::BadFrames;
+  if (over != did) broken(over ? "bad frames over the budget did not stop" : "a bad-frames stop within the budget", op);
+  const bool accepted = p.counter(StatusCounter::Samples) != c.samples_before;
+  if (running && !over && accepted && sh.bucket > 0) --sh.bucket;
+}
+
 // A tick: the sensor deadline, exactly; an unconfirmed stop resent on time; nothing else.
 void check_tick(const Call& c, const Predictor& p, const RecordingSink& sink, const Rules& r, const Shadow& sh, long op) {
   const predictor::Decision& d = p.decision();
@@ -434,6 +465,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (force && c.before.state != PredictorState::InTrial && p.decision().state != c.before.state)
       broken("a force frame outside a trial changed the state", op);
     if (c.ticked) check_tick(c, p, sink, r, sh, op);
+    if (c.frame_sent) check_bucket(c, p, r, sh, started, op);
     const bool new_stop = p.decision().state == PredictorState::Stopped && (c.before.state != PredictorState::Stopped || started);
     if (new_stop) sh.stop_decided_ns = sh.now;
     if (!c.frame_sent && !c.ticked) check_quiet_call(c, p, op);
