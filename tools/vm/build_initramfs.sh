@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Builds the SocketCAN test VM's initramfs (cpio newc, gzip): busybox-static, the CAN modules of
 # Debian's kernel (can, can-raw, can-dev, vcan and their dependencies from modules.dep, loaded in
-# order by /init), can-utils (candump, canplayer, cansend), the project's binaries with their
-# shared libraries (found with ldd), the test logs and model, and the in-VM test script.
+# order by /init; vcan with echo=1), the traffic-control modules and iproute2's tc that drop a
+# CAN identifier on its way out (sch_prio, cls_basic, em_canid, act_gact), can-utils (candump,
+# canplayer, cansend), the project's binaries with their shared libraries (found with ldd), the
+# test logs and model, and the in-VM test script.
 #   build_initramfs.sh --cache build/vm --out build/vm/initramfs.gz --bin BIN... --data DIR --script FILE
 set -euo pipefail
 CACHE=build/vm; OUT=""; DATA=""; SCRIPT=""; BINS=()
@@ -44,6 +46,17 @@ if [ -x /usr/sbin/ip ] || [ -x /sbin/ip ]; then
   copy_with_libs "$ipbin"
   mv "$root/usr/bin/ip" "$root/usr/bin/ip2"
 fi
+# tc: the "stop frames never reach the bus" scenario. Installed as tc2 (as ip is as ip2): the
+# busybox shell runs its own applets first, and busybox's tc has no filters.
+tcbin=$(command -v tc || true)
+[ -z "$tcbin" ] && [ -x /usr/sbin/tc ] && tcbin=/usr/sbin/tc
+[ -n "$tcbin" ] || { echo "build_initramfs.sh: iproute2's tc not installed" >&2; exit 77; }
+copy_with_libs "$tcbin"
+mv "$root/usr/bin/tc" "$root/usr/bin/tc2"
+# Its table of ematch kinds (canid among them): /etc/iproute2 or, since iproute2 6.5, /usr/share.
+for d in /etc/iproute2 /usr/share/iproute2; do
+  if [ -f "$d/ematch_map" ]; then mkdir -p "$root/etc/iproute2" && cp "$d/ematch_map" "$root/etc/iproute2/"; break; fi
+done
 
 # Modules in dependency order (modules.dep lists a module's dependencies after it).
 : > "$root/modules/order"
@@ -64,7 +77,7 @@ add_module() {
   esac
   echo "$name" >> "$root/modules/order"
 }
-for m in can can-raw can-dev vcan; do
+for m in can can-raw can-dev vcan sch_prio cls_basic em_canid act_gact; do
   rel=$(awk -F: -v m="/$m.ko" 'index($1, m) && substr($1, length($1) - length(m) + 1) == m {print $1; exit}' "$KDIR/lib/modules/$release/modules.dep")
   rel=${rel:-$(cd "$KDIR/lib/modules/$release" && find kernel -name "$m.ko*" | head -1)}
   [ -n "$rel" ] || { echo "build_initramfs.sh: module $m not in the kernel package" >&2; exit 1; }
@@ -81,7 +94,13 @@ mount -t proc proc /proc
 mount -t sysfs sys /sys
 mount -t devtmpfs dev /dev 2>/dev/null
 mount -t tmpfs tmp /tmp
-for m in $(cat /modules/order); do insmod /modules/$m || echo "DG-VM: insmod $m failed"; done
+# vcan with echo=1: the driver, not the CAN core, loops a sent frame back once it is "on the
+# bus" (as a real controller does on its transmit-complete interrupt), so a frame dropped on
+# its way out is never echoed: the stop socket's echo means what it means on real hardware.
+for m in $(cat /modules/order); do
+  args=""; [ "$m" = vcan.ko ] && args="echo=1"
+  insmod /modules/$m $args || echo "DG-VM: insmod $m failed"
+done
 echo "DG-VM: kernel $(uname -r) $(uname -v)"
 sh /vm_tests.sh
 echo "DG-VM: done"

@@ -10,6 +10,9 @@ recorded frames and asserts on them by their payloads' counters (logical time):
   hardlimit the hard limit stops at the first sample above 10 N;
   gap       a silent sensor is a sensor_timeout stop, one deadline after the last sample;
   nomodel   a model that does not load refuses the trial;
+  unconfirmed  stop frames dropped on their way out (tc; vcan echo=1, so no echo): the stop is
+            retried, never sent into the next trial, and that trial is refused
+            (stop_unconfirmed) once the way out is clear;
   latency   end to end through the kernel (probe send -> stop frame received), a histogram.
 Every scenario ends with SIGTERM: the daemon must exit 0.
 
@@ -188,7 +191,8 @@ def main():
     late = re.findall(r"scenario (\S+): daemon not listening", console)
     check(not late, "every scenario's daemon was listening before the play" + (f" (not: {', '.join(late)})" if late else ""))
     sec = sections(console)
-    for name in ("clean", "hardlimit", "gap", "nomodel", "latency"):
+    check("scenario unconfirmed: tc" not in console, "unconfirmed: tc dropped 0x080 on its way out of vcan0")
+    for name in ("clean", "hardlimit", "gap", "nomodel", "unconfirmed", "latency"):
         m = re.search(rf"DG-VM: \[[\d.]+\] scenario {name} daemon_exit (\d+)", console)
         check(m is not None and m.group(1) == "0", f"{name}: the daemon exited 0 on SIGTERM")
         check("shutting down" in sec.get(f"{name}.log", ""), f"{name}: clean shutdown logged")
@@ -275,6 +279,17 @@ def main():
     # --- no model ---
     s = stops_in(sec.get("nomodel.rec", ""))
     check(len(s) >= 1 and s[0]["reason"] == "model_error", f"nomodel: model_error stop ({s[0]['reason'] if s else 'none'})")
+
+    # --- stop frames that never reach the bus ---
+    s = stops_in(sec.get("unconfirmed.rec", ""))
+    first, second = facts[hl]["trial"], facts["syn2-good-0-good.log"]["trial"]
+    check(len(s) >= 1 and all(x["ok"] and x["trial"] == second and x["reason"] == "stop_unconfirmed" for x in s),
+          f"unconfirmed: on the bus only trial {second}'s refusal (stop_unconfirmed): "
+          f"{sorted(set((x['trial'], x['reason']) for x in s)) or 'no stop'}")
+    check(not any(x["trial"] == first for x in s), f"unconfirmed: trial {first}'s stop never reached the bus")
+    m = re.search(r"shutting down: (.*)", sec.get("unconfirmed.log", ""))
+    uc = dict((k, int(v)) for k, v in re.findall(r"(\w+)=(\d+)", m.group(1))) if m else {}
+    check(uc.get("tx_retries", 0) >= 10, f"unconfirmed: the unechoed stop was retried ({uc.get('tx_retries')} retries)")
 
     # --- latency ---
     lat = sec.get("latency.out", "")

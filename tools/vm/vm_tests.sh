@@ -82,6 +82,25 @@ scenario gap "--model $MODEL" ",080:7FF,100:7FF"
 play_nomodel() { head -n 40 $D/logs/syn2-good-0-good.log > /tmp/head.log; play_fast /tmp/head.log; }
 scenario nomodel "--model $D/does-not-exist.dgm" ",080:7FF"
 
+# F: stop frames that never reach the bus. tc (iproute2's, as tc2) drops identifier 0x080 on its way out of vcan0, and
+# vcan (echo=1) echoes only what it transmits, so the stop socket gets no echo, as from a
+# controller that cannot send. The hard limit stops the first trial; its stop is retried,
+# unconfirmed. The next trial starts: it is refused (stop_unconfirmed, its own id). Then the way
+# out is cleared, and the refusal must reach the bus, and the first trial's stop never.
+play_unconfirmed() {
+  tc2 qdisc add dev vcan0 root handle 1: prio || say "scenario unconfirmed: tc qdisc failed"
+  tc2 filter add dev vcan0 parent 1: basic match "canid(sff 0x080)" action drop || say "scenario unconfirmed: tc filter failed"
+  play_fast $D/logs/fault-nocaughtrule-*.log
+  sleep 1.1
+  head -n 40 $D/logs/syn2-good-0-good.log > /tmp/head.log
+  play_fast /tmp/head.log
+  sleep 0.1
+  tc2 qdisc del dev vcan0 root || say "scenario unconfirmed: tc qdisc del failed"
+}
+# A 5 s deadline: the second trial's samples end before the way out is cleared, and no timeout
+# stop may replace the pending one meanwhile (that would hide a stale stop resent).
+scenario unconfirmed "--model $MODEL --set stop_consecutive=100000 --set sensor_timeout_ms=5000" ",080:7FF"
+
 # E: end-to-end latency through the kernel: frame in (the probe's send) to stop frame out (the
 # probe's receive), hard-limit trials back to back.
 play_latency() { bench_predictor --e2e vcan0 --trials 1000 > /tmp/latency.out 2>&1; section latency.out /tmp/latency.out; }
