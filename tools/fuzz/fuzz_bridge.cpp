@@ -13,9 +13,11 @@
 //               heartbeat (E2E-accepted) is older than the timeout, wrap-safe;
 //   heartbeat   sent on the tick when due (period from the last one, wrap-safe), E2E-protected,
 //               carrying the state: StopLatched while latched, else SensorLost after a failed
-//               read until the next reading, else Ok.
+//               read until the next reading, else Ok; the failed reads (saturating at 255),
+//               the reconnects (at 65535) and the whole seconds since start, across the wrap.
 //
 // A broken rule prints which and aborts, which libFuzzer reports with the input that did it.
+#include <algorithm>
 #include <cstdint>
 
 #include "bridge_core.h"
@@ -49,6 +51,8 @@ struct Shadow {
   bool sampled = false;
   uint32_t last_predictor = 0;
   uint32_t next_heartbeat = 0;
+  uint32_t start = 0;
+  uint32_t sensor_errors = 0, reconnects = 0;  // counted without bound
   protocol::E2EChecker trial_e2e{MsgId::TrialStart, 255};
   protocol::E2EChecker hb_e2e{MsgId::HeartbeatPredictor, 255};
 };
@@ -121,6 +125,9 @@ void tick(BridgeCore& c, Shadow& sh, long op) {
   if (!protected_as(hb, MsgId::HeartbeatBridge) || !protocol::decode(hb, m)) broken("the heartbeat is not an E2E-protected HeartbeatBridge", op);
   if (m.counter != ++sh.c_hb) broken("the heartbeat counter did not advance by one", op);
   if (m.state != expected_state(sh)) broken("the heartbeat's state is not the bridge's", op);
+  if (m.sensor_errors != std::min<uint32_t>(sh.sensor_errors, 255)) broken("the heartbeat's sensor errors are not the failed reads (saturating)", op);
+  if (m.reconnects != std::min<uint32_t>(sh.reconnects, 0xFFFF)) broken("the heartbeat's reconnects are not the reconnects", op);
+  if (m.uptime_s != std::min<uint32_t>((sh.now - sh.start) / 1000, 0xFFFF)) broken("the heartbeat's uptime is not the seconds since start", op);
 }
 
 }  // namespace
@@ -134,7 +141,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   cfg.heartbeat_period_ms = 1 + h[1];
   Shadow sh;
   sh.now = static_cast<uint32_t>(h[2] | h[3] << 8 | h[4] << 16 | static_cast<uint32_t>(h[5]) << 24);
-  sh.last_predictor = sh.next_heartbeat = sh.now;
+  sh.last_predictor = sh.next_heartbeat = sh.start = sh.now;
   sh.c_hb = 0xFF;  // one before the first heartbeat's counter (protocol::AliveCounter starts at 0)
   BridgeCore c;
   bridge::bridge_init(c, cfg, sh.now);
@@ -151,8 +158,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       case BridgeOp::SensorError:
         bridge::bridge_on_sensor_error(c, sh.now);
         sh.sensor_lost = true;
+        ++sh.sensor_errors;
         break;
-      case BridgeOp::Reconnect: bridge::bridge_on_reconnect(c); break;
+      case BridgeOp::Reconnect:
+        bridge::bridge_on_reconnect(c);
+        ++sh.reconnects;
+        break;
       case BridgeOp::Stop: {
         if (!in.take(3)) return 0;
         const uint8_t ctl = in.u8(), reason = in.u8(), trial = in.u8();

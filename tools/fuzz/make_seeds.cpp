@@ -270,6 +270,14 @@ int bridge_seeds(const std::filesystem::path& dir) {
     w.op(BridgeOp::Wait, 0, {30});
     seeds.emplace_back("sensor_lost", w);
   }
+  {
+    BridgeWriter w(plain);  // a sensor that keeps failing: its error count saturates at 255
+    for (int i = 0; i < 300; ++i) w.op(BridgeOp::SensorError, 1);
+    w.tick(1);
+    w.op(BridgeOp::Reconnect, 1);
+    readings(w, 3, -1.0);
+    seeds.emplace_back("sensor_errors", w);
+  }
   return write_seeds(dir, seeds);
 }
 int candump_seeds(const std::filesystem::path& dir) {
