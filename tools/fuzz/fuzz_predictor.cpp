@@ -21,12 +21,19 @@
 //   outputs       every other frame the predictor sends is E2E-protected and 8 bytes long;
 //   logical time  a sample's index counts the lost frames (the protocol's E2E checker, run
 //                 beside it, says how many); a timeout's is the sample that never came;
+//   reports       the heartbeat with the state, the model, the trial and the seconds since
+//                 the first call; status pages in turn, each with its two counters (saturating; samples modulo
+//                 65536) and the state; posteriors in 1/255 with the sample index;
+//   counters      a force frame moves the status counters (corrupted, bad length, repeated,
+//                 late, wrong sequence, lost frames, samples) as that checker's verdict says;
 //   filter        posteriors in [0, 1], summing to 1;
 //   real time     on_frame, on_tick, on_stop_echo, on_kernel_drops, on_bus_error and on_shutdown
 //                 allocate nothing (every malloc and operator new, counted by the sanitizer's
 //                 allocation hook).
 //
 // A broken rule prints which and aborts, which libFuzzer reports with the input that did it.
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 
@@ -63,6 +70,8 @@ struct RecordingSink final : predictor::PredictorSink {
   int64_t now_ns = 0;
   int fail_next = 0;        // the next n stop transmissions fail
   bool bad_output = false;  // a frame that is not E2E-protected or not 8 bytes
+  int status_sends = 0, post_sends = 0, hb_sends = 0;  // in the current operation
+  Frame last_status{}, last_post{}, last_hb{};
 
   uint8_t transmit_stop(const Frame& f) noexcept override {
     ++stop_sends;
@@ -78,9 +87,21 @@ struct RecordingSink final : predictor::PredictorSink {
   uint8_t transmit(const Frame& f) noexcept override {
     MsgId m;
     switch (f.id) {
-      case protocol::id_of(MsgId::PredictorStatus): m = MsgId::PredictorStatus; break;
-      case protocol::id_of(MsgId::Posteriors): m = MsgId::Posteriors; break;
-      case protocol::id_of(MsgId::HeartbeatPredictor): m = MsgId::HeartbeatPredictor; break;
+      case protocol::id_of(MsgId::PredictorStatus):
+        m = MsgId::PredictorStatus;
+        last_status = f;
+        ++status_sends;
+        break;
+      case protocol::id_of(MsgId::Posteriors):
+        m = MsgId::Posteriors;
+        last_post = f;
+        ++post_sends;
+        break;
+      case protocol::id_of(MsgId::HeartbeatPredictor):
+        m = MsgId::HeartbeatPredictor;
+        last_hb = f;
+        ++hb_sends;
+        break;
       default: bad_output = true; return 0;
     }
     if (!protected_as(f, m)) bad_output = true;
@@ -150,6 +171,8 @@ struct Shadow {
   int64_t last_accept_ns = 0;  // trial start or the last accepted sample in a trial
   int64_t stop_decided_ns = 0; // the latest stop's first transmission
   int64_t bucket = 0;          // the bad-frame budget's leaky bucket, from the trial start
+  uint8_t next_page = 0;       // the status page due next
+  int64_t first_tick = -1;     // the predictor's clock starts at its first call
   int run = 0;                 // consecutive samples with P(caught) > threshold
   // Logical time: sample 0 is the trial's first accepted sample, and lost frames count (the
   // protocol's own E2E checker, fed the same force frames, says how many were lost).
@@ -167,6 +190,9 @@ struct Call {
   uint8_t echo_mode = 0;
   uint32_t e2e_lost = 0;   // the shadow checker's verdict on a force frame
   bool e2e_ok = false;
+  protocol::E2EStatus e2e = protocol::E2EStatus::Ok;
+  bool torque_first = false;  // the op sent the sample's torque frame before its force frame
+  std::array<uint32_t, static_cast<int>(StatusCounter::Count)> counters_before{};
   predictor::Decision before;
   uint32_t samples_before = 0, starts_before = 0;
   long steps_before = 0;
@@ -187,13 +213,14 @@ bool run_one(Reader& in, Predictor& p, RecordingSink& sink, Shadow& sh, Call& c,
   c.kind = static_cast<TrafficOp>(opbyte & 0x0F);
   sh.now += (opbyte >> 4) * fuzz::kTrafficTimeUnitNs;
   sink.now_ns = sh.now;
-  sink.stop_sends = 0;
+  sink.stop_sends = sink.status_sends = sink.post_sends = sink.hb_sends = 0;
   c.before = p.decision();
   c.samples_before = p.counter(StatusCounter::Samples);
   c.starts_before = p.trials_started();
   c.steps_before = p.filter() ? p.filter()->samples() : 0;
   c.pending_before = p.stop_pending();
   c.bad_before = bad_frames(p);
+  for (int k = 0; k < static_cast<int>(StatusCounter::Count); ++k) c.counters_before[k] = p.counter(static_cast<StatusCounter>(k));
 
   switch (c.kind) {
     case TrafficOp::Force: {
@@ -204,6 +231,7 @@ bool run_one(Reader& in, Predictor& p, RecordingSink& sink, Shadow& sh, Call& c,
       if (!(ctl & 0x10))
         for (auto& x : v) x = static_cast<int16_t>(static_cast<int8_t>(x & 0xFF) * 10);
       const uint8_t ctr = counter_for(ctl, sh.c_force, static_cast<uint8_t>(v[0]));
+      c.torque_first = ctl & 0x80;
       if (ctl & 0x80) {  // the torque frame of the same sample, first
         const CountAllocations a;
         p.on_frame(protocol::encode(protocol::FtTorque{ctr, 0, 0, 0}), sh.now);
@@ -252,7 +280,10 @@ bool run_one(Reader& in, Predictor& p, RecordingSink& sink, Shadow& sh, Call& c,
       break;
     default: break;
   }
-  if (c.frame_sent && is(c.sent, MsgId::FtForce)) c.e2e_ok = protocol::accepted(sh.e2e.check(c.sent, c.e2e_lost));
+  if (c.frame_sent && is(c.sent, MsgId::FtForce)) {
+    c.e2e = sh.e2e.check(c.sent, c.e2e_lost);
+    c.e2e_ok = protocol::accepted(c.e2e);
+  }
 
   const CountAllocations a;
   switch (c.kind) {
@@ -374,6 +405,19 @@ void check_sample(const Call& c, const Predictor& p, const Rules& r, Shadow& sh,
   if (should != did) broken(should ? "k samples over the threshold did not stop" : "a caught stop before k samples over the threshold", op);
 }
 
+// The status counters of a force frame (alone in its call): each counts what the protocol's E2E
+// checker, run beside the predictor, says of it, and nothing else moves.
+void check_force_counters(const Call& c, const Predictor& p, long op) {
+  using S = protocol::E2EStatus;
+  const auto delta = [&](StatusCounter k) { return p.counter(k) - c.counters_before[static_cast<int>(k)]; };
+  const bool lost = c.e2e == S::OkSomeLost || c.e2e == S::WrongSequence;
+  if (delta(StatusCounter::Corrupted) != (c.e2e == S::Corrupted) || delta(StatusCounter::BadLength) != (c.e2e == S::BadLength) ||
+      delta(StatusCounter::Repeated) != (c.e2e == S::Repeated) || delta(StatusCounter::Late) != (c.e2e == S::Late) ||
+      delta(StatusCounter::WrongSequence) != (c.e2e == S::WrongSequence) ||
+      delta(StatusCounter::LostFrames) != (lost ? c.e2e_lost : 0u) || delta(StatusCounter::Samples) != (c.e2e_ok ? 1u : 0u))
+    broken("a force frame's status counters are not what the protocol's E2E check says of it", op);
+}
+
 // The bad-frame budget (a leaky bucket): every charged frame adds the weight, every sample
 // accepted in a running trial drains 1, and a running trial stops the moment the bucket holds
 // more than budget * weight; a trial start empties it.
@@ -390,6 +434,37 @@ void check_bucket(const Call& c, const Predictor& p, const Rules& r, Shadow& sh,
   if (over != did) broken(over ? "bad frames over the budget did not stop" : "a bad-frames stop within the budget", op);
   const bool accepted = p.counter(StatusCounter::Samples) != c.samples_before;
   if (running && !over && accepted && sh.bucket > 0) --sh.bucket;
+}
+
+// What a tick reports: the status pages in turn, each with its two counters (saturating at
+// 65535, the sample count modulo 65536) and the state; the posteriors in 1/255 with the sample.
+void check_reports(const Predictor& p, const RecordingSink& sink, const Rules& r, Shadow& sh, long op) {
+  const predictor::Decision& d = p.decision();
+  if (sink.hb_sends > 0) {
+    protocol::HeartbeatPredictor m;
+    protocol::decode(sink.last_hb, m);
+    const int64_t up = (sh.now - sh.first_tick) / 1'000'000'000;
+    if (m.state != d.state || m.model_loaded != (r.has_model ? 1 : 0) || m.trial_id != d.trial ||
+        m.uptime_s != std::min<int64_t>(up, 0xFFFF))
+      broken("the heartbeat does not carry the state, the model, the trial and the seconds since start", op);
+  }
+  if (sink.status_sends > 0) {
+    protocol::PredictorStatus m;
+    protocol::decode(sink.last_status, m);
+    if (m.page != sh.next_page) broken("the status pages are not sent in turn", op);
+    sh.next_page = static_cast<uint8_t>((m.page + 1) % protocol::kStatusPages);
+    const auto sat = [](uint32_t v) { return static_cast<uint16_t>(std::min<uint32_t>(v, 0xFFFF)); };
+    const uint32_t v0 = p.counter(static_cast<StatusCounter>(2 * m.page)), v1 = p.counter(static_cast<StatusCounter>(2 * m.page + 1));
+    const uint16_t e0 = 2 * m.page == static_cast<int>(StatusCounter::Samples) ? static_cast<uint16_t>(v0) : sat(v0);
+    if (m.value0 != e0 || m.value1 != sat(v1) || m.state != d.state) broken("a status page does not carry its two counters and the state", op);
+  }
+  if (sink.post_sends > 0 && p.filter()) {
+    protocol::Posteriors m;
+    protocol::decode(sink.last_post, m);
+    if (m.sample != static_cast<uint16_t>(d.sample) || m.state != d.state) broken("the posteriors frame does not carry the sample and the state", op);
+    for (int k = 0; k < p.filter()->classes() && k < 3; ++k)
+      if (m.p[k] != std::lround(p.filter()->posterior(k) * 255.0)) broken("the posteriors frame is not the filter's posteriors in 1/255", op);
+  }
 }
 
 // A tick: the sensor deadline, exactly; an unconfirmed stop resent on time; nothing else.
@@ -457,6 +532,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     Call c;
     if (!run_one(in, p, sink, sh, c, op)) break;
     const bool started = p.trials_started() != c.starts_before;
+    if (sh.first_tick < 0 && (c.frame_sent || c.ticked)) sh.first_tick = sh.now;
     check_outputs(p, sink, op);
     if (started) check_trial_start(c, p, r, sh, op);
     check_stop_state(c, p, sink, started, op);
@@ -465,7 +541,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (force && c.before.state != PredictorState::InTrial && p.decision().state != c.before.state)
       broken("a force frame outside a trial changed the state", op);
     if (c.ticked) check_tick(c, p, sink, r, sh, op);
+    if (c.ticked) check_reports(p, sink, r, sh, op);
     if (c.frame_sent) check_bucket(c, p, r, sh, started, op);
+    if (force && !c.torque_first) check_force_counters(c, p, op);
     const bool new_stop = p.decision().state == PredictorState::Stopped && (c.before.state != PredictorState::Stopped || started);
     if (new_stop) sh.stop_decided_ns = sh.now;
     if (!c.frame_sent && !c.ticked) check_quiet_call(c, p, op);
