@@ -144,7 +144,7 @@ enum class StopReason : uint8_t {
   BadFrames = 4,      // too many corrupted or lost frames
   ModelError = 5,     // the model did not load: every trial is refused
   Shutdown = 6,       // the daemon is shutting down during a trial
-  StopUnconfirmed = 7,  // the previous trial's stop never reached the bus: this trial is refused
+  StopUnconfirmed = 7,  // the previous trial's stop got no echo within a retry period: refused
 };
 const char* stop_reason_name(StopReason r);  // "caught", "hard_limit", ...
 
