@@ -104,9 +104,17 @@ void EventLogger::log_one(const Event& e) {
     case EventKind::StopConfirmed:
       log_->info("stop of trial {} confirmed on the bus after {} retries", e.trial, e.value);
       break;
-    case EventKind::StopRetry: log_->warn("stop of trial {} not confirmed: retry {}", e.trial, e.value); break;
+    // A stop that cannot get out is retried every tick (500 times a second) and may fail each
+    // time: logged at the 1st, 2nd, 4th, 8th, ... so that an outage of minutes writes tens of
+    // lines, not tens of thousands. The counters (status pages) and "confirmed after N retries"
+    // keep the exact numbers.
+    case EventKind::StopRetry:
+      if (power_of_two(e.value)) log_->warn("stop of trial {} not confirmed: {} retries so far", e.trial, e.value);
+      break;
     case EventKind::TxError:
-      log_->error("send of 0x{:03X} failed: {}", e.can_id, can::send_result_name(static_cast<can::SendResult>(e.send_result)));
+      if (power_of_two(++tx_errors_))
+        log_->error("send of 0x{:03X} failed: {} ({} failed sends so far)", e.can_id,
+                    can::send_result_name(static_cast<can::SendResult>(e.send_result)), tx_errors_);
       break;
     case EventKind::BusError: log_->error("CAN controller error frame, class 0x{:X}", e.value); break;
     case EventKind::ModelMissing: log_->error("trial {} refused: no model loaded", e.trial); break;

@@ -62,10 +62,12 @@ class EventLogger {
  private:
   void run();
   void log_one(const Event& e);
+  static bool power_of_two(uint64_t n) { return n != 0 && (n & (n - 1)) == 0; }
   EventQueue& q_;
   std::shared_ptr<spdlog::logger> log_;
   std::vector<std::string> names_;
   std::atomic<bool> stop_{false};
+  uint64_t tx_errors_ = 0;  // failed sends seen (the logging thread's own count)
   std::thread thread_;
 };
 

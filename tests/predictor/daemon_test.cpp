@@ -132,6 +132,38 @@ TEST(Daemon, UnconfirmedStopIsRetriedUntilTheEchoComes) {
   EXPECT_GE(stops, 4) << "the robot heard the retries";
 }
 
+// A stop that cannot get out for 2 s: 1000 retries, each send failing. The log keeps a line per
+// doubling (1, 2, 4, ..., 512: 10 of each kind), not one per retry.
+TEST(EventLogger, RetriesAndFailedSendsAreLoggedAtEachDoubling) {
+  EventQueue q;
+  for (uint32_t i = 1; i <= 1000; ++i) {
+    Event r;
+    r.kind = EventKind::StopRetry;
+    r.trial = 7;
+    r.value = i;
+    Event t;
+    t.kind = EventKind::TxError;
+    t.can_id = protocol::id_of(protocol::MsgId::Stop);
+    t.send_result = static_cast<uint8_t>(can::SendResult::NoBuffers);
+    ASSERT_TRUE(q.push(r) && q.push(t));
+  }
+  std::ostringstream text;
+  auto log = std::make_shared<spdlog::logger>("test", std::make_shared<spdlog::sinks::ostream_sink_mt>(text));
+  {
+    EventLogger logger(q, log, {"good", "missed", "caught"});
+  }
+  std::istringstream lines(text.str());
+  int retries = 0, failures = 0;
+  for (std::string l; std::getline(lines, l);) {
+    retries += l.find("not confirmed") != std::string::npos;
+    failures += l.find("failed sends so far") != std::string::npos;
+  }
+  EXPECT_EQ(retries, 10);
+  EXPECT_EQ(failures, 10);
+  EXPECT_NE(text.str().find("stop of trial 7 not confirmed: 512 retries so far"), std::string::npos) << text.str();
+  EXPECT_NE(text.str().find("(512 failed sends so far)"), std::string::npos) << text.str();
+}
+
 TEST(Daemon, ShutdownDuringATrialStopsTheRobotFirst) {
   Rig rig;
   rig.sensor->send(rig.src.trial_start(5));
