@@ -2,6 +2,7 @@
 #include "predictor_core.h"
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <stdexcept>
 
@@ -47,6 +48,17 @@ namespace {
   throw std::runtime_error(name + ":" + std::to_string(line) + ": " + what);
 }
 
+// The largest period or deadline (10 min) and force (1 kN: three times a Robotiq FT 300's range).
+constexpr double kMaxConfigMs = 600'000.0;
+constexpr double kMaxConfigNewtons = 1000.0;
+
+// A bound as a person writes it: 0.001, 127, 1e+06.
+std::string config_text(double d) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", d);
+  return buf;
+}
+
 double config_number(const std::string& name, long line, const std::string& key, const std::string& v) {
   size_t used = 0;
   double d = 0;
@@ -82,29 +94,34 @@ PredictorConfig parse_predictor_config(const std::string& text, const std::strin
     if (eq == std::string::npos) config_error(name, line, "expected 'key = value'");
     const std::string key = trim(s.substr(0, eq)), v = trim(s.substr(eq + 1));
     auto num = [&] { return config_number(name, line, key, v); };
-    auto positive = [&](double lo) {
+    // Every value has a range: beyond it a typo would overflow the integer it is stored in (in
+    // practice a negative count or a deadline already past, silently) or make no physical sense.
+    auto in_range = [&](double lo, double hi) {
       const double d = num();
-      if (d < lo) config_error(name, line, key + " must be >= " + std::to_string(lo));
+      if (d < lo || d > hi) config_error(name, line, key + " must be in [" + config_text(lo) + ", " + config_text(hi) + "], not " + v);
       return d;
     };
-    auto ms = [&] { return static_cast<int64_t>(positive(0.001) * 1e6); };
+    auto whole = [&](double lo, double hi) {  // a count: 2.5 samples is a typo, not 2
+      const double d = in_range(lo, hi);
+      if (d != std::floor(d)) config_error(name, line, key + " must be a whole number, not " + v);
+      return static_cast<int>(d);
+    };
+    auto ms = [&] { return static_cast<int64_t>(in_range(0.001, kMaxConfigMs) * 1e6); };
     if (key == "stop_threshold") {
       c.stop_threshold = num();
       if (!(c.stop_threshold > 0.0 && c.stop_threshold < 1.0)) config_error(name, line, "stop_threshold must be in (0, 1)");
     } else if (key == "stop_consecutive") {
-      c.stop_consecutive = static_cast<int>(positive(1));
+      c.stop_consecutive = whole(1, 1e6);
     } else if (key == "hard_limit_n") {
-      c.hard_limit_n = positive(0.01);
+      c.hard_limit_n = in_range(0.01, kMaxConfigNewtons);
     } else if (key == "sensor_timeout_ms") {
       c.sensor_timeout_ns = ms();
     } else if (key == "bad_frame_budget") {
-      c.bad_frame_budget = static_cast<int>(positive(0));
+      c.bad_frame_budget = whole(0, 1e6);
     } else if (key == "bad_frame_weight") {
-      c.bad_frame_weight = static_cast<int>(positive(1));
+      c.bad_frame_weight = whole(1, 1e6);
     } else if (key == "max_delta_counter") {
-      const double d = positive(1);
-      if (d > 127) config_error(name, line, "max_delta_counter must be <= 127");
-      c.max_delta_counter = static_cast<uint8_t>(d);
+      c.max_delta_counter = static_cast<uint8_t>(whole(1, 127));
     } else if (key == "status_period_ms") {
       c.status_period_ns = ms();
     } else if (key == "heartbeat_period_ms") {
@@ -114,14 +131,15 @@ PredictorConfig parse_predictor_config(const std::string& text, const std::strin
     } else if (key == "stop_retry_ms") {
       c.stop_retry_ns = ms();
     } else if (key == "sample_period_ms") {
-      c.sample_period_s = positive(0.001) / 1000.0;
+      c.sample_period_s = in_range(0.001, kMaxConfigMs) / 1000.0;
     } else if (key == "acceleration_m_s2") {
-      c.acceleration_m_s2 = positive(0.0);
+      c.acceleration_m_s2 = in_range(0.0, 1000.0);
     } else if (key == "mount_axes") {
       // Three tokens, one per rig axis (motion, lateral, vertical): [-]x|y|z.
       std::istringstream t(v);
       std::string tok;
       int k = 0;
+      bool used[3] = {false, false, false};  // each sensor axis once: "x x z" would read x twice
       while (t >> tok) {
         if (k == 3) config_error(name, line, "mount_axes takes three axes");
         double sign = 1.0;
@@ -130,6 +148,8 @@ PredictorConfig parse_predictor_config(const std::string& text, const std::strin
           tok = tok.substr(1);
         }
         if (tok != "x" && tok != "y" && tok != "z") config_error(name, line, "mount_axes: '" + tok + "' is not x, y or z");
+        if (used[tok[0] - 'x']) config_error(name, line, "mount_axes: sensor axis " + tok + " given twice");
+        used[tok[0] - 'x'] = true;
         c.mount.axis[k] = tok[0] - 'x';
         c.mount.sign[k] = sign;
         ++k;
@@ -141,6 +161,8 @@ PredictorConfig parse_predictor_config(const std::string& text, const std::strin
         std::string tok;
         if (!(t >> tok)) config_error(name, line, "mount_bias takes three numbers [N]");
         c.mount.bias[k] = config_number(name, line, key, tok);
+        if (std::fabs(c.mount.bias[k]) > kMaxConfigNewtons)
+          config_error(name, line, key + " must be in [-" + config_text(kMaxConfigNewtons) + ", " + config_text(kMaxConfigNewtons) + "] N, not " + tok);
       }
     } else if (others) {
       others->push_back({key, v, line});

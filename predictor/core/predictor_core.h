@@ -72,9 +72,12 @@ struct PredictorConfig {
 };
 
 // Reads "key = value" lines ('#' comments). Keys are PredictorConfig's names plus
-// mount_axes (e.g. "x y z" or "-x z y"), mount_bias ("0 0 0" N), sensor_timeout_ms,
-// status_period_ms, heartbeat_period_ms, posteriors_period_ms, stop_retry_ms. Unknown keys and
-// bad values throw std::runtime_error naming `name`, the line and the key. Keys it does not own
+// mount_axes (e.g. "x y z" or "-x z y": each sensor axis once), mount_bias ("0 0 0" N, each
+// within 1000 N), sensor_timeout_ms, status_period_ms, heartbeat_period_ms, posteriors_period_ms,
+// stop_retry_ms (each in (0, 600000]). Counts are whole numbers in a range (stop_consecutive
+// 1..1e6, bad_frame_budget 0..1e6, bad_frame_weight 1..1e6, max_delta_counter 1..127);
+// hard_limit_n is in [0.01, 1000] N. Unknown keys and bad or out-of-range values throw
+// std::runtime_error naming `name`, the line and the key. Keys it does not own
 // (the daemon's: interface, model, rt_priority, ...) are returned in `others` when given.
 struct ConfigEntry {
   std::string key, value;

@@ -4,7 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <random>
+#include <sstream>
 #include <vector>
 
 #include "alloc_counter.h"
@@ -378,6 +380,64 @@ TEST(Config, ParsesKeysAndNamesBadLines) {
       EXPECT_NE(std::string(e.what()).find("p.conf:2:"), std::string::npos) << e.what();
     }
   }
+}
+
+// A typo must not become a silent misconfiguration: 1e300 samples or milliseconds do not fit the
+// integers they are stored in (undefined behaviour, in practice a negative count that falls back
+// to the model's k or a deadline already past), 2.5 samples is not a count, and a sensor axis
+// read twice leaves a rig axis unread. Each is an error naming the line, the key and its range.
+TEST(Config, ValuesOutOfRangeOrNotWholeAreErrors) {
+  for (const char* bad : {"stop_consecutive = 1e300\n", "stop_consecutive = 2.5\n", "sensor_timeout_ms = 1e300\n",
+                          "bad_frame_budget = 3e9\n", "bad_frame_weight = 0.5\n", "max_delta_counter = 3.5\n",
+                          "stop_retry_ms = 1e18\n", "hard_limit_n = 1e9\n", "mount_bias = 0 0 1e12\n",
+                          "mount_axes = x -x z\n"}) {
+    try {
+      parse_predictor_config(std::string("\n") + bad, "p.conf");
+      ADD_FAILURE() << "accepted: " << bad;
+    } catch (const std::runtime_error& e) {
+      const std::string key = std::string(bad).substr(0, std::string(bad).find(' '));
+      EXPECT_NE(std::string(e.what()).find("p.conf:2: " + key), std::string::npos) << e.what();
+    }
+  }
+  // The largest values the VM test and a slow rig use still parse.
+  const auto c = parse_predictor_config("stop_consecutive = 100000\nsensor_timeout_ms = 5000\n", "p.conf");
+  EXPECT_EQ(c.stop_consecutive, 100000);
+  EXPECT_EQ(c.sensor_timeout_ns, 5000 * kMs);
+}
+
+// The configuration file installed with the daemon says "the values below are the defaults":
+// it parses, every key it sets equals PredictorConfig's default, and the daemon's own keys come
+// back to the daemon.
+TEST(Config, TheShippedFileParsesToTheDefaults) {
+  const std::string path = std::string(DRESSGUARD_SOURCE_DIR) + "/predictor/daemon/dressguard-predictor.conf";
+  std::ifstream f(path);
+  ASSERT_TRUE(f) << path;
+  std::stringstream text;
+  text << f.rdbuf();
+  std::vector<ConfigEntry> others;
+  const PredictorConfig c = parse_predictor_config(text.str(), path, &others);
+  const PredictorConfig d;
+  EXPECT_EQ(c.stop_threshold, d.stop_threshold);
+  EXPECT_EQ(c.stop_consecutive, d.stop_consecutive);
+  EXPECT_EQ(c.hard_limit_n, d.hard_limit_n);
+  EXPECT_EQ(c.sensor_timeout_ns, d.sensor_timeout_ns);
+  EXPECT_EQ(c.bad_frame_budget, d.bad_frame_budget);
+  EXPECT_EQ(c.bad_frame_weight, d.bad_frame_weight);
+  EXPECT_EQ(c.max_delta_counter, d.max_delta_counter);
+  EXPECT_EQ(c.stop_retry_ns, d.stop_retry_ns);
+  EXPECT_EQ(c.status_period_ns, d.status_period_ns);
+  EXPECT_EQ(c.heartbeat_period_ns, d.heartbeat_period_ns);
+  EXPECT_EQ(c.posteriors_period_ns, d.posteriors_period_ns);
+  EXPECT_DOUBLE_EQ(c.sample_period_s, d.sample_period_s);
+  EXPECT_DOUBLE_EQ(c.acceleration_m_s2, d.acceleration_m_s2);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(c.mount.axis[k], d.mount.axis[k]);
+    EXPECT_EQ(c.mount.sign[k], d.mount.sign[k]);
+    EXPECT_EQ(c.mount.bias[k], d.mount.bias[k]);
+  }
+  std::vector<std::string> keys;
+  for (const auto& e : others) keys.push_back(e.key);
+  EXPECT_EQ(keys, (std::vector<std::string>{"interface", "model", "tick_ms", "rt_priority", "cpu", "mlock", "log_level"}));
 }
 
 TEST(CommandedTravel, TrapezoidProfile) {

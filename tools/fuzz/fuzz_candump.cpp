@@ -23,15 +23,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     frames = protocol::parse_candump_log(text, "trial.log");
   } catch (const std::runtime_error& e) {
-    const std::string_view m = e.what();
-    const std::string_view prefix = "trial.log:";
-    if (m.substr(0, prefix.size()) != prefix) broken("an error that does not name the file", 0);
-    size_t i = prefix.size();
-    long line = 0;
-    while (i < m.size() && m[i] >= '0' && m[i] <= '9' && line < 1'000'000'000) line = line * 10 + (m[i++] - '0');
-    long lines = 1;
-    for (char ch : text) lines += ch == '\n';
-    if (line < 1 || line > lines || m.substr(i, 2) != ": " || m.size() <= i + 2) broken("an error that does not name the line and what", line);
+    fuzz::check_error_names_line(e.what(), "trial.log", text);
     return 0;
   }
   for (const auto& lf : frames) {

@@ -41,17 +41,6 @@ bool finite_samples(const std::vector<HapticSample>& v) {
   return true;
 }
 
-// "PATH:LINE: what" with LINE in 1..lines, or "PATH: what".
-void check_message(std::string_view m, const std::string& path, std::string_view text) {
-  if (m.substr(0, path.size() + 1) != path + ":") broken("an error that does not name the file", 0);
-  size_t i = path.size() + 1;
-  if (i < m.size() && m[i] == ' ') return;  // no line: "PATH: what"
-  long line = 0;
-  while (i < m.size() && m[i] >= '0' && m[i] <= '9' && line < 1'000'000'000) line = line * 10 + (m[i++] - '0');
-  long lines = 1;
-  for (char ch : text) lines += ch == '\n';
-  if (line < 1 || line > lines || m.substr(i, 2) != ": " || m.size() <= i + 2) broken("an error that does not name a line of the file and what", line);
-}
 
 }  // namespace
 
@@ -86,7 +75,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       }
     }
   } catch (const InputError& e) {
-    check_message(e.what(), path.string(), text);
+    fuzz::check_error_names_line(e.what(), path.string(), text, true);  // or "PATH: what"
   }
   return 0;
 }

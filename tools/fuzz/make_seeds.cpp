@@ -11,7 +11,9 @@
 //   candump    fuzz_candump: `candump -l` logs of each message of the protocol, with blank
 //              lines, CRLF endings and a short frame;
 //   inputs     fuzz_inputs: a dataset trial CSV, a study trial, an OBJ with every face form,
-//              and each with a value that is not finite or an index out of range.
+//              and each with a value that is not finite or an index out of range;
+//   config     fuzz_config: the daemon's configuration with every key (as shipped), a --set
+//              line, a remounted sensor, and values just outside their ranges.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -317,12 +319,27 @@ int input_seeds(const std::filesystem::path& dir) {
       {"nan.obj", "\x02" "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n"}};
   return write_texts(dir, seeds);
 }
+int config_seeds(const std::filesystem::path& dir) {
+  const std::vector<std::pair<std::string, std::string>> seeds = {
+      {"shipped.conf",
+       "# dressguard-predictor configuration\ninterface = can0\nmodel = /usr/share/dressguard/default.dgm\n"
+       "# stop_threshold = 0.9\n# stop_consecutive = 5\nhard_limit_n = 10   # the study's limit\n"
+       "sensor_timeout_ms = 50\nbad_frame_budget = 5\nbad_frame_weight = 20\nmax_delta_counter = 3\n"
+       "mount_axes = x y z\nmount_bias = 0 0 0\nsample_period_ms = 10\nacceleration_m_s2 = 1\ntick_ms = 1\n"
+       "stop_retry_ms = 2\nstatus_period_ms = 100\nheartbeat_period_ms = 100\nposteriors_period_ms = 100\n"
+       "rt_priority = 80\ncpu = -1\nmlock = 1\nlog_level = info\n"},
+      {"set.conf", "stop_threshold=0.95\nstop_consecutive=100000\nsensor_timeout_ms=200\n"},
+      {"remounted.conf", "mount_axes = -z +y x\r\nmount_bias = 0.5 -1.25 12\r\n"},
+      {"ranges.conf", "stop_consecutive = 1000001\nsensor_timeout_ms = 600000.001\nmax_delta_counter = 128\n"
+                      "bad_frame_budget = 2.5\nmount_axes = x x z\nmount_bias = 0 0 1000.5\n"}};
+  return write_texts(dir, seeds);
+}
 }  // namespace
 
 int main(int argc, char** argv) {
   const std::string kind = argc == 3 ? argv[1] : "";
-  if (kind != "dgm" && kind != "predictor" && kind != "bridge" && kind != "candump" && kind != "inputs") {
-    std::fprintf(stderr, "usage: dg_fuzz_seeds dgm|predictor|bridge|candump|inputs DIR\n");
+  if (kind != "dgm" && kind != "predictor" && kind != "bridge" && kind != "candump" && kind != "inputs" && kind != "config") {
+    std::fprintf(stderr, "usage: dg_fuzz_seeds dgm|predictor|bridge|candump|inputs|config DIR\n");
     return 2;
   }
   const std::filesystem::path dir = argv[2];
@@ -335,5 +352,6 @@ int main(int argc, char** argv) {
   if (kind == "dgm") return dgm_seeds(dir);
   if (kind == "candump") return candump_seeds(dir);
   if (kind == "inputs") return input_seeds(dir);
+  if (kind == "config") return config_seeds(dir);
   return kind == "predictor" ? predictor_seeds(dir) : bridge_seeds(dir);
 }

@@ -36,6 +36,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <initializer_list>
+#include <string_view>
 #include <vector>
 
 #include "dg_protocol.h"
@@ -85,6 +86,21 @@ enum class BridgeOp : uint8_t {
 [[noreturn]] inline void broken(const char* rule, long op) {
   std::fprintf(stderr, "rule broken at operation %ld: %s\n", op, rule);
   std::abort();
+}
+
+// A reader's error must say "NAME:LINE: what", LINE a line of `text` (1-based) and `what` not
+// empty; with `line_optional`, "NAME: what" (about the whole input) is allowed too.
+inline void check_error_names_line(std::string_view what, std::string_view name, std::string_view text,
+                                   bool line_optional = false) {
+  if (what.substr(0, name.size()) != name || what.substr(name.size(), 1) != ":") broken("an error that does not name the file", 0);
+  size_t i = name.size() + 1;
+  if (line_optional && i < what.size() && what[i] == ' ') return;
+  long line = 0;
+  while (i < what.size() && what[i] >= '0' && what[i] <= '9' && line < 1'000'000'000) line = line * 10 + (what[i++] - '0');
+  long lines = 1;
+  for (char ch : text) lines += ch == '\n';
+  if (line < 1 || line > lines || what.substr(i, 2) != ": " || what.size() <= i + 2)
+    broken("an error that does not name a line of the input and what is wrong", line);
 }
 
 // Reads an input front to back.
