@@ -96,11 +96,11 @@ PredictorConfig parse_predictor_config(const std::string& text, const std::strin
     auto num = [&] { return config_number(name, line, key, v); };
     // Every value has a range: beyond it a typo would overflow the integer it is stored in (in
     // practice a negative count or a deadline already past, silently) or make no physical sense.
-    auto in_range = [&](double lo, double hi) {
-      const double d = num();
-      if (d < lo || d > hi) config_error(name, line, key + " must be in [" + config_text(lo) + ", " + config_text(hi) + "], not " + v);
+    auto bounded = [&](double d, double lo, double hi, const std::string& given) {
+      if (d < lo || d > hi) config_error(name, line, key + " must be in [" + config_text(lo) + ", " + config_text(hi) + "], not " + given);
       return d;
     };
+    auto in_range = [&](double lo, double hi) { return bounded(num(), lo, hi, v); };
     auto whole = [&](double lo, double hi) {  // a count: 2.5 samples is a typo, not 2
       const double d = in_range(lo, hi);
       if (d != std::floor(d)) config_error(name, line, key + " must be a whole number, not " + v);
@@ -160,9 +160,7 @@ PredictorConfig parse_predictor_config(const std::string& text, const std::strin
       for (int k = 0; k < 3; ++k) {
         std::string tok;
         if (!(t >> tok)) config_error(name, line, "mount_bias takes three numbers [N]");
-        c.mount.bias[k] = config_number(name, line, key, tok);
-        if (std::fabs(c.mount.bias[k]) > kMaxConfigNewtons)
-          config_error(name, line, key + " must be in [-" + config_text(kMaxConfigNewtons) + ", " + config_text(kMaxConfigNewtons) + "] N, not " + tok);
+        c.mount.bias[k] = bounded(config_number(name, line, key, tok), -kMaxConfigNewtons, kMaxConfigNewtons, tok);
       }
     } else if (others) {
       others->push_back({key, v, line});

@@ -22,8 +22,9 @@
 //   logical time  a sample's index counts the lost frames (the protocol's E2E checker, run
 //                 beside it, says how many); a timeout's is the sample that never came;
 //   reports       the heartbeat with the state, the model, the trial and the seconds since
-//                 the first call; status pages in turn, each with its two counters (saturating; samples modulo
-//                 65536) and the state; posteriors in 1/255 with the sample index;
+//                 the first frame or tick; status pages in turn, each with its two counters
+//                 (saturating; samples modulo 65536) and the state; posteriors in 1/255 with
+//                 the sample index;
 //   counters      a force frame moves the status counters (corrupted, bad length, repeated,
 //                 late, wrong sequence, lost frames, samples) as that checker's verdict says;
 //   filter        posteriors in [0, 1], summing to 1;
@@ -172,7 +173,7 @@ struct Shadow {
   int64_t stop_decided_ns = 0; // the latest stop's first transmission
   int64_t bucket = 0;          // the bad-frame budget's leaky bucket, from the trial start
   uint8_t next_page = 0;       // the status page due next
-  int64_t first_tick = -1;     // the predictor's clock starts at its first call
+  int64_t clock_start = -1;    // the predictor's clock starts at its first frame or tick
   int run = 0;                 // consecutive samples with P(caught) > threshold
   // Logical time: sample 0 is the trial's first accepted sample, and lost frames count (the
   // protocol's own E2E checker, fed the same force frames, says how many were lost).
@@ -194,16 +195,14 @@ struct Call {
   bool torque_first = false;  // the op sent the sample's torque frame before its force frame
   std::array<uint32_t, static_cast<int>(StatusCounter::Count)> counters_before{};
   predictor::Decision before;
-  uint32_t samples_before = 0, starts_before = 0;
+  uint32_t starts_before = 0;
   long steps_before = 0;
   bool pending_before = false;
-  uint32_t bad_before = 0;  // frames the bucket is charged for, so far
 };
 
-// What the bad-frame budget charges: corrupted frames, frames of a bad length and lost frames, of
-// any stream the predictor checks (the predictor's own counters say how many).
-uint32_t bad_frames(const Predictor& p) {
-  return p.counter(StatusCounter::Corrupted) + p.counter(StatusCounter::BadLength) + p.counter(StatusCounter::LostFrames);
+// How much a status counter moved in the call.
+uint32_t moved(const Call& c, const Predictor& p, StatusCounter k) {
+  return p.counter(k) - c.counters_before[static_cast<int>(k)];
 }
 
 // Reads one operation's frame or arguments, then makes the one predictor call (allocations
@@ -215,11 +214,9 @@ bool run_one(Reader& in, Predictor& p, RecordingSink& sink, Shadow& sh, Call& c,
   sink.now_ns = sh.now;
   sink.stop_sends = sink.status_sends = sink.post_sends = sink.hb_sends = 0;
   c.before = p.decision();
-  c.samples_before = p.counter(StatusCounter::Samples);
   c.starts_before = p.trials_started();
   c.steps_before = p.filter() ? p.filter()->samples() : 0;
   c.pending_before = p.stop_pending();
-  c.bad_before = bad_frames(p);
   for (int k = 0; k < static_cast<int>(StatusCounter::Count); ++k) c.counters_before[k] = p.counter(static_cast<StatusCounter>(k));
 
   switch (c.kind) {
@@ -377,7 +374,7 @@ void check_stop_state(const Call& c, const Predictor& p, const RecordingSink& si
 void check_sample(const Call& c, const Predictor& p, const Rules& r, Shadow& sh, long op) {
   const predictor::Decision& d = p.decision();
   const bool bad_frame_stop = d.state == PredictorState::Stopped && d.reason == StopReason::BadFrames;
-  const bool accepted = p.counter(StatusCounter::Samples) != c.samples_before;
+  const bool accepted = moved(c, p, StatusCounter::Samples) != 0;
   const bool stepped = p.filter() && p.filter()->samples() != c.steps_before;
   if (accepted && !stepped && !bad_frame_stop) broken("an accepted sample in a trial did not reach the filter", op);
   if (!accepted && d.state != PredictorState::InTrial && !bad_frame_stop)
@@ -409,7 +406,7 @@ void check_sample(const Call& c, const Predictor& p, const Rules& r, Shadow& sh,
 // checker, run beside the predictor, says of it, and nothing else moves.
 void check_force_counters(const Call& c, const Predictor& p, long op) {
   using S = protocol::E2EStatus;
-  const auto delta = [&](StatusCounter k) { return p.counter(k) - c.counters_before[static_cast<int>(k)]; };
+  const auto delta = [&](StatusCounter k) { return moved(c, p, k); };
   const bool lost = c.e2e == S::OkSomeLost || c.e2e == S::WrongSequence;
   if (delta(StatusCounter::Corrupted) != (c.e2e == S::Corrupted) || delta(StatusCounter::BadLength) != (c.e2e == S::BadLength) ||
       delta(StatusCounter::Repeated) != (c.e2e == S::Repeated) || delta(StatusCounter::Late) != (c.e2e == S::Late) ||
@@ -422,7 +419,11 @@ void check_force_counters(const Call& c, const Predictor& p, long op) {
 // accepted in a running trial drains 1, and a running trial stops the moment the bucket holds
 // more than budget * weight; a trial start empties it.
 void check_bucket(const Call& c, const Predictor& p, const Rules& r, Shadow& sh, bool started, long op) {
-  sh.bucket += static_cast<int64_t>(bad_frames(p) - c.bad_before) * r.cfg.bad_frame_weight;
+  // Charged: corrupted frames, frames of a bad length and lost frames, of any stream the
+  // predictor checks (its own counters say how many).
+  const uint32_t charged = moved(c, p, StatusCounter::Corrupted) + moved(c, p, StatusCounter::BadLength) +
+                           moved(c, p, StatusCounter::LostFrames);
+  sh.bucket += static_cast<int64_t>(charged) * r.cfg.bad_frame_weight;
   if (started) {
     sh.bucket = 0;
     return;
@@ -432,18 +433,19 @@ void check_bucket(const Call& c, const Predictor& p, const Rules& r, Shadow& sh,
   const bool over = running && sh.bucket > static_cast<int64_t>(r.cfg.bad_frame_budget) * r.cfg.bad_frame_weight;
   const bool did = running && d.state == PredictorState::Stopped && d.reason == StopReason::BadFrames;
   if (over != did) broken(over ? "bad frames over the budget did not stop" : "a bad-frames stop within the budget", op);
-  const bool accepted = p.counter(StatusCounter::Samples) != c.samples_before;
+  const bool accepted = moved(c, p, StatusCounter::Samples) != 0;
   if (running && !over && accepted && sh.bucket > 0) --sh.bucket;
 }
 
-// What a tick reports: the status pages in turn, each with its two counters (saturating at
-// 65535, the sample count modulo 65536) and the state; the posteriors in 1/255 with the sample.
+// What a tick reports: the heartbeat (state, model, trial, seconds since the clock started); the
+// status pages in turn, each with its two counters (saturating at 65535, the sample count modulo
+// 65536) and the state; the posteriors in 1/255 with the sample.
 void check_reports(const Predictor& p, const RecordingSink& sink, const Rules& r, Shadow& sh, long op) {
   const predictor::Decision& d = p.decision();
   if (sink.hb_sends > 0) {
     protocol::HeartbeatPredictor m;
     protocol::decode(sink.last_hb, m);
-    const int64_t up = (sh.now - sh.first_tick) / 1'000'000'000;
+    const int64_t up = (sh.now - sh.clock_start) / 1'000'000'000;
     if (m.state != d.state || m.model_loaded != (r.has_model ? 1 : 0) || m.trial_id != d.trial ||
         m.uptime_s != std::min<int64_t>(up, 0xFFFF))
       broken("the heartbeat does not carry the state, the model, the trial and the seconds since start", op);
@@ -532,7 +534,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     Call c;
     if (!run_one(in, p, sink, sh, c, op)) break;
     const bool started = p.trials_started() != c.starts_before;
-    if (sh.first_tick < 0 && (c.frame_sent || c.ticked)) sh.first_tick = sh.now;
+    if (sh.clock_start < 0 && (c.frame_sent || c.ticked)) sh.clock_start = sh.now;
     check_outputs(p, sink, op);
     if (started) check_trial_start(c, p, r, sh, op);
     check_stop_state(c, p, sink, started, op);
