@@ -316,6 +316,26 @@ TEST(StopTransmission, AStopJustSentIsDroppedAtTheNextTrialStart) {
   EXPECT_EQ(h.p->decision().state, PredictorState::InTrial);
 }
 
+// The heartbeat's uptime is whole seconds since the predictor's first frame or tick, saturating
+// at 65,535 s (18.2 h) rather than wrapping to a freshly restarted daemon's. (Out of
+// fuzz_predictor's reach.)
+TEST(Status, HeartbeatUptimeSaturates) {
+  Harness h;
+  const int64_t s = 1'000'000'000;
+  const auto uptime = [&h](int64_t t) {
+    h.sink.others.clear();
+    h.p->on_tick(t);
+    for (const Frame& f : h.sink.others) {
+      protocol::HeartbeatPredictor m;
+      if (protocol::decode(f, m)) return static_cast<int>(m.uptime_s);
+    }
+    return -1;
+  };
+  EXPECT_EQ(uptime(5 * s), 0);  // the clock starts here
+  EXPECT_EQ(uptime(5 * s + 65'535 * s), 65535);
+  EXPECT_EQ(uptime(5 * s + 70'000 * s), 65535) << "saturates, does not wrap to 4464";
+}
+
 TEST(Status, PagesCarryEveryCounter) {
   Harness h;
   h.start();

@@ -103,6 +103,25 @@ TEST(BridgeCore, HeartbeatCarriesSensorState) {
   EXPECT_EQ(bridge_on_tick(c, 50, &hb, &a), 0) << "next heartbeat only after 100 ms";
 }
 
+// Uptime is whole seconds since bridge_init, across the millisecond clock's wrap (49.7 days), and
+// saturates at 65,535 s (18.2 h) instead of wrapping: the robot controller reads a long-running
+// bridge as "up at least that long", never as freshly restarted. (Out of fuzz_bridge's reach.)
+TEST(BridgeCore, HeartbeatUptimeCrossesTheWrapAndSaturates) {
+  const auto uptime = [](uint32_t start, uint32_t now) {
+    BridgeCore c;
+    bridge_init(c, {}, start);
+    Frame hb;
+    BridgeAction a;
+    EXPECT_EQ(bridge_on_tick(c, now, &hb, &a), 1);
+    protocol::HeartbeatBridge m;
+    EXPECT_TRUE(protocol::decode(hb, m));
+    return m.uptime_s;
+  };
+  EXPECT_EQ(uptime(0xFFFFFFFFu - 999, 2500), 3) << "3.5 s across the wrap";
+  EXPECT_EQ(uptime(0, 65'535'999), 65535);
+  EXPECT_EQ(uptime(0, 70'000'000), 65535) << "saturates, does not wrap to 4464";
+}
+
 // Found by fuzz_bridge (session 80): a trial start used to report Ok when it released the latch,
 // even with no reading since a failed one (or none at all).
 TEST(BridgeCore, ReleasedLatchReportsTheSensorAsItIs) {
