@@ -32,6 +32,16 @@ namespace {
 
 // ---- portable core ---------------------------------------------------------------------------
 
+// The heartbeat a tick at `t` must send (one is due).
+protocol::HeartbeatBridge heartbeat_at(BridgeCore& c, uint32_t t) {
+  Frame hb;
+  BridgeAction a;
+  EXPECT_EQ(bridge_on_tick(c, t, &hb, &a), 1);
+  protocol::HeartbeatBridge m{};
+  EXPECT_TRUE(protocol::decode(hb, m));
+  return m;
+}
+
 TEST(BridgeCore, ReadingBecomesTwoFramesWithOneCounter) {
   BridgeCore c;
   bridge_init(c, {}, 0);
@@ -110,12 +120,7 @@ TEST(BridgeCore, HeartbeatUptimeCrossesTheWrapAndSaturates) {
   const auto uptime = [](uint32_t start, uint32_t now) {
     BridgeCore c;
     bridge_init(c, {}, start);
-    Frame hb;
-    BridgeAction a;
-    EXPECT_EQ(bridge_on_tick(c, now, &hb, &a), 1);
-    protocol::HeartbeatBridge m;
-    EXPECT_TRUE(protocol::decode(hb, m));
-    return m.uptime_s;
+    return heartbeat_at(c, now).uptime_s;
   };
   EXPECT_EQ(uptime(0xFFFFFFFFu - 999, 2500), 3) << "3.5 s across the wrap";
   EXPECT_EQ(uptime(0, 65'535'999), 65535);
@@ -127,14 +132,7 @@ TEST(BridgeCore, HeartbeatUptimeCrossesTheWrapAndSaturates) {
 TEST(BridgeCore, ReleasedLatchReportsTheSensorAsItIs) {
   BridgeCore c;
   bridge_init(c, {}, 0);
-  const auto heartbeat_state = [&c](uint32_t t) {
-    Frame hb;
-    BridgeAction a;
-    EXPECT_EQ(bridge_on_tick(c, t, &hb, &a), 1);
-    protocol::HeartbeatBridge m;
-    EXPECT_TRUE(protocol::decode(hb, m));
-    return m.state;
-  };
+  const auto heartbeat_state = [&c](uint32_t t) { return heartbeat_at(c, t).state; };
   EXPECT_EQ(bridge_on_frame(c, protocol::encode(protocol::Stop{0, protocol::StopReason::Caught, 250, 1, 100}), 1),
             BridgeAction::StopRobot);
   EXPECT_EQ(heartbeat_state(2), protocol::BridgeState::StopLatched);
