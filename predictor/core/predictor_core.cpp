@@ -26,6 +26,7 @@ const char* event_kind_name(EventKind k) {
     case EventKind::TxError: return "tx_error";
     case EventKind::BusError: return "bus_error";
     case EventKind::ModelMissing: return "model_missing";
+    case EventKind::StopDropped: return "stop_dropped";
     case EventKind::Posteriors: return "posteriors";
   }
   return "unknown";
@@ -286,6 +287,13 @@ void Predictor::on_trial_start(const Frame& f, int64_t now_ns) noexcept {
   // cannot send a stop cannot guard it. A younger one (decided moments ago, e.g. by this very
   // frame's lost counter) is simply dropped; its echo, if it comes, is ignored.
   const bool unconfirmed = stop_pending_ && now_ns - stop_decided_ns_ >= cfg_.stop_retry_ns;
+  if (stop_pending_ && !unconfirmed) {
+    // Logged: a stop nobody saw leave is worth a line even when it no longer matters.
+    Event e = make_event(EventKind::StopDropped, now_ns);  // names the finished trial
+    e.reason = decision_.reason;
+    e.value = static_cast<uint32_t>((now_ns - stop_decided_ns_) / 1000);  // [us] < stop_retry_ns
+    emit(e);
+  }
   stop_pending_ = false;
   decision_ = Decision{};
   ++trials_started_;

@@ -94,6 +94,7 @@ double commanded_travel(double speed, double accel, double t) noexcept;
 enum class EventKind : uint8_t {
   TrialStarted, TrialEnded, BadFrame, LostFrames, KernelDrops, StopSent, StopConfirmed, StopRetry,
   TxError, BusError, ModelMissing, Posteriors,
+  StopDropped,  // a stop still unconfirmed when the next trial started (younger than a retry period)
 };
 const char* event_kind_name(EventKind k);
 

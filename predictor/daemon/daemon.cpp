@@ -118,6 +118,10 @@ void EventLogger::log_one(const Event& e) {
       break;
     case EventKind::BusError: log_->error("CAN controller error frame, class 0x{:X}", e.value); break;
     case EventKind::ModelMissing: log_->error("trial {} refused: no model loaded", e.trial); break;
+    case EventKind::StopDropped:
+      log_->warn("stop of trial {} ({}) not confirmed {} us after it was sent: dropped, a new trial started", e.trial,
+                 protocol::stop_reason_name(e.reason), e.value);
+      break;
     case EventKind::Posteriors: break;
   }
 }

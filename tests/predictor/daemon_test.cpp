@@ -164,6 +164,25 @@ TEST(EventLogger, RetriesAndFailedSendsAreLoggedAtEachDoubling) {
   EXPECT_NE(text.str().find("(512 failed sends so far)"), std::string::npos) << text.str();
 }
 
+// A young stop dropped at the next trial's start gets its own line: trial, reason and age.
+TEST(EventLogger, ADroppedStopIsLogged) {
+  EventQueue q;
+  Event e;
+  e.kind = EventKind::StopDropped;
+  e.trial = 9;
+  e.reason = protocol::StopReason::Caught;
+  e.value = 1500;
+  ASSERT_TRUE(q.push(e));
+  std::ostringstream text;
+  auto log = std::make_shared<spdlog::logger>("test", std::make_shared<spdlog::sinks::ostream_sink_mt>(text));
+  {
+    EventLogger logger(q, log, {"good", "missed", "caught"});
+  }
+  const std::string want = std::string("stop of trial 9 (") + protocol::stop_reason_name(protocol::StopReason::Caught) +
+                           ") not confirmed 1500 us after it was sent: dropped";
+  EXPECT_NE(text.str().find(want), std::string::npos) << text.str();
+}
+
 TEST(Daemon, ShutdownDuringATrialStopsTheRobotFirst) {
   Rig rig;
   rig.sensor->send(rig.src.trial_start(5));

@@ -306,9 +306,20 @@ TEST(StopTransmission, AStopJustSentIsDroppedAtTheNextTrialStart) {
   h.sample(-20.0, 0.0);
   ASSERT_TRUE(h.p->stop_pending());
   const size_t sent = h.sink.stops.size();
+  h.sink.events.clear();
   h.p->on_frame(h.src.trial_start(2), h.now + kMs);  // within stop_retry_ns (2 ms)
   EXPECT_EQ(h.p->decision().state, PredictorState::InTrial);
   EXPECT_FALSE(h.p->stop_pending());
+  // It is not dropped silently: one event names the finished trial, its reason and its age.
+  int dropped = 0;
+  for (const auto& e : h.sink.events) {
+    if (e.kind != EventKind::StopDropped) continue;
+    ++dropped;
+    EXPECT_EQ(e.trial, 1);
+    EXPECT_EQ(e.reason, protocol::StopReason::HardLimit);
+    EXPECT_EQ(e.value, 1000u) << "age in microseconds";
+  }
+  EXPECT_EQ(dropped, 1);
   h.now += kMs;
   h.sample(1.0, 0.0);
   EXPECT_EQ(h.sink.stops.size(), sent) << "the finished trial's stop was resent into the next one";
