@@ -108,7 +108,13 @@ struct RecordingSink final : predictor::PredictorSink {
     if (!protected_as(f, m)) bad_output = true;
     return 0;
   }
-  void event(const predictor::Event&) noexcept override {}
+  int dropped = 0;           // StopDropped events in the current operation
+  predictor::Event last_dropped{};
+  void event(const predictor::Event& e) noexcept override {
+    if (e.kind != predictor::EventKind::StopDropped) return;
+    ++dropped;
+    last_dropped = e;
+  }
 };
 
 // Allocations while a CountAllocations is open. The sanitizer's hook sees malloc and operator
@@ -212,7 +218,7 @@ bool run_one(Reader& in, Predictor& p, RecordingSink& sink, Shadow& sh, Call& c,
   c.kind = static_cast<TrafficOp>(opbyte & 0x0F);
   sh.now += (opbyte >> 4) * fuzz::kTrafficTimeUnitNs;
   sink.now_ns = sh.now;
-  sink.stop_sends = sink.status_sends = sink.post_sends = sink.hb_sends = 0;
+  sink.stop_sends = sink.status_sends = sink.post_sends = sink.hb_sends = sink.dropped = 0;
   c.before = p.decision();
   c.starts_before = p.trials_started();
   c.steps_before = p.filter() ? p.filter()->samples() : 0;
@@ -328,7 +334,8 @@ void check_outputs(const Predictor& p, const RecordingSink& sink, long op) {
 
 // Trial start: the shadow restarts; with a model the trial runs, unless the last stop was never
 // confirmed; without a model it is refused.
-void check_trial_start(const Call& c, const Predictor& p, const Rules& r, Shadow& sh, long op) {
+void check_trial_start(const Call& c, const Predictor& p, const RecordingSink& sink, const Rules& r, Shadow& sh,
+                       long op) {
   protocol::TrialStart m;
   if (!protocol::decode(c.sent, m) || p.decision().trial != m.trial_id) broken("the decision's trial is not the start frame's", op);
   sh.last_accept_ns = sh.now;
@@ -345,6 +352,12 @@ void check_trial_start(const Call& c, const Predictor& p, const Rules& r, Shadow
     broken("a trial start with the last stop unconfirmed was not refused with stop_unconfirmed", op);
   if (!r.has_model && (d.state != PredictorState::Stopped || d.reason != StopReason::ModelError))
     broken("a trial start without a model was not refused", op);
+  // A younger pending stop is dropped, and says so once, naming the finished trial. (A stop the
+  // start frame itself decided, through the bad-frame budget, is younger still.)
+  if (unconfirmed && sink.dropped != 0) broken("a stale stop was reported dropped, not refused", op);
+  if (c.pending_before && !unconfirmed && sink.dropped != 1) broken("a young pending stop was dropped silently", op);
+  if (sink.dropped > 1) broken("one dropped stop was reported twice", op);
+  if (sink.dropped == 1 && sink.last_dropped.trial != c.before.trial) broken("the dropped stop names another trial", op);
 }
 
 // No stop outside a trial; the latch; and the stop frame of a new stop.
@@ -536,7 +549,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const bool started = p.trials_started() != c.starts_before;
     if (sh.clock_start < 0 && (c.frame_sent || c.ticked)) sh.clock_start = sh.now;
     check_outputs(p, sink, op);
-    if (started) check_trial_start(c, p, r, sh, op);
+    if (started) check_trial_start(c, p, sink, r, sh, op);
+    if (!started && sink.dropped != 0) broken("a stop was dropped without a trial start", op);
     check_stop_state(c, p, sink, started, op);
     const bool force = c.frame_sent && is(c.sent, MsgId::FtForce);
     if (force && !started && c.before.state == PredictorState::InTrial) check_sample(c, p, r, sh, op);
