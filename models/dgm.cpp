@@ -132,6 +132,9 @@ void check_features(const FeatureConvention& f, const std::string& source) {
     check_finite(f.offset[k], source, w + " offset");
     check_finite(f.scale[k], source, w + " scale");
     if (!(f.scale[k] > 0.0)) fail(source, w + " scale is not positive");
+    // FORMAT.md: an unused feature stores offset 0 and scale 1 (it is 0 for every sample).
+    if (f.axis[k] == kAxisNone && (f.offset[k] != 0.0 || f.scale[k] != 1.0))
+      fail(source, w + " is 'none' (axis 3) but its offset is not 0 or its scale not 1");
   }
 }
 

@@ -142,7 +142,7 @@ enum class StopReason : uint8_t {
   HardLimit = 2,      // |force| above the hard limit on the motion or vertical axis
   SensorTimeout = 3,  // no valid sample within the deadline during a trial
   BadFrames = 4,      // too many corrupted or lost frames
-  ModelError = 5,     // the model did not load: every trial is refused
+  ModelError = 5,     // the model did not load (every trial is refused), or it failed on a sample
   Shutdown = 6,       // the daemon is shutting down during a trial
   StopUnconfirmed = 7,  // the previous trial's stop got no echo within a retry period: refused
 };

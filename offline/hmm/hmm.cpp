@@ -481,6 +481,7 @@ std::vector<double> forward_prefix_log_likelihoods(const ClassHmm& h, const Feat
     }
     double m = kNegInf;
     for (int j = 0; j < n; ++j) {
+      if (pred[j] < kFlushBelow) pred[j] = 0.0;  // as the filter's kernel (emission_update.h)
       lb[j] = emission_log_density(h.emission[j], s.at(t));
       if (pred[j] > 0.0) m = std::max(m, lb[j]);
     }
@@ -515,7 +516,7 @@ ViterbiResult viterbi(const ClassHmm& h, const FeatureSequence& s) {
   for (size_t t = 1; t < T; ++t) {
     for (int j = 0; j < n; ++j) {
       double best = kNegInf;
-      int arg = -1;
+      int arg = j;  // kept when no path reaches j (every v is -inf): a valid index, never -1
       for (int i = 0; i < n; ++i) {
         const double v = delta[i] + logA[i * n + j];
         if (v > best) best = v, arg = i;

@@ -103,6 +103,8 @@ double forward_log_likelihood(const ClassHmm& hmm, const FeatureSequence& seq);
 std::vector<double> forward_prefix_log_likelihoods(const ClassHmm& hmm, const FeatureSequence& seq);
 
 // The most probable state path and its joint log-probability log p(x, path), in log space.
+// When no path can produce the sequence (log_probability -inf) the path is arbitrary, but every
+// entry is a valid state index.
 struct ViterbiResult {
   std::vector<int> path;
   double log_probability = -std::numeric_limits<double>::infinity();

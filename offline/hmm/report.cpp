@@ -42,7 +42,7 @@ std::string json_array(It b, It e, F f) {
 
 std::string model_json(const model::OutcomeModel& m) {
   std::ostringstream o;
-  o << "{\"format_version\": " << model::kFormatVersion << ", \"tool_version\": " << json_string(m.tool_version)
+  o << "{\"format_version\": " << model::format_version_of(m) << ", \"tool_version\": " << json_string(m.tool_version)
     << ", \"created\": " << json_string(m.created) << ", \"source_dataset\": " << json_string(m.source_dataset)
     << ", \"training_summary\": " << json_string(m.training_summary) << ", \"features\": [";
   static const char* kAxis[] = {"f_motion", "f_lateral", "f_vertical", "none"};

@@ -357,6 +357,11 @@ void Predictor::on_force(const Frame& f, int64_t now_ns) noexcept {
     stop(StopReason::HardLimit, now_ns);
     return;
   }
+  // Posteriors that are NaN would never exceed the threshold: a filter that failed is a fault.
+  if (filter_->failed()) {
+    stop(StopReason::ModelError, now_ns);
+    return;
+  }
   if (filter_->posterior(caught_) > threshold_) {
     if (++consecutive_ >= consecutive_needed_) stop(StopReason::Caught, now_ns);
   } else {

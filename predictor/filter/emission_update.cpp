@@ -23,6 +23,7 @@ double class_update_portable(const ClassBlock& b, bool pred_given, double x0, do
   }
   double m = -std::numeric_limits<double>::infinity();
   for (int j = 0; j < n; ++j) {
+    if (pred[j] < kFlushBelow) pred[j] = 0.0;  // see emission_update.h: c >= kFlushBelow
     const double d0 = x0 - b.m0[j], d1 = x1 - b.m1[j];
     logb[j] = b.lc[j] - 0.5 * (b.ip[j] * d0 * d0 + 2.0 * b.iq[j] * d0 * d1 + b.ir[j] * d1 * d1);
     if (pred[j] > 0.0 && logb[j] > m) m = logb[j];
@@ -105,7 +106,8 @@ __attribute__((target("avx2,fma"))) double class_update_avx2_impl(const ClassBlo
   const int n = b.n_padded;
   const __m256d vx0 = _mm256_set1_pd(x0), vx1 = _mm256_set1_pd(x1), half = _mm256_set1_pd(0.5),
                 two = _mm256_set1_pd(2.0), zero = _mm256_setzero_pd(),
-                ninf = _mm256_set1_pd(-std::numeric_limits<double>::infinity());
+                ninf = _mm256_set1_pd(-std::numeric_limits<double>::infinity()),
+                flush = _mm256_set1_pd(kFlushBelow);
   __m256d vmax = ninf;
   // Pass 1: prediction along the band (reads of alpha_{j-d} below 0 hit the zero pad), log
   // densities, and their maximum over reachable states. pred is written to its own buffer
@@ -118,8 +120,9 @@ __attribute__((target("avx2,fma"))) double class_update_avx2_impl(const ClassBlo
       const __m256d cur = _mm256_loadu_pd(alpha + j), prev = _mm256_loadu_pd(alpha + j - 4);
       pr = _mm256_mul_pd(_mm256_loadu_pd(b.diag[0] + j), cur);
       for (int d = 1; d <= b.band; ++d) pr = _mm256_fmadd_pd(_mm256_loadu_pd(b.diag[d] + j), shifted(prev, cur, d), pr);
-      _mm256_storeu_pd(pred + j, pr);
     }
+    pr = _mm256_and_pd(pr, _mm256_cmp_pd(pr, flush, _CMP_GE_OQ));  // see emission_update.h
+    _mm256_storeu_pd(pred + j, pr);
     const __m256d d0 = _mm256_sub_pd(vx0, _mm256_loadu_pd(b.m0 + j));
     const __m256d d1 = _mm256_sub_pd(vx1, _mm256_loadu_pd(b.m1 + j));
     __m256d q = _mm256_mul_pd(_mm256_mul_pd(_mm256_loadu_pd(b.ip + j), d0), d0);
@@ -147,7 +150,7 @@ __attribute__((target("avx2,fma"))) double class_update_avx2_impl(const ClassBlo
   _mm256_store_pd(cs, vc);
   const double c = (cs[0] + cs[1]) + (cs[2] + cs[3]);
   // Pass 3: normalise, flushing probabilities below kFlushBelow to 0.
-  const __m256d inv = _mm256_set1_pd(1.0 / c), flush = _mm256_set1_pd(kFlushBelow);
+  const __m256d inv = _mm256_set1_pd(1.0 / c);
   for (int j = 0; j < n; j += 4) {
     const __m256d a = _mm256_mul_pd(_mm256_loadu_pd(alpha + j), inv);
     _mm256_storeu_pd(alpha + j, _mm256_and_pd(a, _mm256_cmp_pd(a, flush, _CMP_GE_OQ)));

@@ -1,6 +1,7 @@
 // The per-class step of the forward filter, the one place the filter spends its time:
 //     pred_j  = sum_{d=0..w} B_d[j] alpha_{j-d}        (B_d[j] = A_{j-d,j}: the left-right band)
 //     logb_j  = lc_j - q_j / 2,   q_j = (x - mu_j)^T S_j^-1 (x - mu_j)     (Gaussian log density)
+//     pred_j  = 0 where pred_j < kFlushBelow          (written back into pred)
 //     m       = max { logb_j : pred_j > 0 }
 //     alpha_j = pred_j exp(logb_j - m) / c,   c = sum_j pred_j exp(logb_j - m)   (0 below kFlushBelow)
 // returning c and m: the sample's log-likelihood increment is log c + m (see forward_filter.h).
@@ -19,6 +20,11 @@ namespace dressguard::filter {
 // model has left behind decay through the subnormal range, where every multiplication costs ~100
 // cycles. hmm::forward_log_likelihood flushes alike, so the two agree; a state this improbable
 // (< 1e-300) never matters to a classification.
+// Predictions below it are flushed too, and that bounds the normaliser: the state that attains m
+// has pred >= kFlushBelow and exp(0) = 1, so c >= 1e-300, and 1/c and the filter's running
+// product of the c stay normal numbers. Without it a tiny transition (a trained band can hold
+// 1e-258) times a small alpha gives a subnormal prediction; when that state alone explains the
+// sample, c is subnormal, 1/c overflows and the posteriors turn NaN.
 inline constexpr double kFlushBelow = 1e-300;
 // Widest band the band path takes (w <= kMaxBand); wider or non-left-right models take the
 // general O(n^2) prediction, done by the caller.

@@ -122,6 +122,7 @@ void ForwardFilter::reset() noexcept {
   for (size_t k = 0; k < alpha_.size(); ++k) alpha_[k] = initial_[k];
   samples_ = 0;
   rejected_ = 0;
+  failed_ = false;
 }
 
 void ForwardFilter::step(double f_motion, double f_lateral, double f_vertical) noexcept {
@@ -177,6 +178,8 @@ void ForwardFilter::step_features(const double x[model::kFeatures]) noexcept {
     posterior_[c] = e[c] * mant_[c];
     z += posterior_[c];
   }
+  // NaN fails both comparisons; a best score of -inf means no class can explain the samples.
+  if (!(z > 0.0 && z <= std::numeric_limits<double>::max()) || !std::isfinite(best_score)) failed_ = true;
   const double iz = 1.0 / z;
   for (int c = 0; c < n_classes_; ++c) posterior_[c] *= iz;
   ++samples_;

@@ -60,6 +60,12 @@ class ForwardFilter {
   // Samples taken (non-finite samples are skipped, not taken, and counted in rejected()).
   long samples() const noexcept { return samples_; }
   long rejected() const noexcept { return rejected_; }
+  // True from the first sample after which no class has a finite log-likelihood, or whose
+  // posteriors came out NaN, infinite or all zero, until reset():
+  // the model cannot represent the trial (a sample some class rates at log density -inf, an
+  // extreme model). The posteriors mean nothing then; the predictor stops on it (model_error)
+  // rather than read them, since a NaN compares false against every threshold.
+  bool failed() const noexcept { return failed_; }
   // True when the AVX2+FMA emission update runs (chosen once at construction from the CPU).
   bool vectorised() const noexcept;
 
@@ -84,6 +90,7 @@ class ForwardFilter {
   // the normalisers c_t is kept as mantissa and exponent, so a sample costs no log.
   std::vector<double> shift_sum_, exp2_, mant_, score_, posterior_;
   long samples_ = 0, rejected_ = 0;
+  bool failed_ = false;
 };
 
 }  // namespace dressguard::filter

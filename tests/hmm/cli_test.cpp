@@ -116,6 +116,10 @@ TEST_F(CliTest, TrainClassifyShowOnSyntheticData) {
   const auto showj = run("model show " + (dir / "m.dgm").string() + " --json");
   ASSERT_EQ(showj.code, 0);
   EXPECT_EQ(json_field(showj.out, "states"), 5.0);
+  // The version the file's bytes carry (two force axes: format 1, models/FORMAT.md), as the
+  // text says, not the newest version this build can write.
+  EXPECT_NE(show.out.find("format 1"), std::string::npos) << show.out;
+  EXPECT_EQ(json_field(showj.out, "format_version"), 1.0) << showj.out;
 }
 
 // A committee (--model A,B,C) votes: with two right models and one trained on swapped good and

@@ -149,6 +149,104 @@ TEST(ForwardFilter, PriorNonFiniteSamplesAndReset) {
   EXPECT_NEAR(ps, 1.0, 1e-12);
 }
 
+namespace {
+// Two classes of two states, A = [[0.9 0.1][0 1]], unit covariances; state 1 of class "caught"
+// sits `far` standard deviations out on feature 0 and starts with probability pi1.
+model::OutcomeModel tiny_start_model(double pi1, double far) {
+  model::OutcomeModel m;
+  for (const char* name : {"good", "caught"}) {
+    model::ClassHmm h;
+    h.name = name;
+    h.n_states = 2;
+    h.initial = {1.0 - pi1, pi1};
+    h.transition = {0.9, 0.1, 0.0, 1.0};
+    h.emission.resize(2);
+    h.emission[1].mean[0] = far;
+    h.log_prior = std::log(0.5);
+    m.classes.push_back(h);
+  }
+  m.classes[0].initial = {1.0, 0.0};
+  m.classes[0].emission[1].mean[0] = -far;
+  return m;
+}
+}  // namespace
+
+// A state whose prediction is tiny but which alone explains the sample (every other state 40
+// standard deviations away: log density -800). Closed form of the first sample's log-likelihood
+// of "caught": log(pi0 N(x; 0, I) + pi1 N(x; mu1, I)) with x = mu1 = (40, 0), which is
+// log N(0; 0, I) + log(pi1 + e^-800) = -log 2pi + log pi1 for pi1 = 1e-290. Below kFlushBelow
+// (pi1 = 1e-310, a subnormal the model file accepts) the state counts as unreachable, as in the
+// offline forward, and the likelihood is state 0's alone: -log 2pi - 800. Before predictions
+// were flushed, the normaliser c was subnormal there, 1/c overflowed and the posteriors went NaN
+// (posterior > threshold is false for NaN: no caught stop could fire).
+TEST(ForwardFilter, ATinyPredictionThatAloneExplainsTheSampleStaysFinite) {
+  const double log2pi = std::log(2 * M_PI);
+  for (const double pi1 : {1e-290, 1e-310}) {
+    const auto m = tiny_start_model(pi1, 40.0);
+    filter::ForwardFilter f(m);
+    hmm::FeatureSequence seq;
+    seq.x = {40, 0, 40, 0, 40, 0};
+    const auto pre = hmm::forward_prefix_log_likelihoods(m.classes[1], seq);
+    const double want = pi1 > filter::kFlushBelow ? -log2pi + std::log(pi1) : -log2pi - 800.0;
+    EXPECT_NEAR(pre[0], want, 1e-9 * std::fabs(want)) << "pi1 " << pi1;
+    for (size_t t = 0; t < seq.size(); ++t) {
+      f.step_features(seq.at(t));
+      ASSERT_FALSE(f.failed()) << "pi1 " << pi1 << " sample " << t;
+      ASSERT_TRUE(std::isfinite(f.log_likelihood(1))) << "pi1 " << pi1 << " sample " << t;
+      EXPECT_TRUE(close(f.log_likelihood(1), pre[t])) << "pi1 " << pi1 << " sample " << t;
+      EXPECT_NEAR(f.posterior(0) + f.posterior(1), 1.0, 1e-12);
+    }
+    // Class "good" (state 1 at -40) rates each sample at -log 2pi - 800; "caught" from the
+    // second sample at about -log 2pi: caught wins in both cases.
+    EXPECT_EQ(f.best(), 1) << "pi1 " << pi1;
+  }
+}
+
+// Both kernels flush predictions below kFlushBelow (pred given, as at a trial's first sample):
+// the normaliser stays >= kFlushBelow and the two agree.
+TEST(ForwardFilter, BothKernelsFlushTinyPredictions) {
+  const int np = 4;
+  const double zero[np] = {0, 0, 0, 0}, lc[np] = {0, 0, 0, 0}, one[np] = {1, 1, 1, 1};
+  const double m0[np] = {0, 40, 0, 0};
+  filter::ClassBlock b;
+  b.n_padded = np;
+  b.band = 0;
+  b.diag[0] = one;
+  b.m0 = m0, b.m1 = zero, b.ip = one, b.iq = zero, b.ir = one, b.lc = lc;
+  std::vector<filter::ClassUpdateFn> kernels{filter::class_update_portable};
+  if (auto avx = filter::class_update_avx2()) kernels.push_back(avx);
+  for (const auto update : kernels) {
+    std::vector<double> alpha(filter::kBandPad + np, 0.0), logb(np);
+    double pred[np] = {1.0, 1e-310, 0.0, 0.0}, m = 0.0;
+    const double c = update(b, true, 40.0, 0.0, alpha.data() + filter::kBandPad, pred, logb.data(), &m, nullptr);
+    EXPECT_EQ(pred[1], 0.0) << "the subnormal prediction is flushed";
+    EXPECT_GE(c, filter::kFlushBelow);
+    EXPECT_EQ(m, -800.0) << "only state 0 is reachable";
+    EXPECT_EQ(alpha[filter::kBandPad], 1.0);
+    EXPECT_EQ(alpha[filter::kBandPad + 1], 0.0);
+  }
+}
+
+// A sample that every state of every class rates at log density -inf (here a feature scale of
+// 1e-200 turns 2 N into 2e200: its square overflows) leaves posteriors that mean nothing: the
+// filter says so, from that sample until reset.
+TEST(ForwardFilter, SaysWhenItsPosteriorsFail) {
+  auto m = tiny_start_model(0.0, 3.0);
+  filter::ForwardFilter ok(m);
+  ok.step(-2.0, 0.0, 0.0);
+  EXPECT_FALSE(ok.failed());
+  m.features.scale[0] = 1e-200;
+  filter::ForwardFilter f(m);
+  f.step(0.0, 0.0, 0.0);
+  EXPECT_FALSE(f.failed());
+  f.step(-2.0, 0.0, 0.0);
+  EXPECT_TRUE(f.failed());
+  f.step(0.0, 0.0, 0.0);
+  EXPECT_TRUE(f.failed()) << "sticky until reset";
+  f.reset();
+  EXPECT_FALSE(f.failed());
+}
+
 // An invalid model is refused at construction, never at step time.
 TEST(ForwardFilter, RefusesInvalidModel) {
   model::OutcomeModel m;

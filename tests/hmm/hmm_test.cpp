@@ -94,6 +94,17 @@ TEST(HmmKnownAnswer, LeftRightThreeStateMatchesEnumeration) {
   for (size_t t = 1; t < v.path.size(); ++t) EXPECT_GE(v.path[t], v.path[t - 1]) << "left-right path went back";
 }
 
+// A sample no state can produce (1e200 feature units: its squared distance overflows, log
+// density -inf): no path has a finite probability. Viterbi says so and still returns a path of
+// valid state indices (it once backtracked through -1).
+TEST(HmmKnownAnswer, ViterbiOfAnImpossibleSequenceKeepsValidStates) {
+  const auto h = fx::known_left_right(3, 0.6, 0.3);
+  const auto v = hmm::viterbi(h, seq({0.0, 0.0, 1e200, 1e200, 0.0, 0.0}));
+  EXPECT_EQ(v.log_probability, -std::numeric_limits<double>::infinity());
+  ASSERT_EQ(v.path.size(), 3u);
+  for (int j : v.path) EXPECT_TRUE(j >= 0 && j < h.n_states) << j;
+}
+
 // pi = (1, 0), A = [[a, 1 - a], [0, 1]]: the chain leaves state 0 once, after a geometric dwell;
 // the emissions overlap, so one sample says little about the state.
 static model::ClassHmm two_state_chain(double a) {
@@ -328,7 +339,7 @@ TEST(HmmRecover, TenStatesBandTwo) { expect_recovered(10, 2, 600, 900, 13); }
 // standard deviations from every state keep finite log-likelihoods; the scaled forward equals a
 // pure log-space forward (log-sum-exp) to 1e-9 relative, and bounds Viterbi from above.
 // (Limit of any scaled forward, stated in hmm.h: a state whose normalised forward probability
-// falls below 1e-308 is dropped, which matters only when a later sample is so far out that such a
+// falls below 1e-300 is dropped, which matters only when a later sample is so far out that such a
 // state alone explains it.)
 TEST(HmmNumerics, LongSequencesDoNotUnderflow) {
   const auto h = fx::known_left_right(10, 0.999, 0.0);

@@ -193,6 +193,9 @@ TEST(ModelFile, UnusedFeatureIsZeroAndNeedsVersion2) {
   auto both = m;
   both.features.axis[0] = kAxisNone;
   EXPECT_THROW(encode_model(both), ModelError);
+  auto scaled = m;  // FORMAT.md: offset 0 and scale 1 where the axis is none
+  scaled.features.scale[1] = 2.0;
+  EXPECT_THROW(encode_model(scaled), ModelError);
 }
 
 TEST(ModelFileRejects, BadCrc) {

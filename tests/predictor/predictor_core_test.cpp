@@ -300,6 +300,22 @@ TEST(StopTransmission, AStopNeverConfirmedRefusesTheNextTrial) {
 
 // A stop decided less than a retry period before the next TrialStart may simply not have been
 // echoed yet: it is dropped (not resent into the new trial), and the new trial runs.
+// A filter whose posteriors failed (NaN compares false against the threshold) stops the robot
+// as a model error instead of letting the trial run unguarded. The model's feature scale of
+// 1e-200 makes any non-zero force overflow the Gaussian's exponent.
+TEST(StopPolicy, AFailedFilterIsAModelError) {
+  Harness h;
+  h.model.features.scale[0] = 1e-200;
+  h.p = std::make_unique<Predictor>(&h.model, h.cfg, h.sink);
+  h.start(3);
+  h.sample(0.0, 0.0);
+  EXPECT_EQ(h.p->decision().state, PredictorState::InTrial);
+  h.sample(-2.0, 0.0);
+  EXPECT_EQ(h.p->decision().state, PredictorState::Stopped);
+  EXPECT_EQ(h.p->decision().reason, protocol::StopReason::ModelError);
+  EXPECT_EQ(h.last_stop().reason, protocol::StopReason::ModelError);
+}
+
 TEST(StopTransmission, AStopJustSentIsDroppedAtTheNextTrialStart) {
   Harness h;
   h.start(1);
