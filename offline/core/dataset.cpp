@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <iterator>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include "files.h"
@@ -45,16 +46,19 @@ double parse_double(std::string_view s, const fs::path& file, long line, std::st
   while (!s.empty() && s.front() == ' ') s.remove_prefix(1);
   while (!s.empty() && (s.back() == ' ' || s.back() == '\r')) s.remove_suffix(1);
   const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec == std::errc::result_out_of_range && p == s.data() + s.size())
+    throw_input_error(file, line, "column " + std::string(column) + ": beyond the range of a double: '" + std::string(s) + "'");
   if (ec != std::errc() || p != s.data() + s.size() || !std::isfinite(v)) {
     throw_input_error(file, line, "column " + std::string(column) + ": not a finite number: '" + std::string(s) + "'");
   }
   return v;
 }
 
+// Calls f(line, number) for every line, CR of a CRLF removed, a UTF-8 byte-order mark skipped.
 template <typename F>
 void for_each_line(const std::string& text, F&& f) {
   long lineno = 0;
-  size_t start = 0;
+  size_t start = text.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
   while (start < text.size()) {
     size_t end = text.find('\n', start);
     if (end == std::string::npos) end = text.size();
@@ -69,10 +73,29 @@ void for_each_line(const std::string& text, F&& f) {
 constexpr const char* kTrialHeader = "t,travel,f_motion,f_lateral,f_vertical";
 constexpr const char* kManifestHeader = "trial_id,participant,height,speed,label,file";
 
-void check_time_increases(const std::vector<HapticSample>& s, const fs::path& file, long line) {
-  if (s.size() >= 2 && !(s.back().t > s[s.size() - 2].t)) {
-    throw_input_error(file, line, "time does not increase");
-  }
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+// The bounds of dataset.h on one new sample, against the one before it.
+void check_sample(const std::vector<HapticSample>& s, const char* const names[5], const fs::path& file, long line) {
+  const HapticSample& x = s.back();
+  if (!(x.travel >= kMinTravel && x.travel <= kMaxTravel))
+    throw_input_error(file, line, std::string("column ") + names[1] + ": " + number(x.travel) + " m is outside [" +
+                                      number(kMinTravel) + ", " + number(kMaxTravel) + "] m (travel is in metres)");
+  const double f[3] = {x.f_motion, x.f_lateral, x.f_vertical};
+  for (int k = 0; k < 3; ++k)
+    if (std::fabs(f[k]) > kMaxForce)
+      throw_input_error(file, line, std::string("column ") + names[2 + k] + ": " + number(f[k]) + " N is beyond +-" +
+                                        number(kMaxForce) + " N");
+  if (s.size() < 2) return;
+  const HapticSample& p = s[s.size() - 2];
+  if (!(x.t > p.t)) throw_input_error(file, line, "time does not increase");
+  if (x.travel < p.travel - kTravelJitter)
+    throw_input_error(file, line, std::string("column ") + names[1] + " goes back " + number(p.travel - x.travel) +
+                                      " m from the line before (more than " + number(kTravelJitter) + " m)");
 }
 
 // Parses the five fields of one row (names as the file calls its columns) and appends the sample.
@@ -81,8 +104,10 @@ void append_sample(const std::vector<std::string_view>& f, const char* const nam
   double v[5];
   for (int i = 0; i < 5; ++i) v[i] = parse_double(f[i], file, line, names[i]);
   out.push_back({v[0], v[1], v[2], v[3], v[4]});
-  check_time_increases(out, file, line);
+  check_sample(out, names, file, line);
 }
+
+bool is_control(char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7F; }
 
 }  // namespace
 
@@ -118,8 +143,9 @@ std::string format_trial_csv(const std::vector<HapticSample>& samples) {
 Dataset load_dataset(const fs::path& dir) {
   const fs::path manifest = dir / "manifest.csv";
   const std::string text = read_file(manifest);
+  if (text.empty()) throw_input_error(manifest, 0, std::string("empty file (expected the header '") + kManifestHeader + "')");
   Dataset ds;
-  std::map<std::string, long> seen;
+  std::map<std::string, long> seen, files;
   for_each_line(text, [&](std::string_view line, long n) {
     if (n == 1) {
       if (line != kManifestHeader) throw_input_error(manifest, 1, std::string("expected header '") + kManifestHeader + "'");
@@ -139,14 +165,24 @@ Dataset load_dataset(const fs::path& dir) {
     if (!h) throw_input_error(manifest, n, "height must be high, middle or low, not '" + std::string(f[2]) + "'");
     seq.height = *h;
     seq.speed = parse_double(f[3], manifest, n, "speed");
-    if (seq.speed <= 0.0) throw_input_error(manifest, n, "speed must be positive");
+    if (!(seq.speed >= kMinSpeed && seq.speed <= kMaxSpeed))
+      throw_input_error(manifest, n, "speed " + number(seq.speed) + " m/s is outside [" + number(kMinSpeed) + ", " +
+                                         number(kMaxSpeed) + "] m/s (speed is in m/s)");
     if (!f[4].empty()) {
       const auto o = parse_outcome(f[4]);
       if (!o) throw_input_error(manifest, n, "label must be good, missed, caught or empty, not '" + std::string(f[4]) + "'");
       seq.label = *o;
     }
     if (f[5].empty()) throw_input_error(manifest, n, "empty file");
+    if (auto [it, fresh] = files.emplace(std::string(f[5]), n); !fresh) {
+      throw_input_error(manifest, n, "file '" + it->first + "' repeats line " + std::to_string(it->second));
+    }
     seq.samples = read_trial_csv(dir / std::string(f[5]));
+    if (const size_t k = unrecorded_samples(seq); k > kMaxUnrecordedSamples)
+      throw_input_error(manifest, n, "trial '" + seq.id + "' would start " + std::to_string(k) +
+                                         " samples into its pull (first travel " + number(seq.samples.front().travel) +
+                                         " m at " + number(seq.speed) + " m/s), more than " +
+                                         std::to_string(kMaxUnrecordedSamples) + ": is t in seconds?");
     ds.trials.push_back(std::move(seq));
   });
   return ds;
@@ -168,19 +204,92 @@ Dataset load_datasets(const std::vector<fs::path>& dirs) {
   return all;
 }
 
+std::string trial_id_problem(std::string_view id) {
+  if (id.empty()) return "is empty";
+  if (id.front() == '.') return "starts with '.'";
+  for (const char c : id) {
+    if (c == ',' || c == '/' || c == '\\') return std::string("holds '") + c + "'";
+    if (is_control(c)) return "holds a control character";
+  }
+  return {};
+}
+
+namespace {
+
+// trial id -> file, for the plain file names (no folder part) the manifest in `dir` names; none
+// when it has none or cannot be read: then there is nothing a save could overwrite that a
+// manifest still names.
+std::map<std::string, std::string> files_named(const fs::path& dir) {
+  std::map<std::string, std::string> out;
+  std::error_code ec;
+  if (!fs::is_regular_file(dir / "manifest.csv", ec)) return out;
+  std::string text;
+  try {
+    text = read_file(dir / "manifest.csv");
+  } catch (const InputError&) {
+    return out;
+  }
+  for_each_line(text, [&](std::string_view line, long n) {
+    const auto f = split(line, ',');
+    if (n > 1 && f.size() == 6 && !f[5].empty() && f[5].find('/') == std::string_view::npos) out.emplace(f[0], f[5]);
+  });
+  return out;
+}
+
+bool holds(const fs::path& file, const std::string& content) {
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec) || fs::file_size(file, ec) != content.size()) return false;
+  try {
+    return read_file(file) == content;
+  } catch (const InputError&) {
+    return false;
+  }
+}
+
+}  // namespace
+
 void save_dataset(const Dataset& ds, const fs::path& dir) {
+  const fs::path manifest = dir / "manifest.csv";
+  std::set<std::string> ids;
+  for (const auto& seq : ds.trials) {
+    if (const std::string why = trial_id_problem(seq.id); !why.empty())
+      throw_input_error(manifest, 0, "cannot save trial id '" + seq.id + "': it " + why);
+    if (!ids.insert(seq.id).second) throw_input_error(manifest, 0, "cannot save trial id '" + seq.id + "' twice");
+    for (const char c : seq.participant)
+      if (c == ',' || is_control(c))
+        throw_input_error(manifest, 0, "cannot save trial '" + seq.id + "': its participant '" + seq.participant +
+                                           "' holds a comma or a control character");
+  }
   fs::create_directories(dir);
+  const std::map<std::string, std::string> named = files_named(dir);
+  std::set<std::string> before, after;
+  for (const auto& [id, file] : named) before.insert(file);
   std::ostringstream m;
   m << kManifestHeader << '\n';
   for (const auto& seq : ds.trials) {
-    const std::string file = seq.id + ".csv";
-    write_file_atomic(dir / file, format_trial_csv(seq.samples));
-    char speed[32];
-    std::snprintf(speed, sizeof speed, "%.6g", seq.speed);
-    m << seq.id << ',' << seq.participant << ',' << arm_height_name(seq.height) << ',' << speed << ','
+    const std::string text = format_trial_csv(seq.samples);
+    // The file the previous manifest gave this trial if it holds these samples already, else
+    // <id>.csv, else the first <id>.<k>.csv that no manifest names (and that is not another
+    // trial's own name: ids "a" and "a.1").
+    // A name is usable unless this save gave it already or a manifest names it for other samples.
+    const auto usable = [&](const std::string& f) {
+      return !after.count(f) && (!before.count(f) || holds(dir / f, text));
+    };
+    const auto prev = named.find(seq.id);
+    std::string file = prev != named.end() && usable(prev->second) ? prev->second : seq.id + ".csv";
+    for (int k = 1; !usable(file); ++k) {
+      if (!ids.count(seq.id + "." + std::to_string(k))) file = seq.id + "." + std::to_string(k) + ".csv";
+    }
+    if (!holds(dir / file, text)) write_file_atomic(dir / file, text);
+    after.insert(file);
+    m << seq.id << ',' << seq.participant << ',' << arm_height_name(seq.height) << ',' << number(seq.speed) << ','
       << (seq.label ? outcome_name(*seq.label) : std::string_view()) << ',' << file << '\n';
   }
-  write_file_atomic(dir / "manifest.csv", m.str());
+  write_file_atomic(manifest, m.str());
+  for (const auto& f : before) {
+    std::error_code ec;
+    if (!after.count(f)) fs::remove(dir / f, ec);  // best effort: the new dataset is already whole
+  }
 }
 
 std::vector<HapticSample> read_study_trial(const fs::path& path) {
@@ -223,6 +332,7 @@ Dataset import_study(const fs::path& study) {
   };
   if (!fs::is_directory(study)) throw_input_error(study, 0, "not a folder");
   Dataset ds;
+  std::map<std::string, fs::path> from;  // trial id -> its file
   for (const auto& folder : folders) {
     const fs::path dir = study / folder.name;
     if (!fs::is_directory(dir)) throw_input_error(dir, 0, "missing: expected the study's good/, miss/ and caughtmiss/ folders");
@@ -235,11 +345,17 @@ Dataset import_study(const fs::path& study) {
     }
     std::sort(files.begin(), files.end());
     for (const auto& f : files) {
+      for (const char c : f.string())
+        if (is_control(c)) throw_input_error(f, 0, "the path holds a control character");
       const std::string subj = f.parent_path().filename().string();
       if (subj.rfind("subject", 0) != 0) throw_input_error(f.parent_path(), 0, "expected a folder named subject<N>");
       HapticSequence seq;
       seq.participant = subj.substr(7);
       seq.id = "s" + seq.participant + "-" + folder.tag + "-" + f.stem().string();
+      if (const std::string why = trial_id_problem(seq.id); !why.empty())
+        throw_input_error(f, 0, "its trial id '" + seq.id + "' " + why);
+      if (auto [it, fresh] = from.emplace(seq.id, f); !fresh)
+        throw_input_error(f, 0, "its trial id '" + seq.id + "' is also that of " + it->second.string());
       seq.height = folder.height;
       seq.label = folder.label;
       seq.samples = read_study_trial(f);
@@ -247,6 +363,7 @@ Dataset import_study(const fs::path& study) {
       ds.trials.push_back(std::move(seq));
     }
   }
+  if (ds.trials.empty()) throw_input_error(study, 0, "no trial files (<outcome>/subject<N>/<k>.txt)");
   return ds;
 }
 

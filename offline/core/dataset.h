@@ -6,15 +6,33 @@
 //   <file>.csv    t,travel,f_motion,f_lateral,f_vertical   (see haptic.h for units and signs)
 //
 // Simulated and measured trials share the format, so every command reads both alike.
+//
+// What a reader accepts (else InputError naming file and line): every number finite; t
+// increasing; travel in [kMinTravel, kMaxTravel] metres, never going back by more than
+// kTravelJitter; each force within +-kMaxForce; speed in [kMinSpeed, kMaxSpeed] m/s; a trial
+// that starts late (haptic.h, unrecorded_samples) at most kMaxUnrecordedSamples into its pull;
+// a trial id and a file named once per manifest. The bounds are far outside any dressing pull;
+// what they catch is a unit slip (travel in mm, speed in mm/s) or a glitch, which would
+// otherwise train a model without a word or ask the HMMs for 10^300 unrecorded samples.
+// A UTF-8 byte-order mark at the start of a file is skipped; CRLF line ends are accepted.
 #pragma once
 
+#include <cstddef>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "haptic.h"
 
 namespace dressguard {
+
+inline constexpr double kMinTravel = -0.01;   // [m] an encoder's zero a centimetre off
+inline constexpr double kMaxTravel = 2.0;     // [m] the study's rig runs 0.85 m
+inline constexpr double kTravelJitter = 1e-3; // [m] the study's travel never decreases at all
+inline constexpr double kMaxForce = 1000.0;   // [N] the study's rig stops at 10 N
+inline constexpr double kMinSpeed = 1e-3, kMaxSpeed = 2.0;  // [m/s] the study pulls at 0.1, 0.15
+inline constexpr std::size_t kMaxUnrecordedSamples = 100000;  // 1000 s at 100 Hz
 
 struct Dataset {
   std::vector<HapticSequence> trials;
@@ -35,9 +53,19 @@ const HapticSequence* find_trial(const Dataset& ds, const std::string& id);
 // the next (every synthesized set names its trials sim-high-000, ...); within one they may not.
 Dataset load_datasets(const std::vector<std::filesystem::path>& dirs);
 
-// Writes every trial file and then the manifest, each atomically: an interrupted save leaves
-// the previous manifest in place. Trial files are named <id>.csv.
+// Writes every trial file and then the manifest, each atomically. The manifest is the commit
+// point: a save that fails anywhere leaves the previous dataset whole, because a trial file the
+// previous manifest names is never overwritten with other content. Trial files are named
+// <id>.csv, or <id>.1.csv (.2, ...) while the previous manifest still names <id>.csv with
+// other samples; a file whose content is unchanged is not rewritten. After the new manifest is in
+// place, the files only the previous one named (plain names in the folder) are removed.
+// Throws InputError, before writing anything, for a trial id that is empty, repeats or holds a
+// comma, a slash, a backslash or a control character, starts with '.', or a participant with a
+// comma or a control character (the manifest could not be read back).
 void save_dataset(const Dataset& ds, const std::filesystem::path& dir);
+
+// Why `id` cannot name a trial in a manifest and its file (see save_dataset), or empty if it can.
+std::string trial_id_problem(std::string_view id);
 
 // One trial file of the study (shared/data/kapusta2016-calibration-trials): space-separated
 // "t position F_motion F_lateral F_vertical" rows. Already in the rig's convention.

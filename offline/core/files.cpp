@@ -6,6 +6,7 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <fcntl.h>
 #include <unistd.h>
 
 #ifndef DRESSGUARD_DEFAULT_SHARED_DIR
@@ -24,6 +25,8 @@ void throw_input_error(const fs::path& file, long line, std::string_view what) {
 }
 
 std::string read_file(const fs::path& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw_input_error(path, 0, "is a folder, not a file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw_input_error(path, 0, std::string("cannot open: ") + std::strerror(errno));
   std::ostringstream os;
@@ -41,9 +44,9 @@ void write_file_atomic(const fs::path& path, std::string_view content) {
     std::FILE* f = std::fopen(tmp.c_str(), "wb");
     if (!f) throw_input_error(tmp, 0, std::string("cannot create: ") + std::strerror(errno));
     const size_t n = std::fwrite(content.data(), 1, content.size(), f);
-    const bool ok = n == content.size() && std::fflush(f) == 0 && ::fsync(fileno(f)) == 0;
-    const int err = errno;
-    std::fclose(f);
+    bool ok = n == content.size() && std::fflush(f) == 0 && ::fsync(fileno(f)) == 0;
+    int err = errno;
+    if (std::fclose(f) != 0 && ok) ok = false, err = errno;
     if (!ok) {
       fs::remove(tmp);
       throw_input_error(tmp, 0, std::string("write failed: ") + std::strerror(err));
@@ -54,6 +57,13 @@ void write_file_atomic(const fs::path& path, std::string_view content) {
   if (ec) {
     fs::remove(tmp);
     throw_input_error(path, 0, "cannot rename temporary into place: " + ec.message());
+  }
+  // The rename is durable once the folder's entry is on disk too (a power cut may otherwise
+  // bring back the old file). Best effort: some file systems refuse fsync on a folder.
+  const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  if (const int fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC); fd >= 0) {
+    ::fsync(fd);
+    ::close(fd);
   }
 }
 

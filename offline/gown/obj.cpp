@@ -1,6 +1,8 @@
 // OBJ reading and writing: only what a cloth mesh needs (v and f lines).
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
+#include <map>
 #include <cstdlib>
 #include <string>
 #include <string_view>
@@ -12,6 +14,12 @@ namespace dressguard::gown {
 namespace {
 
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r'; }
+
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
 
 // Splits a line into whitespace-separated tokens (views into the line).
 std::vector<std::string_view> tokens(std::string_view line) {
@@ -48,30 +56,67 @@ int parse_vertex_ref(std::string_view s, int n_vertices_so_far) {
   return (idx >= 0 && idx < n_vertices_so_far) ? static_cast<int>(idx) : -1;
 }
 
+// The mesh must be a cloth the simulator can take: no triangle of (near) zero area (its bending
+// and stretching constraints divide by it), none twice, and no edge shared by more than two
+// triangles (a cloth sheet is a 2-manifold; its boundary loops are only defined then).
+void check_cloth_topology(const GownMesh& mesh, const std::vector<long>& face_line, const std::filesystem::path& path) {
+  std::map<std::array<int, 3>, size_t> faces;
+  std::map<std::pair<int, int>, std::vector<size_t>> edges;
+  for (size_t f = 0; f < mesh.triangles.size(); ++f) {
+    const auto& tri = mesh.triangles[f];
+    const double area =
+        0.5 * (mesh.x[tri[1]] - mesh.x[tri[0]]).cross(mesh.x[tri[2]] - mesh.x[tri[0]]).norm();
+    if (!(area >= kMinObjFaceArea))
+      throw_input_error(path, face_line[f], "face of area " + number(area) + " m^2 (its vertices are collinear)");
+    std::array<int, 3> key = tri;
+    std::sort(key.begin(), key.end());
+    if (auto [it, fresh] = faces.emplace(key, f); !fresh)
+      throw_input_error(path, face_line[f], "the same triangle as line " + std::to_string(face_line[it->second]));
+    for (int k = 0; k < 3; ++k) {
+      const int a = tri[k], b = tri[(k + 1) % 3];
+      auto& users = edges[{std::min(a, b), std::max(a, b)}];
+      users.push_back(f);
+      if (users.size() > 2)
+        throw_input_error(path, face_line[f], "edge " + std::to_string(std::min(a, b) + 1) + "-" +
+                                                  std::to_string(std::max(a, b) + 1) + " is shared by three faces (lines " +
+                                                  std::to_string(face_line[users[0]]) + ", " +
+                                                  std::to_string(face_line[users[1]]) + " and this one)");
+    }
+  }
+}
+
 }  // namespace
 
 GownMesh read_obj(const std::filesystem::path& path, double scale) {
-  if (!(scale > 0)) throw_input_error(path, 0, "scale must be positive, got " + std::to_string(scale));
+  if (!(scale > 0)) throw_input_error(path, 0, "scale must be positive, got " + number(scale));
   const std::string text = read_file(path);
   GownMesh mesh;
+  std::vector<long> face_line;  // the line of each triangle, for the topology's messages
   long line_no = 0;
-  size_t pos = 0;
+  size_t pos = text.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;  // a UTF-8 byte-order mark
   while (pos < text.size()) {
     size_t eol = text.find('\n', pos);
     if (eol == std::string::npos) eol = text.size();
     const std::string_view line(text.data() + pos, eol - pos);
     pos = eol + 1;
     ++line_no;
-    if (line.size() < 2 || line[0] == '#') continue;
-    if (line[0] == 'v' && is_space(line[1])) {
-      const auto t = tokens(line);
+    const auto t = tokens(line);  // leading blanks are no reason to skip a line
+    if (t.empty() || t[0][0] == '#') continue;
+    // OBJ keywords are lower case; a "V" or "F" line skipped would shift every later index.
+    if (t[0] == "V" || t[0] == "F" || t[0] == "Vt" || t[0] == "VT" || t[0] == "Vn" || t[0] == "VN")
+      throw_input_error(path, line_no, "keyword '" + std::string(t[0]) + "': OBJ keywords are lower case");
+    if (t[0] == "v") {
       Eigen::Vector3d p;
       if (t.size() < 4 || !parse_double(t[1], p.x()) || !parse_double(t[2], p.y()) || !parse_double(t[3], p.z()))
         throw_input_error(path, line_no, "malformed vertex line (want 'v x y z'): '" + std::string(line) + "'");
-      if (!p.allFinite()) throw_input_error(path, line_no, "vertex coordinate is not finite");
-      mesh.x.push_back(scale * p);
-    } else if (line[0] == 'f' && is_space(line[1])) {
-      const auto t = tokens(line);
+      p *= scale;
+      if (!p.allFinite()) throw_input_error(path, line_no, "vertex coordinate is not finite (after the scale)");
+      if (p.cwiseAbs().maxCoeff() > kMaxObjCoordinate)
+        throw_input_error(path, line_no, "vertex " + std::to_string(mesh.x.size() + 1) + " lies " +
+                                             number(p.cwiseAbs().maxCoeff()) + " m out (after the scale " +
+                                             number(scale) + "): a gown spans about a metre");
+      mesh.x.push_back(p);
+    } else if (t[0] == "f") {
       if (t.size() < 4) throw_input_error(path, line_no, "face with fewer than 3 vertices");
       std::vector<int> idx;
       for (size_t i = 1; i < t.size(); ++i) {
@@ -88,10 +133,12 @@ GownMesh read_obj(const std::filesystem::path& path, double scale) {
         if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
           throw_input_error(path, line_no, "degenerate face (a vertex repeated)");
         mesh.triangles.push_back(tri);
+        face_line.push_back(line_no);
       }
     }
   }
   if (mesh.triangles.empty()) throw_input_error(path, 0, "no faces");
+  check_cloth_topology(mesh, face_line, path);
   mesh.boundary_loops = find_boundary_loops(mesh.triangles, static_cast<int>(mesh.x.size()));
   return mesh;
 }

@@ -40,7 +40,7 @@ TEST(Dataset, RoundTripKeepsEverySampleAndLabel) {
     s.height = static_cast<ArmHeight>(k);
     s.speed = k == 2 ? 0.15 : 0.1;
     if (k != 1) s.label = static_cast<Outcome>(k);
-    for (int i = 0; i < 50; ++i) s.samples.push_back({0.01 * i, 0.001 * i * i, -0.123456 * i, 1e-7 * i, 0.5 - i});
+    for (int i = 0; i < 50; ++i) s.samples.push_back({0.01 * i, 0.0002 * i * i, -0.123456 * i, 1e-7 * i, 0.5 - i});
     ds.trials.push_back(s);
   }
   const TempDir tmp("roundtrip");
@@ -84,6 +84,189 @@ TEST(Dataset, MalformedRowNamesFileAndLine) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("manifest.csv:2"), std::string::npos) << e.what();
   }
+}
+
+namespace {
+
+constexpr const char* kManifestHead = "trial_id,participant,height,speed,label,file\n";
+constexpr const char* kTrialHead = "t,travel,f_motion,f_lateral,f_vertical\n";
+
+// The InputError message of f(), or "" when it throws none.
+template <typename F>
+std::string input_error_of(F&& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Success when the error message `msg` holds `want`.
+::testing::AssertionResult names(const std::string& msg, const std::string& want) {
+  if (msg.find(want) != std::string::npos) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "want '" << want << "', got '" << msg << "'";
+}
+
+// A one-trial dataset whose trial file holds `rows` (after the header) and whose manifest row
+// carries `speed`; load_dataset's error message, or "" when it loads.
+std::string load_error(const fs::path& dir, const std::string& rows, const std::string& speed = "0.1") {
+  write_text(dir / "manifest.csv", std::string(kManifestHead) + "a,1,high," + speed + ",good,a.csv\n");
+  write_text(dir / "a.csv", kTrialHead + rows);
+  try {
+    load_dataset(dir);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+HapticSequence ramp_trial(const std::string& id, double f_scale) {
+  HapticSequence s;
+  s.id = id;
+  s.participant = "2";
+  for (int i = 0; i < 20; ++i) s.samples.push_back({0.01 * i, 0.001 * i, -f_scale * i, 0.0, 0.1 * i});
+  return s;
+}
+
+}  // namespace
+
+// Each bound of dataset.h: a unit slip or a glitch is named with its file, line and column, not
+// trained on (a speed of 1e-300 m/s once asked the HMMs for 10^300 unrecorded samples and
+// crashed `train`).
+TEST(DatasetRejects, ImplausibleValuesNameFileLineAndColumn) {
+  const TempDir tmp("bounds");
+  const fs::path& dir = tmp.path;
+  const std::string ok = "0,0,0,0,0\n0.01,0.001,-0.1,0,0.05\n0.02,0.002,-0.2,0,0.1\n";
+  EXPECT_EQ(load_error(dir, ok), "");
+  struct Case { std::string rows, speed, want; };
+  const Case cases[] = {
+      {"0,0,0,0,0\n0.01,1.5,-0.1,0,0\n0.02,850,-0.2,0,0\n", "0.1", "a.csv:4: column travel: 850 m is outside"},
+      {"0,0,0,0,0\n0.01,0.001,-1e20,0,0\n", "0.1", "a.csv:3: column f_motion: -1e+20 N is beyond"},
+      {"0,0,0,0,0\n0.01,0.001,0,0,2000\n", "0.1", "a.csv:3: column f_vertical: 2000 N"},
+      {"0,0,0,0,0\n0.01,0.3,0,0,0\n0.02,0.1,0,0,0\n", "0.1", "a.csv:4: column travel goes back 0.2 m"},
+      {"0,0,0,0,0\n0.01,1e-400,0,0,0\n", "0.1", "a.csv:3: column travel: beyond the range of a double"},
+      {ok, "1e-300", "manifest.csv:2: speed 1e-300 m/s is outside"},
+      {ok, "100", "manifest.csv:2: speed 100 m/s is outside"},
+      // Late start, t in kiloseconds: 0.5 m into a pull at 0.1 m/s is 5.05 s, 5e5 periods of 1e-5.
+      {"0,0.5,0,0,0\n0.00001,0.5,0,0,0\n0.00002,0.5,0,0,0\n", "0.1", "samples into its pull"},
+  };
+  for (const auto& c : cases) EXPECT_TRUE(names(load_error(dir, c.rows, c.speed), c.want));
+  // A travel jitter under a millimetre is a sensor's, not a glitch.
+  EXPECT_EQ(load_error(dir, "0,0,0,0,0\n0.01,0.0105,0,0,0\n0.02,0.0100,0,0,0\n"), "");
+}
+
+TEST(DatasetRejects, EmptyManifestRepeatedFileAndFolders) {
+  const TempDir tmp("manifest");
+  const fs::path& dir = tmp.path;
+  write_text(dir / "manifest.csv", "");
+  EXPECT_TRUE(names(input_error_of([&] { load_dataset(dir); }), "manifest.csv: empty file"));
+  write_text(dir / "a.csv", std::string(kTrialHead) + "0,0,0,0,0\n");
+  write_text(dir / "manifest.csv", std::string(kManifestHead) + "a,1,high,0.1,good,a.csv\nb,1,high,0.1,good,a.csv\n");
+  EXPECT_TRUE(names(input_error_of([&] { load_dataset(dir); }), "manifest.csv:3: file 'a.csv' repeats line 2"));
+  fs::create_directories(dir / "sub");
+  write_text(dir / "manifest.csv", std::string(kManifestHead) + "a,1,high,0.1,good,sub\n");
+  EXPECT_TRUE(names(input_error_of([&] { load_dataset(dir); }), "sub: is a folder, not a file"));
+}
+
+// A byte-order mark (Excel's "CSV UTF-8") is skipped, in the manifest and in a trial file.
+TEST(Dataset, AByteOrderMarkIsSkipped) {
+  const TempDir tmp("bom");
+  const fs::path& dir = tmp.path;
+  write_text(dir / "manifest.csv", std::string("\xEF\xBB\xBF") + kManifestHead + "a,1,high,0.1,good,a.csv\n");
+  write_text(dir / "a.csv", std::string("\xEF\xBB\xBF") + kTrialHead + "0,0,-1,0,0\r\n0.01,0.001,-2,0,0\r\n");
+  const Dataset ds = load_dataset(dir);
+  ASSERT_EQ(ds.trials.size(), 1u);
+  EXPECT_EQ(ds.trials[0].samples.size(), 2u);
+  EXPECT_EQ(ds.trials[0].samples[1].f_motion, -2.0);
+}
+
+// The manifest is the commit point: a save that fails part-way leaves the previous dataset whole
+// (it once overwrote trial files in place before it failed); a save that succeeds leaves no file
+// of the previous one behind and rewrites nothing that did not change.
+TEST(Dataset, AFailedSaveLeavesThePreviousDatasetWhole) {
+  const TempDir tmp("commit");
+  const fs::path& dir = tmp.path;
+  Dataset first;
+  for (const char* id : {"a", "b", "c"}) first.trials.push_back(ramp_trial(id, 0.1));
+  save_dataset(first, dir);
+  const std::string a_before = read_file(dir / "a.csv"), manifest_before = read_file(dir / "manifest.csv");
+
+  // The second save's third trial cannot be written (folders are in the way of both names c's
+  // file could take): it fails after a and b have new content.
+  Dataset second;
+  for (const char* id : {"a", "b", "c"}) second.trials.push_back(ramp_trial(id, 0.2));
+  fs::remove(dir / "c.csv");
+  fs::create_directories(dir / "c.csv" / "x");
+  fs::create_directories(dir / "c.1.csv" / "x");
+  EXPECT_THROW(save_dataset(second, dir), InputError);
+  EXPECT_EQ(read_file(dir / "manifest.csv"), manifest_before);
+  EXPECT_EQ(read_file(dir / "a.csv"), a_before) << "a trial the manifest names was overwritten";
+  fs::remove_all(dir / "c.csv");
+  fs::remove_all(dir / "c.1.csv");
+
+  // Without the obstacle the save goes through under other names; the old files are removed.
+  first.trials.pop_back();
+  save_dataset(first, dir);  // the manifest names a.csv, b.csv again
+  save_dataset(second, dir);
+  const Dataset back = load_dataset(dir);
+  ASSERT_EQ(back.trials.size(), 3u);
+  EXPECT_NEAR(back.trials[0].samples[5].f_motion, -1.0, 1e-12);
+  EXPECT_TRUE(fs::exists(dir / "a.1.csv"));
+  EXPECT_FALSE(fs::exists(dir / "a.csv")) << "the previous manifest's file was left behind";
+  EXPECT_TRUE(fs::exists(dir / "c.csv")) << "c was not named by the previous manifest: its own name";
+  // Saving the same dataset again changes no file.
+  const auto stamp = fs::last_write_time(dir / "a.1.csv");
+  save_dataset(second, dir);
+  EXPECT_EQ(fs::last_write_time(dir / "a.1.csv"), stamp);
+  EXPECT_EQ(load_dataset(dir).trials.size(), 3u);
+}
+
+TEST(DatasetRejects, IdsTheManifestCouldNotReadBack) {
+  const TempDir tmp("ids");
+  const fs::path& dir = tmp.path;
+  for (const std::string id : {std::string(), std::string("a,b"), std::string("a/b"), std::string(".hidden"), std::string("a\nb")}) {
+    Dataset ds;
+    ds.trials.push_back(ramp_trial(id, 0.1));
+    EXPECT_THROW(save_dataset(ds, dir / "out"), InputError) << "id '" << id << "'";
+  }
+  Dataset twice;
+  twice.trials = {ramp_trial("a", 0.1), ramp_trial("a", 0.2)};
+  EXPECT_THROW(save_dataset(twice, dir / "out"), InputError);
+  Dataset comma;
+  comma.trials.push_back(ramp_trial("a", 0.1));
+  comma.trials[0].participant = "1,2";
+  EXPECT_THROW(save_dataset(comma, dir / "out"), InputError);
+  EXPECT_FALSE(fs::exists(dir / "out")) << "a refused save wrote something";
+  // Ids "a" and "a.1": the alternate name of a's file never takes a.1's.
+  Dataset pair;
+  pair.trials = {ramp_trial("a", 0.1), ramp_trial("a.1", 0.1)};
+  save_dataset(pair, dir / "pair");
+  pair.trials[0] = ramp_trial("a", 0.3);
+  save_dataset(pair, dir / "pair");
+  const Dataset back = load_dataset(dir / "pair");
+  EXPECT_NEAR(back.trials[0].samples[1].f_motion, -0.3, 1e-12);
+  EXPECT_NEAR(back.trials[1].samples[1].f_motion, -0.1, 1e-12);
+}
+
+// The study import names the file whose id cannot be saved or repeats another's, and refuses a
+// study folder without trials.
+TEST(StudyRejects, UnsavableOrRepeatedIdsAndNoTrials) {
+  const TempDir tmp("study");
+  const fs::path& dir = tmp.path;
+  const std::string rows = "0 0 0 0 0\n0.01 0.001 -0.1 0 0\n";
+  for (const char* f : {"good", "miss", "caughtmiss"}) fs::create_directories(dir / f);
+  EXPECT_TRUE(names(input_error_of([&] { import_study(dir); }), "no trial files"));
+  fs::create_directories(dir / "good" / "subject0");
+  write_text(dir / "good" / "subject0" / "0,1.txt", rows);
+  EXPECT_TRUE(names(input_error_of([&] { import_study(dir); }), "0,1.txt: its trial id 's0-good-0,1' holds ','"));
+  fs::remove(dir / "good" / "subject0" / "0,1.txt");
+  // subject1-good-2/3.txt and subject1/2-good-3.txt would both be s1-good-2-good-3.
+  fs::create_directories(dir / "good" / "subject1-good-2");
+  fs::create_directories(dir / "good" / "subject1");
+  write_text(dir / "good" / "subject1-good-2" / "3.txt", rows);
+  write_text(dir / "good" / "subject1" / "2-good-3.txt", rows);
+  EXPECT_TRUE(names(input_error_of([&] { import_study(dir); }), "is also that of"));
 }
 
 TEST(Files, AtomicWriteReplacesWholeOrNothing) {

@@ -51,19 +51,22 @@ std::string grid_obj(int n, double h) {
 }  // namespace
 
 TEST(ReadObj, AcceptsEveryFaceFormAndNegativeIndices) {
-  // One unit square four ways: plain, v/vt/vn, v//vn, negative; plus comments, normals, blank lines.
+  // A 2 x 1 strip of unit squares (vertices 1-3 at y = 0, 4-6 at y = 1), its four triangles
+  // four ways: plain, v/vt/vn, v//vn, negative; plus comments, normals, blank lines, a
+  // byte-order mark, an indented vertex line and CRLF line ends.
   const std::string text =
-      "# square\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nvt 0 0\n\n"
-      "f 1 2 3\nf 1/1/1 3/1/1 4/1/1\nf 1//1 2//1 4//1\nf -4 -2 -1\ng group\ns off\n";
+      "\xEF\xBB\xBF# strip\r\nv 0 0 0\nv 1 0 0\nv 2 0 0\n\tv 0 1 0\nv 1 1 0\nv 2 1 0\r\nvn 0 0 1\nvt 0 0\n\n"
+      "f 1 2 5\nf 1/1/1 5/1/1 4/1/1\nf 2//1 3//1 6//1\nf -5 -1 -2\ng group\ns off\n";
   const fs::path p = write_obj("forms.obj", text);
   const GownMesh m = read_obj(p, 2.0);
   fs::remove(p);
-  ASSERT_EQ(m.x.size(), 4u);
+  ASSERT_EQ(m.x.size(), 6u);
   ASSERT_EQ(m.triangles.size(), 4u);
-  EXPECT_EQ(m.triangles[1], (std::array<int, 3>{0, 2, 3}));
-  EXPECT_EQ(m.triangles[3], (std::array<int, 3>{0, 2, 3}));  // -4 -2 -1 after 4 vertices
-  EXPECT_DOUBLE_EQ(m.x[2].x(), 2.0);                         // scaled by 2
-  EXPECT_DOUBLE_EQ(m.x[2].y(), 2.0);
+  EXPECT_EQ(m.triangles[1], (std::array<int, 3>{0, 4, 3}));
+  EXPECT_EQ(m.triangles[3], (std::array<int, 3>{1, 5, 4}));  // -5 -1 -2 after 6 vertices
+  EXPECT_DOUBLE_EQ(m.x[3].y(), 2.0);                         // the indented line; scaled by 2
+  EXPECT_DOUBLE_EQ(m.x[4].x(), 2.0);
+  EXPECT_NEAR(total_area(m), 8.0, 1e-12);                    // 2 unit squares, times 2^2
 }
 
 TEST(ReadObj, FanTriangulatesPolygonsAndKeepsArea) {
@@ -92,6 +95,30 @@ TEST(ReadObj, ErrorsNameFileAndLine) {
   EXPECT_NE(error_of("g.obj", "v 0 0 0\n").find("no faces"), std::string::npos);
   EXPECT_NE(error_of("h.obj", "v 0 0 0\nv 1 0 0\nf 1 2 1\n").find(":3:"), std::string::npos);  // degenerate
   EXPECT_THROW(read_obj("/nonexistent/gown.obj", 1.0), InputError);
+}
+
+// What a cloth mesh cannot be, each named at the face's line: a triangle of zero area, the same
+// triangle twice (also a quad folded onto itself), an edge of three faces; an upper-case
+// keyword; a vertex a unit slip put kilometres out, or a scale that overflows.
+TEST(ReadObj, RejectsWhatTheSimulatorCannotTake) {
+  const std::string square = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 0.5 0 0\nf 1 2 3\nf 1 3 4\n";
+  struct Case { const char* name; std::string text, want; };
+  const Case cases[] = {
+      {"area.obj", square + "f 1 6 2\n", ":9: face of area 0"},
+      {"twice.obj", square + "f 3 2 1\n", ":9: the same triangle as line 7"},
+      {"folded.obj", square + "f 2 5 3 5\n", ":9: the same triangle as line 9"},
+      {"fan.obj", square + "f 1 3 5\n", ":9: edge 1-3 is shared by three faces (lines 7, 8 and this one)"},
+      {"upper.obj", "v 0 0 0\nV 1 0 0\nv 1 1 0\nf 1 2 3\n", ":2: keyword 'V'"},
+      {"far.obj", "v 0 0 0\nv 1000 0 0\nv 0 1 0\nf 1 2 3\n", ":2: vertex 2 lies 1000"},
+  };
+  for (const auto& c : cases) {
+    const std::string e = error_of(c.name, c.text);
+    EXPECT_NE(e.find(c.name + std::string(c.want)), std::string::npos) << "want '" << c.want << "', got '" << e << "'";
+  }
+  const fs::path p = write_obj("scale.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  EXPECT_THROW(read_obj(p, 1e307), InputError);
+  EXPECT_THROW(read_obj(p, 1e309), InputError);  // inf: not a positive finite scale either
+  fs::remove(p);
 }
 
 TEST(BoundaryLoops, GridHasOneOrderedLoopOfItsPerimeter) {
