@@ -269,9 +269,9 @@ void save_dataset(const Dataset& ds, const fs::path& dir) {
   for (const auto& seq : ds.trials) {
     const std::string text = format_trial_csv(seq.samples);
     // The file the previous manifest gave this trial if it holds these samples already, else
-    // <id>.csv, else the first <id>.<k>.csv that no manifest names (and that is not another
-    // trial's own name: ids "a" and "a.1").
-    // A name is usable unless this save gave it already or a manifest names it for other samples.
+    // <id>.csv, else the first usable <id>.<k>.csv that is not another trial's own name (ids "a"
+    // and "a.1"). Usable: not given by this save already, and not named by the previous
+    // manifest unless it holds these very samples.
     const auto usable = [&](const std::string& f) {
       return !after.count(f) && (!before.count(f) || holds(dir / f, text));
     };
