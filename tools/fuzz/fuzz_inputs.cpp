@@ -4,14 +4,22 @@
 //
 //   errors   bad input throws InputError "PATH:LINE: what" (or "PATH: what"), LINE a line of the
 //            file; no other exception escapes (a std::stod out_of_range, a bad_alloc, ...);
-//   values   what a reader returns is finite: a measured or simulated force, a vertex position.
+//   values   what a reader returns is within dataset.h's bounds (finite; travel in [kMinTravel,
+//            kMaxTravel], never back by more than kTravelJitter; forces within kMaxForce; t
+//            increasing), and a mesh is one gown.h's read_obj promises (vertices within
+//            kMaxObjCoordinate, indices in range, triangles of at least kMinObjFaceArea, none
+//            twice, no edge of three).
 //
 // Readers: 0 a dataset trial CSV (read_trial_csv), 1 a trial of the study's layout
 // (read_study_trial), 2 an OBJ mesh (read_obj, scale 1.679 as the measured gown's).
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <map>
+#include <set>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -33,12 +41,34 @@ std::filesystem::path scratch_file() {
   return p;
 }
 
-bool finite_samples(const std::vector<HapticSample>& v) {
-  for (const auto& s : v)
-    if (!std::isfinite(s.t) || !std::isfinite(s.travel) || !std::isfinite(s.f_motion) || !std::isfinite(s.f_lateral) ||
-        !std::isfinite(s.f_vertical))
-      return false;
-  return true;
+bool plausible_samples(const std::vector<HapticSample>& v) {
+  for (size_t i = 0; i < v.size(); ++i) {
+    const HapticSample& s = v[i];
+    if (!std::isfinite(s.t) || !(s.travel >= kMinTravel && s.travel <= kMaxTravel)) return false;
+    for (const double f : {s.f_motion, s.f_lateral, s.f_vertical})
+      if (!(std::fabs(f) <= kMaxForce)) return false;
+    if (i > 0 && !(s.t > v[i - 1].t && s.travel >= v[i - 1].travel - kTravelJitter)) return false;
+  }
+  return !v.empty();
+}
+
+void check_mesh(const gown::GownMesh& m) {
+  for (const auto& p : m.x)
+    if (!p.allFinite() || p.cwiseAbs().maxCoeff() > gown::kMaxObjCoordinate) broken("an OBJ read with a vertex out of bounds", 0);
+  std::set<std::array<int, 3>> faces;
+  std::map<std::pair<int, int>, int> edges;
+  for (const auto& t : m.triangles) {
+    for (int k = 0; k < 3; ++k)
+      if (t[k] < 0 || t[k] >= static_cast<int>(m.x.size())) broken("an OBJ read with an index out of range", 0);
+    if (!(0.5 * (m.x[t[1]] - m.x[t[0]]).cross(m.x[t[2]] - m.x[t[0]]).norm() >= gown::kMinObjFaceArea))
+      broken("an OBJ read with a face of (near) zero area", 0);
+    auto key = t;
+    std::sort(key.begin(), key.end());
+    if (!faces.insert(key).second) broken("an OBJ read with a triangle twice", 0);
+    for (int k = 0; k < 3; ++k)
+      if (++edges[{std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])}] > 2)
+        broken("an OBJ read with an edge of three faces", 0);
+  }
 }
 
 
@@ -59,20 +89,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     switch (reader) {
       case 0:
-        if (!finite_samples(read_trial_csv(path))) broken("a trial CSV read with a non-finite value", 0);
+        if (!plausible_samples(read_trial_csv(path))) broken("a trial CSV read with a value out of bounds", 0);
         break;
       case 1:
-        if (!finite_samples(read_study_trial(path))) broken("a study trial read with a non-finite value", 0);
+        if (!plausible_samples(read_study_trial(path))) broken("a study trial read with a value out of bounds", 0);
         break;
-      default: {
-        const gown::GownMesh m = gown::read_obj(path, 1.679);
-        for (const auto& p : m.x)
-          if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z())) broken("an OBJ read with a non-finite vertex", 0);
-        for (const auto& t : m.triangles)
-          for (int k = 0; k < 3; ++k)
-            if (t[k] < 0 || t[k] >= static_cast<int>(m.x.size())) broken("an OBJ read with an index out of range", 0);
+      default:
+        check_mesh(gown::read_obj(path, 1.679));
         break;
-      }
     }
   } catch (const InputError& e) {
     fuzz::check_error_names_line(e.what(), path.string(), text, true);  // or "PATH: what"
