@@ -81,17 +81,21 @@ void BridgeApp::try_stop(uint32_t t) {
 }
 
 void BridgeApp::on_timer(uint32_t t) {
-  // The sensor: reconnect with exponential backoff, else read one sample.
+  // The sensor: reconnect with exponential backoff, else read one sample. The backoff is reset
+  // by a good reading, not by a connect: a device that accepts and then fails every request is
+  // retried ever more slowly too.
+  const auto back_off = [&] {
+    next_connect_ms_ = t + static_cast<uint32_t>(backoff_ms_);
+    backoff_ms_ = backoff_ms_ == 0 ? cfg_.backoff_min_ms : std::min(2 * backoff_ms_, cfg_.backoff_max_ms);
+  };
   if (!sensor_.link().connected()) {
     if (due(t, next_connect_ms_)) {
       if (sensor_.link().connect()) {
-        backoff_ms_ = 0;
         bridge_on_reconnect(core_);
         ++stats_.reconnects;
       } else {
         ++stats_.connect_failures;
-        backoff_ms_ = backoff_ms_ == 0 ? cfg_.backoff_min_ms : std::min(2 * backoff_ms_, cfg_.backoff_max_ms);
-        next_connect_ms_ = t + static_cast<uint32_t>(backoff_ms_);
+        back_off();
       }
     }
   }
@@ -103,10 +107,17 @@ void BridgeApp::on_timer(uint32_t t) {
       const int n = bridge_on_reading(core_, r, t, frames);
       for (int i = 0; i < n; ++i) send(frames[i]);
       ++stats_.readings;
+      backoff_ms_ = 0;
     } else {
       bridge_on_sensor_error(core_, t);
       ++stats_.sensor_errors;
-      if (rr == ReadResult::Disconnected) next_connect_ms_ = t + static_cast<uint32_t>(cfg_.backoff_min_ms);
+      if (!sensor_.link().connected()) {
+        // Closed after a timeout or a garbled answer (modbus_link.h): the first reconnect waits
+        // one response timeout, so that a late answer lands before the link reopens.
+        back_off();
+        const uint32_t quiet = t + static_cast<uint32_t>(sensor_.link().endpoint().response_timeout_ms);
+        if (!due(next_connect_ms_, quiet)) next_connect_ms_ = quiet;
+      }
     }
   } else {
     bridge_on_sensor_error(core_, t);

@@ -1,6 +1,7 @@
 // dressguard-bridge: Modbus force-torque sensor -> CAN, and CAN stop -> robot controller.
 #include <signal.h>
 
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -27,13 +28,15 @@ const char* kUsage =
     "  with exponential backoff; meanwhile no sample frames are sent (the predictor's deadline stops\n"
     "  the robot).\n"
     "  --interface IF          SocketCAN interface (default can0)\n"
-    "  --sensor SPEC           tcp:HOST:PORT or rtu:DEVICE:BAUD[:PARITY] (default rtu:/dev/ttyUSB0:19200:N)\n"
+    "  --sensor SPEC           tcp:HOST:PORT or rtu:DEVICE:BAUD[:PARITY] (default rtu:/dev/ttyUSB0:19200:N;\n"
+    "                          HOST a numeric IPv4 address)\n"
     "  --sensor-slave N        Modbus unit id (default 9)\n"
     "  --sensor-register N     first of the six registers (default 180)\n"
     "  --input-registers       read with FC04 instead of FC03\n"
     "  --force-scale S         sensor counts -> 0.01 N counts (default 1, the FT 300's)\n"
     "  --torque-scale S        sensor counts -> 0.001 Nm counts (default 1)\n"
-    "  --timeout-ms N          Modbus response timeout (default 20)\n"
+    "  --timeout-ms N          Modbus response timeout, 1-1000 (default 20); a stop frame can wait about\n"
+    "                          this long behind a sensor read that gets no answer\n"
     "  --period-ms N           sampling period (default 10: 100 Hz)\n"
     "  --robot SPEC            robot controller, tcp:HOST:PORT or rtu:...; none: stops are only logged\n"
     "  --robot-slave N         its unit id (default 1)\n"
@@ -50,8 +53,9 @@ int bad(const std::string& why) {
 
 bool to_int(const std::string& s, long& v) {
   char* end = nullptr;
+  errno = 0;
   v = std::strtol(s.c_str(), &end, 10);
-  return !s.empty() && end && *end == '\0';
+  return !s.empty() && end && *end == '\0' && errno == 0;
 }
 
 }  // namespace
@@ -90,21 +94,38 @@ int main(int argc, char** argv) {
       const auto eq = v.find('=');
       long addr = 0, val = 0;
       if (eq == std::string::npos || !to_int(v.substr(0, eq), addr) || !to_int(v.substr(eq + 1), val) || addr < 0 ||
-          val < 0 || val > 65535)
+          addr > 65535 || val < 0 || val > 65535)
         return bad("--stop-register: '" + v + "' is not ADDR=VALUE");
       target = {false, static_cast<int>(addr), static_cast<int>(val)};
-    } else if (!is_int || n < 0) {
-      return bad(a + ": '" + v + "' is not a non-negative integer (or unknown option)");
-    } else if (a == "--sensor-slave") sensor_ep.slave = static_cast<int>(n);
-    else if (a == "--sensor-register") map.first_register = static_cast<int>(n);
-    else if (a == "--timeout-ms") sensor_ep.response_timeout_ms = static_cast<int>(n);
-    else if (a == "--period-ms") cfg.sample_period_ms = static_cast<int>(n);
-    else if (a == "--robot-slave") robot_ep.slave = static_cast<int>(n);
-    else if (a == "--stop-coil") target = {true, static_cast<int>(n), 1};
-    else if (a == "--predictor-timeout-ms") cfg.core.predictor_timeout_ms = static_cast<uint32_t>(n);
-    else return bad("unknown option '" + a + "'");
+    } else {
+      // Whole-number options and their ranges: Modbus addresses are 16 bits (the six sensor
+      // registers must fit), unit ids 0-255 (libmodbus refuses above 247 on a serial line),
+      // and a response timeout or a period beyond a second is no sampling of a 100 Hz sensor.
+      struct Range { const char* name; long lo, hi; };
+      static constexpr Range kRanges[] = {
+          {"--sensor-slave", 0, 255},   {"--sensor-register", 0, 65530}, {"--timeout-ms", 1, 1000},
+          {"--period-ms", 1, 1000},     {"--robot-slave", 0, 255},       {"--stop-coil", 0, 65535},
+          {"--predictor-timeout-ms", 0, 60000},
+      };
+      const Range* r = nullptr;
+      for (const auto& k : kRanges)
+        if (a == k.name) r = &k;
+      if (!r) return bad("unknown option '" + a + "'");
+      if (!is_int || n < r->lo || n > r->hi)
+        return bad(a + ": '" + v + "' is not a whole number in " + std::to_string(r->lo) + "-" + std::to_string(r->hi));
+      if (a == "--sensor-slave") sensor_ep.slave = static_cast<int>(n);
+      else if (a == "--sensor-register") map.first_register = static_cast<int>(n);
+      else if (a == "--timeout-ms") sensor_ep.response_timeout_ms = static_cast<int>(n);
+      else if (a == "--period-ms") cfg.sample_period_ms = static_cast<int>(n);
+      else if (a == "--robot-slave") robot_ep.slave = static_cast<int>(n);
+      else if (a == "--stop-coil") target = {true, static_cast<int>(n), 1};
+      else cfg.core.predictor_timeout_ms = static_cast<uint32_t>(n);
+    }
   }
-  if (cfg.sample_period_ms < 1) return bad("--period-ms must be >= 1");
+  // Both endpoints are checked now, not when the first stop must go out.
+  if (const std::string why = parse_endpoint(sensor_ep.spec); !why.empty()) return bad("--sensor: " + why);
+  if (!robot_spec.empty())
+    if (const std::string why = parse_endpoint(robot_spec); !why.empty()) return bad("--robot: " + why);
   try {
     can::PortOptions opt;
     opt.ids = {protocol::id_of(protocol::MsgId::Stop), protocol::id_of(protocol::MsgId::TrialStart),

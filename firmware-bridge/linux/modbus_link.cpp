@@ -1,10 +1,12 @@
 // libmodbus connections of the bridge's Linux port.
 #include "modbus_link.h"
 
+#include <arpa/inet.h>
 #include <modbus.h>
 
 #include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <sstream>
 #include <vector>
 
@@ -21,6 +23,41 @@ const char* read_result_name(ReadResult r) {
   return "unknown";
 }
 
+std::string parse_endpoint(const std::string& spec, EndpointParts* out) {
+  std::vector<std::string> parts;
+  std::stringstream in(spec);
+  std::string tok;
+  while (std::getline(in, tok, ':')) parts.push_back(tok);
+  const auto whole = [](const std::string& s, long lo, long hi, int& v) {
+    char* end = nullptr;
+    errno = 0;
+    const long n = std::strtol(s.c_str(), &end, 10);
+    if (s.empty() || *end != '\0' || errno != 0 || n < lo || n > hi) return false;
+    v = static_cast<int>(n);
+    return true;
+  };
+  EndpointParts p;
+  if (parts.size() == 3 && parts[0] == "tcp") {
+    p.tcp = true;
+    in_addr a{};
+    if (inet_pton(AF_INET, parts[1].c_str(), &a) != 1)
+      return "'" + spec + "': host '" + parts[1] + "' is not a numeric IPv4 address (libmodbus resolves no names)";
+    if (!whole(parts[2], 1, 65535, p.number)) return "'" + spec + "': port '" + parts[2] + "' is not in 1-65535";
+  } else if ((parts.size() == 3 || parts.size() == 4) && parts[0] == "rtu") {
+    if (parts[1].empty()) return "'" + spec + "': no device";
+    if (!whole(parts[2], 1, 4000000, p.number)) return "'" + spec + "': baud rate '" + parts[2] + "' is not a positive number";
+    if (parts.size() == 4) {
+      if (parts[3] != "N" && parts[3] != "E" && parts[3] != "O") return "'" + spec + "': parity is not N, E or O";
+      p.parity = parts[3][0];
+    }
+  } else {
+    return "'" + spec + "' is not tcp:HOST:PORT or rtu:DEVICE:BAUD[:PARITY]";
+  }
+  p.where = parts[1];
+  if (out) *out = p;
+  return {};
+}
+
 ModbusLink::ModbusLink(ModbusEndpoint ep) : ep_(std::move(ep)) {}
 
 ModbusLink::~ModbusLink() { close(); }
@@ -35,32 +72,28 @@ void ModbusLink::close() {
 
 bool ModbusLink::connect() {
   close();
-  std::vector<std::string> parts;
-  std::stringstream in(ep_.spec);
-  std::string tok;
-  while (std::getline(in, tok, ':')) parts.push_back(tok);
-  if (parts.size() >= 3 && parts[0] == "tcp") {
-    ctx_ = modbus_new_tcp(parts[1].c_str(), std::stoi(parts[2]));
-  } else if (parts.size() >= 3 && parts[0] == "rtu") {
-    const char parity = parts.size() >= 4 && !parts[3].empty() ? parts[3][0] : 'N';
-    ctx_ = modbus_new_rtu(parts[1].c_str(), std::stoi(parts[2]), parity, 8, 1);
-  } else {
-    error_ = "bad Modbus endpoint '" + ep_.spec + "' (expected tcp:HOST:PORT or rtu:DEVICE:BAUD[:PARITY])";
+  EndpointParts p;
+  if (const std::string why = parse_endpoint(ep_.spec, &p); !why.empty()) {
+    error_ = "bad Modbus endpoint " + why;
     return false;
   }
+  ctx_ = p.tcp ? modbus_new_tcp(p.where.c_str(), p.number) : modbus_new_rtu(p.where.c_str(), p.number, p.parity, 8, 1);
   if (!ctx_) {
-    error_ = std::string("modbus_new: ") + modbus_strerror(errno);
+    error_ = ep_.spec + ": modbus_new: " + modbus_strerror(errno);
     return false;
   }
-  modbus_set_slave(ctx_, ep_.slave);
-  modbus_set_response_timeout(ctx_, static_cast<uint32_t>(ep_.response_timeout_ms / 1000),
-                              static_cast<uint32_t>((ep_.response_timeout_ms % 1000) * 1000));
-  if (modbus_connect(ctx_) != 0) {
-    error_ = ep_.spec + ": " + modbus_strerror(errno);
+  const auto fail = [this](const char* what) {
+    error_ = ep_.spec + ": " + what + ": " + modbus_strerror(errno);
     modbus_free(ctx_);
     ctx_ = nullptr;
     return false;
-  }
+  };
+  if (modbus_set_slave(ctx_, ep_.slave) != 0) return fail("unit id");
+  if (modbus_set_response_timeout(ctx_, static_cast<uint32_t>(ep_.response_timeout_ms / 1000),
+                                  static_cast<uint32_t>((ep_.response_timeout_ms % 1000) * 1000)) != 0)
+    return fail("response timeout");
+  if (modbus_connect(ctx_) != 0) return fail("connect");
+  modbus_flush(ctx_);  // whatever a device sent before this connection is not an answer to it
   error_.clear();
   return true;
 }
@@ -71,13 +104,9 @@ ReadResult ModbusLink::classify_failure() {
   // Modbus exceptions keep the link (the device answered); anything else may have lost it.
   if (e > MODBUS_ENOBASE && e < MODBUS_ENOBASE + 20 && e != EMBBADDATA && e != EMBBADCRC && e != EMBBADSLAVE)
     return ReadResult::Exception;
+  close();  // see the header: a late or garbled answer must not be read as the next one's
   if (e == ETIMEDOUT) return ReadResult::Timeout;
-  if (e == EMBBADDATA || e == EMBBADCRC || e == EMBBADSLAVE || e == EMBBADEXC || e == EMBUNKEXC) {
-    // A garbled answer: flush and keep the link.
-    modbus_flush(ctx_);
-    return ReadResult::BadData;
-  }
-  close();
+  if (e == EMBBADDATA || e == EMBBADCRC || e == EMBBADSLAVE || e == EMBBADEXC || e == EMBUNKEXC) return ReadResult::BadData;
   return ReadResult::Disconnected;
 }
 
@@ -87,7 +116,10 @@ ReadResult ModbusSensor::read(FtReading& out) {
   const int n = map_.input_registers ? modbus_read_input_registers(link_.ctx(), map_.first_register, 6, regs)
                                      : modbus_read_registers(link_.ctx(), map_.first_register, 6, regs);
   if (n != 6) {
-    if (n >= 0) return ReadResult::BadData;
+    if (n >= 0) {  // a short answer: as garbled as any
+      link_.close();
+      return ReadResult::BadData;
+    }
     return link_.classify_failure();
   }
   auto scaled = [](uint16_t raw, double s) {

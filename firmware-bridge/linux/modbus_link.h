@@ -20,6 +20,17 @@ struct ModbusEndpoint {
   int response_timeout_ms = 20;
 };
 
+// A spec taken apart: "tcp:HOST:PORT" (HOST a numeric IPv4 address: libmodbus 3.1 resolves no
+// names) or "rtu:DEVICE:BAUD[:PARITY]".
+struct EndpointParts {
+  bool tcp = false;
+  std::string where;   // host or device
+  int number = 0;      // port (1-65535) or baud (> 0)
+  char parity = 'N';   // N, E or O
+};
+// Empty when `spec` is a valid endpoint (written to *out), else what is wrong with it.
+std::string parse_endpoint(const std::string& spec, EndpointParts* out = nullptr);
+
 enum class ReadResult : uint8_t { Ok = 0, Timeout = 1, Exception = 2, Disconnected = 3, BadData = 4 };
 const char* read_result_name(ReadResult r);
 
@@ -36,7 +47,11 @@ class ModbusLink {
   bool connected() const { return ctx_ != nullptr; }
   const std::string& last_error() const { return error_; }
   modbus_t* ctx() { return ctx_; }
-  // Classifies the errno of a failed libmodbus call, closing the link when it is gone.
+  // Classifies the errno of a failed libmodbus call. The link is closed unless the device answered
+  // with a Modbus exception: after a timeout or a garbled answer, a late answer may still be on
+  // its way, and on a serial line nothing tells it from the answer to the next request (TCP's
+  // transaction id does, but libmodbus then fails every later request). A closed link reopens
+  // on a fresh connection, flushed.
   ReadResult classify_failure();
   const ModbusEndpoint& endpoint() const { return ep_; }
 

@@ -7,6 +7,8 @@
 //                          2  never answer a read of register 180 (the client times out)
 //                          3  disappear: close every connection and the listening socket for
 //                             register 901 milliseconds, then listen again (the sensor unplugged)
+//                          4  answer the next read of register 180 register 902 milliseconds
+//                             late, then go back to 0 (one late answer)
 //   holding register 910      number of reads of register 180 answered (mod 65536)
 // The registers 180-185 are set by clients (FC06/FC16), e.g. by the test.
 //
@@ -24,11 +26,19 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <chrono>
 #include <thread>
 
 namespace {
 
-constexpr int kFaultMode = 900, kDarkMs = 901, kReadsServed = 910, kFtRegister = 180;
+constexpr int kFaultMode = 900, kDarkMs = 901, kLateMs = 902, kReadsServed = 910, kFtRegister = 180;
+
+// Mode 4: sleeps before the answer to a read of the sensor's registers, once.
+void maybe_late(modbus_mapping_t* map, bool ft_read) {
+  if (!ft_read || map->tab_registers[kFaultMode] != 4) return;
+  map->tab_registers[kFaultMode] = 0;
+  std::this_thread::sleep_for(std::chrono::milliseconds(map->tab_registers[kLateMs]));
+}
 
 int listen_on(modbus_t* ctx, int& port) {
   // modbus_tcp_listen binds the port of the context; for port 0 ask the kernel which it chose.
@@ -67,6 +77,7 @@ int serve_rtu(const char* device, int slave) {
       modbus_reply_exception(ctx, query, MODBUS_EXCEPTION_SLAVE_OR_SERVER_FAILURE);
       continue;
     }
+    maybe_late(map, ft_read);
     modbus_reply(ctx, query, rc, map);
     if (ft_read) ++map->tab_registers[kReadsServed];
   }
@@ -137,6 +148,7 @@ int main(int argc, char** argv) {
         modbus_reply_exception(ctx, query, MODBUS_EXCEPTION_SLAVE_OR_SERVER_FAILURE);
         continue;
       }
+      maybe_late(map, ft_read);
       modbus_reply(ctx, query, rc, map);
       if (ft_read) ++map->tab_registers[kReadsServed];
       if (map->tab_registers[kFaultMode] == 3) {
