@@ -39,8 +39,9 @@ bool parse_candump_line(std::string_view line, LoggedFrame& out, std::string& wh
   const size_t dot = ts.find('.');
   if (dot == std::string_view::npos || dot == 0 || ts.size() - dot - 1 != 6)
     return why = "timestamp is not seconds.microseconds (6 digits)", false;
-  // Microseconds since the epoch must fit an int64_t: 12 digits of seconds (31,000 years) do.
-  if (dot > 12) return why = "timestamp has more than 12 digits of seconds", false;
+  // Nanoseconds since the epoch must fit an int64_t (a replay counts in them): up to 9.2e9 s,
+  // the year 2262. 10 digits of seconds, then the value.
+  if (dot > 10) return why = "timestamp has more than 10 digits of seconds", false;
   int64_t sec = 0, usec = 0;
   for (size_t i = 0; i < ts.size(); ++i) {
     if (i == dot) continue;
@@ -76,6 +77,7 @@ bool parse_candump_line(std::string_view line, LoggedFrame& out, std::string& wh
     if (hi < 0 || lo < 0) return why = "data is not hex", false;
     f.data[i] = static_cast<uint8_t>(hi * 16 + lo);
   }
+  if (sec > kMaxLogSeconds) return why = "timestamp beyond 9000000000 s (the year 2255): its nanoseconds would overflow", false;
   out.time_us = sec * 1000000 + usec;
   out.frame = f;
   return true;
@@ -95,6 +97,12 @@ std::vector<LoggedFrame> parse_candump_log(std::string_view text, const std::str
     if (line.find_first_not_of(" \t\r") == std::string_view::npos) continue;
     LoggedFrame lf;
     if (!parse_candump_line(line, lf, why)) throw std::runtime_error(name + ":" + std::to_string(line_no) + ": " + why);
+    if (!frames.empty() && lf.time_us < frames.back().time_us) {
+      char back[64];
+      std::snprintf(back, sizeof back, "%.6f", (frames.back().time_us - lf.time_us) * 1e-6);
+      throw std::runtime_error(name + ":" + std::to_string(line_no) + ": time goes back " + back + " s from line " +
+                               std::to_string(frames.back().line) + " (a clock step?): a log is read in time order");
+    }
     lf.line = line_no;
     frames.push_back(std::move(lf));
   }

@@ -35,8 +35,12 @@ std::string format_candump_line(int64_t time_us, std::string_view iface, const F
 // Parses one line; returns false with `why` set when it is not a classic candump frame line.
 bool parse_candump_line(std::string_view line, LoggedFrame& out, std::string& why);
 
+// The latest timestamp a line may carry [s] (the year 2255): its nanoseconds fit an int64_t.
+inline constexpr int64_t kMaxLogSeconds = 9'000'000'000;
+
 // Whole log text. Blank lines are skipped; anything else malformed throws std::runtime_error
-// with "name:line: what" (callers pass the file name for the message).
+// with "name:line: what" (callers pass the file name for the message); so does a timestamp
+// earlier than the line before's (a clock step: candump stamps with the wall clock).
 std::vector<LoggedFrame> parse_candump_log(std::string_view text, const std::string& name);
 
 }  // namespace dressguard::protocol

@@ -186,11 +186,20 @@ int run_replay(int argc, char** argv) {
   try {
     std::vector<predictor::ConfigEntry> others;  // the daemon's own keys: not replay's business
     cfg = predictor::parse_predictor_config(cfg_text, cfg_name, &others);
+    for (const auto& e : others) {
+      // A typo (stop_treshold) would otherwise replay the default policy without a word.
+      const auto& keys = predictor::kDaemonConfigKeys;
+      if (std::find_if(std::begin(keys), std::end(keys), [&](const char* k) { return e.key == k; }) == std::end(keys))
+        throw InputError(cfg_name + ":" + std::to_string(e.line) + ": unknown key '" + e.key + "'");
+    }
   } catch (const std::runtime_error& e) {
     throw InputError(e.what());
   }
   const long tick_ms = args.integer("tick-ms", 1);
-  if (tick_ms < 1) throw UsageError("--tick-ms must be >= 1");
+  // The sensor deadline is judged on each tick, as in the daemon (tick_ms there has the same bound).
+  if (tick_ms < 1 || tick_ms > std::max<int64_t>(1, cfg.sensor_timeout_ns / 1'000'000))
+    throw UsageError("--tick-ms must be in 1-" + std::to_string(std::max<int64_t>(1, cfg.sensor_timeout_ns / 1'000'000)) +
+                     " (no longer than sensor_timeout_ms)");
 
   std::unique_ptr<model::OutcomeModel> m;
   std::string model_error;

@@ -85,6 +85,10 @@ struct ConfigEntry {
 };
 PredictorConfig parse_predictor_config(const std::string& text, const std::string& name,
                                        std::vector<ConfigEntry>* others = nullptr);
+// The keys of the daemon's config file that are not the predictor's (predictor/daemon/main.cpp
+// reads them). A replay of the same file accepts and ignores them; any other key is an error.
+inline constexpr const char* kDaemonConfigKeys[] = {"interface", "model", "rt_priority", "cpu",
+                                                    "mlock",     "tick_ms", "log_level"};
 
 // Commanded travel [m] after t seconds of a pull at `speed` with ramp `accel` (trapezoid start):
 //   x(t) = a t^2 / 2                      for t < v/a

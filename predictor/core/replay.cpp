@@ -6,6 +6,8 @@
 namespace dressguard::predictor {
 namespace {
 
+constexpr int64_t kQuietTicksNs = 60'000'000'000;  // 60 s
+
 // Records stops and confirms each stop frame at once, as the stop socket's echo would.
 class ReplaySink final : public PredictorSink {
  public:
@@ -56,8 +58,14 @@ ReplayResult replay_frames(const model::OutcomeModel* model, const PredictorConf
     t.f_motion = d.stop_f_motion;
     t.f_vertical = d.stop_f_vertical;
   };
+  // Through a long silence (a log left running between sessions, a clock stepped forward) the
+  // ticks stop after kQuietTicksNs plus the sensor deadline: by then the deadline has fired, and
+  // nothing else a replay records happens on a tick. The next tick is the last one before the
+  // frame, in phase. (Ticking every millisecond through a jump of years took hours.)
   auto tick_until = [&](int64_t t_ns) {
+    const int64_t quiet_end = next_tick + kQuietTicksNs + cfg.sensor_timeout_ns;
     while (next_tick <= t_ns) {
+      if (next_tick > quiet_end && t_ns - next_tick > tick_ns) next_tick += (t_ns - next_tick) / tick_ns * tick_ns;
       p.on_tick(next_tick);
       record_stop(next_tick);
       confirm(next_tick);

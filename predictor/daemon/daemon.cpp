@@ -219,6 +219,7 @@ int PredictorDaemon::run() {
     const int n = epoll_wait(epoll_fd_, evs, 8, shutdown_at >= 0 ? 1 : -1);
     if (n < 0) {
       if (errno == EINTR) continue;
+      predictor_.on_shutdown(now_ns());  // cannot wait any more: a running trial is stopped first
       return 1;
     }
     const int64_t now = now_ns();

@@ -1,6 +1,7 @@
 // dressguard-predictor: the real-time predictor daemon. See predictor/README.md.
 #include <signal.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -47,7 +48,10 @@ std::string read_text(const std::string& path) {
   char buf[4096];
   size_t n;
   while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) s.append(buf, n);
+  const bool failed = std::ferror(f);
+  const int err = errno;
   std::fclose(f);
+  if (failed) throw std::runtime_error(path + ": cannot read (" + std::strerror(err) + ")");  // a folder, say
   return s;
 }
 
@@ -94,27 +98,44 @@ int main(int argc, char** argv) {
   RtOptions rt;
   DaemonOptions dopt;
   try {
-    const std::string text = (config_path.empty() ? std::string() : read_text(config_path)) + config_text;
+    // The file, then the --set lines: later entries win. The --set lines alone are parsed first
+    // so that their errors name "--set" and which one, not a line past the file's end.
+    std::string text = config_path.empty() ? std::string() : read_text(config_path);
+    if (!text.empty() && text.back() != '\n') text += '\n';  // else the first --set joins its last line
+    const long file_lines = static_cast<long>(std::count(text.begin(), text.end(), '\n'));
+    std::vector<ConfigEntry> set_only;
+    parse_predictor_config(config_text, "--set", &set_only);
     std::vector<ConfigEntry> others;
-    cfg = parse_predictor_config(text, config_path.empty() ? "--set" : config_path, &others);
+    cfg = parse_predictor_config(text + config_text, config_path.empty() ? "--set" : config_path, &others);
     for (const auto& e : others) {
-      auto integer = [&] {
+      const std::string where =
+          e.line > file_lines ? "--set " + std::to_string(e.line - file_lines) : config_path + ":" + std::to_string(e.line);
+      auto integer = [&](long lo, long hi) {
         try {
           size_t used = 0;
           const long v = std::stol(e.value, &used);
-          if (used == e.value.size()) return v;
+          if (used == e.value.size() && v >= lo && v <= hi) return v;
         } catch (const std::exception&) {
         }
-        throw std::runtime_error(config_path + ":" + std::to_string(e.line) + ": " + e.key + ": '" + e.value + "' is not an integer");
+        throw std::runtime_error(where + ": " + e.key + ": '" + e.value + "' is not a whole number in " +
+                                 std::to_string(lo) + "-" + std::to_string(hi));
       };
       if (e.key == "interface") iface = e.value;
       else if (e.key == "model") model_path = e.value;
-      else if (e.key == "rt_priority") rt.fifo_priority = static_cast<int>(integer());
-      else if (e.key == "cpu") rt.cpu = static_cast<int>(integer());
-      else if (e.key == "mlock") rt.lock_memory = integer() != 0;
-      else if (e.key == "tick_ms") dopt.tick_ns = integer() * 1000000;
-      else if (e.key == "log_level") log->set_level(spdlog::level::from_str(e.value));
-      else throw std::runtime_error(config_path + ":" + std::to_string(e.line) + ": unknown key '" + e.key + "'");
+      else if (e.key == "rt_priority") rt.fifo_priority = static_cast<int>(integer(0, 99));
+      else if (e.key == "cpu") rt.cpu = static_cast<int>(integer(-1, 4095));
+      else if (e.key == "mlock") rt.lock_memory = integer(0, 1) != 0;
+      // The sensor deadline is checked on each tick: a tick longer than it would let a silent
+      // sensor run on for up to a tick.
+      else if (e.key == "tick_ms") dopt.tick_ns = integer(1, std::max<long>(1, cfg.sensor_timeout_ns / 1000000)) * 1000000;
+      else if (e.key == "log_level") {
+        // spdlog turns a name it does not know into "off": a typo would silence every error.
+        const auto level = spdlog::level::from_str(e.value);
+        if (level == spdlog::level::off && e.value != "off")
+          throw std::runtime_error(where + ": log_level: '" + e.value +
+                                   "' is not trace, debug, info, warn, error, critical or off");
+        log->set_level(level);
+      } else throw std::runtime_error(where + ": unknown key '" + e.key + "'");
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "dressguard-predictor: %s\n", e.what());

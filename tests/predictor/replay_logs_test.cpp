@@ -16,6 +16,7 @@
 #include "candump_log.h"
 #include "dgm.h"
 #include "replay.h"
+#include "test_model.h"
 
 using namespace dressguard;
 using namespace dressguard::predictor;
@@ -193,6 +194,36 @@ TEST(ReplayLogs, DefaultModelRunsTheFaultLogsAndReportsTheCleanOnes) {
   }
 }
 
+// A trial whose sensor falls silent and a log that resumes 10^8 s (three years) later: the
+// replay stops the trial on the sensor timeout, at the sample that never came, and gets to the
+// frame after the jump without ticking through it (one tick a millisecond took hours).
+TEST(ReplayLogs, ALongSilenceIsNotTickedThroughMillisecondByMillisecond) {
+  testkit::FrameSource src;
+  std::vector<protocol::LoggedFrame> frames;
+  int64_t t_us = 1'000'000;
+  auto add = [&](const protocol::Frame& f) {
+    protocol::LoggedFrame lf;
+    lf.time_us = t_us;
+    lf.frame = f;
+    frames.push_back(lf);
+  };
+  add(src.trial_start(1));
+  for (int i = 0; i < 5; ++i) {
+    t_us += 10'000;
+    add(src.force(-1.0, 0.0));
+    src.next();
+  }
+  t_us += 100'000'000LL * 1'000'000;
+  add(src.trial_start(2));
+  const auto m = testkit::test_model();
+  const auto r = replay_frames(&m, PredictorConfig{}, frames);
+  ASSERT_EQ(r.trials.size(), 2u);
+  EXPECT_TRUE(r.trials[0].stopped);
+  EXPECT_EQ(r.trials[0].reason, protocol::StopReason::SensorTimeout);
+  EXPECT_EQ(r.trials[0].stop_sample, 5u) << "the sample after the last one received";
+  EXPECT_EQ(r.trials[1].trial, 2);
+}
+
 TEST(ReplayLogs, ModelThatDoesNotLoadStopsEveryTrial) {
   const auto frames = load(kLogs / "syn2-good-0-good.log");
   const auto r = replay_frames(nullptr, PredictorConfig{}, frames);
@@ -290,6 +321,13 @@ TEST(ReplayCli, EverySetOverridesItsKey) {
   EXPECT_EQ(WEXITSTATUS(rc), 2);
   EXPECT_NE(twice.find("option --model given 2 times"), std::string::npos) << twice;
   EXPECT_NE(twice.find("'other.dgm'"), std::string::npos) << twice;
+  // A key neither the predictor nor the daemon knows is an error, as in the daemon (a typo once
+  // replayed the default policy without a word); the daemon's own keys are accepted.
+  const std::string typo = run(base + " --set stop_treshold=0.2 2>&1", rc);
+  EXPECT_EQ(WEXITSTATUS(rc), 2);
+  EXPECT_NE(typo.find("unknown key 'stop_treshold'"), std::string::npos) << typo;
+  const std::string daemon_key = run(base + " --set rt_priority=80 --json", rc);
+  EXPECT_EQ(rc, 0) << daemon_key;
 }
 
 // The study's measured trials as candump logs in tmp/logs (`import`, then `export-candump --data`
