@@ -363,6 +363,8 @@ OutcomeModel decode_model(const uint8_t* data, size_t size, const std::string& s
 }
 
 OutcomeModel read_model(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) fail(path.string(), "is a folder, not a model file");
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(path.string(), std::string("cannot open: ") + std::strerror(errno));
   std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

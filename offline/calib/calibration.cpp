@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <cstdlib>
 #include <fstream>
 #include <limits>
@@ -121,6 +122,9 @@ Bounds read_bounds(const std::filesystem::path& path) {
       for (const PersonParamInfo& info : kPersonParamInfo) known += std::string(", ") + info.name;
       throw_input_error(path, n, "unknown parameter '" + name + "' (expected " + known + ")");
     }
+    if (ref->kind == ParamRef::Kind::Offset && (pb.lower < -kMaxArmOffset || pb.upper > kMaxArmOffset))
+      throw_input_error(path, n, "arm_offset must lie within +-" + std::to_string(kMaxArmOffset).substr(0, 3) +
+                                     " m (a calibration file holds no more)");
     if (ref->kind == ParamRef::Kind::Person) {
       const PersonParamInfo& info = kPersonParamInfo[ref->index];
       if (pb.lower < info.lowest || pb.upper > info.highest) throw_input_error(path, n, name + " " + info.range);
@@ -522,6 +526,28 @@ std::string fingerprint(const std::vector<HapticSequence>& inputs, const Paramet
   return f.str();
 }
 
+// FNV-1a (64 bits) over the bit patterns of every sample of the inputs: a checkpoint's inputs are
+// the same data, not only the same trial ids and lengths (a corrected file once resumed).
+std::string samples_hash(const std::vector<HapticSequence>& inputs) {
+  uint64_t h = 0xcbf29ce484222325ULL;
+  const auto mix = [&h](double v) {
+    uint64_t bits;
+    std::memcpy(&bits, &v, sizeof bits);
+    for (int k = 0; k < 8; ++k) h = (h ^ ((bits >> (8 * k)) & 0xFF)) * 0x100000001b3ULL;
+  };
+  for (const auto& seq : inputs)
+    for (const auto& x : seq.samples) {
+      mix(x.t);
+      mix(x.travel);
+      mix(x.f_motion);
+      mix(x.f_lateral);
+      mix(x.f_vertical);
+    }
+  char buf[24];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
 struct Checkpoint {
   std::string fingerprint;
   int generations_done = 0;
@@ -647,7 +673,10 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   cs.max_generations = options.generations;
   Cmaes es(cs);
 
-  const std::string fp = fingerprint(inputs, space, options);
+  // Checkpoints carry the samples' hash since session 82; an older one (without it) still resumes
+  // on the rest of the fingerprint, as it did.
+  const std::string fp_before_hash = fingerprint(inputs, space, options);
+  const std::string fp = fp_before_hash + ";samples=" + samples_hash(inputs);
   std::vector<double> best_fits(static_cast<std::size_t>(T), 0.0);
   int done = 0;
   bool resumed = false;
@@ -658,7 +687,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
     comm.broadcast(text);
     if (!text.empty()) {
       const Checkpoint c = decode_checkpoint(text, options.checkpoint);
-      if (c.fingerprint != fp)
+      if (c.fingerprint != fp && c.fingerprint != fp_before_hash)
         throw_input_error(options.checkpoint, 2,
                           "checkpoint belongs to a different calibration (inputs, seed, budget, bounds, gown or "
                           "objective differ); remove it or choose another --checkpoint");
@@ -1038,7 +1067,7 @@ Calibration calibration_from_json(const Json& j, const std::filesystem::path& so
       const Json& e = j.at("arm_offsets").at(std::string(arm_height_name(h)));
       c.offsets[static_cast<int>(h)] = e.at("offset_m").number();
       c.offset_calibrated[static_cast<int>(h)] = e.at("calibrated").boolean();
-      if (std::abs(c.offsets[static_cast<int>(h)]) > 0.5) throw std::runtime_error("arm offset beyond 0.5 m");
+      if (std::abs(c.offsets[static_cast<int>(h)]) > kMaxArmOffset) throw std::runtime_error("arm offset beyond 0.5 m");
     }
     c.objective_kind = j.at("objective_kind").string();
     c.objective = j.at("objective").number();

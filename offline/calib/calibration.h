@@ -79,6 +79,9 @@ struct ClothValues {
   std::string friction_scheme = kFrictionSchemes[0];
 };
 inline constexpr double kPaperArealDensity = 0.145;
+// [m] the largest arm offset a calibration file holds (read_calibration refuses more, so does
+// `simulate --arm-offset`); a bounds file's arm_offset box must lie within it.
+inline constexpr double kMaxArmOffset = 0.5;
 inline constexpr int kClothParams = 5;
 // A cuff's limits (sim/params.cpp checks the same): width in [0, 0.2] m, ratio in [1, 1e4].
 inline constexpr double kMaxHemWidth = 0.2, kMaxHemBendRatio = 1e4;

@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <ctime>
+#include <filesystem>
 #include <sstream>
 
 namespace dressguard::cli {
@@ -27,6 +28,8 @@ Args::Args(int argc, char** argv, std::set<std::string> flags) {
     if (a.rfind("--", 0) == 0 && a.size() > 2) {
       std::string name = a.substr(2);
       if (auto eq = name.find('='); eq != std::string::npos) {
+        // A switch takes no value: "--json=no" would otherwise switch JSON on.
+        if (flags.count(name.substr(0, eq))) throw UsageError("option --" + name.substr(0, eq) + " takes no value");
         values_[name.substr(0, eq)].push_back(name.substr(eq + 1));
       } else if (flags.count(name)) {
         flags_set_.insert(name);
@@ -63,6 +66,14 @@ std::string Args::require(const std::string& name) const {
   return *v;
 }
 
+std::string Args::require_output_file(const std::string& name) const {
+  const std::string path = require(name);
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw UsageError("option --" + name + ": '" + path + "' is a folder; give the file to write");
+  return path;
+}
+
 double Args::number(const std::string& name, double fallback) const {
   auto v = get(name);
   if (!v) return fallback;
@@ -74,7 +85,7 @@ double Args::number(const std::string& name, double fallback) const {
   return x;
 }
 
-long Args::integer(const std::string& name, long fallback) const {
+long Args::integer(const std::string& name, long fallback, long lo, long hi) const {
   auto v = get(name);
   if (!v) return fallback;
   long x = 0;
@@ -82,12 +93,16 @@ long Args::integer(const std::string& name, long fallback) const {
   if (ec != std::errc() || p != v->data() + v->size()) {
     throw UsageError("option --" + name + ": not an integer: '" + *v + "'");
   }
+  if (x < lo || x > hi)
+    throw UsageError("option --" + name + ": " + *v + " is outside " + std::to_string(lo) + "-" + std::to_string(hi));
   return x;
 }
 
-void Args::allow_only(const std::set<std::string>& known) const {
+void Args::allow_only(const std::set<std::string>& known, std::size_t max_positional) const {
   for (const auto& [k, v] : values_) if (!known.count(k)) throw UsageError("unknown option --" + k);
   for (const auto& k : flags_set_) if (!known.count(k)) throw UsageError("unknown option --" + k);
+  if (positional_.size() > max_positional)
+    throw UsageError("unexpected word '" + positional_[max_positional] + "' (options start with --)");
 }
 
 std::string utc_now() {

@@ -4,6 +4,8 @@
 // bad input exits non-zero with one line naming what was wrong (UsageError, caught in main).
 #pragma once
 
+#include <climits>
+#include <cstddef>
 #include <map>
 #include <optional>
 #include <set>
@@ -24,6 +26,9 @@ std::set<std::string> split_list(const std::string& s);
 // a pooled training set (--data A,B), whose order is the order of the trials HMM training sums.
 std::vector<std::string> split_in_order(const std::string& s);
 
+// --threads N: 0 is every core; more than this is no machine's.
+inline constexpr long kMaxThreads = 1024;
+
 class Args {
  public:
   // `flags`: names that take no value (e.g. "json", "help"); every other "--name" takes one.
@@ -36,11 +41,17 @@ class Args {
   // Every value of a repeatable option, in the order given (e.g. replay's --set KEY=VALUE).
   std::vector<std::string> all(const std::string& name) const;
   std::string require(const std::string& name) const;  // UsageError when absent
+  // require() for a file to be written: a UsageError now, too, when it names a folder (the
+  // write would fail only after the whole run).
+  std::string require_output_file(const std::string& name) const;
   double number(const std::string& name, double fallback) const;  // UsageError when not a number
-  long integer(const std::string& name, long fallback) const;
+  // UsageError when not a whole number in [lo, hi] (the default range: what an int holds).
+  long integer(const std::string& name, long fallback, long lo = -2147483647L - 1, long hi = 2147483647L) const;
   const std::vector<std::string>& positional() const { return positional_; }
-  // UsageError naming the first option that is not in `known` (catches typos like --sped).
-  void allow_only(const std::set<std::string>& known) const;
+  // UsageError naming the first option that is not in `known` (catches typos like --sped), or
+  // the first word that is no option when the command takes fewer than `max_positional` of them
+  // ("-generations 2", with one dash, once ran the paper's budget of hours).
+  void allow_only(const std::set<std::string>& known, std::size_t max_positional = 0) const;
 
  private:
   std::map<std::string, std::vector<std::string>> values_;

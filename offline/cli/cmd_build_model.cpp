@@ -77,7 +77,7 @@ int run_build_model(int argc, char** argv) {
   args.allow_only({"help", "json", "no-gown-noise", "no-arm-noise", "calibration", "data", "out", "synth-dir",
                    "states", "per-height", "seed", "gown", "threads", "forces", "middle", "high-low", "created", "discrepancy", "label-margin",
                    "priors", "training-out"});
-  const std::string out = args.require("out");
+  const std::string out = args.require_output_file("out");
   if (args.has("calibration") == args.has("data")) throw UsageError("give exactly one of --calibration and --data");
   const int states = static_cast<int>(args.integer("states", 10));
   if (states < 1 || states > 32) throw UsageError("--states must be in 1..32");

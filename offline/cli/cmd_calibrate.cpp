@@ -35,7 +35,7 @@ int rescore_file(const Args& args) {
   args.allow_only({"help", "json", "rescore", "data", "out", "why"});
   const std::string file = args.require("rescore");
   const std::string data = args.require("data");
-  const std::string out = args.require("out");
+  const std::string out = args.require_output_file("out");
   Calibration cal;
   try {
     cal = read_calibration(file);
@@ -174,20 +174,20 @@ int run_calibrate(int argc, char** argv) {
                    "support-depth", "support-lateral", "inputs", "friction", "prune"});
   const std::string data = args.require("data");
   const std::string participant = args.require("participant");
-  const std::string out = args.require("out");
+  const std::string out = args.require_output_file("out");
   const std::string profile = args.get("profile").value_or("default");
   if (profile != "default" && profile != "quick") throw UsageError("--profile must be default or quick");
   CalibrationOptions o;
   o.generations = profile == "quick" ? 6 : 50;
   o.population = profile == "quick" ? 8 : 32;
-  o.generations = static_cast<int>(args.integer("generations", o.generations));
-  o.population = static_cast<int>(args.integer("population", o.population));
+  o.generations = static_cast<int>(args.integer("generations", o.generations, 1, 1000000));
+  o.population = static_cast<int>(args.integer("population", o.population, 4, 1000000));
   if (o.generations < 1 || o.population < 4) throw UsageError("need --generations >= 1 and --population >= 4");
   if (const auto s0 = args.get("sigma0")) {
     o.sigma0 = args.number("sigma0", o.sigma0);
     if (!(o.sigma0 > 0 && o.sigma0 <= 1)) throw UsageError("--sigma0 must be in (0, 1], not '" + *s0 + "'");
   }
-  const long seed = args.integer("seed", 1);
+  const long seed = args.integer("seed", 1, 0, LONG_MAX);
   if (seed < 0) throw UsageError("--seed must be non-negative");
   o.seed = static_cast<std::uint64_t>(seed);
   const auto kind = parse_objective(args.get("objective").value_or("area"));
@@ -211,9 +211,9 @@ int run_calibrate(int argc, char** argv) {
     if (!(o.prune >= 0 && o.prune <= 100)) throw UsageError("--prune must be in [0, 100], not '" + *pr + "'");
     if (o.prune > 0 && o.objective != ObjectiveKind::Area) throw UsageError("--prune needs --objective area");
   }
-  o.threads = static_cast<int>(args.integer("threads", 0));
+  o.threads = static_cast<int>(args.integer("threads", 0, 0, kMaxThreads));
   o.checkpoint = args.get("checkpoint").value_or(out + ".ckpt");
-  o.stop_after_generations = static_cast<int>(args.integer("stop-after-generations", 0));
+  o.stop_after_generations = static_cast<int>(args.integer("stop-after-generations", 0, 0, 1000000));
   const std::string gown = args.get("gown").value_or("reduced");
   if (gown != "full" && gown != "reduced" && gown != "coarse") throw UsageError("--gown must be full, reduced or coarse");
   o.gown = gown;

@@ -19,7 +19,7 @@ int run_model(int argc, char** argv) {
         "  --json   print the whole model as one JSON object");
     return 0;
   }
-  args.allow_only({"help", "json"});
+  args.allow_only({"help", "json"}, 2);
   const auto& pos = args.positional();
   if (pos.empty()) throw UsageError("missing subcommand (show)");
   if (pos[0] != "show") throw UsageError("unknown subcommand '" + pos[0] + "' (show)");

@@ -66,7 +66,7 @@ int run_predict(int argc, char** argv) {
   args.allow_only({"help", "json", "calibration", "data", "out", "gown", "threads", "window", "discrepancy"});
   const std::string cal_path = args.require("calibration");
   const std::string data = args.require("data");
-  const int threads = static_cast<int>(args.integer("threads", 0));
+  const int threads = static_cast<int>(args.integer("threads", 0, 0, kMaxThreads));
   const double window = args.number("window", 0.05);
   if (!(window >= 0.005 && window <= 0.85)) throw UsageError("--window must be between 0.005 and 0.85 m");
   const Calibration cal = read_calibration(cal_path);

@@ -116,7 +116,7 @@ int run_simulate(int argc, char** argv) {
   if (std::abs(spec.arm_offset) > 0.5) throw UsageError("--arm-offset must be within +-0.5 m");
   spec.speed = args.number("speed", 0.1);
   if (!(spec.speed > 0.0 && spec.speed <= 1.0)) throw UsageError("--speed must be in (0, 1] m/s");
-  const long seed = args.integer("seed", 0);
+  const long seed = args.integer("seed", 0, LONG_MIN, LONG_MAX);
   if (seed < 0) throw UsageError("--seed must be non-negative");
   spec.seed = static_cast<uint64_t>(seed);
   if (args.has("params") && args.has("calibration")) throw UsageError("give at most one of --params and --calibration");

@@ -18,14 +18,14 @@ using namespace dressguard::calib;
 // Shared with build-model: reads the synthesis options from the command line.
 SynthesisOptions synthesis_options_from(const Args& args) {
   SynthesisOptions o;
-  o.per_height = static_cast<int>(args.integer("per-height", 100));
+  o.per_height = static_cast<int>(args.integer("per-height", 100, 2, 100000));
   if (o.per_height < 2) throw UsageError("--per-height must be at least 2 (half at each speed)");
   o.gown_noise = !args.has("no-gown-noise");
   o.arm_noise = !args.has("no-arm-noise");
-  const long seed = args.integer("seed", 1);
+  const long seed = args.integer("seed", 1, 0, LONG_MAX);
   if (seed < 0) throw UsageError("--seed must be non-negative");
   o.seed = static_cast<std::uint64_t>(seed);
-  o.threads = static_cast<int>(args.integer("threads", 0));
+  o.threads = static_cast<int>(args.integer("threads", 0, 0, kMaxThreads));
   const auto middle = parse_middle_arm(args.get("middle").value_or("nominal"));
   if (!middle) throw UsageError("--middle must be nominal or caught-edge");
   o.middle = *middle;
@@ -44,13 +44,17 @@ SynthesisSummary run_synthesis(const Calibration& cal, const std::string& gown, 
 #else
   const Comm& comm = Comm::world();
   const TrialSimulator sim = make_cloth_simulator(gown).trial;
+  // The gown the trials are simulated on goes into the folder's record (synthesis.json), which
+  // guards a resume: trials of another --gown are never kept as this run's.
+  Calibration used = cal;
+  used.gown = gown;
   int last = -1;
   if (o.high_low == HighLowArm::RepeatBand && o.arm_noise && comm.is_root())
     std::fprintf(stderr, "synthesize: scanning the high and low arms' heights for their repeat bands (26 trials, "
                          "unless an earlier run kept them)\n");
   if (o.middle == MiddleArm::CaughtEdge && comm.is_root())
     std::fprintf(stderr, "synthesize: locating the simulator's good/caught edge for the middle arm (about 10 trials)\n");
-  const SynthesisSummary s = synthesize(cal, sim, o, out, comm, [&](const SynthesisProgress& p) {
+  const SynthesisSummary s = synthesize(used, sim, o, out, comm, [&](const SynthesisProgress& p) {
     const int pct = 100 * p.done / std::max(1, p.total);
     if (pct / 5 == last / 5 && p.done != p.total) return;
     last = pct;

@@ -37,7 +37,7 @@ int run_train(int argc, char** argv) {
   }
   args.allow_only({"help", "json", "uniform-priors", "data", "out", "states", "band", "cov-floor", "max-iter",
                    "tolerance", "exclude-participant", "stop-threshold", "stop-consecutive", "created"});
-  const std::string data = args.require("data"), out = args.require("out");
+  const std::string data = args.require("data"), out = args.require_output_file("out");
   hmm::ModelOptions opt;
   opt.hmm.n_states = static_cast<int>(args.integer("states", 10));
   opt.hmm.band = static_cast<int>(args.integer("band", 1));

@@ -36,6 +36,19 @@ expect_fail("calibrate with the support beyond the gown" "--support-depth must b
 expect_fail("calibrate with the arm beside the opening" "--arm-lateral must be fit, fixed or a value (arm_lateral must be within +-0.1 m" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --arm-lateral 0.15)
 expect_fail("calibrate with a weightless gown" "areal_density must be within 0.01 and 1 kg/m" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --density 0)
 expect_fail("calibrate on a missing dataset" "manifest.csv" calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json)
+# Words that are no options, counts that would wrap in an int, a switch given a value, an output
+# that is a folder: each refused at once (the one-dash "-generations 2" once ran the paper's
+# budget, 4294967297 generations ran as 1, a folder --out failed only after the whole search).
+expect_fail("calibrate with a one-dash option" "unexpected word '-generations' (options start with --)"
+            calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json -generations 2)
+expect_fail("calibrate with a count that wraps" "option --generations: 4294967297 is outside 1-1000000"
+            calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --generations 4294967297)
+expect_fail("calibrate with threads beyond any machine" "option --threads: 99999999999 is outside 0-1024"
+            calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --threads 99999999999)
+expect_fail("a switch given a value" "option --json takes no value"
+            calibrate --data ${WORK}/nothing --participant 1 --out ${WORK}/c.json --json=no)
+expect_fail("calibrate into a folder" "option --out: '${WORK}' is a folder"
+            calibrate --data ${WORK}/nothing --participant 1 --out ${WORK})
 
 # The shipped calibrations' standing on their own sequences as a picture (no study needed: the
 # files hold their objectives): per participant the file whose worse sequence is lower, and the
@@ -59,6 +72,8 @@ endif()
 file(WRITE ${WORK}/bad.json "{\"format\": \"dressguard-calibration 1\",\n\"participant\": 4,\n}")
 expect_fail("synthesize with a bad calibration file" "bad.json" synthesize --calibration ${WORK}/bad.json --out ${WORK}/s)
 expect_fail("synthesize with --per-height 1" "--per-height" synthesize --calibration ${WORK}/bad.json --out ${WORK}/s --per-height 1)
+expect_fail("synthesize with a count that wraps" "option --per-height: 4294967298 is outside 2-100000"
+            synthesize --calibration ${WORK}/bad.json --out ${WORK}/s --per-height 4294967298)
 expect_fail("synthesize with an unknown middle placement" "--middle" synthesize --calibration ${WORK}/bad.json --out ${WORK}/s --middle centre)
 expect_fail("synthesize with an unknown high/low placement" "--high-low" synthesize --calibration ${WORK}/bad.json --out ${WORK}/s --high-low wide)
 expect_fail("build-model with both inputs" "exactly one" build-model --calibration ${WORK}/bad.json --data ${WORK} --out ${WORK}/m.dgm)
@@ -127,6 +142,12 @@ if(HMM)
                   RESULT_VARIABLE rc OUTPUT_VARIABLE js ERROR_VARIABLE err)
   if(NOT rc EQUAL 0 OR NOT js MATCHES "\"resumed\": 6,")
     message(FATAL_ERROR "synthesize --json on a finished set (${rc}):\n${js}\n${err}")
+  endif()
+  if(STUDY)
+    # The same set on another gown (--gown overrides the calibration's): refused before anything
+    # is simulated; the gown is part of the folder's record (it once kept the coarse gown's trials).
+    expect_fail("synthesize resumed on another gown" "holds a synthesis with other settings"
+                synthesize --calibration ${WORK}/calB.json --out ${WORK}/sB ${synth_opts} --gown reduced)
   endif()
   file(STRINGS ${WORK}/sB/manifest.csv rows)
   foreach(h high middle low)
@@ -214,6 +235,10 @@ if(STUDY)
   file(WRITE ${WORK}/bounds.txt "friction 0 2\nstiffness 0 1\n")
   expect_fail("calibrate with a bad bounds file" "bounds.txt:2: unknown parameter 'stiffness'"
               calibrate --data ${WORK}/study --participant 4 --out ${WORK}/c.json --bounds ${WORK}/bounds.txt)
+  # An arm offset box no calibration file can hold (read_calibration refuses beyond 0.5 m).
+  file(WRITE ${WORK}/bounds-arm.txt "arm_offset 0.6 0.9\n")
+  expect_fail("calibrate with an arm offset box beyond 0.5 m" "bounds-arm.txt:1: arm_offset must lie within +-0.5 m"
+              calibrate --data ${WORK}/study --participant 4 --out ${WORK}/c.json --bounds ${WORK}/bounds-arm.txt)
   expect_fail("calibrate an absent participant" "participant '42'" calibrate --data ${WORK}/study --participant 42 --out ${WORK}/c.json)
   expect_fail("calibrate --inputs with another person's trial"
               "--inputs: trial 's1-miss-1' is participant 1's, not 4's (${WORK}/study/manifest.csv)"
@@ -367,6 +392,23 @@ if(STUDY)
   if(rc EQUAL 0 OR EXISTS ${WORK}/p1.json OR NOT EXISTS ${WORK}/r.json.ckpt
      OR NOT err MATCHES "calibrate: note: --start [^\n]*participant1-worst\\.json was fitted to s1-good-3, s1-miss-1; --inputs names s1-good-1, s1-miss-1\n")
     message(FATAL_ERROR "calibrate --inputs naming other trials than --start's (${rc}):\n${out}\n${err}")
+  endif()
+  # The same command on data changed in place (participant 4's forces; the same trials, the same
+  # lengths): refused, as the checkpoint holds the samples' hash (it once resumed on ids and
+  # lengths alone).
+  file(COPY ${WORK}/study/ DESTINATION ${WORK}/study-changed)
+  file(GLOB p4 ${WORK}/study-changed/s4-*.csv)
+  foreach(f IN LISTS p4)
+    file(READ ${f} text)
+    string(REPLACE ",-0." ",-1." text "${text}")
+    file(WRITE ${f} "${text}")
+  endforeach()
+  execute_process(COMMAND ${DG} calibrate --data ${WORK}/study-changed --participant 4 --gown coarse --generations 2
+                          --population 4 --threads 2 --seed 3 --out ${WORK}/r.json
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(rc EQUAL 0 OR EXISTS ${WORK}/r.json OR NOT EXISTS ${WORK}/r.json.ckpt
+     OR NOT err MATCHES "r\\.json\\.ckpt:2: checkpoint belongs to a different calibration")
+    message(FATAL_ERROR "calibrate resumed on changed data (${rc}):\n${out}\n${err}")
   endif()
   execute_process(COMMAND ${DG} ${again} --out ${WORK}/r.json RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/r.json OR EXISTS ${WORK}/r.json.ckpt

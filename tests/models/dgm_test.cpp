@@ -198,6 +198,16 @@ TEST(ModelFile, UnusedFeatureIsZeroAndNeedsVersion2) {
   EXPECT_THROW(encode_model(scaled), ModelError);
 }
 
+// A folder given as the model is named as such (the stream's own message named no path).
+TEST(ModelFileRejects, AFolder) {
+  try {
+    read_model(std::filesystem::temp_directory_path());
+    FAIL() << "no error";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("is a folder, not a model file"), std::string::npos) << e.what();
+  }
+}
+
 TEST(ModelFileRejects, BadCrc) {
   auto b = encode_model(sample_model());
   b[b.size() / 2] ^= 0x10;
