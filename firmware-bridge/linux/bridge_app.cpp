@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdarg>
 #include <cstdio>
 #include <system_error>
 
@@ -24,6 +25,7 @@ uint32_t now_ms() {
 constexpr uint64_t kTimer = 1, kCan = 2, kShutdown = 3;
 
 bool due(uint32_t now, uint32_t t) { return static_cast<int32_t>(now - t) >= 0; }
+bool power_of_two(uint64_t n) { return n != 0 && (n & (n - 1)) == 0; }
 
 }  // namespace
 
@@ -59,6 +61,23 @@ void BridgeApp::request_shutdown() noexcept {
 
 std::string BridgeApp::last_error() const { return sensor_.link().last_error(); }
 
+void BridgeApp::say(const char* fmt, ...) {
+  if (!cfg_.log) return;
+  char line[512];
+  va_list ap;
+  va_start(ap, fmt);
+  std::vsnprintf(line, sizeof line, fmt, ap);
+  va_end(ap);
+  std::fprintf(cfg_.log, "dressguard-bridge: %s\n", line);
+  std::fflush(cfg_.log);
+}
+
+void BridgeApp::sensor_failed(const char* what) {
+  if (power_of_two(++sensor_failures_))
+    say("sensor: %s: %s (%llu in a row; no frames until it answers)", what, sensor_.link().last_error().c_str(),
+        static_cast<unsigned long long>(sensor_failures_));
+}
+
 void BridgeApp::send(const Frame& f) {
   // A full transmit queue drops this frame (the next sample supersedes it); counted, never blocked on.
   if (port_.send(f) == can::SendResult::Ok) ++stats_.frames_sent;
@@ -69,13 +88,19 @@ void BridgeApp::try_stop(uint32_t t) {
   if (!stop_pending_ || !due(t, next_stop_try_ms_)) return;
   if (!robot_) {
     stop_pending_ = false;
+    say("stop requested; no --robot: not written");
     return;
   }
   if (robot_->write_stop()) {
     stop_pending_ = false;
     ++stats_.stops_written;
+    say("stop written to the robot controller%s", stop_failures_ ? " (after failed writes)" : "");
+    stop_failures_ = 0;
   } else {
     ++stats_.stop_write_failures;
+    if (power_of_two(++stop_failures_))
+      say("stop write failed: %s (%llu in a row; retried every %d ms)", robot_->link().last_error().c_str(),
+          static_cast<unsigned long long>(stop_failures_), cfg_.stop_retry_ms);
     next_stop_try_ms_ = t + static_cast<uint32_t>(cfg_.stop_retry_ms);
   }
 }
@@ -95,6 +120,7 @@ void BridgeApp::on_timer(uint32_t t) {
         ++stats_.reconnects;
       } else {
         ++stats_.connect_failures;
+        sensor_failed("connect");
         back_off();
       }
     }
@@ -108,9 +134,13 @@ void BridgeApp::on_timer(uint32_t t) {
       for (int i = 0; i < n; ++i) send(frames[i]);
       ++stats_.readings;
       backoff_ms_ = 0;
+      if (sensor_failures_ > 0)
+        say("sensor answers again after %llu failures", static_cast<unsigned long long>(sensor_failures_));
+      sensor_failures_ = 0;
     } else {
       bridge_on_sensor_error(core_, t);
       ++stats_.sensor_errors;
+      sensor_failed(read_result_name(rr));
       if (!sensor_.link().connected()) {
         // Closed after a timeout or a garbled answer (modbus_link.h): the first reconnect waits
         // one response timeout, so that a late answer lands before the link reopens.

@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <cstdio>
 #include <memory>
 #include <string>
 
@@ -21,6 +22,10 @@ struct BridgeAppConfig {
   int backoff_min_ms = 50;         // first reconnect delay, doubled per failure ...
   int backoff_max_ms = 2000;       // ... up to this
   int stop_retry_ms = 10;          // an unacknowledged stop write is retried this often
+  // Where the bridge says what went wrong (null: nowhere). A failing sensor or stop write is
+  // reported at its 1st, 2nd, 4th, 8th, ... consecutive failure with libmodbus's reason, and
+  // once when it recovers; every stop is reported.
+  std::FILE* log = stderr;
 };
 
 struct BridgeStats {
@@ -44,6 +49,8 @@ class BridgeApp {
   void drain_can(uint32_t now_ms);
   void send(const Frame& f);
   void try_stop(uint32_t now_ms);
+  void say(const char* fmt, ...) __attribute__((format(printf, 2, 3)));
+  void sensor_failed(const char* what);
 
   BridgeAppConfig cfg_;
   ModbusSensor& sensor_;
@@ -56,6 +63,8 @@ class BridgeApp {
   uint32_t next_connect_ms_ = 0;
   bool stop_pending_ = false;
   uint32_t next_stop_try_ms_ = 0;
+  uint64_t sensor_failures_ = 0;  // in a row, since the last good reading
+  uint64_t stop_failures_ = 0;    // in a row, for the pending stop
 };
 
 }  // namespace dressguard::bridge

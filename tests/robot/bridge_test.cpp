@@ -16,7 +16,10 @@
 #include <array>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <thread>
 
@@ -209,6 +212,7 @@ struct BridgeRig {
   std::unique_ptr<RobotStopWriter> robot;
   std::unique_ptr<BridgeApp> app;
   std::thread loop;
+  std::FILE* log = std::tmpfile();  // what the bridge says
   BridgeRig() {
     bridge_port = bus.open({{protocol::id_of(protocol::MsgId::Stop), protocol::id_of(protocol::MsgId::TrialStart)}, false, true});
     listener = bus.open({{protocol::id_of(protocol::MsgId::FtForce), protocol::id_of(protocol::MsgId::FtTorque),
@@ -219,12 +223,21 @@ struct BridgeRig {
     BridgeAppConfig cfg;
     cfg.backoff_min_ms = 20;
     cfg.backoff_max_ms = 160;
+    cfg.log = log;
     app = std::make_unique<BridgeApp>(cfg, *sensor, robot.get(), *bridge_port);
     loop = std::thread([this] { app->run(); });
   }
   ~BridgeRig() {
     app->request_shutdown();
     loop.join();
+    if (log) std::fclose(log);
+  }
+  // What the bridge has logged so far (read through its own descriptor).
+  std::string logged() const {
+    std::ifstream in("/proc/self/fd/" + std::to_string(fileno(log)));
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
   }
   // Force frames received within `d`, the last one in *last.
   int collect(std::chrono::milliseconds d, protocol::FtForce* last = nullptr, protocol::HeartbeatBridge* hb = nullptr) {
@@ -319,6 +332,33 @@ TEST(BridgeModbus, ALateAnswerIsDroppedWithItsConnection) {
   EXPECT_EQ(last.fx, 300);
   EXPECT_GT(rig.app->stats().reconnects.load(), reconnects) << "the late answer's connection was kept";
   EXPECT_LE(rig.app->stats().sensor_errors.load(), 3u) << "more than the one late answer failed";
+}
+
+// The bridge says what fails: a sensor that times out at the 1st, 2nd, 4th, ... failure in a
+// row with libmodbus's reason (not once per period), once when it answers again, and every stop.
+TEST(BridgeModbus, FailuresAndStopsAreLoggedAtEachDoubling) {
+  BridgeRig rig;
+  ASSERT_GT(rig.sensor_emu.port(), 0);
+  EXPECT_GE(rig.collect(100ms), 3);
+  ASSERT_TRUE(rig.sensor_emu.write(900, {2}));
+  rig.collect(400ms);
+  ASSERT_TRUE(rig.sensor_emu.write(900, {0}));
+  EXPECT_GE(rig.collect(400ms), 5);
+  rig.predictor->send(protocol::encode(protocol::Stop{0, protocol::StopReason::Caught, 240, 3, 250}));
+  for (int i = 0; i < 200 && rig.app->stats().stops_written.load() == 0; ++i) std::this_thread::sleep_for(1ms);
+  std::this_thread::sleep_for(5ms);
+  const std::string text = rig.logged();
+  std::istringstream lines(text);
+  int failures = 0;
+  for (std::string l; std::getline(lines, l);) failures += l.find("sensor: timeout: ") != std::string::npos;
+  const uint64_t errors = rig.app->stats().sensor_errors.load();
+  ASSERT_GE(errors, 2u);
+  // One line per power of two up to the run's length: floor(log2(errors)) + 1 at most.
+  EXPECT_GE(failures, 1);
+  EXPECT_LE(failures, static_cast<int>(std::log2(static_cast<double>(errors))) + 1) << text;
+  EXPECT_NE(text.find("(1 in a row; no frames until it answers)"), std::string::npos) << text;
+  EXPECT_NE(text.find("sensor answers again after "), std::string::npos) << text;
+  EXPECT_NE(text.find("stop written to the robot controller"), std::string::npos) << text;
 }
 
 TEST(BridgeModbus, StopFrameWritesTheRobotsStopCoil) {
