@@ -891,6 +891,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
 
   CalibrationResult r;
   r.complete = es.stopped();
+  if (r.complete) r.stopped_by = stop_reason_name(es.stop_reason());
   r.generations_done = done;
   r.evaluations = es.state().evaluations + 1;  // and the start
   r.pruned = pruned_total;

@@ -442,6 +442,8 @@ void measure_axis_fits(std::vector<SequenceFit>& fits, const std::vector<HapticS
 
 struct CalibrationResult {
   bool complete = false;          // false: stopped by stop_after_generations (resume later)
+  const char* stopped_by = "";    // complete: CMA-ES's stop criterion (cmaes.h), "max-generations"
+                                  // when the budget ran out
   int generations_done = 0;
   long evaluations = 0;           // candidate evaluations (each = one simulation per sequence), the start's included
   long pruned = 0, resimulated = 0;  // in this process: candidates cut short, and finished whole after all (options.prune)

@@ -418,6 +418,9 @@ int run_calibrate(int argc, char** argv) {
       std::printf("participant %s: L = %.4f after %d generations (%ld evaluations, %s; the start's L %.4f)\n",
                   participant.c_str(), r.objective, r.generations_done, r.evaluations, minutes(r.elapsed_s).c_str(),
                   r.start_objective);
+      if (std::string(r.stopped_by) != "max-generations")
+        std::printf("  CMA-ES stopped on its own criterion (%s) before the budget of %d generations\n", r.stopped_by,
+                    o.generations);
       if (o.prune > 0)
         std::printf("  pruned at %g x the last generation's median: %ld candidates cut, %ld of them finished whole "
                     "from the cut (this process)\n", o.prune, r.pruned, r.resimulated);

@@ -26,6 +26,9 @@ SynthesisOptions synthesis_options_from(const Args& args) {
   if (seed < 0) throw UsageError("--seed must be non-negative");
   o.seed = static_cast<std::uint64_t>(seed);
   o.threads = static_cast<int>(args.integer("threads", 0, 0, kMaxThreads));
+  // --gown overrides the calibration's (read later): checked here, with the other options.
+  if (const auto g = args.get("gown"); g && *g != "full" && *g != "reduced" && *g != "coarse")
+    throw UsageError("--gown must be full, reduced or coarse, not '" + *g + "'");
   const auto middle = parse_middle_arm(args.get("middle").value_or("nominal"));
   if (!middle) throw UsageError("--middle must be nominal or caught-edge");
   o.middle = *middle;

@@ -74,6 +74,8 @@ expect_fail("synthesize with a bad calibration file" "bad.json" synthesize --cal
 expect_fail("synthesize with --per-height 1" "--per-height" synthesize --calibration ${WORK}/bad.json --out ${WORK}/s --per-height 1)
 expect_fail("synthesize with a count that wraps" "option --per-height: 4294967298 is outside 2-100000"
             synthesize --calibration ${WORK}/bad.json --out ${WORK}/s --per-height 4294967298)
+expect_fail("synthesize on an unknown gown" "--gown must be full, reduced or coarse, not 'bogus'"
+            synthesize --calibration ${WORK}/bad.json --out ${WORK}/s --gown bogus)
 expect_fail("synthesize with an unknown middle placement" "--middle" synthesize --calibration ${WORK}/bad.json --out ${WORK}/s --middle centre)
 expect_fail("synthesize with an unknown high/low placement" "--high-low" synthesize --calibration ${WORK}/bad.json --out ${WORK}/s --high-low wide)
 expect_fail("build-model with both inputs" "exactly one" build-model --calibration ${WORK}/bad.json --data ${WORK} --out ${WORK}/m.dgm)
@@ -239,6 +241,15 @@ if(STUDY)
   file(WRITE ${WORK}/bounds-arm.txt "arm_offset 0.6 0.9\n")
   expect_fail("calibrate with an arm offset box beyond 0.5 m" "bounds-arm.txt:1: arm_offset must lie within +-0.5 m"
               calibrate --data ${WORK}/study --participant 4 --out ${WORK}/c.json --bounds ${WORK}/bounds-arm.txt)
+  # A search CMA-ES ends on one of its own criteria says which, and that the budget was not used
+  # (sigma0 1e-300: no step moves the mean; ~15 s on the coarse gown). It once said nothing.
+  execute_process(COMMAND ${DG} calibrate --data ${WORK}/study --participant 4 --gown coarse --generations 5
+                          --population 4 --sigma0 1e-300 --out ${WORK}/tiny.json
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR NOT out MATCHES "after 1 generations"
+     OR NOT out MATCHES "CMA-ES stopped on its own criterion \\([a-z-]+\\) before the budget of 5 generations")
+    message(FATAL_ERROR "calibrate stopped by CMA-ES (${rc}):\n${out}\n${err}")
+  endif()
   expect_fail("calibrate an absent participant" "participant '42'" calibrate --data ${WORK}/study --participant 42 --out ${WORK}/c.json)
   expect_fail("calibrate --inputs with another person's trial"
               "--inputs: trial 's1-miss-1' is participant 1's, not 4's (${WORK}/study/manifest.csv)"
