@@ -22,12 +22,7 @@ using namespace dressguard::calib;
 namespace {
 
 // A JSON number, or null for NaN (no yardstick, no sign to agree on).
-std::string number(double v) {
-  if (!std::isfinite(v)) return "null";
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
+std::string number(double v) { return std::isfinite(v) ? format_number(v) : "null"; }
 
 }  // namespace
 

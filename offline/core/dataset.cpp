@@ -73,29 +73,26 @@ void for_each_line(const std::string& text, F&& f) {
 constexpr const char* kTrialHeader = "t,travel,f_motion,f_lateral,f_vertical";
 constexpr const char* kManifestHeader = "trial_id,participant,height,speed,label,file";
 
-std::string number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
 // The bounds of dataset.h on one new sample, against the one before it.
 void check_sample(const std::vector<HapticSample>& s, const char* const names[5], const fs::path& file, long line) {
   const HapticSample& x = s.back();
   if (!(x.travel >= kMinTravel && x.travel <= kMaxTravel))
-    throw_input_error(file, line, std::string("column ") + names[1] + ": " + number(x.travel) + " m is outside [" +
-                                      number(kMinTravel) + ", " + number(kMaxTravel) + "] m (travel is in metres)");
+    throw_input_error(file, line,
+                      std::string("column ") + names[1] + ": " + format_number(x.travel) + " m is outside [" +
+                          format_number(kMinTravel) + ", " + format_number(kMaxTravel) + "] m (travel is in metres)");
   const double f[3] = {x.f_motion, x.f_lateral, x.f_vertical};
   for (int k = 0; k < 3; ++k)
     if (std::fabs(f[k]) > kMaxForce)
-      throw_input_error(file, line, std::string("column ") + names[2 + k] + ": " + number(f[k]) + " N is beyond +-" +
-                                        number(kMaxForce) + " N");
+      throw_input_error(file, line,
+                        std::string("column ") + names[2 + k] + ": " + format_number(f[k]) + " N is beyond +-" +
+                            format_number(kMaxForce) + " N");
   if (s.size() < 2) return;
   const HapticSample& p = s[s.size() - 2];
   if (!(x.t > p.t)) throw_input_error(file, line, "time does not increase");
   if (x.travel < p.travel - kTravelJitter)
-    throw_input_error(file, line, std::string("column ") + names[1] + " goes back " + number(p.travel - x.travel) +
-                                      " m from the line before (more than " + number(kTravelJitter) + " m)");
+    throw_input_error(file, line,
+                      std::string("column ") + names[1] + " goes back " + format_number(p.travel - x.travel) +
+                          " m from the line before (more than " + format_number(kTravelJitter) + " m)");
 }
 
 // Parses the five fields of one row (names as the file calls its columns) and appends the sample.
@@ -166,8 +163,9 @@ Dataset load_dataset(const fs::path& dir) {
     seq.height = *h;
     seq.speed = parse_double(f[3], manifest, n, "speed");
     if (!(seq.speed >= kMinSpeed && seq.speed <= kMaxSpeed))
-      throw_input_error(manifest, n, "speed " + number(seq.speed) + " m/s is outside [" + number(kMinSpeed) + ", " +
-                                         number(kMaxSpeed) + "] m/s (speed is in m/s)");
+      throw_input_error(manifest, n,
+                        "speed " + format_number(seq.speed) + " m/s is outside [" + format_number(kMinSpeed) + ", " +
+                            format_number(kMaxSpeed) + "] m/s (speed is in m/s)");
     if (!f[4].empty()) {
       const auto o = parse_outcome(f[4]);
       if (!o) throw_input_error(manifest, n, "label must be good, missed, caught or empty, not '" + std::string(f[4]) + "'");
@@ -179,10 +177,11 @@ Dataset load_dataset(const fs::path& dir) {
     }
     seq.samples = read_trial_csv(dir / std::string(f[5]));
     if (const size_t k = unrecorded_samples(seq); k > kMaxUnrecordedSamples)
-      throw_input_error(manifest, n, "trial '" + seq.id + "' would start " + std::to_string(k) +
-                                         " samples into its pull (first travel " + number(seq.samples.front().travel) +
-                                         " m at " + number(seq.speed) + " m/s), more than " +
-                                         std::to_string(kMaxUnrecordedSamples) + ": is t in seconds?");
+      throw_input_error(manifest, n,
+                        "trial '" + seq.id + "' would start " + std::to_string(k) +
+                            " samples into its pull (first travel " + format_number(seq.samples.front().travel) +
+                            " m at " + format_number(seq.speed) + " m/s), more than " +
+                            std::to_string(kMaxUnrecordedSamples) + ": is t in seconds?");
     ds.trials.push_back(std::move(seq));
   });
   return ds;
@@ -282,8 +281,8 @@ void save_dataset(const Dataset& ds, const fs::path& dir) {
     }
     if (!holds(dir / file, text)) write_file_atomic(dir / file, text);
     after.insert(file);
-    m << seq.id << ',' << seq.participant << ',' << arm_height_name(seq.height) << ',' << number(seq.speed) << ','
-      << (seq.label ? outcome_name(*seq.label) : std::string_view()) << ',' << file << '\n';
+    m << seq.id << ',' << seq.participant << ',' << arm_height_name(seq.height) << ',' << format_number(seq.speed)
+      << ',' << (seq.label ? outcome_name(*seq.label) : std::string_view()) << ',' << file << '\n';
   }
   write_file_atomic(manifest, m.str());
   for (const auto& f : before) {

@@ -16,6 +16,12 @@
 namespace dressguard {
 namespace fs = std::filesystem;
 
+std::string format_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
 void throw_input_error(const fs::path& file, long line, std::string_view what) {
   std::ostringstream os;
   os << file.string();

@@ -18,6 +18,9 @@ class InputError : public std::runtime_error {
 // "path:line: what" (line 0 omits the line).
 [[noreturn]] void throw_input_error(const std::filesystem::path& file, long line, std::string_view what);
 
+// A number as people read it in messages and CSV: six significant digits ("%.6g").
+std::string format_number(double v);
+
 // Reads a whole file; throws InputError naming the file if it cannot.
 std::string read_file(const std::filesystem::path& path);
 

@@ -15,12 +15,6 @@ namespace {
 
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r'; }
 
-std::string number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
 // Splits a line into whitespace-separated tokens (views into the line).
 std::vector<std::string_view> tokens(std::string_view line) {
   std::vector<std::string_view> out;
@@ -67,7 +61,8 @@ void check_cloth_topology(const GownMesh& mesh, const std::vector<long>& face_li
     const double area =
         0.5 * (mesh.x[tri[1]] - mesh.x[tri[0]]).cross(mesh.x[tri[2]] - mesh.x[tri[0]]).norm();
     if (!(area >= kMinObjFaceArea))
-      throw_input_error(path, face_line[f], "face of area " + number(area) + " m^2 (its vertices are collinear)");
+      throw_input_error(path, face_line[f],
+                        "face of area " + format_number(area) + " m^2 (its vertices are collinear)");
     std::array<int, 3> key = tri;
     std::sort(key.begin(), key.end());
     if (auto [it, fresh] = faces.emplace(key, f); !fresh)
@@ -88,7 +83,7 @@ void check_cloth_topology(const GownMesh& mesh, const std::vector<long>& face_li
 }  // namespace
 
 GownMesh read_obj(const std::filesystem::path& path, double scale) {
-  if (!(scale > 0)) throw_input_error(path, 0, "scale must be positive, got " + number(scale));
+  if (!(scale > 0)) throw_input_error(path, 0, "scale must be positive, got " + format_number(scale));
   const std::string text = read_file(path);
   GownMesh mesh;
   std::vector<long> face_line;  // the line of each triangle, for the topology's messages
@@ -112,9 +107,10 @@ GownMesh read_obj(const std::filesystem::path& path, double scale) {
       p *= scale;
       if (!p.allFinite()) throw_input_error(path, line_no, "vertex coordinate is not finite (after the scale)");
       if (p.cwiseAbs().maxCoeff() > kMaxObjCoordinate)
-        throw_input_error(path, line_no, "vertex " + std::to_string(mesh.x.size() + 1) + " lies " +
-                                             number(p.cwiseAbs().maxCoeff()) + " m out (after the scale " +
-                                             number(scale) + "): a gown spans about a metre");
+        throw_input_error(path, line_no,
+                          "vertex " + std::to_string(mesh.x.size() + 1) + " lies " +
+                              format_number(p.cwiseAbs().maxCoeff()) + " m out (after the scale " +
+                              format_number(scale) + "): a gown spans about a metre");
       mesh.x.push_back(p);
     } else if (t[0] == "f") {
       if (t.size() < 4) throw_input_error(path, line_no, "face with fewer than 3 vertices");
