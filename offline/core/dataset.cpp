@@ -106,6 +106,13 @@ void append_sample(const std::vector<std::string_view>& f, const char* const nam
 
 bool is_control(char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7F; }
 
+// The study's trial files are <k>.txt; a copy through another file system may say .TXT.
+bool is_trial_file_name(const fs::path& p) {
+  std::string e = p.extension().string();
+  for (char& c : e) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return e == ".txt";
+}
+
 }  // namespace
 
 std::vector<HapticSample> read_trial_csv(const fs::path& path) {
@@ -339,7 +346,7 @@ Dataset import_study(const fs::path& study) {
     for (const auto& subj : fs::directory_iterator(dir)) {
       if (!subj.is_directory()) continue;
       for (const auto& f : fs::directory_iterator(subj.path())) {
-        if (f.path().extension() == ".txt") files.push_back(f.path());
+        if (is_trial_file_name(f.path())) files.push_back(f.path());
       }
     }
     std::sort(files.begin(), files.end());

@@ -269,6 +269,22 @@ TEST(StudyRejects, UnsavableOrRepeatedIdsAndNoTrials) {
   EXPECT_TRUE(names(input_error_of([&] { import_study(dir); }), "is also that of"));
 }
 
+// A trial file's extension in any case is a trial (a copy through a FAT volume says 1.TXT); a
+// note beside the trials is not.
+TEST(Study, ImportsTrialFilesWhateverTheExtensionsCase) {
+  const TempDir tmp("study_case");
+  const fs::path& dir = tmp.path;
+  for (const char* f : {"good", "miss", "caughtmiss"}) fs::create_directories(dir / f / "subject2");
+  const std::string rows = "0 0 0 0 0\n0.01 0.001 -0.1 0 0\n";
+  write_text(dir / "good" / "subject2" / "1.TXT", rows);
+  write_text(dir / "miss" / "subject2" / "4.txt", rows);
+  write_text(dir / "miss" / "subject2" / "notes.md", "not a trial\n");
+  const Dataset ds = import_study(dir);
+  ASSERT_EQ(ds.trials.size(), 2u);
+  EXPECT_EQ(ds.trials[0].id, "s2-good-1");
+  EXPECT_EQ(ds.trials[1].id, "s2-miss-4");
+}
+
 TEST(Files, AtomicWriteReplacesWholeOrNothing) {
   const TempDir tmp("atomic");
   const fs::path& dir = tmp.path;
