@@ -575,12 +575,17 @@ Checkpoint decode_checkpoint(const std::string& text, const std::filesystem::pat
   in.get();
   std::getline(in, c.fingerprint);
   std::size_t nfits = 0;
-  if (!(in >> word >> c.generations_done) || word != "generations_done") throw_input_error(path, 3, "expected 'generations_done'");
+  if (!(in >> word >> c.generations_done) || word != "generations_done" || c.generations_done < 0)
+    throw_input_error(path, 3, "expected 'generations_done' and a count of 0 or more");
   if (!(in >> word >> nfits) || word != "best_fits" || nfits > 16) throw_input_error(path, 4, "expected 'best_fits'");
   c.best_fits.resize(nfits);
   for (auto& v : c.best_fits) {
     if (!(in >> word)) throw_input_error(path, 4, "truncated best_fits");
-    v = std::strtod(word.c_str(), nullptr);
+    // A fit is an area between curves (eq. 3-5): finite and not negative.
+    char* end = nullptr;
+    v = std::strtod(word.c_str(), &end);
+    if (end != word.c_str() + word.size() || !std::isfinite(v) || v < 0)
+      throw_input_error(path, 4, "best_fits: '" + word + "' is not a fit (a finite number of 0 or more)");
   }
   if (!(in >> word) || word != "cmaes") throw_input_error(path, 5, "expected 'cmaes'");
   in.get();

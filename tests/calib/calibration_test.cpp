@@ -939,6 +939,21 @@ TEST(Calibration, CheckpointOfAnotherRunIsRefused) {
   EXPECT_EQ(constraint.cloth(constraint.initial_unit()).friction_scheme, "constraint");
   EXPECT_THROW(calibrate(inputs, constraint, testing::fake_simulate, o, Comm::world()), InputError);
   EXPECT_NO_THROW(calibrate(inputs, space, testing::fake_simulate, o, Comm::world()));  // its own run resumes
+  // Its own checkpoint with a fit that is not a number, or a negative one, is refused at line 4.
+  const std::string text = read_file(o.checkpoint);
+  const std::size_t fits = text.find("best_fits ");
+  ASSERT_NE(fits, std::string::npos);
+  const std::size_t first = text.find(' ', fits + 10) + 1;  // after "best_fits <n> "
+  const std::size_t after = text.find_first_of(" \n", first);  // the first fit is [first, after)
+  for (const char* bad : {"0x1.8p+1junk", "nan", "-0x1p-1"}) {
+    write_file_atomic(o.checkpoint, text.substr(0, first) + bad + text.substr(after));
+    try {
+      calibrate(inputs, space, testing::fake_simulate, o, Comm::world());
+      FAIL() << "a checkpoint with the fit '" << bad << "' resumed";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(":4: best_fits"), std::string::npos) << e.what();
+    }
+  }
   write_file_atomic(o.checkpoint, "garbage\n");
   EXPECT_THROW(calibrate(inputs, space, testing::fake_simulate, o, Comm::world()), InputError);
   fs::remove_all(dir);
