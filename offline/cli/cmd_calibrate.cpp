@@ -284,7 +284,8 @@ int run_calibrate(int argc, char** argv) {
     // Said before the first generation (minutes away at the paper's budget): whether this run
     // starts afresh or continues a stopped one. A checkpoint of another command is refused then.
     std::fprintf(stderr, "calibrate: checkpoint %s (%s)\n", o.checkpoint.c_str(),
-                 std::filesystem::exists(o.checkpoint) ? "exists: resuming it" : "new: written each generation");
+                 std::filesystem::exists(o.checkpoint) ? "exists: resumed if it is this run's"
+                                                       : "new: written each generation");
     // The seed picks the sequences (IV-B.1: one per height at random) unless --inputs names them.
     // Continuing a calibration of the same person on other trials than the file was fitted to (its
     // offsets included) is legitimate but rarely what was meant: said before the hours of search,

@@ -423,7 +423,7 @@ if(STUDY)
   endif()
   execute_process(COMMAND ${DG} ${again} --out ${WORK}/r.json RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/r.json OR EXISTS ${WORK}/r.json.ckpt
-     OR NOT err MATCHES "calibrate: checkpoint [^\n]*/r\\.json\\.ckpt \\(exists: resuming it\\)\n"
+     OR NOT err MATCHES "calibrate: checkpoint [^\n]*/r\\.json\\.ckpt \\(exists: resumed if it is this run's\\)\n"
      OR NOT err MATCHES "\ngeneration 2/2  best L [^\n]*  \\(resumed after generation 1\\)\n"
      OR err MATCHES "generation 1/2")
     message(FATAL_ERROR "calibrate resumed (${rc}):\n${out}\n${err}")
