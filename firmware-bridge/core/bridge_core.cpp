@@ -14,7 +14,17 @@ void bridge_init(BridgeCore& c, const BridgeConfig& cfg, uint32_t now_ms) {
   c.start_ms = now_ms;
   c.next_heartbeat_ms = now_ms;
   c.last_predictor_ms = now_ms;
+  c.last_trial_frame_ms = now_ms;
 }
+
+namespace {
+
+// Wrap-safe: more than protocol::kSporadicResyncMs since `then`.
+bool silent_since(uint32_t now_ms, uint32_t then) {
+  return static_cast<uint32_t>(now_ms - then) > protocol::kSporadicResyncMs;
+}
+
+}  // namespace
 
 int bridge_on_reading(BridgeCore& c, const FtReading& r, uint32_t, Frame out[2]) {
   const uint8_t n = c.sample_counter.next();
@@ -51,18 +61,26 @@ BridgeAction bridge_on_frame(BridgeCore& c, const Frame& f, uint32_t now_ms) {
       c.last_stop_reason = s.reason;
       if (c.stop_cause != StopCause::None) return BridgeAction::None;  // already latched
       c.stop_cause = StopCause::StopFrame;
+      c.stop_written = false;
       return BridgeAction::StopRobot;
     }
     case protocol::id_of(protocol::MsgId::TrialStart):
+      // A robot controller that restarted counts from 0 again.
+      if (silent_since(now_ms, c.last_trial_frame_ms)) c.trial_checker.reset();
+      c.last_trial_frame_ms = now_ms;
       if (!protocol::accepted(c.trial_checker.check(f, lost))) {
         ++c.bad_frames;
         return BridgeAction::None;
       }
-      // A new trial releases the latch (the robot controller restarts the motion itself).
+      // A new trial releases a latch whose stop reached the robot (the robot controller restarts
+      // the motion itself); one still unwritten stands (bridge_core.h).
+      if (c.stop_cause != StopCause::None && !c.stop_written) return BridgeAction::None;
       c.stop_cause = StopCause::None;
       c.last_stop_reason = protocol::StopReason::None;
       return BridgeAction::None;
     case protocol::id_of(protocol::MsgId::HeartbeatPredictor):
+      // A restarted predictor counts from 0 again; it was silent for its restart.
+      if (silent_since(now_ms, c.last_predictor_ms)) c.predictor_hb_checker.reset();
       if (!protocol::accepted(c.predictor_hb_checker.check(f, lost))) {
         ++c.bad_frames;
         return BridgeAction::None;
@@ -79,6 +97,7 @@ int bridge_on_tick(BridgeCore& c, uint32_t now_ms, Frame* out, BridgeAction* act
   if (c.cfg.predictor_timeout_ms > 0 && c.stop_cause == StopCause::None &&
       static_cast<uint32_t>(now_ms - c.last_predictor_ms) > c.cfg.predictor_timeout_ms) {
     c.stop_cause = StopCause::PredictorSilent;
+    c.stop_written = false;
     *action = BridgeAction::StopRobot;
   }
   // Wrap-safe comparison of millisecond ticks.

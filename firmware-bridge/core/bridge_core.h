@@ -9,7 +9,12 @@
 //     a failed read produces no frame at all (never stale data: the predictor's deadline then
 //     stops the robot), and the heartbeat says "sensor lost";
 //   - a valid Stop frame (E2E-checked) latches a stop: the port must stop the robot and keeps
-//     the latch until the next TrialStart frame on the bus;
+//     the latch until the next TrialStart frame on the bus, once the port has written the stop
+//     (bridge_on_stop_written); a stop the robot never received is not released by a trial
+//     start, so it is neither lost nor written into the next trial unannounced: the heartbeat
+//     says StopLatched until it is written;
+//   - trial starts and the predictor's heartbeat are sporadic streams whose sender may restart:
+//     their E2E checkers resynchronise after protocol::kSporadicResyncMs of silence;
 //   - optionally, a predictor whose heartbeat is silent for predictor_timeout_ms is itself a
 //     reason to stop (the robot must not run unguarded).
 #pragma once
@@ -56,8 +61,10 @@ struct BridgeCore {
   uint32_t bad_frames = 0;       // stop/trial/heartbeat frames that failed their E2E check
   uint32_t start_ms = 0;
   uint32_t next_heartbeat_ms = 0;
-  uint32_t last_predictor_ms = 0;
+  uint32_t last_predictor_ms = 0;     // the last accepted predictor heartbeat (or the start)
+  uint32_t last_trial_frame_ms = 0;   // the last TrialStart frame, accepted or not (or the start)
   bool predictor_seen = false;
+  bool stop_written = false;          // the latched stop reached the robot (bridge_on_stop_written)
 };
 
 void bridge_init(BridgeCore& c, const BridgeConfig& cfg, uint32_t now_ms);
@@ -69,6 +76,10 @@ int bridge_on_reading(BridgeCore& c, const FtReading& r, uint32_t now_ms, Frame 
 void bridge_on_sensor_error(BridgeCore& c, uint32_t now_ms);
 // The port reconnected to the sensor.
 void bridge_on_reconnect(BridgeCore& c);
+
+// The port wrote the latched stop to the robot controller (or has no robot to write it to): a
+// TrialStart may release the latch from now on.
+inline void bridge_on_stop_written(BridgeCore& c) { c.stop_written = true; }
 
 // A frame received from the bus (Stop, TrialStart, HeartbeatPredictor; others are ignored).
 BridgeAction bridge_on_frame(BridgeCore& c, const Frame& f, uint32_t now_ms);

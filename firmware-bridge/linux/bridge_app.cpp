@@ -31,7 +31,11 @@ bool power_of_two(uint64_t n) { return n != 0 && (n & (n - 1)) == 0; }
 
 BridgeApp::BridgeApp(const BridgeAppConfig& cfg, ModbusSensor& sensor, RobotStopWriter* robot, can::CanPort& port)
     : cfg_(cfg), sensor_(sensor), robot_(robot), port_(port) {
-  bridge_init(core_, cfg.core, now_ms());
+  const uint32_t t0 = now_ms();
+  bridge_init(core_, cfg.core, t0);
+  // The first connect is due now. (0 would be due only while the uptime modulo 2^32 ms is below
+  // 2^31 ms, due() being wrap-safe: on a machine up 24.9 to 49.7 days, never.)
+  next_connect_ms_ = t0;
   epoll_fd_ = epoll_create1(EPOLL_CLOEXEC);
   timer_fd_ = timerfd_create(CLOCK_MONOTONIC, TFD_NONBLOCK | TFD_CLOEXEC);
   shutdown_fd_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
@@ -88,11 +92,13 @@ void BridgeApp::try_stop(uint32_t t) {
   if (!stop_pending_ || !due(t, next_stop_try_ms_)) return;
   if (!robot_) {
     stop_pending_ = false;
+    bridge_on_stop_written(core_);  // nothing will ever write it: a trial start may release it
     say("stop requested; no --robot: not written");
     return;
   }
   if (robot_->write_stop()) {
     stop_pending_ = false;
+    bridge_on_stop_written(core_);
     ++stats_.stops_written;
     say("stop written to the robot controller%s", stop_failures_ ? " (after failed writes)" : "");
     stop_failures_ = 0;

@@ -257,6 +257,12 @@ class E2EChecker {
   bool have_last_ = false;
 };
 
+// Sporadic streams (trial frames, the other node's heartbeat) have no deadline of their own, and
+// their sender may restart with its counter at 0: a receiver that has heard nothing of a stream
+// for this long resets its checker, so that the restarted sender's frames are not discarded as
+// late for up to 128 of them. A delayed frame is never this late on CAN.
+inline constexpr uint32_t kSporadicResyncMs = 1000;
+
 // A sender's alive counter: one per transmitted stream.
 struct AliveCounter {
   uint8_t value = 0;

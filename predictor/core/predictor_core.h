@@ -173,7 +173,7 @@ class Predictor {
   void on_trial_start(const Frame& f, int64_t now_ns) noexcept;
   void on_trial_end(const Frame& f, int64_t now_ns) noexcept;
   void resync_events(int64_t now_ns) noexcept;
-  static constexpr int64_t kEventResyncNs = 1'000'000'000;
+  static constexpr int64_t kEventResyncNs = int64_t{protocol::kSporadicResyncMs} * 1'000'000;
   // E2E check with counting; true when the frame may be used.
   bool checked(protocol::E2EChecker& chk, const Frame& f, int64_t now_ns, uint32_t& lost) noexcept;
   void charge_bad(uint32_t frames, int64_t now_ns) noexcept;

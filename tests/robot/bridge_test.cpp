@@ -2,6 +2,7 @@
 // the Linux port against real Modbus TCP peers on 127.0.0.1 (dg_modbus_emulator, a libmodbus
 // server with fault injection, as the sensor and as the robot controller) with the CAN side on
 // the in-process bus; mbpoll as an independent Modbus client checks what the peers hold.
+#include <dlfcn.h>
 #include <gtest/gtest.h>
 #include <modbus.h>
 #include <signal.h>
@@ -22,6 +23,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <time.h>
 
 #include "bridge_app.h"
 #include "bridge_core.h"
@@ -30,6 +32,23 @@
 using namespace dressguard;
 using namespace dressguard::bridge;
 using namespace std::chrono_literals;
+
+// The machine's uptime as the bridge sees it: CLOCK_MONOTONIC plus g_uptime_shift_ms. Defined in
+// this executable, clock_gettime takes the place of libc's for the code linked in statically
+// (the bridge's libraries); libstdc++'s steady_clock, which the tests time with, keeps libc's.
+static std::atomic<int64_t> g_uptime_shift_ms{0};
+extern "C" int clock_gettime(clockid_t id, timespec* ts) noexcept {
+  using Real = int (*)(clockid_t, timespec*);
+  static const Real real = reinterpret_cast<Real>(dlsym(RTLD_NEXT, "clock_gettime"));
+  const int r = real(id, ts);
+  const int64_t shift = g_uptime_shift_ms.load();
+  if (r == 0 && id == CLOCK_MONOTONIC && shift != 0) {
+    const int64_t ns = ts->tv_nsec + shift % 1000 * 1000000;
+    ts->tv_sec += shift / 1000 + ns / 1000000000;
+    ts->tv_nsec = ns % 1000000000;
+  }
+  return r;
+}
 
 namespace {
 
@@ -75,10 +94,70 @@ TEST(BridgeCore, StopLatchesUntilTheNextTrialAndIgnoresCorruptStops) {
   EXPECT_EQ(bridge_on_frame(c, stop, 2), BridgeAction::StopRobot);
   EXPECT_EQ(bridge_on_frame(c, stop, 3), BridgeAction::None) << "already latched";
   EXPECT_EQ(bridge_state(c), protocol::BridgeState::StopLatched);
+  bridge_on_stop_written(c);  // the port wrote it to the robot
   bridge_on_frame(c, protocol::encode(protocol::TrialStart{0, 2, 100, protocol::HeightClass::High}), 4);
   EXPECT_FALSE(bridge_stop_latched(c));
   EXPECT_EQ(bridge_on_frame(c, protocol::encode(protocol::Stop{2, protocol::StopReason::HardLimit, 0, 2, 5}), 5),
             BridgeAction::StopRobot);
+}
+
+// A stop the port could not write to the robot (its Modbus link down) is not released by the
+// next trial start: the heartbeat keeps saying StopLatched, and the write, when it succeeds,
+// belongs to a latch the robot controller can see. (Released, the port's pending write landed in
+// the next trial under an "Ok" heartbeat.)
+TEST(BridgeCore, TrialStartKeepsAStopNotYetWritten) {
+  BridgeCore c;
+  bridge_init(c, {}, 0);
+  EXPECT_EQ(bridge_on_frame(c, protocol::encode(protocol::Stop{0, protocol::StopReason::Caught, 250, 1, 100}), 1),
+            BridgeAction::StopRobot);
+  bridge_on_frame(c, protocol::encode(protocol::TrialStart{0, 2, 100, protocol::HeightClass::High}), 2);
+  EXPECT_TRUE(bridge_stop_latched(c)) << "released before the robot had it";
+  EXPECT_EQ(heartbeat_at(c, 3).state, protocol::BridgeState::StopLatched);
+  bridge_on_stop_written(c);
+  bridge_on_frame(c, protocol::encode(protocol::TrialStart{1, 3, 100, protocol::HeightClass::High}), 4);
+  EXPECT_FALSE(bridge_stop_latched(c));
+  // A predictor's silence latches an unwritten stop too.
+  bridge_init(c, BridgeConfig{100, 300}, 0);
+  Frame hb;
+  BridgeAction a;
+  bridge_on_tick(c, 400, &hb, &a);
+  ASSERT_EQ(a, BridgeAction::StopRobot);
+  bridge_on_frame(c, protocol::encode(protocol::TrialStart{0, 5, 100, protocol::HeightClass::High}), 401);
+  EXPECT_TRUE(bridge_stop_latched(c));
+}
+
+// A robot controller or predictor that restarts counts from 0 again. After a silence of
+// protocol::kSporadicResyncMs its frames are heard at once; before, the E2E check discarded them
+// as late until the counter passed the old one (up to 128 trial starts: a latch that never
+// released; up to 12.8 s of heartbeats: a predictor taken for silent).
+TEST(BridgeCore, RestartedSendersAreHeardAfterASilence) {
+  BridgeCore c;
+  bridge_init(c, {}, 0);
+  const auto trial_start = [&c](uint8_t counter, uint16_t trial, uint32_t t) {
+    bridge_on_frame(c, protocol::encode(protocol::TrialStart{counter, trial, 100, protocol::HeightClass::High}), t);
+  };
+  for (uint8_t k = 0; k < 40; ++k) trial_start(k, k, 100u * k);
+  const auto latch_at = [&c](uint32_t t) {
+    bridge_on_frame(c, protocol::encode(protocol::Stop{0, protocol::StopReason::Caught, 250, 1, 100}), t);
+    bridge_on_stop_written(c);
+  };
+  latch_at(4000);
+  trial_start(0, 0, 4500);  // restarted within the resync time: a late frame, discarded
+  EXPECT_TRUE(bridge_stop_latched(c));
+  trial_start(0, 0, 4500 + protocol::kSporadicResyncMs + 1);
+  EXPECT_FALSE(bridge_stop_latched(c)) << "a restarted robot controller's trial start was discarded";
+  EXPECT_EQ(c.bad_frames, 1u);
+
+  bridge_init(c, BridgeConfig{100, 300}, 0);
+  Frame hb;
+  BridgeAction a;
+  for (uint8_t k = 0; k < 50; ++k)
+    bridge_on_frame(c, protocol::encode(protocol::HeartbeatPredictor{k, protocol::PredictorState::Idle, 1, 0, 0}), 10u * k);
+  bridge_on_tick(c, 900, &hb, &a);
+  ASSERT_EQ(a, BridgeAction::StopRobot) << "silent for 410 ms";
+  const uint32_t back = 490 + protocol::kSporadicResyncMs + 1;
+  bridge_on_frame(c, protocol::encode(protocol::HeartbeatPredictor{0, protocol::PredictorState::Idle, 1, 0, 0}), back);
+  EXPECT_EQ(c.last_predictor_ms, back) << "a restarted predictor's heartbeat was discarded";
 }
 
 TEST(BridgeCore, SilentPredictorStopsWhenConfigured) {
@@ -139,6 +218,7 @@ TEST(BridgeCore, ReleasedLatchReportsTheSensorAsItIs) {
   EXPECT_EQ(bridge_on_frame(c, protocol::encode(protocol::Stop{0, protocol::StopReason::Caught, 250, 1, 100}), 1),
             BridgeAction::StopRobot);
   EXPECT_EQ(heartbeat_state(2), protocol::BridgeState::StopLatched);
+  bridge_on_stop_written(c);
   bridge_on_frame(c, protocol::encode(protocol::TrialStart{0, 2, 100, protocol::HeightClass::High}), 3);
   EXPECT_FALSE(bridge_stop_latched(c));
   EXPECT_EQ(heartbeat_state(200), protocol::BridgeState::SensorLost) << "no reading yet";
@@ -147,6 +227,7 @@ TEST(BridgeCore, ReleasedLatchReportsTheSensorAsItIs) {
   EXPECT_EQ(heartbeat_state(400), protocol::BridgeState::Ok);
   bridge_on_sensor_error(c, 401);
   bridge_on_frame(c, protocol::encode(protocol::Stop{1, protocol::StopReason::HardLimit, 0, 2, 5}), 402);
+  bridge_on_stop_written(c);
   bridge_on_frame(c, protocol::encode(protocol::TrialStart{1, 3, 100, protocol::HeightClass::High}), 403);
   EXPECT_EQ(heartbeat_state(600), protocol::BridgeState::SensorLost) << "the last read failed";
 }
@@ -311,6 +392,23 @@ TEST(BridgeModbus, ReadingsFlowToCanAndSurviveFaults) {
   EXPECT_GE(rig.collect(1000ms), 20) << "did not come back after the sensor did";
   EXPECT_GT(rig.app->stats().reconnects.load(), reconnects);
   EXPECT_GE(rig.app->stats().connect_failures.load(), 1u) << "the backoff never tried while it was gone";
+}
+
+// The bridge's millisecond clock is CLOCK_MONOTONIC mod 2^32 (49.7 days), compared wrap-safely.
+// Its first connect used to be due at 0, which such a comparison finds due only while the clock
+// is below 2^31: on a machine up 24.9 to 49.7 days (mod 49.7) it never connected, sent no frame
+// and said nothing. Here the clock reads 2^31 + 2^30 ms, the middle of that half.
+TEST(BridgeModbus, ConnectsWhateverTheUptime) {
+  timespec ts;
+  ASSERT_EQ(clock_gettime(CLOCK_MONOTONIC, &ts), 0);
+  const uint32_t now = static_cast<uint32_t>(static_cast<uint64_t>(ts.tv_sec) * 1000 + ts.tv_nsec / 1000000);
+  g_uptime_shift_ms = static_cast<uint32_t>((3u << 30) - now);
+  struct Unshift {
+    ~Unshift() { g_uptime_shift_ms = 0; }
+  } unshift;
+  BridgeRig rig;
+  ASSERT_GT(rig.sensor_emu.port(), 0);
+  EXPECT_GE(rig.collect(300ms), 15) << "no readings at an uptime of 37.3 days (mod 49.7)";
 }
 
 // One answer 40 ms late against the 20 ms timeout: the link is closed at the timeout and

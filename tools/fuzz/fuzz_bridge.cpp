@@ -8,7 +8,11 @@
 //   stop        a Stop frame with a valid CRC latches the stop (a repeated one too: a stop is
 //               never dropped for its counter), and asks the robot to stop exactly when it
 //               was not latched; a corrupted or short one changes nothing;
-//   release     only a TrialStart that its E2E check accepts releases the latch;
+//   release     only a TrialStart that its E2E check accepts releases the latch, and only once
+//               the port has written the stop (bridge_on_stop_written);
+//   resync      a TrialStart after more than protocol::kSporadicResyncMs without one, and a
+//               predictor heartbeat that long after the last accepted one, start their E2E
+//               check afresh (a restarted sender counts from 0);
 //   silence     with a predictor timeout, a tick latches the stop exactly when the predictor's
 //               heartbeat (E2E-accepted) is older than the timeout, wrap-safe;
 //   heartbeat   sent on the tick when due (period from the last one, wrap-safe), E2E-protected,
@@ -46,10 +50,12 @@ struct Shadow {
   uint8_t c_stop = 0, c_trial = 0, c_phb = 0;  // the predictor's and the robot's senders
   uint8_t c_hb = 0;                            // the bridge's heartbeat, as last received
   bool latched = false;
+  bool written = false;     // the latched stop was written (StopWritten)
   bool sensor_lost = true;  // until the first reading
   uint8_t sample_counter = 0;
   bool sampled = false;
   uint32_t last_predictor = 0;
+  uint32_t last_trial = 0;  // the last TrialStart frame, accepted or not
   uint32_t next_heartbeat = 0;
   uint32_t start = 0;
   uint32_t sensor_errors = 0, reconnects = 0;  // counted without bound
@@ -90,21 +96,35 @@ void stop_frame(const Frame& f, BridgeCore& c, Shadow& sh, long op) {
   const bool asks = a == BridgeAction::StopRobot;
   if (valid && asks != !sh.latched) broken(sh.latched ? "a stop asked again while latched" : "a valid stop frame did not stop the robot", op);
   if (!valid && asks) broken("a corrupted or short stop frame stopped the robot", op);
+  if (asks) sh.written = false;
   if (valid) sh.latched = true;
   if (bridge::bridge_stop_latched(c) != sh.latched) broken(valid ? "a valid stop frame did not latch" : "a corrupted or short stop frame changed the latch", op);
 }
 
-// Any other frame: a TrialStart accepted by its E2E check releases the latch; a predictor
+// Wrap-safe: more than protocol::kSporadicResyncMs since `then`.
+bool resyncs(const Shadow& sh, uint32_t then) {
+  return static_cast<uint32_t>(sh.now - then) > protocol::kSporadicResyncMs;
+}
+
+// Any other frame: a TrialStart accepted by its E2E check releases a written latch; a predictor
 // heartbeat accepted by its check restarts the silence clock; nothing asks for a stop.
 void other_frame(const Frame& f, BridgeCore& c, Shadow& sh, long op) {
   uint32_t lost = 0;
+  if (is(f, MsgId::TrialStart)) {
+    if (resyncs(sh, sh.last_trial)) sh.trial_e2e.reset();
+    sh.last_trial = sh.now;
+  }
+  if (is(f, MsgId::HeartbeatPredictor) && resyncs(sh, sh.last_predictor)) sh.hb_e2e.reset();
   const bool trial_ok = is(f, MsgId::TrialStart) && protocol::accepted(sh.trial_e2e.check(f, lost));
   const bool hb_ok = is(f, MsgId::HeartbeatPredictor) && protocol::accepted(sh.hb_e2e.check(f, lost));
   if (bridge::bridge_on_frame(c, f, sh.now) != BridgeAction::None) broken("a frame other than a stop stopped the robot", op);
-  if (trial_ok) sh.latched = false;
+  if (trial_ok && (!sh.latched || sh.written)) sh.latched = false;
   if (hb_ok) sh.last_predictor = sh.now;
   if (bridge::bridge_stop_latched(c) != sh.latched)
-    broken(trial_ok ? "an accepted trial start did not release the latch" : "a frame other than a stop or a trial start changed the latch", op);
+    broken(!trial_ok ? "a frame other than a stop or a trial start changed the latch"
+           : sh.latched ? "an accepted trial start released a stop not yet written"
+                        : "an accepted trial start did not release the latch", op);
+
 }
 
 // A tick: the predictor's silence, then the heartbeat when due.
@@ -116,7 +136,10 @@ void tick(BridgeCore& c, Shadow& sh, long op) {
   BridgeAction a = BridgeAction::None;
   const int n = bridge::bridge_on_tick(c, sh.now, &hb, &a);
   if ((a == BridgeAction::StopRobot) != silent) broken(silent ? "a silent predictor did not stop the robot" : "a tick stopped the robot with the predictor heard", op);
-  if (silent) sh.latched = true;
+  if (silent) {
+    sh.latched = true;
+    sh.written = false;
+  }
   if (bridge::bridge_stop_latched(c) != sh.latched) broken("a tick changed the latch other than for the predictor's silence", op);
   if ((n == 1) != due) broken(due ? "a heartbeat due was not sent" : "a heartbeat before it was due", op);
   if (n != 1) return;
@@ -141,7 +164,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   cfg.heartbeat_period_ms = 1 + h[1];
   Shadow sh;
   sh.now = static_cast<uint32_t>(h[2] | h[3] << 8 | h[4] << 16 | static_cast<uint32_t>(h[5]) << 24);
-  sh.last_predictor = sh.next_heartbeat = sh.start = sh.now;
+  sh.last_predictor = sh.last_trial = sh.next_heartbeat = sh.start = sh.now;
   sh.c_hb = 0xFF;  // one before the first heartbeat's counter (protocol::AliveCounter starts at 0)
   BridgeCore c;
   bridge::bridge_init(c, cfg, sh.now);
@@ -195,6 +218,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         if (is(f, MsgId::Stop)) stop_frame(f, c, sh, op); else other_frame(f, c, sh, op);
         break;
       }
+      case BridgeOp::StopWritten:
+        bridge::bridge_on_stop_written(c);
+        sh.written = true;
+        if (bridge::bridge_stop_latched(c) != sh.latched) broken("a written stop changed the latch", op);
+        break;
       case BridgeOp::Wait:
         if (!in.take(1)) return 0;
         sh.now += in.u8() * fuzz::kBridgeTimeUnitMs;

@@ -241,6 +241,7 @@ int bridge_seeds(const std::filesystem::path& dir) {
     w.op(BridgeOp::Stop, 1, {1, 1, 7});
     w.op(BridgeOp::Stop, 1, {0x20, 1, 7});
     readings(w, 20, -6.0);
+    w.op(BridgeOp::StopWritten, 1);
     w.op(BridgeOp::TrialStart, 1, {0, 8});
     readings(w, 20, -2.0);
     seeds.emplace_back("stop_release", w);
@@ -252,6 +253,7 @@ int bridge_seeds(const std::filesystem::path& dir) {
       w.tick();
     }
     for (int i = 0; i < 45; ++i) w.tick(1);
+    w.op(BridgeOp::StopWritten, 1);
     w.op(BridgeOp::TrialStart, 1, {0, 2});
     w.op(BridgeOp::PredictorHeartbeat, 1, {0});
     w.tick(1);

@@ -77,6 +77,7 @@ enum class BridgeOp : uint8_t {
   RawFrame = 6,     // as TrafficOp::RawFrame
   Tick = 7,         // the port's periodic tick
   Wait = 8,         // 4 x b ms pass, then a tick
+  StopWritten = 9,  // the port wrote the latched stop to the robot
 };
 
 // ---- helpers of both harnesses ----
