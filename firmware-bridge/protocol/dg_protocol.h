@@ -106,7 +106,7 @@ inline constexpr double kForceCountsPerNewton = 100.0;       // 0.01 N per count
 inline constexpr double kTorqueCountsPerNewtonMetre = 1000.0;  // 0.001 Nm per count, +-32.767 Nm
 
 // Rounds to the nearest count and saturates at the int16 range (a saturated reading is still
-// far above every limit, so saturation never hides a stop).
+// beyond every hard limit the predictor's config accepts, so saturation never hides a stop).
 constexpr int16_t to_counts(double value, double counts_per_unit) {
   const double c = value * counts_per_unit;
   if (!(c == c)) return 0;  // NaN: the bridge never sends one; 0 keeps the frame well-formed

@@ -86,6 +86,7 @@ PredictorConfig parse_predictor_config(const std::string& text, const std::strin
   std::istringstream in(text);
   std::string raw;
   long line = 0;
+  long limit_line = 0, bias_line = 0;  // where hard_limit_n and mount_bias were given
   while (std::getline(in, raw)) {
     ++line;
     const size_t hash = raw.find('#');
@@ -115,6 +116,7 @@ PredictorConfig parse_predictor_config(const std::string& text, const std::strin
       c.stop_consecutive = whole(1, 1e6);
     } else if (key == "hard_limit_n") {
       c.hard_limit_n = in_range(0.01, kMaxConfigNewtons);
+      limit_line = line;
     } else if (key == "sensor_timeout_ms") {
       c.sensor_timeout_ns = ms();
     } else if (key == "bad_frame_budget") {
@@ -163,11 +165,24 @@ PredictorConfig parse_predictor_config(const std::string& text, const std::strin
         if (!(t >> tok)) config_error(name, line, "mount_bias takes three numbers [N]");
         c.mount.bias[k] = bounded(config_number(name, line, key, tok), -kMaxConfigNewtons, kMaxConfigNewtons, tok);
       }
+      bias_line = line;
     } else if (others) {
       others->push_back({key, v, line});
     } else {
       config_error(name, line, "unknown key '" + key + "'");
     }
+  }
+  // A saturated reading (+-327.67 N, the protocol's int16 counts) less the mount bias must still
+  // be beyond the hard limit on both axes it watches, in both directions: else saturation would
+  // hide the very stop the limit is for.
+  const double saturated = protocol::force_newtons(32767);
+  for (const int k : {0, 2}) {
+    if (c.hard_limit_n + std::fabs(c.mount.bias[k]) < saturated) continue;
+    config_error(name, limit_line ? limit_line : bias_line,
+                 "hard_limit_n " + config_text(c.hard_limit_n) + " N plus the mount bias's " +
+                     config_text(std::fabs(c.mount.bias[k])) + " N on the " + (k == 0 ? "motion" : "vertical") +
+                     " axis must stay below the " + config_text(saturated) +
+                     " N where the protocol's forces saturate (a saturated reading would never pass it)");
   }
   return c;
 }
@@ -205,7 +220,8 @@ Event Predictor::make_event(EventKind k, int64_t now_ns) const noexcept {
   return e;
 }
 
-bool Predictor::checked(protocol::E2EChecker& chk, const Frame& f, int64_t now_ns, uint32_t& lost) noexcept {
+bool Predictor::checked(protocol::E2EChecker& chk, const Frame& f, int64_t now_ns, uint32_t& lost,
+                        bool charge_lost) noexcept {
   const E2EStatus s = chk.check(f, lost);
   switch (s) {
     case E2EStatus::Ok:
@@ -219,7 +235,7 @@ bool Predictor::checked(protocol::E2EChecker& chk, const Frame& f, int64_t now_n
       e.status = s;
       e.value = lost;
       emit(e);
-      charge_bad(lost, now_ns);
+      if (charge_lost) charge_bad(lost, now_ns);
       return true;
     }
     case E2EStatus::Repeated: count(StatusCounter::Repeated); break;
@@ -273,7 +289,7 @@ void Predictor::resync_events(int64_t now_ns) noexcept {
 void Predictor::on_trial_start(const Frame& f, int64_t now_ns) noexcept {
   uint32_t lost = 0;
   resync_events(now_ns);
-  if (!checked(chk_start_, f, now_ns, lost)) return;
+  if (!checked(chk_start_, f, now_ns, lost, false)) return;
   chk_end_.reset();  // this trial's end is the first of its kind
   // The sample stream resynchronises at a trial start: its first sample is sample 0, and a
   // counter jump since the previous trial is no loss inside this one.
@@ -284,8 +300,8 @@ void Predictor::on_trial_start(const Frame& f, int64_t now_ns) noexcept {
   // A pending stop names a trial that is over: it is not resent into this one (the robot would
   // be latched with another trial's reason and id). If it has waited a whole retry period or
   // more for its echo, the stop socket cannot send, and this trial is refused: a guard that
-  // cannot send a stop cannot guard it. A younger one (decided moments ago, e.g. by this very
-  // frame's lost counter) is simply dropped; its echo, if it comes, is ignored.
+  // cannot send a stop cannot guard it. A younger one (decided moments ago) is simply dropped;
+  // its echo, if it comes, is ignored.
   const bool unconfirmed = stop_pending_ && now_ns - stop_decided_ns_ >= cfg_.stop_retry_ns;
   if (stop_pending_ && !unconfirmed) {
     // Logged: a stop nobody saw leave is worth a line even when it no longer matters.
@@ -295,6 +311,7 @@ void Predictor::on_trial_start(const Frame& f, int64_t now_ns) noexcept {
     emit(e);
   }
   stop_pending_ = false;
+  trial_ended_ = false;
   decision_ = Decision{};
   ++trials_started_;
   decision_.trial = m.trial_id;
@@ -318,7 +335,7 @@ void Predictor::on_trial_start(const Frame& f, int64_t now_ns) noexcept {
 void Predictor::on_trial_end(const Frame& f, int64_t now_ns) noexcept {
   uint32_t lost = 0;
   resync_events(now_ns);
-  if (!checked(chk_end_, f, now_ns, lost)) return;
+  if (!checked(chk_end_, f, now_ns, lost, false)) return;
   protocol::TrialEnd m;
   protocol::decode(f, m);
   if (m.trial_id != decision_.trial) return;  // the end of a trial we never saw start
@@ -326,19 +343,27 @@ void Predictor::on_trial_end(const Frame& f, int64_t now_ns) noexcept {
   e.reason = decision_.reason;
   e.value = m.samples;
   emit(e);
-  if (decision_.state == PredictorState::InTrial) decision_.state = PredictorState::Idle;
-  if (decision_.state == PredictorState::Stopped && !stop_pending_) decision_.state = PredictorState::Idle;
+  trial_ended_ = true;
+  // A stop stays latched while its frame is unconfirmed (on_stop_echo rests it then).
+  if (decision_.state == PredictorState::InTrial || (decision_.state == PredictorState::Stopped && !stop_pending_))
+    decision_.state = rest_state();
 }
 
 void Predictor::on_force(const Frame& f, int64_t now_ns) noexcept {
   uint32_t lost = 0;
-  if (!checked(chk_force_, f, now_ns, lost)) return;
+  if (!checked(chk_force_, f, now_ns, lost, false)) return;
   count(StatusCounter::Samples);
-  if (decision_.state != PredictorState::InTrial) return;
+  if (decision_.state != PredictorState::InTrial) {
+    charge_bad(lost, now_ns);  // outside a trial it stops nothing
+    return;
+  }
   // Logical time: the sensor's counter, lost samples included (the first sample of a trial is 0).
   if (samples_started_) decision_.sample += 1 + lost;
   samples_started_ = true;
   last_sample_ns_ = now_ns;
+  // The lost samples, charged now: a bad-frames stop names this sample, the one that decided.
+  charge_bad(lost, now_ns);
+  if (decision_.state != PredictorState::InTrial) return;
   if (bad_score_ > 0) --bad_score_;
 
   // Scaling and mounting: sensor counts -> rig axes [N].
@@ -414,6 +439,7 @@ void Predictor::on_stop_echo(const Frame& f, int64_t now_ns) noexcept {
   e.reason = decision_.reason;
   e.value = stop_retries_;
   emit(e);
+  if (trial_ended_ && decision_.state == PredictorState::Stopped) decision_.state = rest_state();
 }
 
 void Predictor::on_kernel_drops(uint32_t cumulative, int64_t now_ns) noexcept {

@@ -76,7 +76,8 @@ struct PredictorConfig {
 // within 1000 N), sensor_timeout_ms, status_period_ms, heartbeat_period_ms, posteriors_period_ms,
 // stop_retry_ms (each in (0, 600000]). Counts are whole numbers in a range (stop_consecutive
 // 1..1e6, bad_frame_budget 0..1e6, bad_frame_weight 1..1e6, max_delta_counter 1..127);
-// hard_limit_n is in [0.01, 1000] N. Unknown keys and bad or out-of-range values throw
+// hard_limit_n is in [0.01, 1000] N, and with the mount bias's motion and vertical components
+// below the 327.67 N where the protocol's forces saturate. Unknown keys and bad or out-of-range values throw
 // std::runtime_error naming `name`, the line and the key. Keys it does not own
 // (the daemon's: interface, model, rt_priority, ...) are returned in `others` when given.
 struct ConfigEntry {
@@ -175,7 +176,15 @@ class Predictor {
   void resync_events(int64_t now_ns) noexcept;
   static constexpr int64_t kEventResyncNs = int64_t{protocol::kSporadicResyncMs} * 1'000'000;
   // E2E check with counting; true when the frame may be used.
-  bool checked(protocol::E2EChecker& chk, const Frame& f, int64_t now_ns, uint32_t& lost) noexcept;
+  // `charge_lost`: lost frames go to the bad-frame budget at once. Force frames charge them
+  // after advancing the sample index (the stop names the sample that decided); trial frames not
+  // at all (sporadic: a lost start or end of another trial says nothing of this one's data).
+  bool checked(protocol::E2EChecker& chk, const Frame& f, int64_t now_ns, uint32_t& lost,
+               bool charge_lost = true) noexcept;
+  // Where a trial that is over rests: Idle, or Fault without a model.
+  protocol::PredictorState rest_state() const noexcept {
+    return filter_ ? protocol::PredictorState::Idle : protocol::PredictorState::Fault;
+  }
   void charge_bad(uint32_t frames, int64_t now_ns) noexcept;
   void stop(StopReason r, int64_t now_ns) noexcept;
   void send_stop_frame(int64_t now_ns) noexcept;
@@ -207,6 +216,7 @@ class Predictor {
   uint32_t kernel_drops_seen_ = 0;
   // Stop transmission.
   bool stop_pending_ = false;
+  bool trial_ended_ = false;  // the robot ended the trial (TrialEnd); a stop's echo then rests it
   Frame stop_frame_;
   int64_t stop_decided_ns_ = 0;  // first transmission
   int64_t stop_sent_ns_ = 0;     // latest transmission

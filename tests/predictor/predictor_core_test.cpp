@@ -147,6 +147,27 @@ TEST(StopPolicy, ModelThatDidNotLoadRefusesEveryTrial) {
   ASSERT_EQ(h.sink.stops.size(), 1u);
   EXPECT_EQ(h.last_stop().reason, protocol::StopReason::ModelError);
   EXPECT_EQ(h.last_stop().trial_id, 3);
+  // After the refused trial's end the heartbeat says fault again (PROTOCOL.md: 3 fault, no
+  // model), not idle as if a model were loaded.
+  h.p->on_stop_echo(h.sink.stops.back(), h.now);
+  h.p->on_frame(h.src.trial_end(3, 0), h.now);
+  EXPECT_EQ(h.p->decision().state, PredictorState::Fault);
+}
+
+// A trial end that comes before the stop's echo leaves the stop latched (unconfirmed, it is
+// still being resent); the echo then rests the predictor, instead of leaving it "stopped",
+// sending posteriors, until the next trial start.
+TEST(StopTransmission, AnEchoAfterTheTrialEndRestsThePredictor) {
+  Harness h;
+  h.start(4);
+  h.sample(-20.0, 0.0);
+  ASSERT_TRUE(h.p->stop_pending());
+  h.p->on_frame(h.src.trial_end(4, 1), h.now);
+  EXPECT_EQ(h.p->decision().state, PredictorState::Stopped);
+  h.p->on_stop_echo(h.sink.stops.back(), h.now);
+  EXPECT_FALSE(h.p->stop_pending());
+  EXPECT_EQ(h.p->decision().state, PredictorState::Idle);
+  EXPECT_EQ(h.p->decision().reason, protocol::StopReason::HardLimit) << "the finished trial's reason stays readable";
 }
 
 TEST(E2EHandling, CorruptedRepeatedLateFramesAreCountedAndNotUsed) {
@@ -181,6 +202,39 @@ TEST(E2EHandling, LostFramesAdvanceLogicalTime) {
   EXPECT_EQ(h.p->decision().sample, 12u);
   EXPECT_EQ(h.p->counter(StatusCounter::LostFrames), 4u) << "2 force + 2 torque frames";
   EXPECT_TRUE(h.sink.stops.empty()) << "two lost samples are within the budget";
+}
+
+// Trial frames are sporadic: trial starts and ends of other trials lost on the way (here the
+// previous trial's end and six starts) are counted, not charged to the running trial's budget.
+// Charged, they stopped the old trial with its id after the new start was on the bus, and the
+// bridge latched that stop into the new trial.
+TEST(E2EHandling, LostTrialFramesAreNotChargedToTheRunningTrial) {
+  Harness h;
+  h.start(1);
+  for (int i = 0; i < 10; ++i) h.sample(-2.0, 0.0);
+  h.src.trial_end(1, 10);  // lost
+  for (uint16_t t = 2; t < 8; ++t) h.src.trial_start(t);  // lost
+  h.start(8);
+  EXPECT_TRUE(h.sink.stops.empty()) << "a stop for trial " << h.last_stop().trial_id;
+  EXPECT_EQ(h.p->decision().state, PredictorState::InTrial);
+  EXPECT_EQ(h.p->decision().trial, 8);
+  EXPECT_EQ(h.p->counter(StatusCounter::LostFrames), 6u) << "the six starts; the end is another stream";
+  for (int i = 0; i < 10; ++i) h.sample(-2.0, 0.0);
+  EXPECT_TRUE(h.sink.stops.empty());
+}
+
+// A stop decided by the samples a force frame's counter says were lost names that frame's
+// sample (previous + 1 + lost), as the protocol's `sample` field promises, not the previous one.
+TEST(E2EHandling, ABadFramesStopNamesTheSampleThatDecided) {
+  Harness h;
+  h.start();
+  for (int i = 0; i < 10; ++i) h.sample(-2.0, 0.0);  // samples 0..9
+  for (int i = 0; i < 6; ++i) h.src.next();          // 10..15 lost: 6 x 20 > budget 5 x 20
+  h.sample(-2.0, 0.0);                               // sample 16 decides
+  ASSERT_EQ(h.sink.stops.size(), 1u);
+  EXPECT_EQ(h.last_stop().reason, protocol::StopReason::BadFrames);
+  EXPECT_EQ(h.last_stop().sample, 16);
+  EXPECT_EQ(h.p->decision().stop_sample, 16u);
 }
 
 TEST(E2EHandling, BurstOfCorruptedFramesIsAFailSafeStop) {
@@ -450,6 +504,29 @@ TEST(Config, ValuesOutOfRangeOrNotWholeAreErrors) {
   const auto c = parse_predictor_config("stop_consecutive = 100000\nsensor_timeout_ms = 5000\n", "p.conf");
   EXPECT_EQ(c.stop_consecutive, 100000);
   EXPECT_EQ(c.sensor_timeout_ns, 5000 * kMs);
+}
+
+// The protocol's forces saturate at 327.67 N: a hard limit that a saturated reading, less the
+// mount bias, cannot pass would never fire. Refused, naming the line of the limit (or of the
+// bias when the limit is the default); the lateral axis, which the limit does not watch, is free.
+TEST(Config, AHardLimitASaturatedReadingCannotPassIsAnError) {
+  const auto error_of = [](const std::string& text) -> std::string {
+    try {
+      parse_predictor_config(text, "p.conf");
+    } catch (const std::runtime_error& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_NE(error_of("\nhard_limit_n = 400\n").find("p.conf:2: hard_limit_n 400 N"), std::string::npos);
+  EXPECT_NE(error_of("hard_limit_n = 300\nmount_bias = 0 0 -30\n").find("p.conf:1: hard_limit_n 300 N plus the mount "
+                                                                          "bias's 30 N on the vertical axis"),
+            std::string::npos);
+  EXPECT_NE(error_of("mount_bias = 320 0 0\n").find("p.conf:1: hard_limit_n 10 N plus the mount bias's 320 N on the "
+                                                     "motion axis"),
+            std::string::npos);
+  EXPECT_EQ(error_of("hard_limit_n = 300\nmount_bias = 0 200 0\n"), "");
+  EXPECT_EQ(error_of("hard_limit_n = 327.66\n"), "");
 }
 
 // The configuration file installed with the daemon says "the values below are the defaults":

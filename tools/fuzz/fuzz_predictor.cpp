@@ -8,12 +8,14 @@
 //                 P(caught) > threshold for k consecutive samples; a tick stops exactly when
 //                 no sample was accepted for longer than the sensor timeout; SIGTERM in a trial
 //                 stops; a frame stops exactly when the bad-frame bucket (weight per corrupted,
-//                 short or lost frame, minus 1 per accepted sample, empty at a trial start)
-//                 holds more than budget * weight;
+//                 short or lost frame, lost trial frames aside, minus 1 per accepted sample,
+//                 empty at a trial start) holds more than budget * weight; a stop decided by a
+//                 force frame's lost samples names that frame's sample;
 //   in a trial    no stop outside a trial, except a trial refused for want of a model or
 //                 because the last stop waited stop_retry or more for its echo;
 //   latch         a stop stays (state and reason) until a trial start, or a trial end once its
-//                 stop frame is confirmed;
+//                 stop frame is confirmed (or its confirmation after the trial end); a trial
+//                 that ends rests in idle, or in fault without a model;
 //   stop frame    every stop hands a stop frame to the sink in the same call, E2E-protected,
 //                 with the decision's reason, trial and sample; an unconfirmed stop is resent
 //                 by every tick at least stop_retry after the last send, and only within its
@@ -66,6 +68,7 @@ namespace {
 // sink that allocates either).
 struct RecordingSink final : predictor::PredictorSink {
   int stop_sends = 0;       // transmit_stop calls in the current operation
+  Frame first_stop;         // the current operation's first stop frame
   Frame last_stop;          // the last stop frame handed over
   int64_t last_stop_ns = 0;  // when (the harness's clock)
   int64_t now_ns = 0;
@@ -75,7 +78,7 @@ struct RecordingSink final : predictor::PredictorSink {
   Frame last_status{}, last_post{}, last_hb{};
 
   uint8_t transmit_stop(const Frame& f) noexcept override {
-    ++stop_sends;
+    if (stop_sends++ == 0) first_stop = f;
     last_stop = f;
     last_stop_ns = now_ns;
     if (f.id != protocol::id_of(MsgId::Stop) || !protected_as(f, MsgId::Stop)) bad_output = true;
@@ -110,7 +113,10 @@ struct RecordingSink final : predictor::PredictorSink {
   }
   int dropped = 0;           // StopDropped events in the current operation
   predictor::Event last_dropped{};
+  bool trial_ended = false;  // a TrialEnded event since the last trial start
   void event(const predictor::Event& e) noexcept override {
+    if (e.kind == predictor::EventKind::TrialStarted) trial_ended = false;
+    if (e.kind == predictor::EventKind::TrialEnded) trial_ended = true;
     if (e.kind != predictor::EventKind::StopDropped) return;
     ++dropped;
     last_dropped = e;
@@ -352,12 +358,16 @@ void check_trial_start(const Call& c, const Predictor& p, const RecordingSink& s
     broken("a trial start with the last stop unconfirmed was not refused with stop_unconfirmed", op);
   if (!r.has_model && (d.state != PredictorState::Stopped || d.reason != StopReason::ModelError))
     broken("a trial start without a model was not refused", op);
-  // A younger pending stop is dropped, and says so once, naming the finished trial. (A stop the
-  // start frame itself decided, through the bad-frame budget, is younger still.)
+  // A younger pending stop is dropped, and says so once, naming the finished trial.
   if (unconfirmed && sink.dropped != 0) broken("a stale stop was reported dropped, not refused", op);
   if (c.pending_before && !unconfirmed && sink.dropped != 1) broken("a young pending stop was dropped silently", op);
   if (sink.dropped > 1) broken("one dropped stop was reported twice", op);
   if (sink.dropped == 1 && sink.last_dropped.trial != c.before.trial) broken("the dropped stop names another trial", op);
+  // The start frame decides no stop for the trial before it (its lost predecessors are not
+  // charged): a stop sent after the start was on the bus would latch the new trial.
+  protocol::Stop first{};
+  if (sink.stop_sends > 0 && protocol::decode(sink.first_stop, first) && first.trial_id != m.trial_id)
+    broken("a trial start sent a stop for the trial before it", op);
 }
 
 // No stop outside a trial; the latch; and the stop frame of a new stop.
@@ -365,10 +375,17 @@ void check_stop_state(const Call& c, const Predictor& p, const RecordingSink& si
   const predictor::Decision& d = p.decision();
   const bool stopped_now = c.before.state != PredictorState::Stopped && d.state == PredictorState::Stopped;
   if (stopped_now && c.before.state != PredictorState::InTrial && !started) broken("a stop outside a trial", op);
-  // Latch: out of Stopped only by a trial start, or a trial end after the stop was confirmed.
+  // Latch: out of Stopped only by a trial start, or a trial end after the stop was confirmed, or
+  // the confirmation after the trial end; at rest then (fault without a model).
+  const PredictorState rest = p.filter() ? PredictorState::Idle : PredictorState::Fault;
   if (c.before.state == PredictorState::Stopped && !started) {
-    const bool ended_clean = c.frame_sent && is(c.sent, MsgId::TrialEnd) && d.state == PredictorState::Idle && !p.stop_pending();
-    if (d.state != PredictorState::Stopped && !ended_clean) broken("a stop was released without a trial start or end", op);
+    const bool ended_clean = c.frame_sent && is(c.sent, MsgId::TrialEnd) && d.state == rest && !p.stop_pending();
+    const bool confirmed_after_end = c.kind == TrafficOp::StopEcho && sink.trial_ended && d.state == rest &&
+                                     c.pending_before && !p.stop_pending();
+    if (d.state != PredictorState::Stopped && !ended_clean && !confirmed_after_end)
+      broken("a stop was released without a trial start or end", op);
+    if (d.state == PredictorState::Stopped && sink.trial_ended && !p.stop_pending())
+      broken("a confirmed stop outlived its trial's end", op);
     if (d.state == PredictorState::Stopped && d.reason != c.before.reason) broken("a latched stop changed its reason", op);
   }
   // The stop frame: handed over in the same call, saying what the decision says.
@@ -390,6 +407,11 @@ void check_sample(const Call& c, const Predictor& p, const Rules& r, Shadow& sh,
   const bool accepted = moved(c, p, StatusCounter::Samples) != 0;
   const bool stepped = p.filter() && p.filter()->samples() != c.steps_before;
   if (accepted && !stepped && !bad_frame_stop) broken("an accepted sample in a trial did not reach the filter", op);
+  // A bad-frames stop that this accepted frame's lost samples decided names this frame's sample.
+  // (Not when the sample's torque frame came first: its own losses may have decided.)
+  if (accepted && !stepped && bad_frame_stop && !c.torque_first &&
+      d.stop_sample != (sh.started ? sh.sample + 1 + c.e2e_lost : 0))
+    broken("a bad-frames stop decided by lost samples does not name the sample that decided", op);
   if (!accepted && d.state != PredictorState::InTrial && !bad_frame_stop)
     broken("a rejected frame changed the trial's state other than by the bad-frame budget", op);
   if (accepted != c.e2e_ok) broken("the sample's E2E verdict is not the protocol's", op);
@@ -433,9 +455,10 @@ void check_force_counters(const Call& c, const Predictor& p, long op) {
 // more than budget * weight; a trial start empties it.
 void check_bucket(const Call& c, const Predictor& p, const Rules& r, Shadow& sh, bool started, long op) {
   // Charged: corrupted frames, frames of a bad length and lost frames, of any stream the
-  // predictor checks (its own counters say how many).
+  // predictor checks (its own counters say how many), except the sporadic trial frames' losses.
+  const bool trial_frame = is(c.sent, MsgId::TrialStart) || is(c.sent, MsgId::TrialEnd);
   const uint32_t charged = moved(c, p, StatusCounter::Corrupted) + moved(c, p, StatusCounter::BadLength) +
-                           moved(c, p, StatusCounter::LostFrames);
+                           (trial_frame ? 0u : moved(c, p, StatusCounter::LostFrames));
   sh.bucket += static_cast<int64_t>(charged) * r.cfg.bad_frame_weight;
   if (started) {
     sh.bucket = 0;
@@ -504,7 +527,7 @@ void check_tick(const Call& c, const Predictor& p, const RecordingSink& sink, co
 }
 
 // The calls that carry no frame and no tick: the echo, SIGTERM, drops, bus errors.
-void check_quiet_call(const Call& c, const Predictor& p, long op) {
+void check_quiet_call(const Call& c, const Predictor& p, const RecordingSink& sink, long op) {
   const predictor::Decision& d = p.decision();
   // The echo of the stop frame last sent confirms it; nothing else does.
   if (c.kind == TrafficOp::StopEcho && c.pending_before) {
@@ -514,7 +537,11 @@ void check_quiet_call(const Call& c, const Predictor& p, long op) {
   const bool was_in = c.before.state == PredictorState::InTrial;
   if (c.shut_down && was_in && (d.state != PredictorState::Stopped || d.reason != StopReason::Shutdown))
     broken("SIGTERM in a trial did not stop with reason shutdown", op);
-  if (!(c.shut_down && was_in) && d.state != c.before.state) broken("a call that carries no frame changed the state", op);
+  // Or the echo that confirms a stop after its trial's end, which rests the predictor (the
+  // latch rule checks that).
+  const bool rested = c.kind == TrafficOp::StopEcho && sink.trial_ended && c.before.state == PredictorState::Stopped;
+  if (!(c.shut_down && was_in) && !rested && d.state != c.before.state)
+    broken("a call that carries no frame changed the state", op);
 }
 
 }  // namespace
@@ -562,7 +589,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (force && !c.torque_first) check_force_counters(c, p, op);
     const bool new_stop = p.decision().state == PredictorState::Stopped && (c.before.state != PredictorState::Stopped || started);
     if (new_stop) sh.stop_decided_ns = sh.now;
-    if (!c.frame_sent && !c.ticked) check_quiet_call(c, p, op);
+    if (!c.frame_sent && !c.ticked) check_quiet_call(c, p, sink, op);
   }
   return 0;
 }

@@ -23,6 +23,21 @@ import time
 SRC = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
 # name, the line as it is, the line with the fault.
 PREDICTOR_FAULTS = [
+    ("a lost trial start charged to the running trial",
+     "if (!checked(chk_start_, f, now_ns, lost, false)) return;",
+     "if (!checked(chk_start_, f, now_ns, lost, true)) return;"),
+    ("a bad-frames stop names the sample before the one that decided",
+     "  // Logical time: the sensor's counter, lost samples included (the first sample of a trial is 0).\n"
+     "  if (samples_started_) decision_.sample += 1 + lost;\n",
+     "  charge_bad(lost, now_ns);\n"
+     "  if (decision_.state != PredictorState::InTrial) return;\n"
+     "  if (samples_started_) decision_.sample += 1 + lost;\n"),
+    ("a stop confirmed after its trial's end stays latched",
+     "if (trial_ended_ && decision_.state == PredictorState::Stopped) decision_.state = rest_state();",
+     ""),
+    ("a trial end without a model rests in idle",
+     "    decision_.state = rest_state();\n}",
+     "    decision_.state = PredictorState::Idle;\n}"),
     ("hard limit ignored",
      "if (std::fabs(rig[0]) > cfg_.hard_limit_n || std::fabs(rig[2]) > cfg_.hard_limit_n) {",
      "if (false && (std::fabs(rig[0]) > cfg_.hard_limit_n || std::fabs(rig[2]) > cfg_.hard_limit_n)) {"),
@@ -39,8 +54,8 @@ PREDICTOR_FAULTS = [
      "if (++consecutive_ >= consecutive_needed_)",
      "if (++consecutive_ > consecutive_needed_)"),
     ("latch released before the echo",
-     "if (decision_.state == PredictorState::Stopped && !stop_pending_) decision_.state = PredictorState::Idle;",
-     "if (decision_.state == PredictorState::Stopped) decision_.state = PredictorState::Idle;"),
+     "(decision_.state == PredictorState::Stopped && !stop_pending_))",
+     "decision_.state == PredictorState::Stopped)"),
     ("retry one period late",
      "if (stop_pending_ && now_ns - stop_sent_ns_ >= cfg_.stop_retry_ns) {",
      "if (stop_pending_ && now_ns - stop_sent_ns_ > cfg_.stop_retry_ns) {"),
@@ -48,8 +63,8 @@ PREDICTOR_FAULTS = [
      "if (!stop_pending_ || f.id != stop_frame_.id || f.data[1] != stop_frame_.data[1]) return;",
      "if (!stop_pending_ || f.id != stop_frame_.id) return;"),
     ("an unconfirmed stop carried into the next trial",
-     "stop_pending_ = false;\n  decision_ = Decision{};",
-     "decision_ = Decision{};"),
+     "stop_pending_ = false;\n  trial_ended_ = false;\n  decision_ = Decision{};",
+     "trial_ended_ = false;\n  decision_ = Decision{};"),
     ("a young stop dropped silently",
      "if (stop_pending_ && !unconfirmed) {",
      "if (false) {"),
@@ -63,7 +78,7 @@ PREDICTOR_FAULTS = [
      "if (bad_score_ > 0) --bad_score_;",
      ""),
     ("lost frames not charged to the budget",
-     "      charge_bad(lost, now_ns);\n      return true;",
+     "      if (charge_lost) charge_bad(lost, now_ns);\n      return true;",
      "      return true;"),
     ("the budget not emptied at a trial start",
      "  bad_score_ = 0;\n  samples_started_ = false;",
