@@ -86,7 +86,7 @@ void print_summary(const hmm::Evaluation& ev, size_t models) {
   }
   std::printf("\naccuracy %.4f (%d/%d)%s%s%s\n", ev.accuracy(), ev.correct, ev.total,
               models > 1 ? (", a vote of " + std::to_string(models) + " models").c_str() : "",
-              ev.skipped ? (", " + std::to_string(ev.skipped) + " trials skipped (unlabelled, label not in the model, or empty)").c_str() : "",
+              ev.skipped ? (", " + std::to_string(ev.skipped) + " trials skipped (unlabelled, or no sample before the cut)").c_str() : "",
               interval.c_str());
   std::printf("%s", hmm::confusion_text(ev).c_str());
 }
@@ -137,6 +137,9 @@ int run_classify(int argc, char** argv) {
         "usage: dressguard classify --model MODEL.dgm[,MODEL2.dgm,...] --data DATASET [options] [--json]\n"
         "  Classifies every labelled trial by the highest posterior (log-likelihood + log prior) and\n"
         "  prints per-trial results, the accuracy and the confusion matrix (rows truth, columns predicted).\n"
+        "  A labelled trial whose label the model has no class for counts as wrong: its label gets a row\n"
+        "  of the matrix (and a column of zeros); only unlabelled trials and cuts before a trial's first\n"
+        "  sample are skipped.\n"
         "  With several models, they vote (a committee, e.g. the STCs of several people's simulators):\n"
         "  each model classifies the trial, the class most of them pick wins, a tie goes to the larger\n"
         "  sum of their posteriors; classes are matched by name.\n"
@@ -355,7 +358,7 @@ int run_classify(int argc, char** argv) {
   if (json) {
     std::string rows;
     for (const auto& r : per) {
-      if (r.truth < 0) continue;
+      if (r.result.predicted < 0) continue;  // skipped; a label the model lacks is scored (wrong)
       std::string ll, post;
       for (size_t c = 0; c < single->classes.size(); ++c) {
         ll += (c ? ", " : "") + hmm::json_number(r.result.log_likelihood[c]);
@@ -363,7 +366,7 @@ int run_classify(int argc, char** argv) {
       }
       rows += (rows.empty() ? "" : ", ") + std::string("{\"id\": ") + hmm::json_string(r.trial->id) +
               ", \"participant\": " + hmm::json_string(r.trial->participant) + ", \"samples\": " + std::to_string(r.samples) +
-              ", \"unrecorded_samples\": " + std::to_string(unrecorded_samples(*r.trial)) + ", \"truth\": " + hmm::json_string(single->classes[r.truth].name) + ", \"predicted\": " +
+              ", \"unrecorded_samples\": " + std::to_string(unrecorded_samples(*r.trial)) + ", \"truth\": " + hmm::json_string(outcome_name(*r.trial->label)) + ", \"predicted\": " +
               hmm::json_string(single->classes[r.result.predicted].name) + ", \"log_likelihood\": [" + ll + "], \"posterior\": [" +
               post + "]}";
     }
@@ -374,9 +377,9 @@ int run_classify(int argc, char** argv) {
   }
   std::printf("%-24s %-6s %7s %-8s %-8s %9s\n", "trial", "part.", "samples", "truth", "predicted", "posterior");
   for (const auto& r : per) {
-    if (r.truth < 0) continue;
+    if (r.result.predicted < 0) continue;
     std::printf("%-24s %-6s %7zu %-8s %-8s %9.4f%s\n", r.trial->id.c_str(), r.trial->participant.c_str(), r.samples,
-                single->classes[r.truth].name.c_str(), single->classes[r.result.predicted].name.c_str(),
+                std::string(outcome_name(*r.trial->label)).c_str(), single->classes[r.result.predicted].name.c_str(),
                 r.result.posterior[r.result.predicted], r.truth == r.result.predicted ? "" : "   WRONG");
   }
   print_late_starts(trials);

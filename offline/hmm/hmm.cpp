@@ -682,6 +682,22 @@ Classification classify(const model::OutcomeModel& m, const FeatureSequence& seq
   return r;
 }
 
+namespace {
+
+// The confusion matrix's row of the label `name`: its class's, or a row appended (with a column
+// that stays 0) when the classifier has no such class, so that a trial it can never get right
+// shows as wrong in the matrix too, not only in the accuracy.
+int truth_row(Evaluation& ev, const std::string& name) {
+  const auto it = std::find(ev.classes.begin(), ev.classes.end(), name);
+  if (it != ev.classes.end()) return static_cast<int>(it - ev.classes.begin());
+  ev.classes.push_back(name);
+  for (auto& row : ev.confusion) row.push_back(0);
+  ev.confusion.emplace_back(ev.classes.size(), 0);
+  return static_cast<int>(ev.classes.size()) - 1;
+}
+
+}  // namespace
+
 Evaluation evaluate(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials, double truncate_at,
                     std::vector<TrialResult>* per_trial, const ClassChoice& among) {
   Evaluation ev;
@@ -694,12 +710,13 @@ Evaluation evaluate(const model::OutcomeModel& m, const std::vector<const Haptic
     if (t->label) tr.truth = m.class_index(outcome_name(*t->label));
     const FeatureSequence seq = features_of(*t, m.features, truncate_at);
     tr.samples = seq.size();
-    if (tr.truth < 0 || seq.size() == 0) {
+    if (!t->label || seq.size() == 0) {
       ++ev.skipped;
       tr.truth = -1;
     } else {
+      // A label the model has no class for is scored too: wrong, whatever the model answers.
       tr.result = classify(m, seq, among);
-      ev.confusion[tr.truth][tr.result.predicted]++;
+      ev.confusion[truth_row(ev, std::string(outcome_name(*t->label)))][tr.result.predicted]++;
       ev.total++;
       if (tr.result.predicted == tr.truth) ev.correct++;
     }
@@ -913,11 +930,12 @@ Evaluation evaluate_vote(const std::vector<const model::OutcomeModel*>& models,
   ev.classes = committee_classes(models);
   ev.confusion.assign(ev.classes.size(), std::vector<int>(ev.classes.size(), 0));
   for (const auto* t : trials) {
-    const int truth = t->label ? index_of(ev.classes, std::string(outcome_name(*t->label))) : -1;
-    Vote v = truth >= 0 ? vote(models, *t, truncate_at, among, weights) : Vote{};
-    if (truth < 0 || v.predicted < 0) {
+    Vote v = t->label ? vote(models, *t, truncate_at, among, weights) : Vote{};
+    if (!t->label || v.predicted < 0) {
       ++ev.skipped;
     } else {
+      // A label no model has a class for is scored too: wrong, whatever the committee answers.
+      const int truth = truth_row(ev, std::string(outcome_name(*t->label)));
       ev.confusion[truth][v.predicted]++;
       ev.total++;
       if (v.predicted == truth) ev.correct++;
@@ -928,7 +946,7 @@ Evaluation evaluate_vote(const std::vector<const model::OutcomeModel*>& models,
 }
 
 int right_or_not(const TrialResult& r) {
-  if (r.truth < 0 || r.result.predicted < 0) return -1;
+  if (!r.trial || !r.trial->label || r.result.predicted < 0) return -1;
   return r.result.predicted == r.truth;
 }
 

@@ -166,24 +166,30 @@ struct Classification {
 using ClassChoice = std::vector<std::string>;
 Classification classify(const model::OutcomeModel& m, const FeatureSequence& seq, const ClassChoice& among = {});
 
-// Truth-by-prediction counts over a model's classes: confusion[truth][predicted].
+// Truth-by-prediction counts: confusion[truth][predicted] over `classes`, the model's classes
+// and then every label of a scored trial that the model has no class for (its column stays 0:
+// the model never predicts it; its row holds that label's trials, all wrong).
 struct Evaluation {
   std::vector<std::string> classes;
   std::vector<std::vector<int>> confusion;
-  int correct = 0, total = 0, skipped = 0;  // skipped: unlabelled, label not a model class, or empty
+  int correct = 0, total = 0, skipped = 0;  // skipped: unlabelled, or no sample before the cut
   double accuracy() const { return total ? static_cast<double>(correct) / total : 0.0; }
 };
 
 // One trial's result in an evaluation.
 struct TrialResult {
   const HapticSequence* trial = nullptr;
-  int truth = -1;            // model class index of the label, -1 when skipped
+  int truth = -1;            // model class index of the label; -1 when skipped or when the
+                             // model has no class for the label (then scored, and wrong)
   size_t samples = 0;        // after truncation
   Classification result;     // empty when skipped
 };
 
 // Classifies every trial (cut at truncate_at travel, deciding `among` some classes as classify())
-// and counts the confusion matrix over the trials whose label is one of the model's classes.
+// and counts the confusion matrix over every labelled trial with a sample before the cut. A
+// label the model has no class for counts as wrong (a model trained without any caught trial
+// can never be right about one; skipping such trials once scored a model of "missed" alone
+// 14/14 on the study's 22 trials), as calib::count_correct counts it.
 Evaluation evaluate(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials,
                     double truncate_at = std::numeric_limits<double>::infinity(),
                     std::vector<TrialResult>* per_trial = nullptr, const ClassChoice& among = {});
@@ -239,8 +245,8 @@ double member_weight(int right, int n, int classes);
 // How often a model names the label of `trials` cut at `truncate_at`, deciding `among` some
 // classes (classify()): `scored` counts every labelled trial with a sample before the cut, also
 // one whose label the model does not know (a simulator that never catches, facing a caught
-// trial: in a vote such a member is wrong there, so its weight must count it wrong; evaluate()
-// skips such trials instead), `right` those whose MAP class is the label.
+// trial: in a vote such a member is wrong there, so its weight must count it wrong, as
+// evaluate() does), `right` those whose MAP class is the label.
 struct LabelScore {
   int right = 0, scored = 0;
 };
@@ -323,8 +329,9 @@ std::vector<AnswerModel> simulation_answer_models(const std::vector<const model:
                                                   double truncate_at = std::numeric_limits<double>::infinity(),
                                                   const ClassChoice& among = {});
 
-// evaluate() for a committee: the confusion matrix over the union of the models' classes, every
-// labelled trial whose label one of the models knows. `per_trial` (may be null) gets every trial's
+// evaluate() for a committee: the confusion matrix over the union of the models' classes (then
+// the labels no model has a class for, as evaluate()), every labelled trial with a sample before
+// the cut; a label no model knows counts as wrong. `per_trial` (may be null) gets every trial's
 // vote, skipped trials included (predicted -1). `weights` as vote()'s.
 Evaluation evaluate_vote(const std::vector<const model::OutcomeModel*>& models,
                          const std::vector<const HapticSequence*>& trials,
@@ -335,8 +342,9 @@ Evaluation evaluate_vote(const std::vector<const model::OutcomeModel*>& models,
 // ---- two classifiers on the same trials ------------------------------------------------------
 
 // Whether one classifier got one trial right: 1 when it names the trial's label, 0 when it names
-// another class, -1 when the trial is not scored (unlabelled, a label the classifier does not
-// know, or nothing left after the cut), the rules by which evaluate() and evaluate_vote() count.
+// another class (also when it has no class for the label), -1 when the trial is not scored
+// (unlabelled, or nothing left after the cut), the rules by which evaluate() and evaluate_vote()
+// count.
 // Pairing two classifiers trial by trial (mcnemar_exact_p, below) starts here.
 int right_or_not(const TrialResult& r);
 int right_or_not(const Vote& v, const HapticSequence& trial);

@@ -122,6 +122,32 @@ TEST_F(CliTest, TrainClassifyShowOnSyntheticData) {
   EXPECT_EQ(json_field(showj.out, "format_version"), 1.0) << showj.out;
 }
 
+// A model of "missed" alone cannot be right about a good or a caught trial: classify counts them
+// wrong (6 of 18), each label in a row of the confusion matrix, and skips none. It once scored
+// such a model 6/6 with "12 trials skipped".
+TEST_F(CliTest, ClassifyCountsALabelTheModelLacksAsWrong) {
+  Dataset missed = fx::synthetic_dataset(12, 300, 500, 51, 5, "a");
+  std::erase_if(missed.trials, [](const HapticSequence& t) { return t.label != Outcome::Missed; });
+  save_dataset(missed, dir / "missed");
+  save_dataset(fx::synthetic_dataset(6, 300, 500, 52, 5, "b"), dir / "test");
+  const std::string m1 = (dir / "m1.dgm").string(), test = (dir / "test").string();
+  ASSERT_EQ(run("train --data " + (dir / "missed").string() + " --out " + m1 + " --states 5").code, 0);
+  const auto text = run("classify --model " + m1 + " --data " + test);
+  ASSERT_EQ(text.code, 0) << text.err;
+  EXPECT_NE(text.out.find("accuracy 0.3333 (6/18);"), std::string::npos) << text.out;
+  EXPECT_EQ(text.out.find("skipped"), std::string::npos) << text.out;
+  char row[64];
+  std::snprintf(row, sizeof row, "\n%-14s %8d %8d %8d\n", "caught", 6, 0, 0);
+  EXPECT_NE(text.out.find(row), std::string::npos) << text.out;
+  const auto js = run("classify --model " + m1 + " --data " + test + " --json");
+  ASSERT_EQ(js.code, 0) << js.err;
+  EXPECT_EQ(json_field(js.out, "total", js.out.find("\"evaluation\"")), 18.0) << js.out;
+  EXPECT_NE(js.out.find("\"truth\": \"good\", \"predicted\": \"missed\""), std::string::npos) << js.out;
+  const auto vote = run("classify --model " + m1 + "," + m1 + " --data " + test);
+  ASSERT_EQ(vote.code, 0) << vote.err;
+  EXPECT_NE(vote.out.find("accuracy 0.3333 (6/18), a vote of 2 models;"), std::string::npos) << vote.out;
+}
+
 // A committee (--model A,B,C) votes: with two right models and one trained on swapped good and
 // missed labels, the majority is right on every trial; with the liar twice, the good and missed
 // trials go the liar's way and only the caught ones stay right. A bad file in the list is named.

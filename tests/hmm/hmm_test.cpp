@@ -4,12 +4,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <limits>
 #include <stdexcept>
 
 #include "fixtures.h"
 #include "hmm.h"
+#include "report.h"
 
 using namespace dressguard;
 using dressguard::hmm::FeatureSequence;
@@ -573,7 +575,7 @@ TEST(HmmVote, TieGoesToTheLargerPosteriorSum) {
 }
 
 // Classes are the union by name: a model that knows "caught" brings it in, the others give it
-// no vote, and a caught trial is scored; a label no model knows is skipped.
+// no vote, and a caught trial is scored; a label no model knows is scored too, wrong.
 TEST(HmmVote, ClassesAreTheUnionOfTheModels) {
   const auto a = one_state_model(0, 3), b = one_state_model(0, 3), c = one_state_model(0, 3, true);
   const std::vector<const model::OutcomeModel*> committee = {&a, &b, &c};
@@ -587,12 +589,16 @@ TEST(HmmVote, ClassesAreTheUnionOfTheModels) {
   EXPECT_EQ(ev.confusion[2][1], 1);
   EXPECT_EQ(ev.confusion[0][0], 1);
   const auto two = hmm::evaluate_vote({&a, &b}, {&caught, &good});
-  EXPECT_EQ(two.total, 1);
-  EXPECT_EQ(two.skipped, 1);
+  EXPECT_EQ(two.total, 2);
+  EXPECT_EQ(two.correct, 1);
+  EXPECT_EQ(two.skipped, 0);
+  ASSERT_EQ(two.classes, (std::vector<std::string>{"good", "missed", "caught"}));
+  EXPECT_EQ(two.confusion[2], (std::vector<int>{0, 1, 0}));
 }
 
 // right_or_not, one model and a committee, on a right, a wrong, an unlabelled and a caught trial
-// (a label the two-class model does not know): 1, 0, -1, -1, and the 1s are evaluate()'s correct.
+// (a label the two-class models do not know, so never right): 1, 0, -1, 0, and the 1s are
+// evaluate()'s correct, the 0s and 1s its total.
 TEST(HmmCompare, RightOrNotFollowsTheEvaluationRules) {
   const auto a = one_state_model(0, 3), b = one_state_model(0, 2), c = one_state_model(3, 0);
   HapticSequence right = one_sample(0.2, Outcome::Good), wrong = one_sample(0.2, Outcome::Missed),
@@ -605,21 +611,51 @@ TEST(HmmCompare, RightOrNotFollowsTheEvaluationRules) {
   EXPECT_EQ(hmm::right_or_not(per[0]), 1);
   EXPECT_EQ(hmm::right_or_not(per[1]), 0);
   EXPECT_EQ(hmm::right_or_not(per[2]), -1);
-  EXPECT_EQ(hmm::right_or_not(per[3]), -1);
+  EXPECT_EQ(hmm::right_or_not(per[3]), 0);
   EXPECT_EQ(ev.correct, 1);
-  EXPECT_EQ(ev.total, 2);
+  EXPECT_EQ(ev.total, 3);
+  EXPECT_EQ(ev.skipped, 1);
   std::vector<hmm::Vote> votes;
   const std::vector<const model::OutcomeModel*> committee = {&a, &b, &c};
   const auto vev = hmm::evaluate_vote(committee, trials, std::numeric_limits<double>::infinity(), &votes);
   ASSERT_EQ(votes.size(), 4u);
   std::vector<int> got;
   for (size_t i = 0; i < 4; ++i) got.push_back(hmm::right_or_not(votes[i], *trials[i]));
-  EXPECT_EQ(got, (std::vector<int>{1, 0, -1, -1}));
+  EXPECT_EQ(got, (std::vector<int>{1, 0, -1, 0}));
   EXPECT_EQ(vev.correct, 1);
+  EXPECT_EQ(vev.total, 3);
   // Cut before the first sample (travel 0): nothing left, not scored.
   std::vector<hmm::TrialResult> cut;
   hmm::evaluate(a, {&right}, -1.0, &cut);
   EXPECT_EQ(hmm::right_or_not(cut[0]), -1);
+}
+
+// A model of "missed" alone can never be right about a good trial: each one counts, wrong, in a
+// row of its own after the model's classes (its column 0, never predicted), in the text and the
+// JSON too. Such trials were once skipped, and a model of "missed" alone scored 14/14 on the
+// study's 22 trials.
+TEST(HmmEvaluate, ALabelTheModelLacksCountsAsWrong) {
+  auto m = one_state_model(0, 3);
+  m.classes.erase(m.classes.begin());
+  m.classes[0].log_prior = 0;
+  HapticSequence good = one_sample(0.0, Outcome::Good), missed = one_sample(3.0, Outcome::Missed),
+                 unlabelled = one_sample(0.0, Outcome::Good);
+  unlabelled.label.reset();
+  const auto ev = hmm::evaluate(m, {&good, &missed, &good, &unlabelled});
+  EXPECT_EQ(ev.correct, 1);
+  EXPECT_EQ(ev.total, 3);
+  EXPECT_EQ(ev.skipped, 1);
+  ASSERT_EQ(ev.classes, (std::vector<std::string>{"missed", "good"}));
+  EXPECT_EQ(ev.confusion, (std::vector<std::vector<int>>{{1, 0}, {2, 0}}));
+  char row[64];
+  std::snprintf(row, sizeof row, "\n%-14s %8d %8d\n", "good", 2, 0);
+  EXPECT_NE(hmm::confusion_text(ev).find(row), std::string::npos) << hmm::confusion_text(ev);
+  EXPECT_NE(hmm::evaluation_json(ev).find("\"confusion\": [[1, 0], [2, 0]], \"correct\": 1, \"total\": 3"),
+            std::string::npos) << hmm::evaluation_json(ev);
+  const auto vev = hmm::evaluate_vote({&m, &m}, {&good, &missed, &good, &unlabelled});
+  EXPECT_EQ(vev.correct, 1);
+  EXPECT_EQ(vev.total, 3);
+  EXPECT_EQ(vev.confusion, ev.confusion);
 }
 
 // Deciding among some classes: a trial at x = 8 is caught for a model with means good 0,
