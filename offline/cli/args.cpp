@@ -22,6 +22,18 @@ std::set<std::string> split_list(const std::string& s) {
   return {items.begin(), items.end()};
 }
 
+void require_known_participants(const std::string& option, const std::set<std::string>& given,
+                                const std::set<std::string>& known, const std::string& data) {
+  std::string unknown, names;
+  int n = 0;
+  for (const auto& p : given)
+    if (!known.count(p)) unknown += (n++ ? ", '" : "'") + p + "'";
+  if (n == 0) return;
+  for (const auto& p : known) names += (names.empty() ? "" : ", ") + p;
+  throw UsageError("--" + option + ": " + data + " has no participant" + (n > 1 ? "s " : " ") + unknown +
+                   " (its participants: " + (names.empty() ? "none" : names) + ")");
+}
+
 Args::Args(int argc, char** argv, std::set<std::string> flags) {
   for (int i = 0; i < argc; ++i) {
     std::string a = argv[i];

@@ -26,6 +26,13 @@ std::set<std::string> split_list(const std::string& s);
 // a pooled training set (--data A,B), whose order is the order of the trials HMM training sums.
 std::vector<std::string> split_in_order(const std::string& s);
 
+// UsageError naming every name of `given` (option --`option`'s list) that is not in `known` (the
+// participants of the dataset `data`), and the known ones: a name that matches nobody would
+// select or leave out nothing without a word (train --exclude-participant p4 once trained on
+// participant "4" while its model said it excluded p4).
+void require_known_participants(const std::string& option, const std::set<std::string>& given,
+                                const std::set<std::string>& known, const std::string& data);
+
 // --threads N: 0 is every core; more than this is no machine's.
 inline constexpr long kMaxThreads = 1024;
 

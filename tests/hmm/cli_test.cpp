@@ -324,6 +324,24 @@ TEST_F(CliTest, BadInputExitsTwoNamingTheProblem) {
   EXPECT_EQ(r.code, 2);
 }
 
+// A participant that the data lacks is named, with the ones it has: "p4" (the ids are "4") once
+// left nobody out of training while the model said it excluded p4, and classify ignored p5.
+TEST_F(CliTest, AnUnknownParticipantIsNamed) {
+  save_dataset(fx::synthetic_dataset(3, 100, 120, 54, 3, "4"), dir / "d");
+  const std::string d = (dir / "d").string(), m = (dir / "m.dgm").string();
+  auto r = run("train --data " + d + " --out " + m + " --states 3 --exclude-participant p4");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--exclude-participant: " + d + " has no participant 'p4' (its participants: 4)"),
+            std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(m));
+  ASSERT_EQ(run("train --data " + d + " --out " + m + " --states 3").code, 0);
+  r = run("classify --model " + m + " --data " + d + " --participant 4,p5,p6");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--participant: " + d + " has no participants 'p5', 'p6' (its participants: 4)"),
+            std::string::npos) << r.err;
+  EXPECT_EQ(run("classify --model " + m + " --data " + d + " --participant 4").code, 0);
+}
+
 // Leave-one-participant-out on the measured study (good vs missed; it has no caught trials):
 // train on six participants, classify the seventh, for each; with the study code's 5 states and
 // the paper's 10. Measured: 22/22 with both. Asserted: at least 20/22 (a majority classifier gets
