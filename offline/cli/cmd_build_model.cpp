@@ -182,6 +182,9 @@ int run_build_model(int argc, char** argv) {
   }
   std::vector<const HapticSequence*> trials;
   for (const auto& t : ds.trials) trials.push_back(&t);
+  // The trials trained on, for the summary: the unlabelled ones teach no class.
+  const auto labelled = static_cast<std::size_t>(
+      std::count_if(trials.begin(), trials.end(), [](const HapticSequence* t) { return t->label.has_value(); }));
   StcAxes axes{model::kAxisVertical, "F_motion and F_vertical (training data given directly)"};
   if (forces == "both") axes = {model::kAxisVertical, "F_motion and F_vertical (--forces both)"};
   else if (forces == "lateral") axes = {model::kAxisLateral, "F_motion and F_lateral (--forces lateral)"};
@@ -204,13 +207,13 @@ int run_build_model(int argc, char** argv) {
     std::printf("{\"model\": \"%s\", \"classes\": %zu, \"training_trials\": %zu, \"training_sets\": %zu, "
                 "\"training_accuracy\": %.4f, \"forces\": \"%s\", \"priors\": \"%s\", \"label_margin\": %.6g, "
                 "\"left_out\": %d}\n",
-                out.c_str(), m.classes.size(), trials.size(), sets.size(), acc, stc_forces_name(axes.second_axis),
+                out.c_str(), m.classes.size(), labelled, sets.size(), acc, stc_forces_name(axes.second_axis),
                 priors.c_str(), label_margin, left_out);
   } else {
     std::printf("wrote %s: %zu classes (", out.c_str(), m.classes.size());
     for (std::size_t i = 0; i < m.classes.size(); ++i) std::printf("%s%s", i ? ", " : "", m.classes[i].name.c_str());
     std::printf(") from %zu trials of %s; accuracy on its own training data %.1f%%\nforces modelled: %s\n",
-                trials.size(), data.c_str(), 100 * acc, axes.reason.c_str());
+                labelled, data.c_str(), 100 * acc, axes.reason.c_str());
   }
   return 0;
 #endif

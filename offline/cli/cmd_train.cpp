@@ -67,9 +67,10 @@ int run_train(int argc, char** argv) {
   std::vector<const HapticSequence*> trials;
   for (const auto& t : ds.trials)
     if (!excluded.count(t.participant)) trials.push_back(&t);
-  bool any_label = false;
-  for (const auto* t : trials) any_label |= t->label.has_value();
-  if (!any_label) throw InputError(data + ": no labelled trials to train on" + (excluded.empty() ? "" : " (after exclusions)"));
+  // The trials trained on, for the summary: the unlabelled ones teach no class.
+  size_t labelled = 0;
+  for (const auto* t : trials) labelled += t->label.has_value();
+  if (labelled == 0) throw InputError(data + ": no labelled trials to train on" + (excluded.empty() ? "" : " (after exclusions)"));
 
   const bool json = args.has("json");
   model::OutcomeModel m;
@@ -91,10 +92,10 @@ int run_train(int argc, char** argv) {
   const auto bytes = model::encode_model(m);
   if (json) {
     std::printf("{\"out\": %s, \"bytes\": %zu, \"trials\": %zu, \"model\": %s}\n", hmm::json_string(out).c_str(),
-                bytes.size(), trials.size(), hmm::model_json(m).c_str());
+                bytes.size(), labelled, hmm::model_json(m).c_str());
   } else {
     std::printf("trained %zu classes (%d states) on %zu trials; wrote %s (%zu bytes)\n", m.classes.size(),
-                opt.hmm.n_states, trials.size(), out.c_str(), bytes.size());
+                opt.hmm.n_states, labelled, out.c_str(), bytes.size());
     std::printf("%s\n", m.training_summary.c_str());
   }
   return 0;

@@ -342,6 +342,32 @@ TEST_F(CliTest, AnUnknownParticipantIsNamed) {
   EXPECT_EQ(run("classify --model " + m + " --data " + d + " --participant 4").code, 0);
 }
 
+// train and build-model report the trials they trained on: 9 labelled, not the 12 of a dataset
+// whose 3 unlabelled trials teach no class (they were counted in, text and JSON).
+TEST_F(CliTest, TrainingCountsOnlyTheLabelledTrials) {
+  Dataset d = fx::synthetic_dataset(3, 100, 120, 54, 3);
+  for (int i = 0; i < 3; ++i) {
+    HapticSequence t = d.trials[static_cast<size_t>(i)];
+    t.id = "unlabelled-" + std::to_string(i);
+    t.label.reset();
+    d.trials.push_back(std::move(t));
+  }
+  save_dataset(d, dir / "d");
+  const std::string data = " --data " + (dir / "d").string() + " --states 3 --out " + (dir / "m.dgm").string();
+  auto r = run("train" + data + " --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(json_field(r.out, "trials"), 9.0) << r.out;
+  r = run("train" + data);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find(" on 9 trials;"), std::string::npos) << r.out;
+  r = run("build-model" + data + " --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(json_field(r.out, "training_trials"), 9.0) << r.out;
+  r = run("build-model" + data);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find(") from 9 trials of "), std::string::npos) << r.out;
+}
+
 // Leave-one-participant-out on the measured study (good vs missed; it has no caught trials):
 // train on six participants, classify the seventh, for each; with the study code's 5 states and
 // the paper's 10. Measured: 22/22 with both. Asserted: at least 20/22 (a majority classifier gets
