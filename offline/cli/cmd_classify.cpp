@@ -37,6 +37,8 @@ std::vector<double> parse_sweep(const std::string& s) {
   }
   if (k != 3) throw UsageError("--sweep must be START:END:STEP, got '" + s + "'");
   if (!(v[2] > 0) || v[1] < v[0]) throw UsageError("--sweep needs STEP > 0 and END >= START");
+  // As --truncate-at: a cut at or before 0 m leaves no trial a sample to score.
+  if (!(v[0] > 0)) throw UsageError("--sweep needs START > 0, got '" + s + "'");
   std::vector<double> out;
   for (int i = 0;; ++i) {
     const double d = v[0] + i * v[2];
@@ -264,13 +266,21 @@ int run_classify(int argc, char** argv) {
     std::string rows_json;
     for (double d : sweep) {
       const auto ev = evaluate_at(d);
-      char line[128];
-      std::snprintf(line, sizeof line, "%.6g,%.6f,%d,%d\n", d, ev.accuracy(), ev.correct, ev.total);
+      // A cut that leaves no trial scored has no accuracy (not 0): empty in the CSV, null in the
+      // JSON, "-" in the text, and the plot leaves it out.
+      char acc[32] = "", acc_json[32] = "null", acc_text[32] = "-";
+      if (ev.total > 0) {
+        std::snprintf(acc, sizeof acc, "%.6f", ev.accuracy());
+        std::snprintf(acc_json, sizeof acc_json, "%.6f", ev.accuracy());
+        std::snprintf(acc_text, sizeof acc_text, "%.4f", ev.accuracy());
+      }
+      char line[160];
+      std::snprintf(line, sizeof line, "%.6g,%s,%d,%d\n", d, acc, ev.correct, ev.total);
       csv += line;
-      std::snprintf(line, sizeof line, "%s{\"travel_m\": %.6g, \"accuracy\": %.6f, \"correct\": %d, \"total\": %d}",
-                    rows_json.empty() ? "" : ", ", d, ev.accuracy(), ev.correct, ev.total);
+      std::snprintf(line, sizeof line, "%s{\"travel_m\": %.6g, \"accuracy\": %s, \"correct\": %d, \"total\": %d}",
+                    rows_json.empty() ? "" : ", ", d, acc_json, ev.correct, ev.total);
       rows_json += line;
-      if (!json) std::printf("travel %.3f m: accuracy %.4f (%d/%d)\n", d, ev.accuracy(), ev.correct, ev.total);
+      if (!json) std::printf("travel %.3f m: accuracy %s (%d/%d)\n", d, acc_text, ev.correct, ev.total);
     }
     write_file_atomic(prefix + ".csv", csv);
     std::string png;

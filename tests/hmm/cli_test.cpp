@@ -292,6 +292,36 @@ TEST_F(CliTest, SweepWritesCsvAndPng) {
   EXPECT_TRUE(fs::exists(dir / "sw.png")) << sw.err;
 }
 
+// A cut before every trial's first sample (trials recorded from 0.2 m on) scores no trial: its
+// accuracy is empty in the CSV and null in the JSON, not 0 (it once read as a classifier wrong
+// on everything); the plot leaves it out. A sweep from 0 m is refused, as --truncate-at 0 is.
+TEST_F(CliTest, SweepCutWithNoTrialHasNoAccuracy) {
+  save_dataset(fx::synthetic_dataset(3, 300, 400, 53, 3), dir / "d");
+  Dataset late = fx::synthetic_dataset(3, 300, 400, 54, 3);
+  for (auto& t : late.trials)
+    for (auto& x : t.samples) x.travel += 0.2;
+  save_dataset(late, dir / "late");
+  const std::string m = (dir / "m.dgm").string(), data = " --data " + (dir / "late").string();
+  ASSERT_EQ(run("train --data " + (dir / "d").string() + " --out " + m + " --states 3").code, 0);
+  const auto sw = run("classify --model " + m + data + " --sweep 0.1:0.3:0.2 --sweep-out " + (dir / "sw").string() +
+                      " --json");
+  ASSERT_EQ(sw.code, 0) << sw.err;
+  EXPECT_NE(sw.out.find("{\"travel_m\": 0.1, \"accuracy\": null, \"correct\": 0, \"total\": 0}"), std::string::npos)
+      << sw.out;
+  std::ifstream csv(dir / "sw.csv");
+  std::string line;
+  std::getline(csv, line);
+  std::getline(csv, line);
+  EXPECT_EQ(line, "0.1,,0,0");
+  std::getline(csv, line);
+  EXPECT_EQ(line.rfind("0.3,", 0), 0u) << line;
+  EXPECT_NE(line.find(",9"), std::string::npos) << line;
+  EXPECT_TRUE(fs::exists(dir / "sw.png")) << sw.err;
+  const auto zero = run("classify --model " + m + data + " --sweep 0:0.3:0.1 --sweep-out " + (dir / "z").string());
+  EXPECT_EQ(zero.code, 2);
+  EXPECT_NE(zero.err.find("--sweep needs START > 0"), std::string::npos) << zero.err;
+}
+
 TEST_F(CliTest, BadInputExitsTwoNamingTheProblem) {
   auto r = run("train --out " + (dir / "m.dgm").string());
   EXPECT_EQ(r.code, 2);

@@ -2,7 +2,8 @@
 """Accuracy against travel distance (paper Fig. 6) from `dressguard classify --sweep`'s CSV.
 
 usage: hmm_sweep.py SWEEP.csv OUT.png [SWEEP2.csv LABEL2 ...]
-The CSV has columns travel_m,accuracy,correct,total. Extra CSV/label pairs add curves (e.g. a
+The CSV has columns travel_m,accuracy,correct,total (accuracy empty where no trial was scored:
+left out). Extra CSV/label pairs add curves (e.g. a
 simulation-trained and a measured-data-trained classifier on one plot).
 """
 import csv
@@ -18,6 +19,8 @@ def read(path):
     xs, ys = [], []
     with open(path, newline="") as f:
         for row in csv.DictReader(f):
+            if row["accuracy"] == "":  # a cut that left no trial scored has no accuracy
+                continue
             xs.append(float(row["travel_m"]))
             ys.append(100.0 * float(row["accuracy"]))
     return xs, ys
