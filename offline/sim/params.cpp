@@ -68,6 +68,9 @@ ClothParams parse_params(const std::string& text, const std::filesystem::path& f
       throw_input_error(file, 0, std::string(name) + " must be within [0, 1] (a position on its compliance scale, sim/trial.h)");
   if (p.friction < 0) throw_input_error(file, 0, "friction must not be negative");
   if (p.self_friction < 0) throw_input_error(file, 0, "self_friction must not be negative");
+  // A decay rate [1/s]: the model would take a negative one as 0 (model.cpp) while the summary
+  // reported the value given.
+  if (p.damping < 0) throw_input_error(file, 0, "damping must not be negative (0: no damping)");
   if (p.areal_density <= 0) throw_input_error(file, 0, "areal_density must be positive");
   if (p.arm_compliance < 0) throw_input_error(file, 0, "arm_compliance must be 0 (a fixed arm) or positive");
   if (!(std::abs(p.fist_shift) <= kMaxFistShift))
