@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -43,6 +44,9 @@ ClothParams parse_params(const std::string& text, const std::filesystem::path& f
   std::istringstream in(t);
   std::string line;
   long lineno = 0;
+  // The line each parameter was given on: a second one would silently replace the first, and a
+  // value out of range is named at its line.
+  std::map<std::string, long> line_of;
   while (std::getline(in, line)) {
     ++lineno;
     if (auto h = line.find('#'); h != std::string::npos) line.resize(h);
@@ -55,37 +59,52 @@ ClothParams parse_params(const std::string& text, const std::filesystem::path& f
       if (!(ws >> value)) throw_input_error(file, lineno, "parameter '" + name + "' has no value");
       if (ws >> extra) throw_input_error(file, lineno, "unexpected '" + extra + "' after " + name);
       double* f = field(p, name);
+      if (f && line_of.count(name))
+        throw_input_error(file, lineno, "parameter '" + name + "' given again (first on line " +
+                                            std::to_string(line_of[name]) + "); give it once");
       if (!f) throw_input_error(file, lineno, "unknown parameter '" + name + "' (stretch, shear, bend, friction, self_friction, damping, areal_density, arm_compliance, fist_shift, arm_lateral, fist_lateral, hem_width, hem_bend_ratio, support_depth, support_lateral)");
       double v = 0;
       auto [ptr, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
       if (ec != std::errc() || ptr != value.data() + value.size() || !std::isfinite(v))
         throw_input_error(file, lineno, "parameter '" + name + "': '" + value + "' is not a number");
       *f = v;
+      line_of[name] = lineno;
     }
   }
+  // The line of a value out of range (0: a default's, which none is).
+  auto at = [&line_of](const std::string& name) {
+    const auto it = line_of.find(name);
+    return it == line_of.end() ? 0L : it->second;
+  };
   for (const auto& [name, k] : {std::pair{"stretch", p.stretch}, {"shear", p.shear}, {"bend", p.bend}})
     if (!(k >= kStiffnessLowest && k <= kStiffnessHighest))
-      throw_input_error(file, 0, std::string(name) + " must be within [0, 1] (a position on its compliance scale, sim/trial.h)");
-  if (p.friction < 0) throw_input_error(file, 0, "friction must not be negative");
-  if (p.self_friction < 0) throw_input_error(file, 0, "self_friction must not be negative");
+      throw_input_error(file, at(name),
+                        std::string(name) + " must be within [0, 1] (a position on its compliance scale, sim/trial.h)");
+  if (p.friction < 0) throw_input_error(file, at("friction"), "friction must not be negative");
+  if (p.self_friction < 0) throw_input_error(file, at("self_friction"), "self_friction must not be negative");
   // A decay rate [1/s]: the model would take a negative one as 0 (model.cpp) while the summary
   // reported the value given.
-  if (p.damping < 0) throw_input_error(file, 0, "damping must not be negative (0: no damping)");
-  if (p.areal_density <= 0) throw_input_error(file, 0, "areal_density must be positive");
-  if (p.arm_compliance < 0) throw_input_error(file, 0, "arm_compliance must be 0 (a fixed arm) or positive");
+  if (p.damping < 0) throw_input_error(file, at("damping"), "damping must not be negative (0: no damping)");
+  if (p.areal_density <= 0) throw_input_error(file, at("areal_density"), "areal_density must be positive");
+  if (p.arm_compliance < 0)
+    throw_input_error(file, at("arm_compliance"), "arm_compliance must be 0 (a fixed arm) or positive");
+  const std::string arm_range = " must be within +-" + std::to_string(kMaxArmLateral) + " m";
   if (!(std::abs(p.fist_shift) <= kMaxFistShift))
-    throw_input_error(file, 0, "fist_shift must be within +-" + std::to_string(kMaxFistShift) + " m");
+    throw_input_error(file, at("fist_shift"), "fist_shift must be within +-" + std::to_string(kMaxFistShift) + " m");
   if (!(std::abs(p.arm_lateral) <= kMaxArmLateral))
-    throw_input_error(file, 0, "arm_lateral must be within +-" + std::to_string(kMaxArmLateral) + " m");
+    throw_input_error(file, at("arm_lateral"), "arm_lateral" + arm_range);
   if (!(std::abs(p.fist_lateral) <= kMaxArmLateral))
-    throw_input_error(file, 0, "fist_lateral must be within +-" + std::to_string(kMaxArmLateral) + " m");
-  if (!(p.hem_width >= 0 && p.hem_width <= kMaxHemWidth)) throw_input_error(file, 0, "hem_width must be within [0, 0.2] m");
+    throw_input_error(file, at("fist_lateral"), "fist_lateral" + arm_range);
+  if (!(p.hem_width >= 0 && p.hem_width <= kMaxHemWidth))
+    throw_input_error(file, at("hem_width"), "hem_width must be within [0, 0.2] m");
   if (!(p.hem_bend_ratio >= 1 && p.hem_bend_ratio <= kMaxHemBendRatio))
-    throw_input_error(file, 0, "hem_bend_ratio must be within [1, 10000] (a hem is stiffer than the fabric)");
+    throw_input_error(file, at("hem_bend_ratio"),
+                      "hem_bend_ratio must be within [1, 10000] (a hem is stiffer than the fabric)");
   if (!(p.support_depth >= 0 && p.support_depth <= kMaxSupportDepth))
-    throw_input_error(file, 0, "support_depth must be within [0, 1.5] m below the grasp (0: no support)");
+    throw_input_error(file, at("support_depth"),
+                      "support_depth must be within [0, 1.5] m below the grasp (0: no support)");
   if (!(std::abs(p.support_lateral) <= kMaxSupportLateral))
-    throw_input_error(file, 0, "support_lateral must be within +-0.3 m");
+    throw_input_error(file, at("support_lateral"), "support_lateral must be within +-0.3 m");
   return p;
 }
 

@@ -2,7 +2,8 @@
 //
 // Params file: one "name value" per line (also "name = value", "name: value", or a flat JSON
 // object {"name": value, ...}); names are the ClothParams fields; '#' starts a comment; fields
-// not given keep their defaults. Unknown names and bad numbers are errors naming file and line.
+// not given keep their defaults. Unknown names, a name given twice, bad numbers and values out of
+// range are errors naming file and line.
 #pragma once
 
 #include <filesystem>

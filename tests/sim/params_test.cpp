@@ -29,3 +29,16 @@ TEST(SimParams, NegativeDampingIsRefused) {
   EXPECT_NE(e.find("damping must not be negative"), std::string::npos) << e;
   EXPECT_EQ(parse_params("damping 0\n", "p.txt").damping, 0.0);  // no damping is a damping
 }
+
+// A parameter given twice is named with both lines (the second silently won); a value out of
+// range is named at its line.
+TEST(SimParams, RepeatedKeyAndRangeErrorsNameTheirLines) {
+  std::string e = error_of("bend 0.5\nstretch 0.9\n\nbend 0.9\n");
+  EXPECT_NE(e.find("p.txt:4: parameter 'bend' given again (first on line 1)"), std::string::npos) << e;
+  e = error_of("{\"bend\": 0.5,\n \"friction\": 0.3, \"bend\": 0.6}\n");  // flat JSON, a repeat on line 2
+  EXPECT_NE(e.find("p.txt:2: parameter 'bend' given again (first on line 1)"), std::string::npos) << e;
+  e = error_of("# a comment\nfriction 0.3\nstretch 1.5\n");
+  EXPECT_NE(e.find("p.txt:3: stretch must be within [0, 1]"), std::string::npos) << e;
+  e = error_of("bend 0.5\n\nsupport_lateral -0.5\n");
+  EXPECT_NE(e.find("p.txt:3: support_lateral must be within"), std::string::npos) << e;
+}
