@@ -55,3 +55,20 @@ set(nb ${CMAKE_MATCH_1})
 if(NOT rc1 EQUAL 0 OR NOT rc2 EQUAL 0 OR "${na}" STREQUAL "" OR NOT nb GREATER na)
   message(FATAL_ERROR "--grip-depth 0.06 should grasp more than the default: ${na} -> ${nb}\n${a}\n${b}")
 endif()
+# --picture replaces the PNG by a rename (tools/plot/figure_file.py), never rewrites the file in
+# place: a reader holding the old file (here a hard link to it) keeps it whole.
+set(pic ${CMAKE_CURRENT_BINARY_DIR}/dg_gown_picture.png)
+file(REMOVE ${pic} ${pic}.old)
+file(WRITE ${pic} "the old picture")
+file(CREATE_LINK ${pic} ${pic}.old)
+execute_process(COMMAND ${DG} gown --parametric --reduced 1500 --picture ${pic} RESULT_VARIABLE rc ERROR_VARIABLE err
+                OUTPUT_QUIET)
+file(SHA256 ${pic}.old old)
+string(SHA256 want "the old picture")
+file(READ ${pic} new LIMIT 8 HEX)
+file(GLOB leftovers ${CMAKE_CURRENT_BINARY_DIR}/.dg_gown_picture.png.*)
+file(REMOVE ${pic} ${pic}.old)
+if(NOT rc EQUAL 0 OR NOT old STREQUAL want OR NOT new STREQUAL "89504e470d0a1a0a" OR leftovers)
+  message(FATAL_ERROR "gown --picture over an old file: rc=${rc} ${err}; the old file was rewritten (${old}), the "
+                      "new one starts ${new}; temporary files left: ${leftovers}")
+endif()

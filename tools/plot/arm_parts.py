@@ -15,6 +15,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from figure_file import save_figure  # a temporary file, then a rename
 
 
 def main():
@@ -42,7 +43,7 @@ def main():
         ax.legend(fontsize=8)
     fig.suptitle("which part of the arm carries the cloth's load")
     fig.tight_layout()
-    fig.savefig(a.out, dpi=100)
+    save_figure(fig, a.out, dpi=100)
 
 
 if __name__ == "__main__":

@@ -16,6 +16,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+from figure_file import save_figure  # a temporary file, then a rename
 
 CUTS = [0.15, 0.20, 0.25, 0.30]
 ONE_NN_REFERENCE = [71, 83, 94, 100]
@@ -71,7 +72,7 @@ def main(argv):
     axes[0].set_ylabel("accuracy on the other participants' trials [%]")
     axes[0].legend(loc="lower right", fontsize=8)
     fig.tight_layout()
-    fig.savefig(argv[1], dpi=120)
+    save_figure(fig, argv[1], dpi=120)
     return 0
 
 

@@ -63,6 +63,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from figure_file import save_figure  # a temporary file, then a rename
 
 
 CUTS = (0.15, 0.20, 0.25, 0.30)  # issue 4's cuts of the sequences [m]
@@ -123,7 +124,7 @@ def plot_fit(args):
             ax.grid(alpha=0.3)
     axes[0][0].legend(loc="lower left", fontsize=8)
     fig.tight_layout()
-    fig.savefig(args.out, dpi=110)
+    save_figure(fig, args.out, dpi=110)
 
 
 def read_dataset(folder):
@@ -154,7 +155,7 @@ def plot_classes(args):
     axes[0].legend(handles=handles, fontsize=8, loc="lower left")
     fig.suptitle(f"{args.dataset}: every labelled trial to {args.up_to:.2f} m of travel (dotted: issue 4's cuts)")
     fig.tight_layout()
-    fig.savefig(args.out, dpi=110)
+    save_figure(fig, args.out, dpi=110)
 
 
 def plot_dataset(args):
@@ -177,7 +178,7 @@ def plot_dataset(args):
     axes[0].legend(handles=handles, fontsize=8, loc="lower left")
     fig.suptitle(f"participant {args.participant}: synthesized data and measured trials")
     fig.tight_layout()
-    fig.savefig(args.out, dpi=110)
+    save_figure(fig, args.out, dpi=110)
 
 
 def plot_predict(args):
@@ -220,7 +221,7 @@ def plot_predict(args):
         ax.set_title(f"{h} arm: eq. 3-5, w = 20")
         ax.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(args.out, dpi=100)
+    save_figure(fig, args.out, dpi=100)
 
 
 def present_forces(rows):
@@ -255,7 +256,7 @@ def plot_residual(args):
             ax.grid(alpha=0.3)
             ax.legend(fontsize=7, loc="lower left")
     fig.tight_layout()
-    fig.savefig(args.out, dpi=100)
+    save_figure(fig, args.out, dpi=100)
 
 
 def plot_contrast(args):
@@ -285,7 +286,7 @@ def plot_contrast(args):
             ax.set_title(f"{name}: high arm (good) minus {h} arm (missed)")
             ax.legend(fontsize=7, loc="lower left")
     fig.tight_layout()
-    fig.savefig(args.out, dpi=100)
+    save_figure(fig, args.out, dpi=100)
 
 
 def plot_discrepancy(args):
@@ -308,7 +309,7 @@ def plot_discrepancy(args):
             ax.set_title(f"{os.path.basename(cal)}: F_{axis}, measured - simulated", fontsize=10)
             ax.legend(fontsize=7, loc="lower left")
     fig.tight_layout()
-    fig.savefig(args.out, dpi=100)
+    save_figure(fig, args.out, dpi=100)
 
 
 PROGRESS = re.compile(r"^generation (\d+)/(\d+)\s+best L ([0-9.eE+-]+|inf)(?: \(([^)]*)\))?\s+"
@@ -350,7 +351,7 @@ def plot_progress(args):
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(args.out, dpi=110)
+    save_figure(fig, args.out, dpi=110)
 
 
 GOAL_L = 0.3  # issue 4: a calibrated simulator fits each of its own sequences at L <= 0.3
@@ -416,7 +417,7 @@ def plot_standing(args):
     ax.set_ylim(0, 1.2 * max(b[0] for b in best.values()))
     ax.legend(fontsize=7, loc="upper right")
     fig.tight_layout()
-    fig.savefig(args.out, dpi=110)
+    save_figure(fig, args.out, dpi=110)
 
 
 def main():

@@ -23,6 +23,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
 from pooled_stc import CUTS, WHOLE_X, cuts_then_whole, read_run  # as the per-run plot
+from figure_file import save_figure  # a temporary file, then a rename
 VOTES = [("vote_accuracy_whole_and_cuts", "vote_against_one_nn_at_cuts", "vote (the paper's rule)"),
          ("vote_good_or_missed_accuracy_whole_and_cuts", "vote_good_or_missed_against_one_nn_at_cuts",
           'vote, each STC asked "good or missed?"')]
@@ -110,7 +111,7 @@ def main(argv):
     rows = (len(labels) + 2) // 3
     fig.legend(handles, labels, fontsize=8, loc="lower center", ncol=3)
     fig.tight_layout(rect=(0, 0.035 * rows * 2 / len(votes), 1, 1))
-    fig.savefig(argv[-1], dpi=110)
+    save_figure(fig, argv[-1], dpi=110)
     return 0
 
 

@@ -16,6 +16,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+from figure_file import save_figure  # a temporary file, then a rename
 
 FORCES = ["F_motion", "F_lateral", "F_vertical"]
 WINDOWS = ["0.10-0.15 m", "0.15-0.20 m", "0.20-0.25 m", "0.25-0.30 m"]
@@ -80,7 +81,7 @@ def main(argv):
             ax.grid(alpha=0.3)
         row[0].legend(fontsize=7, loc="upper left", title="window (bands: all people)", title_fontsize=7)
     fig.tight_layout()
-    fig.savefig(out_png, dpi=110)
+    save_figure(fig, out_png, dpi=110)
     print(f"wrote {out_png}")
     return 0
 

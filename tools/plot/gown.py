@@ -16,6 +16,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from figure_file import save_figure  # a temporary file, then a rename
 
 VIEWS = [("side (x-z)", 0, 2), ("top (x-y)", 0, 1), ("front (y-z), looking along -x", 1, 2)]
 
@@ -103,7 +104,7 @@ def main():
     state = s.get("state", "placed")
     fig.suptitle(f"gown {state}: {len(x)} vertices, {len(tri)} triangles; {s['frame']}")
     fig.tight_layout()
-    fig.savefig(sys.argv[2], dpi=90)
+    save_figure(fig, sys.argv[2], dpi=90)
 
 
 if __name__ == "__main__":

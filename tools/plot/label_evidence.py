@@ -17,6 +17,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+from figure_file import save_figure  # a temporary file, then a rename
 
 RULE = 0.07  # [m] kGoodLabelDistance (offline/core/haptic.h)
 COLOURS = {"good": "tab:green", "caught": "tab:red"}
@@ -84,7 +85,7 @@ def main(argv):
         ax.axis("off")
     fig.suptitle("synthesized trials that stopped early\n(grey: good by the 7 cm rule)", fontsize=9)
     fig.tight_layout()
-    fig.savefig(out, dpi=110)
+    save_figure(fig, out, dpi=110)
     print(f"wrote {out}")
 
 

@@ -19,6 +19,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
 from pooled_stc import CUTS, read_run  # the same cuts and reading as the per-run plot
+from figure_file import save_figure  # a temporary file, then a rename
 
 COLUMNS = ["whole"] + [f"{c:.2f} m" for c in CUTS]
 
@@ -88,7 +89,7 @@ def main(argv):
             ax.set_yticklabels(rows if col == 0 else [], fontsize=8)
             ax.set_title(f"{s['forces']}\n{what}", fontsize=9)
     fig.colorbar(image, ax=axes, shrink=0.6, label='right, asked "good or missed?" [%]')
-    fig.savefig(argv[2], dpi=110, bbox_inches="tight")
+    save_figure(fig, argv[2], dpi=110, bbox_inches="tight")
     return 0
 
 

@@ -20,6 +20,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+from figure_file import save_figure  # a temporary file, then a rename
 
 CUTS = [0.15, 0.20, 0.25, 0.30]
 WHOLE_X = 0.35  # where "whole sequence" is drawn
@@ -114,7 +115,7 @@ def main(argv):
     fig.suptitle(f"STCs on people no simulator was calibrated on: {n} calibrations, {d['per_height']} trials per "
                  f"height each{term}", fontsize=10)
     fig.tight_layout(rect=(0, 0.1, 1, 1))
-    fig.savefig(argv[2], dpi=110)
+    save_figure(fig, argv[2], dpi=110)
     return 0
 
 

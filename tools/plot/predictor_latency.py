@@ -13,6 +13,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from figure_file import save_figure  # a temporary file, then a rename
 
 
 def main():
@@ -37,7 +38,7 @@ def main():
         ax.set_yscale("log")
         ax.tick_params(axis="x", rotation=60)
     fig.tight_layout()
-    fig.savefig(args.out, dpi=120)
+    save_figure(fig, args.out, dpi=120)
     print(f"wrote {args.out}")
     return 0
 

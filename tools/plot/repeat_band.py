@@ -19,6 +19,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+from figure_file import save_figure  # a temporary file, then a rename
 
 
 def load(root):
@@ -64,7 +65,7 @@ def main():
     axes[0].set_ylabel("eq. 3-5 distance to the calibrated height's trial")
     fig.suptitle("Which arm heights a calibrated simulator takes within a repeat's distance")
     fig.tight_layout()
-    fig.savefig(sys.argv[2], dpi=120)
+    save_figure(fig, sys.argv[2], dpi=120)
 
 
 if __name__ == "__main__":

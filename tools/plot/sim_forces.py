@@ -14,6 +14,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
+from figure_file import save_figure  # a temporary file, then a rename
 
 
 def load(path):
@@ -73,7 +74,7 @@ def main():
     if title:
         fig.suptitle(title)
     fig.tight_layout()
-    fig.savefig(out, dpi=110)
+    save_figure(fig, out, dpi=110)
 
 
 if __name__ == "__main__":

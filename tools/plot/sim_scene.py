@@ -13,6 +13,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+from figure_file import save_figure  # a temporary file, then a rename
 
 
 def round_cone_mesh(a, ra, b, rb, n=18, m=10):
@@ -152,7 +153,7 @@ def main():
     fig.suptitle(f"simulated trial, {sc['height']} arm (offset {sc['arm_offset']:+.3f} m): "
                  f"{sc['label']}, travel {sc['travel']:.3f} m, d_max {sc['d_max']:.3f} m")
     fig.tight_layout()
-    fig.savefig(sys.argv[2], dpi=110)
+    save_figure(fig, sys.argv[2], dpi=110)
 
 
 if __name__ == "__main__":

@@ -14,6 +14,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+from figure_file import save_figure  # a temporary file, then a rename
 
 ORDER = ["good", "missed", "caught", "unlabelled"]
 
@@ -68,7 +69,7 @@ def main(argv):
     ax_travel.set_ylim(0, 0.9)
     fig.suptitle("predictor's stop rule on replayed pulls (dressguard replay --logs)")
     fig.tight_layout()
-    fig.savefig(out, dpi=120)
+    save_figure(fig, out, dpi=120)
     print(f"wrote {out}")
 
 

@@ -34,6 +34,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+from figure_file import save_figure  # a temporary file, then a rename
 
 # The study's protocol (shared/data README): pulls of each kind out of 360.
 PROTOCOL = {"good": 120, "low missed": 120, "middle missed": 29, "caught": 91}
@@ -149,7 +150,7 @@ def main():
     ax.set_xlim(left=0)
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(args.out, dpi=120)
+    save_figure(fig, args.out, dpi=120)
     print(f"wrote {args.out}")
     if args.json_out:
         with open(args.json_out + ".tmp", "w") as fh:

@@ -32,6 +32,7 @@ import itertools
 import sys
 
 import numpy as np
+from figure_file import save_figure  # a temporary file, then a rename
 
 GENERATION = 32  # the paper's population
 MU = 16
@@ -206,7 +207,7 @@ def plot(results, out):
         ax.set_title("its held-out generations, one colour each", fontsize=9)
     fig.suptitle("Can a surrogate rank a CMA-ES generation of the calibration objective?")
     fig.tight_layout()
-    fig.savefig(out, dpi=110)
+    save_figure(fig, out, dpi=110)
     print(f"wrote {out}")
 
 
