@@ -21,23 +21,21 @@ std::filesystem::path measured_gown_path() {
 GownMesh load_gown(const GownOptions& options) {
   const std::filesystem::path path =
       options.parametric ? std::filesystem::path{} : (options.obj.empty() ? measured_gown_path() : options.obj);
-  GownMesh mesh;
-  if (path.empty()) {
-    mesh = options.grip ? make_parametric_gown(*options.grip) : make_parametric_gown();
-  } else {
-    mesh = read_obj(path, options.scale);
-    if (!options.already_in_W) {
-      if (options.placement == GownPlacement::Opening)
-        place_at_opening(mesh, options.scene, options.grip.value_or(OpeningGrip{}));
-      else
-        place_like_paper(mesh, options.scene);
-    }
-  }
-  mesh.areal_density = options.areal_density;
+  GownMesh mesh = path.empty() ? (options.grip ? make_parametric_gown(*options.grip) : make_parametric_gown())
+                               : read_obj(path, options.scale);
+  // Before the placement: it looks for the sleeve among the loops, and without two of them it
+  // failed with an error that named no file.
   if (mesh.boundary_loops.size() < 2)
     throw_input_error(path.empty() ? "parametric gown" : path, 0,
                       "the mesh has " + std::to_string(mesh.boundary_loops.size()) +
                           " boundary loop(s); a gown needs its body opening and a sleeve opening");
+  if (!path.empty() && !options.already_in_W) {
+    if (options.placement == GownPlacement::Opening)
+      place_at_opening(mesh, options.scene, options.grip.value_or(OpeningGrip{}));
+    else
+      place_like_paper(mesh, options.scene);
+  }
+  mesh.areal_density = options.areal_density;
   if (options.target_triangles > 0) {
     std::vector<bool> frozen(mesh.x.size(), false);
     for (int v : grasp_vertices(mesh, options.scene)) frozen[v] = true;

@@ -72,3 +72,14 @@ if(NOT rc EQUAL 0 OR NOT old STREQUAL want OR NOT new STREQUAL "89504e470d0a1a0a
   message(FATAL_ERROR "gown --picture over an old file: rc=${rc} ${err}; the old file was rewritten (${old}), the "
                       "new one starts ${new}; temporary files left: ${leftovers}")
 endif()
+# A mesh without a body and a sleeve opening (one triangle: one boundary loop) is bad input that
+# names the file, with or without the placement (which looks for the sleeve among the loops).
+file(WRITE ${CMAKE_CURRENT_BINARY_DIR}/dg_gown_one_loop.obj "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+foreach(how "" "--in-world")
+  execute_process(COMMAND ${DG} gown --obj ${CMAKE_CURRENT_BINARY_DIR}/dg_gown_one_loop.obj ${how}
+                  RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+  if(NOT rc EQUAL 2 OR NOT err MATCHES "dg_gown_one_loop.obj: the mesh has 1 boundary loop")
+    message(FATAL_ERROR "gown --obj, one boundary loop ${how}: expected exit 2 naming the file, got rc=${rc}: ${err}")
+  endif()
+endforeach()
+file(REMOVE ${CMAKE_CURRENT_BINARY_DIR}/dg_gown_one_loop.obj)
