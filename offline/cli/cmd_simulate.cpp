@@ -81,7 +81,7 @@ int run_simulate(int argc, char** argv) {
         "  by tools/plot/sim_scene.py, and FILE.arm.csv: per sample, the cloth's force on each part\n"
         "  of the arm (elbow, fist, [hand,] forearm, upper arm; x y z, N) for tools/plot/arm_parts.py.\n"
         "  --arm-offset M    [m] added to the height's arm height (default 0)\n"
-        "  --speed V         [m/s] pull speed, 0.1 or 0.15 (default 0.1)\n"
+        "  --speed V         [m/s] pull speed within %g-%g: the study's are 0.1 and 0.15 (default 0.1)\n"
         "  --params FILE     cloth parameters ('name value' lines or flat JSON; see offline/sim/params.h)\n"
         "  --calibration CAL a calibration file instead (dressguard calibrate): its cloth and person\n"
         "                    parameters, its offset for this height added to --arm-offset, its gown,\n"
@@ -102,7 +102,7 @@ int run_simulate(int argc, char** argv) {
         "  --frames T1,T2,.. [s] since the start of the pull (negative: settling) to keep the gown\n"
         "                    positions at; default every 0.25 s from -1.6 s\n"
         "  --json            print the summary as JSON\n",
-        kGripHelp);
+        sim::kMinPullSpeed, sim::kMaxPullSpeed, kGripHelp);
     return 0;
   }
   args.allow_only({"help", "json", "noise", "arm-noise", "no-self-collision", "height", "arm-offset", "max-travel", "speed", "params", "calibration", "seed",
@@ -115,7 +115,11 @@ int run_simulate(int argc, char** argv) {
   spec.arm_offset = args.number("arm-offset", 0.0);
   if (std::abs(spec.arm_offset) > 0.5) throw UsageError("--arm-offset must be within +-0.5 m");
   spec.speed = args.number("speed", 0.1);
-  if (!(spec.speed > 0.0 && spec.speed <= 1.0)) throw UsageError("--speed must be in (0, 1] m/s");
+  // The pull's time limit grows as 1 / speed (sim/trial.h): a speed near 0 would run for days.
+  if (!(spec.speed >= sim::kMinPullSpeed && spec.speed <= sim::kMaxPullSpeed))
+    throw UsageError("--speed must be within " + format_number(sim::kMinPullSpeed) + " and " +
+                     format_number(sim::kMaxPullSpeed) + " m/s (the study pulls at 0.1 and 0.15), not " +
+                     format_number(spec.speed));
   const long seed = args.integer("seed", 0, LONG_MIN, LONG_MAX);
   if (seed < 0) throw UsageError("--seed must be non-negative");
   spec.seed = static_cast<uint64_t>(seed);

@@ -150,6 +150,11 @@ const char* friction_scheme_name(FrictionScheme s);
 // The scheme named `name` (friction_scheme_name's inverse); false, and *out untouched, if none is.
 bool parse_friction_scheme(const std::string& name, FrictionScheme* out);
 
+// The pull speeds a trial may ask for [m/s]: the study pulls at 0.1 and 0.15 m/s; half the
+// slower to twice the faster leaves room to look around the rig's speeds, and bounds the pull's
+// time limit (travel / speed + 5 s) to 22 s at the rig's 0.85 m: a speed near 0 ran for days.
+inline constexpr double kMinPullSpeed = 0.05, kMaxPullSpeed = 0.3;
+
 // One trial's conditions.
 struct TrialSpec {
   ArmHeight height = ArmHeight::High;

@@ -130,3 +130,14 @@ execute_process(COMMAND ${DG} simulate --gown coarse --height high --max-travel 
 if(NOT rc EQUAL 0 OR NOT out MATCHES "\"rim_ahead\": 0.025}")
   message(FATAL_ERROR "--rim-ahead did not override the calibration's grasp: rc=${rc} ${out} ${err}")
 endif()
+
+# --speed within sim::kMinPullSpeed-kMaxPullSpeed (0.05-0.3 m/s, around the study's 0.1 and 0.15):
+# the pull's time limit grows as 1 / speed, and 1e-6 m/s ran for days.
+file(REMOVE ${TMP}/dg_speed_never.csv)
+foreach(speed 0.5 1e-6 0.04)
+  execute_process(COMMAND ${DG} simulate --gown coarse --height high --max-travel 0.01 --frames 0 --speed ${speed}
+                  --out ${TMP}/dg_speed_never.csv RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+  if(NOT rc EQUAL 2 OR NOT err MATCHES "--speed must be within 0.05 and 0.3 m/s" OR EXISTS ${TMP}/dg_speed_never.csv)
+    message(FATAL_ERROR "--speed ${speed}: expected exit 2 naming it and no file, got rc=${rc}: ${err}")
+  endif()
+endforeach()
