@@ -1,4 +1,5 @@
 // dressguard simulate: one simulated sleeve-pulling trial (offline/sim) -> trial CSV + summary.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -20,7 +21,14 @@
 namespace dressguard::cli {
 namespace {
 
-std::vector<double> parse_times(const std::string& s) {
+// --frames: at most this many times (the default keeps 55); each frame costs the scene file a copy
+// of the gown's positions (about 75 kB on the reduced gown: 500 frames made 38 MB).
+constexpr std::size_t kMaxFrames = 100;
+
+// --frames: times [s] since the start of the pull, each once, from `earliest` (the longest
+// settling before the pull) to `latest` (the pull's time limit): a time outside kept no frame,
+// or far out overflowed the count of settling's snapshots; a repeat kept the same frame again.
+std::vector<double> parse_times(const std::string& s, double earliest, double latest) {
   std::vector<double> out;
   std::istringstream in(s);
   std::string tok;
@@ -28,8 +36,14 @@ std::vector<double> parse_times(const std::string& s) {
     char* end = nullptr;
     const double v = std::strtod(tok.c_str(), &end);
     if (tok.empty() || *end != '\0' || !std::isfinite(v)) throw UsageError("--frames: '" + tok + "' is not a time in seconds");
+    if (!(v >= earliest && v <= latest))
+      throw UsageError("--frames: " + tok + " s is outside " + format_number(earliest) + " (the longest settling) to " +
+                       format_number(latest) + " s (the pull's time limit)");
+    if (std::find(out.begin(), out.end(), v) != out.end()) throw UsageError("--frames: " + tok + " s given twice");
     out.push_back(v);
   }
+  if (out.size() > kMaxFrames)
+    throw UsageError("--frames: " + std::to_string(out.size()) + " times; at most " + std::to_string(kMaxFrames));
   return out;
 }
 
@@ -100,9 +114,11 @@ int run_simulate(int argc, char** argv) {
         "%s"
         "  --no-self-collision\n"
         "  --frames T1,T2,.. [s] since the start of the pull (negative: settling) to keep the gown\n"
-        "                    positions at; default every 0.25 s from -1.6 s\n"
+        "                    positions at, each once, at most %zu, from -%g s (the longest settling)\n"
+        "                    to the pull's time limit (%g s at 0.1 m/s); default every 0.25 s from -1.6 s\n"
         "  --json            print the summary as JSON\n",
-        sim::kMinPullSpeed, sim::kMaxPullSpeed, kGripHelp);
+        sim::kMinPullSpeed, sim::kMaxPullSpeed, kGripHelp, kMaxFrames, sim::max_settle_time_of({}),
+        sim::max_time_of({}));
     return 0;
   }
   args.allow_only({"help", "json", "noise", "arm-noise", "no-self-collision", "height", "arm-offset", "max-travel", "speed", "params", "calibration", "seed",
@@ -152,7 +168,7 @@ int run_simulate(int argc, char** argv) {
   spec.keep_frames = true;
   spec.record_arm_parts = true;
   if (auto f = args.get("frames")) {
-    spec.frame_times = parse_times(*f);
+    spec.frame_times = parse_times(*f, -sim::max_settle_time_of(spec), sim::max_time_of(spec));
   } else {
     for (double t = -1.6; t < 12.0; t += 0.25) spec.frame_times.push_back(t);
   }

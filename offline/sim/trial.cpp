@@ -59,6 +59,25 @@ Outcome label_outcome(bool full_travel, double d_max) {
 
 namespace {
 
+// Settling (settle()): the gown perturbation's output steps, and the rest check's window and
+// period (0.1 s).
+constexpr int kPerturbFrom = 180, kPerturbTo = 330, kRestWindow = 30;
+int settle_min_steps(const TrialSpec& spec) {
+  return std::max(spec.settle_steps, spec.gown_noise ? kPerturbTo + kRestWindow : 0);
+}
+int settle_max_steps(const TrialSpec& spec) {
+  return spec.settle_speed > 0 ? std::max(settle_min_steps(spec), spec.settle_max_steps) : settle_min_steps(spec);
+}
+
+}  // namespace
+
+double max_settle_time_of(const TrialSpec& spec, const SceneOptions& opt) {
+  // The rest check ends settling on a whole window, at the cap or past it.
+  return (settle_max_steps(spec) + kRestWindow - 1) / kRestWindow * kRestWindow / opt.step_hz;
+}
+
+namespace {
+
 // The random draws of a trial, in the stream's order: the perturbation force first, then the
 // arm-height noise (one random stream per trial).
 struct TrialDraws {
@@ -132,11 +151,9 @@ Settled settle(GownModel& m, GownState& s, const TrialSpec& spec, const TrialDra
   // spread equally over all vertices for 0.5 s (output steps 180-330), then settling until the
   // gown is at rest (TrialSpec::settle_speed).
   const auto clock0 = std::chrono::steady_clock::now();
-  const int perturb_from = 180, perturb_to = 330;
-  constexpr int kWindow = 30;  // 0.1 s: the rest check's window and period
   const bool adaptive = spec.settle_speed > 0;
-  const int min_steps = std::max(spec.settle_steps, spec.gown_noise ? perturb_to + kWindow : 0);
-  const int max_steps = adaptive ? std::max(min_steps, spec.settle_max_steps) : min_steps;
+  const int min_steps = settle_min_steps(spec);
+  const int max_steps = settle_max_steps(spec);
   const double cloth_decay = m.damping_factor;
   const double settle_decay = std::min(cloth_decay, std::exp(-std::max(0.0, spec.settle_damping) * m.h));
   const V3 zero{0, 0, 0};
@@ -151,8 +168,8 @@ Settled settle(GownModel& m, GownState& s, const TrialSpec& spec, const TrialDra
   auto lift_at = [](int step) { return kSupportDrop * std::max(0.0, 1.0 - static_cast<double>(step) / kSupportRiseSteps); };
   int k = 0;
   for (;;) {
-    const bool on = spec.gown_noise && k >= perturb_from && k < perturb_to;
-    const bool was_on = spec.gown_noise && k - 1 >= perturb_from && k - 1 < perturb_to;
+    const bool on = spec.gown_noise && k >= kPerturbFrom && k < kPerturbTo;
+    const bool was_on = spec.gown_noise && k - 1 >= kPerturbFrom && k - 1 < kPerturbTo;
     if (on != was_on)
       for (int i = 0; i < n; ++i) s.ext_force[i] = on ? V3{d.fx / n, d.fy / n, 0} : zero;
     m.damping_factor = on ? cloth_decay : settle_decay;
@@ -184,7 +201,7 @@ Settled settle(GownModel& m, GownState& s, const TrialSpec& spec, const TrialDra
       if (snaps.size() == keep_snaps) snaps.erase(snaps.begin());
       snaps.emplace_back(k, make_frame(s, 0.0, 0.0));
     }
-    if (k % kWindow == 0) {
+    if (k % kRestWindow == 0) {
       double v2 = 0;
       long free_count = 0;
       for (int i = 0; i < n; ++i)
@@ -192,12 +209,12 @@ Settled settle(GownModel& m, GownState& s, const TrialSpec& spec, const TrialDra
           const V3 dx = s.x[i] - x_window[i];
           v2 += dot(dx, dx), ++free_count;
         }
-      r.settle_speed = free_count ? std::sqrt(v2 / free_count) / (kWindow * m.dt) : 0.0;
+      r.settle_speed = free_count ? std::sqrt(v2 / free_count) / (kRestWindow * m.dt) : 0.0;
       x_window = s.x;
     }
     if (k < min_steps || k % 3 != 0) continue;
     if (!adaptive) break;
-    if (k % kWindow == 0 && (r.settle_speed <= spec.settle_speed || k >= max_steps)) break;
+    if (k % kRestWindow == 0 && (r.settle_speed <= spec.settle_speed || k >= max_steps)) break;
   }
   s.watch.clear();
   s.watch_touched = false;
@@ -234,12 +251,6 @@ Settled settle(GownModel& m, GownState& s, const TrialSpec& spec, const TrialDra
   }
   r.wall_settle = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count();
   return out;
-}
-
-// The pull's time limit [s]: past the rig's whole travel by 5 s (a guard; the travel or the
-// force limit ends every pull first).
-double max_time_of(const TrialSpec& spec) {
-  return spec.max_travel / spec.speed + spec.speed / spec.acceleration + 5.0;
 }
 
 // A pull under way: everything its sample loop carries from one sample to the next, so that
@@ -457,6 +468,10 @@ bool same_settling(const TrialSpec& a, const TrialDraws& da, const TrialSpec& b,
 }
 
 }  // namespace
+
+double max_time_of(const TrialSpec& spec) {
+  return spec.max_travel / spec.speed + spec.speed / spec.acceleration + 5.0;
+}
 
 TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const TrialSpec& spec) {
   const SceneData& sc = scene.data();

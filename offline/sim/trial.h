@@ -371,6 +371,12 @@ Scene make_default_scene(GownResolution res = GownResolution::Reduced, bool para
 // 180-330, i.e. 0.5 s) until the gown is at rest, then the pull until max_travel or the force
 // limit. Deterministic: the same inputs give the same bits (single thread, no fast-math).
 TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const TrialSpec& spec);
+// The pull's time limit [s]: past the rig's whole travel by 5 s (a guard; the travel or the
+// force limit ends every pull first).
+double max_time_of(const TrialSpec& spec);
+// The longest settling [s]: it gives up at `settle_max_steps` output steps (at least the gown
+// perturbation's 1.2 s).
+double max_settle_time_of(const TrialSpec& spec, const SceneOptions& opt = {});
 
 // Several trials with one cloth, the same bits as simulate_trial() on each, in the order of
 // `specs`, but each settling done once where it can be: trials that settle alike (the same

@@ -141,3 +141,27 @@ foreach(speed 0.5 1e-6 0.04)
     message(FATAL_ERROR "--speed ${speed}: expected exit 2 naming it and no file, got rc=${rc}: ${err}")
   endif()
 endforeach()
+
+# --frames: each time once, at most 100 of them, from where settling can start (its cap, 10 s
+# before the pull) to the pull's time limit (here 0.01 m / 0.1 m/s + 5.1 s); out of range, a time
+# was undefined behaviour (-1e300) or kept no frame, and 500 copies of 0 kept 500 frames.
+file(REMOVE ${TMP}/dg_frames_never.csv)
+set(many_frames 0)
+foreach(i RANGE 1 100)
+  string(APPEND many_frames ",0.${i}")
+endforeach()
+foreach(frames "0,0.5,0" "-10.5" "5.3" "${many_frames}" "-1e300,-1")
+  execute_process(COMMAND ${DG} simulate --gown coarse --height high --max-travel 0.01 --frames=${frames}
+                  --out ${TMP}/dg_frames_never.csv RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+  if(NOT rc EQUAL 2 OR NOT err MATCHES "--frames" OR EXISTS ${TMP}/dg_frames_never.csv)
+    message(FATAL_ERROR "--frames=${frames}: expected exit 2 naming it and no file, got rc=${rc}: ${err}")
+  endif()
+endforeach()
+# The bounds themselves are times (the pull ends long before its limit: the end frame is kept).
+execute_process(COMMAND ${DG} simulate --gown coarse --height high --max-travel 0.01 --frames=-1,0,5.2
+                --out ${TMP}/dg_frames.csv RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+file(READ ${TMP}/dg_frames.scene.json scene)
+string(REGEX MATCHALL "{\"t\": [-0-9.e]+" frame_ts "${scene}")
+if(NOT rc EQUAL 0 OR NOT frame_ts MATCHES "^{\"t\": -1;{\"t\": 0;")
+  message(FATAL_ERROR "--frames=-1,0,5.2 (the pull's time limit) kept ${frame_ts}: rc=${rc} ${err}")
+endif()
