@@ -164,7 +164,7 @@ int run_simulate(int argc, char** argv) {
   sim::ClothParams params;
   if (auto pf = args.get("params")) params = sim::read_params(*pf);
   if (cal) params = calib::cloth_params_of(cal->cloth);
-  const std::filesystem::path out = args.require("out");
+  const std::filesystem::path out = args.require_output_file("out");  // a folder: refused before the run
   spec.keep_frames = true;
   spec.record_arm_parts = true;
   if (auto f = args.get("frames")) {

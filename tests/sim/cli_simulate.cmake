@@ -165,3 +165,10 @@ string(REGEX MATCHALL "{\"t\": [-0-9.e]+" frame_ts "${scene}")
 if(NOT rc EQUAL 0 OR NOT frame_ts MATCHES "^{\"t\": -1;{\"t\": 0;")
   message(FATAL_ERROR "--frames=-1,0,5.2 (the pull's time limit) kept ${frame_ts}: rc=${rc} ${err}")
 endif()
+
+# --out naming a folder is refused before the simulation (it failed only after the whole run).
+execute_process(COMMAND ${DG} simulate --gown coarse --height high --max-travel 0.01 --frames 0 --out ${TMP}
+                RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "--out: '.*' is a folder")
+  message(FATAL_ERROR "--out FOLDER: expected exit 2 naming --out, got rc=${rc}: ${err}")
+endif()
