@@ -47,6 +47,24 @@ std::vector<double> parse_times(const std::string& s, double earliest, double la
   return out;
 }
 
+// The files simulate writes beside its CSV: the summary, the scene for pictures and the arm's load.
+struct SideFiles {
+  std::filesystem::path meta, scene, arm;
+};
+SideFiles side_files_of(const std::filesystem::path& out) {
+  SideFiles f{out, out, out};
+  f.meta.replace_extension(".json");
+  f.scene.replace_extension(".scene.json");
+  f.arm.replace_extension(".arm.csv");
+  // --out X.json (or X.scene.json) would be written as the CSV and then replaced by a side file.
+  for (const auto& side : {f.meta, f.scene, f.arm})
+    if (side == out)
+      throw UsageError("option --out: '" + out.string() + "' is the name of a file written beside the CSV (" +
+                       f.meta.filename().string() + ", " + f.scene.filename().string() + ", " +
+                       f.arm.filename().string() + "); give FILE.csv");
+  return f;
+}
+
 // The default scene, with the jaws where --grip-depth / --rim-ahead put them. A grip that leaves
 // the jaws off the sleeve's top (the rim too far ahead of them, say) grasps nothing; that is the
 // options' fault, so it is reported as a usage error that names them.
@@ -165,6 +183,7 @@ int run_simulate(int argc, char** argv) {
   if (auto pf = args.get("params")) params = sim::read_params(*pf);
   if (cal) params = calib::cloth_params_of(cal->cloth);
   const std::filesystem::path out = args.require_output_file("out");  // a folder: refused before the run
+  const SideFiles side = side_files_of(out);
   spec.keep_frames = true;
   spec.record_arm_parts = true;
   if (auto f = args.get("frames")) {
@@ -205,15 +224,9 @@ int run_simulate(int argc, char** argv) {
                 r.opening.depth, r.opening.height, r.opening.width, r.opening.centre_y, r.opening.perimeter_ratio,
                 r.opening.rim_low_above_fist, held.depth, held.rim_ahead, out.c_str(),
                 sim::params_json(params).c_str());
-  std::filesystem::path meta = out;
-  meta.replace_extension(".json");
-  write_file_atomic(meta, std::string(b) + "\n");
-  std::filesystem::path scene_file = out;
-  scene_file.replace_extension(".scene.json");
-  write_file_atomic(scene_file, sim::scene_json(scene, params, spec, r));
-  std::filesystem::path arm_file = out;
-  arm_file.replace_extension(".arm.csv");
-  write_file_atomic(arm_file, arm_parts_csv(scene, r));
+  write_file_atomic(side.meta, std::string(b) + "\n");
+  write_file_atomic(side.scene, sim::scene_json(scene, params, spec, r));
+  write_file_atomic(side.arm, arm_parts_csv(scene, r));
   if (args.has("json")) {
     std::printf("%s\n", b);
   } else {

@@ -172,3 +172,14 @@ execute_process(COMMAND ${DG} simulate --gown coarse --height high --max-travel 
 if(NOT rc EQUAL 2 OR NOT err MATCHES "--out: '.*' is a folder")
   message(FATAL_ERROR "--out FOLDER: expected exit 2 naming --out, got rc=${rc}: ${err}")
 endif()
+
+# --out may not be one of the files simulate writes beside it (X.json was written as the CSV and
+# then replaced by the summary).
+file(REMOVE ${TMP}/dg_side.json ${TMP}/dg_side.scene.json)
+foreach(name dg_side.json dg_side.scene.json)
+  execute_process(COMMAND ${DG} simulate --gown coarse --height high --max-travel 0.01 --frames 0 --out ${TMP}/${name}
+                  RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+  if(NOT rc EQUAL 2 OR NOT err MATCHES "--out" OR EXISTS ${TMP}/${name})
+    message(FATAL_ERROR "--out ${name}: expected exit 2 naming --out and no file, got rc=${rc}: ${err}")
+  endif()
+endforeach()
