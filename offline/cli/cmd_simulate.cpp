@@ -200,7 +200,6 @@ int run_simulate(int argc, char** argv) {
   const sim::TrialResult r = sim::simulate_trial(scene, params, spec);
   if (!r.finite) throw std::runtime_error("the simulation diverged (non-finite positions)");
 
-  write_file_atomic(out, format_trial_csv(r.seq.samples));
   const HapticSample last = r.seq.samples.empty() ? HapticSample{} : r.seq.samples.back();
   // What `bend` means as a material on this mesh (model.h): B [N m] and Peirce's bending length.
   const double rigidity = sim::bending_rigidity(params.bend, sim::bend_mesh_factor(scene.data()));
@@ -227,6 +226,10 @@ int run_simulate(int argc, char** argv) {
   write_file_atomic(side.meta, std::string(b) + "\n");
   write_file_atomic(side.scene, sim::scene_json(scene, params, spec, r));
   write_file_atomic(side.arm, arm_parts_csv(scene, r));
+  // The CSV last: it is the commit point. A run that stops before it leaves the old CSV (or none),
+  // never a new CSV beside old side files; new side files beside an old CSV are rewritten by the
+  // next run of the same --out.
+  write_file_atomic(out, format_trial_csv(r.seq.samples));
   if (args.has("json")) {
     std::printf("%s\n", b);
   } else {

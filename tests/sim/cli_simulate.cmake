@@ -183,3 +183,14 @@ foreach(name dg_side.json dg_side.scene.json)
     message(FATAL_ERROR "--out ${name}: expected exit 2 naming --out and no file, got rc=${rc}: ${err}")
   endif()
 endforeach()
+
+# The CSV is written last: a run that fails writing a side file (here a folder in the way of
+# FILE.arm.csv) leaves no new CSV beside old side files.
+file(REMOVE ${TMP}/dg_commit.csv)
+file(MAKE_DIRECTORY ${TMP}/dg_commit.arm.csv)
+execute_process(COMMAND ${DG} simulate --gown coarse --height high --max-travel 0.01 --frames 0 --out ${TMP}/dg_commit.csv
+                RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+file(REMOVE_RECURSE ${TMP}/dg_commit.arm.csv)
+if(rc EQUAL 0 OR EXISTS ${TMP}/dg_commit.csv)
+  message(FATAL_ERROR "a side file that could not be written: expected a failure and no CSV, got rc=${rc}: ${err}")
+endif()
