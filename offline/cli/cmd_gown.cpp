@@ -16,6 +16,7 @@
 #include "gown.h"
 #include "grip_option.h"
 #include "placement.h"
+#include "report.h"
 
 namespace dressguard::cli {
 namespace {
@@ -174,9 +175,9 @@ int run_gown(int argc, char** argv) {
   }
 
   if (args.has("json")) {
-    std::printf("{\"source\": \"%s\", \"vertices\": %zu, \"triangles\": %zu, \"area_m2\": %.5f, \"mass_kg\": %.5f, "
+    std::printf("{\"source\": %s, \"vertices\": %zu, \"triangles\": %zu, \"area_m2\": %.5f, \"mass_kg\": %.5f, "
                 "\"mean_edge_m\": %.5f, \"min_angle_deg\": %.2f, \"seconds\": %.3f, \"hung\": %s, \"loops\": [",
-                source.c_str(), mesh.x.size(), mesh.triangles.size(), gown::total_area(mesh), mass,
+                hmm::json_string(source).c_str(), mesh.x.size(), mesh.triangles.size(), gown::total_area(mesh), mass,
                 gown::mean_edge_length(mesh), gown::min_triangle_angle(mesh) * 180 / M_PI, seconds,
                 args.has("hang") ? "true" : "false");
     for (size_t l = 0; l < mesh.boundary_loops.size(); ++l)

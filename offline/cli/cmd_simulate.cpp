@@ -15,6 +15,7 @@
 #include "grip_option.h"
 #include "model.h"
 #include "params.h"
+#include "report.h"
 #include "sim_bridge.h"
 #include "trial.h"
 
@@ -203,8 +204,8 @@ int run_simulate(int argc, char** argv) {
   const HapticSample last = r.seq.samples.empty() ? HapticSample{} : r.seq.samples.back();
   // What `bend` means as a material on this mesh (model.h): B [N m] and Peirce's bending length.
   const double rigidity = sim::bending_rigidity(params.bend, sim::bend_mesh_factor(scene.data()));
-  char b[2048];
-  std::snprintf(b, sizeof b,
+  // The path as a JSON string (escaped), the rest as long as it needs to be.
+  const std::string b = format_string(
                 "{\"label\": \"%s\", \"height\": \"%s\", \"arm_offset\": %.6g, \"speed\": %.6g, \"seed\": %llu, "
                 "\"noise\": %s, \"gown\": \"%s\", \"friction\": \"%s\", \"travel\": %.6f, \"d_max\": %.6f, "
                 "\"d_behind\": %.6f, \"d_ahead\": %.6f, \"stopped_by_force\": %s, \"contact_travel\": %.6f, \"samples\": %zu, \"f_motion\": %.6f, "
@@ -213,17 +214,16 @@ int run_simulate(int argc, char** argv) {
                 "\"bending_rigidity\": %.6g, \"bending_length\": %.6g, "
                 "\"opening\": {\"depth\": %.4f, \"height\": %.4f, \"width\": %.4f, \"centre_y\": %.4f, "
                 "\"perimeter_ratio\": %.4f, \"rim_low_above_fist\": %.4f}, "
-                "\"grip\": {\"depth\": %.6g, \"rim_ahead\": %.6g}, "
-                "\"out\": \"%s\", \"params\": %s}",
+                "\"grip\": {\"depth\": %.6g, \"rim_ahead\": %.6g}, \"out\": ",
                 std::string(outcome_name(r.outcome)).c_str(), hs.c_str(), r.arm_offset, spec.speed,
                 static_cast<unsigned long long>(spec.seed), spec.gown_noise ? "true" : "false", gs.c_str(), fr.c_str(),
                 r.travel, r.d_max, r.d_behind, r.d_ahead, r.stopped_by_force ? "true" : "false", r.contact_travel, r.seq.samples.size(),
                 last.f_motion, last.f_lateral, last.f_vertical, r.weight, r.support_load, r.area_ratio, r.settle_time,
                 r.settle_speed, r.settled ? "true" : "false", rigidity, sim::bending_length(rigidity, params.areal_density),
                 r.opening.depth, r.opening.height, r.opening.width, r.opening.centre_y, r.opening.perimeter_ratio,
-                r.opening.rim_low_above_fist, held.depth, held.rim_ahead, out.c_str(),
-                sim::params_json(params).c_str());
-  write_file_atomic(side.meta, std::string(b) + "\n");
+                r.opening.rim_low_above_fist, held.depth, held.rim_ahead) +
+                        hmm::json_string(out.string()) + ", \"params\": " + sim::params_json(params) + "}";
+  write_file_atomic(side.meta, b + "\n");
   write_file_atomic(side.scene, sim::scene_json(scene, params, spec, r));
   write_file_atomic(side.arm, arm_parts_csv(scene, r));
   // The CSV last: it is the commit point. A run that stops before it leaves the old CSV (or none),
@@ -231,7 +231,7 @@ int run_simulate(int argc, char** argv) {
   // next run of the same --out.
   write_file_atomic(out, format_trial_csv(r.seq.samples));
   if (args.has("json")) {
-    std::printf("%s\n", b);
+    std::printf("%s\n", b.c_str());
   } else {
     std::printf("%s at %s arm (offset %+.3f m): travel %.3f m, d_max %.3f m, final F motion %.2f N vertical %.2f N -> %s\n",
                 std::string(outcome_name(r.outcome)).c_str(), hs.c_str(), r.arm_offset, r.travel, r.d_max,

@@ -21,6 +21,9 @@ class InputError : public std::runtime_error {
 // A number as people read it in messages and CSV: six significant digits ("%.6g").
 std::string format_number(double v);
 
+// printf into a string as long as it needs (a fixed buffer cut long paths off mid-JSON).
+std::string format_string(const char* format, ...) __attribute__((format(printf, 1, 2)));
+
 // Reads a whole file; throws InputError naming the file if it cannot.
 std::string read_file(const std::filesystem::path& path);
 

@@ -83,3 +83,13 @@ foreach(how "" "--in-world")
   endif()
 endforeach()
 file(REMOVE ${CMAKE_CURRENT_BINARY_DIR}/dg_gown_one_loop.obj)
+# gown --json names its source as a JSON string: a '"' or a '\' in the path is escaped.
+set(odd "${CMAKE_CURRENT_BINARY_DIR}/dg \"odd\" \\gown.obj")
+execute_process(COMMAND ${DG} gown --parametric --reduced 1500 --out "${odd}" RESULT_VARIABLE rc1 OUTPUT_QUIET)
+execute_process(COMMAND ${DG} gown --obj "${odd}" --in-world --scale 1 --json RESULT_VARIABLE rc OUTPUT_VARIABLE out
+                ERROR_VARIABLE err)
+file(REMOVE "${odd}")
+string(JSON source ERROR_VARIABLE jerr GET "${out}" source)
+if(NOT rc1 EQUAL 0 OR NOT rc EQUAL 0 OR jerr OR NOT source STREQUAL "${odd}")
+  message(FATAL_ERROR "gown --obj '${odd}' --json: rc=${rc1},${rc} ${err}; source '${source}' (${jerr})")
+endif()

@@ -194,3 +194,21 @@ file(REMOVE_RECURSE ${TMP}/dg_commit.arm.csv)
 if(rc EQUAL 0 OR EXISTS ${TMP}/dg_commit.csv)
   message(FATAL_ERROR "a side file that could not be written: expected a failure and no CSV, got rc=${rc}: ${err}")
 endif()
+
+# The summary is JSON whatever the path: a '"' and a '\' are escaped, and a path longer than the
+# 2048 characters it was once cut to stays whole (the cut summary was invalid JSON, exit 0).
+string(REPEAT "d" 200 long)
+string(REPEAT "/${long}" 10 deep)
+foreach(dir "${TMP}/dg \"quoted\" \\dir" "${TMP}${deep}")
+  file(MAKE_DIRECTORY "${dir}")
+  execute_process(COMMAND ${DG} simulate --gown coarse --height high --max-travel 0.01 --frames 0 --out "${dir}/t.csv"
+                          --json RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  file(READ "${dir}/t.json" summary)
+  string(JSON printed ERROR_VARIABLE jerr GET "${out}" out)
+  string(JSON written ERROR_VARIABLE jerr2 GET "${summary}" out)
+  if(NOT rc EQUAL 0 OR jerr OR jerr2 OR NOT printed STREQUAL "${dir}/t.csv" OR NOT written STREQUAL printed)
+    message(FATAL_ERROR "summary of --out '${dir}/t.csv': rc=${rc} ${err}; printed '${printed}' (${jerr}), "
+                        "written '${written}' (${jerr2})")
+  endif()
+endforeach()
+file(REMOVE_RECURSE "${TMP}/dg \"quoted\" \\dir" "${TMP}/${long}")
