@@ -105,7 +105,8 @@ int run_gown(int argc, char** argv) {
         "  --in-world      the OBJ is already placed in W (as --out writes it; use --scale 1)\n"
         "  --placement P   opening (default: the jaws hold the sleeve's top 4 cm behind its rim, the\n"
         "                  opening facing the fist) or paper (the paper's code's transform, as read)\n"
-        "  --parametric    use the parametric gown even when the measured one is present\n"
+        "  --parametric    use the parametric gown even when the measured one is present (not with\n"
+        "                  --obj, --scale or --in-world, which read an OBJ)\n"
         "  --reduced N     reduce to about N triangles (quadric edge collapse), e.g. 5000\n"
         "%s"
         "  --hang          let the gown hang 3 s from the jaws in a crude check (edges only, no\n"
@@ -120,7 +121,10 @@ int run_gown(int argc, char** argv) {
   }
   args.allow_only({"help", "json", "parametric", "hang", "in-world", "obj", "scale", "reduced", "out", "dump", "picture",
                   "placement", "grip-depth", "rim-ahead"});
-  if (args.has("parametric") && args.has("obj")) throw UsageError("--parametric and --obj exclude each other");
+  // --scale and --in-world read an OBJ: the parametric gown would silently ignore them.
+  for (const char* o : {"obj", "scale", "in-world"})
+    if (args.has("parametric") && args.has(o))
+      throw UsageError(std::string("--parametric and --") + o + " exclude each other");
   gown::GownOptions opt;
   opt.scale = args.number("scale", 1.679);
   if (!(opt.scale > 0)) throw UsageError("--scale must be positive");
