@@ -110,8 +110,9 @@ int run_gown(int argc, char** argv) {
         "  --reduced N     reduce to about N triangles (quadric edge collapse), e.g. 5000\n"
         "%s"
         "  --hang          let the gown hang 3 s from the jaws in a crude check (edges only, no\n"
-        "                  bending, no collisions; not the simulator) before reporting and drawing\n"
-        "  --out MESH.obj  write the placed mesh (atomically)\n"
+        "                  bending, no collisions; not the simulator) before reporting where its\n"
+        "                  loops are and drawing it (area, mass, edges and --out stay as placed)\n"
+        "  --out MESH.obj  write the placed mesh (atomically; before any --hang)\n"
         "  --dump FILE     write the scene (mesh, grasp, loops, arm, gripper) as JSON for plotting\n"
         "  --picture PNG   draw the placed gown with grasp, sleeve opening and arm (needs python3 +\n"
         "                  matplotlib; tools/plot/gown.py)\n"
@@ -153,14 +154,19 @@ int run_gown(int argc, char** argv) {
   GownMesh mesh = gown::load_gown(opt);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
+  // The cloth as placed: what the simulator starts from, so what --out writes and what the mesh's
+  // statistics describe (a crude hang stretches edges, which is no change of area or mass).
   const auto masses = gown::vertex_masses(mesh);
   double mass = 0;
   for (double m : masses) mass += m;
-  const auto grasp = gown::grasp_vertices(mesh, opt.scene);  // at placement, before any hang
+  const double area = gown::total_area(mesh), mean_edge = gown::mean_edge_length(mesh);
+  const double min_angle_deg = gown::min_triangle_angle(mesh) * 180 / M_PI;
+  const auto grasp = gown::grasp_vertices(mesh, opt.scene);
+  if (auto out = args.get("out")) write_file_atomic(*out, gown::to_obj(mesh));
+  // --hang moves the positions the rest reports and draws: the loops, the sleeve, the picture.
   if (args.has("hang")) mesh.x = gown::crude_hang(mesh, opt.scene);
   const Eigen::Vector3d sleeve_c = gown::loop_centroid(mesh, mesh.sleeve_loop);
 
-  if (auto out = args.get("out")) write_file_atomic(*out, gown::to_obj(mesh));
   const auto dump = args.get("dump");
   const auto picture = args.get("picture");
   if (dump || picture) {
@@ -181,9 +187,8 @@ int run_gown(int argc, char** argv) {
   if (args.has("json")) {
     std::printf("{\"source\": %s, \"vertices\": %zu, \"triangles\": %zu, \"area_m2\": %.5f, \"mass_kg\": %.5f, "
                 "\"mean_edge_m\": %.5f, \"min_angle_deg\": %.2f, \"seconds\": %.3f, \"hung\": %s, \"loops\": [",
-                hmm::json_string(source).c_str(), mesh.x.size(), mesh.triangles.size(), gown::total_area(mesh), mass,
-                gown::mean_edge_length(mesh), gown::min_triangle_angle(mesh) * 180 / M_PI, seconds,
-                args.has("hang") ? "true" : "false");
+                hmm::json_string(source).c_str(), mesh.x.size(), mesh.triangles.size(), area, mass, mean_edge,
+                min_angle_deg, seconds, args.has("hang") ? "true" : "false");
     for (size_t l = 0; l < mesh.boundary_loops.size(); ++l)
       std::printf("%s{\"vertices\": %zu, \"perimeter_m\": %.5f, \"centroid\": %s}", l ? ", " : "",
                   mesh.boundary_loops[l].size(), gown::loop_perimeter(mesh, static_cast<int>(l)),
@@ -192,10 +197,10 @@ int run_gown(int argc, char** argv) {
                 mesh.sleeve_loop, vec_json(sleeve_c).c_str(), mesh.sleeve_lower_half.size(), grasp.size());
   } else {
     std::printf("gown: %s%s\n", source.c_str(), args.has("hang") ? " (after a crude 3 s hang from the jaws)" : "");
-    std::printf("  %zu vertices, %zu triangles, area %.4f m^2, mass %.4f kg (%.3f kg/m^2)\n", mesh.x.size(),
-                mesh.triangles.size(), gown::total_area(mesh), mass, mesh.areal_density);
-    std::printf("  mean edge %.2f cm, smallest angle %.1f deg, built in %.3f s\n", gown::mean_edge_length(mesh) * 100,
-                gown::min_triangle_angle(mesh) * 180 / M_PI, seconds);
+    std::printf("  as placed: %zu vertices, %zu triangles, area %.4f m^2, mass %.4f kg (%.3f kg/m^2)\n",
+                mesh.x.size(), mesh.triangles.size(), area, mass, mesh.areal_density);
+    std::printf("  mean edge %.2f cm, smallest angle %.1f deg, built in %.3f s\n", mean_edge * 100, min_angle_deg,
+                seconds);
     for (size_t l = 0; l < mesh.boundary_loops.size(); ++l) {
       const auto c = gown::loop_centroid(mesh, static_cast<int>(l));
       std::printf("  loop %zu: %zu vertices, perimeter %.3f m, centre (%.3f, %.3f, %.3f)%s\n", l,

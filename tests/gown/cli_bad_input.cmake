@@ -101,3 +101,26 @@ foreach(opt "--scale;2" "--in-world")
     message(FATAL_ERROR "gown --parametric ${opt}: expected exit 2 naming both, got rc=${rc}: ${err}")
   endif()
 endforeach()
+# --hang moves the report's and the picture's positions only: --out writes the placed mesh (what
+# --in-world reads back as the simulator's start), and the area and mass are the cloth's at rest.
+execute_process(COMMAND ${DG} gown --parametric --reduced 1500 --hang --json
+                        --out ${CMAKE_CURRENT_BINARY_DIR}/dg_gown_hung.obj RESULT_VARIABLE rc1 OUTPUT_VARIABLE hung)
+execute_process(COMMAND ${DG} gown --parametric --reduced 1500 --json RESULT_VARIABLE rc2 OUTPUT_VARIABLE placed)
+execute_process(COMMAND ${DG} gown --obj ${CMAKE_CURRENT_BINARY_DIR}/dg_gown_hung.obj --in-world --scale 1 --json
+                RESULT_VARIABLE rc3 OUTPUT_VARIABLE back)
+file(REMOVE ${CMAKE_CURRENT_BINARY_DIR}/dg_gown_hung.obj)
+foreach(key area_m2 mass_kg)
+  string(JSON a ERROR_VARIABLE e1 GET "${hung}" ${key})
+  string(JSON b ERROR_VARIABLE e2 GET "${placed}" ${key})
+  if(NOT a STREQUAL b)
+    message(FATAL_ERROR "gown --hang reports ${key} ${a}, the placed gown ${b}")
+  endif()
+endforeach()
+string(JSON sleeve_back ERROR_VARIABLE e3 GET "${back}" sleeve_center)
+string(JSON sleeve_placed ERROR_VARIABLE e4 GET "${placed}" sleeve_center)
+string(REGEX REPLACE "-(0\\.0*)([],])" "\\1\\2" sleeve_back "${sleeve_back}")  # -0 is 0 (the OBJ's rounding)
+string(REGEX REPLACE "-(0\\.0*)([],])" "\\1\\2" sleeve_placed "${sleeve_placed}")
+if(NOT rc1 EQUAL 0 OR NOT rc2 EQUAL 0 OR NOT rc3 EQUAL 0 OR NOT sleeve_back STREQUAL sleeve_placed)
+  message(FATAL_ERROR "gown --hang --out did not write the placed mesh: sleeve centre ${sleeve_back} read back, "
+                      "${sleeve_placed} placed (rc ${rc1} ${rc2} ${rc3})")
+endif()
