@@ -25,6 +25,7 @@
 #include "haptic.h"
 #include "json.h"
 #include "objective.h"
+#include "person_limits.h"
 #include "runner.h"
 
 namespace dressguard::calib {
@@ -130,10 +131,10 @@ inline constexpr int kFistLateral = 5;    // [m] sim/trial.h ClothParams::fist_l
 inline constexpr int kSupportDepth = 6;    // [m] sim/trial.h ClothParams::support_depth
 inline constexpr int kSupportLateral = 7;  // [m] sim/trial.h ClothParams::support_lateral
 inline constexpr std::array<PersonParamInfo, kPersonParams> kPersonParamInfo = {{
-    {"arm_compliance", "arm-compliance", 0.0, 1.0, 0.0, "cannot be negative (0 is a fixed arm) nor above 1 m/N"},
+    {"arm_compliance", "arm-compliance", 0.0, kMaxArmCompliance, 0.0, kArmComplianceRange},
     {"fist_shift", "fist-shift", -0.2, 0.2, 0.0, "must be within +-0.2 m (the forearm is 0.31 m)"},
     {"rim_shift", "rim-shift", -0.04, 0.06, 0.0, "must be within -0.04 and +0.06 m (the rim 0 to 10 cm ahead of the jaws)"},
-    {"areal_density", "density", 0.01, 1.0, kPaperArealDensity, "must be within 0.01 and 1 kg/m^2 (a heavy canvas is about 0.5)"},
+    {"areal_density", "density", kMinArealDensity, kMaxArealDensity, kPaperArealDensity, kArealDensityRange},
     {"arm_lateral", "arm-lateral", -0.1, 0.1, 0.0, "must be within +-0.1 m (beyond it the fist is beside the opening)"},
     {"fist_lateral", "fist-lateral", -0.1, 0.1, 0.0, "must be within +-0.1 m (beyond it the fist is beside the opening)"},
     {"support_depth", "support-depth", 0.0, 1.5, 0.0, "must be within 0 (no support) and 1.5 m below the grasp"},

@@ -10,6 +10,7 @@
 
 #include "files.h"
 #include "model.h"
+#include "person_limits.h"
 
 namespace dressguard::sim {
 namespace {
@@ -85,9 +86,12 @@ ClothParams parse_params(const std::string& text, const std::filesystem::path& f
   // A decay rate [1/s]: the model would take a negative one as 0 (model.cpp) while the summary
   // reported the value given.
   if (p.damping < 0) throw_input_error(file, at("damping"), "damping must not be negative (0: no damping)");
-  if (p.areal_density <= 0) throw_input_error(file, at("areal_density"), "areal_density must be positive");
-  if (p.arm_compliance < 0)
-    throw_input_error(file, at("arm_compliance"), "arm_compliance must be 0 (a fixed arm) or positive");
+  // The calibration reader's limits (core/person_limits.h): a params file written from a
+  // calibration reads back, and neither takes a value the other refuses.
+  if (!(p.areal_density >= kMinArealDensity && p.areal_density <= kMaxArealDensity))
+    throw_input_error(file, at("areal_density"), std::string("areal_density ") + kArealDensityRange);
+  if (!(p.arm_compliance >= 0 && p.arm_compliance <= kMaxArmCompliance))
+    throw_input_error(file, at("arm_compliance"), std::string("arm_compliance ") + kArmComplianceRange);
   const std::string arm_range = " must be within +-" + std::to_string(kMaxArmLateral) + " m";
   if (!(std::abs(p.fist_shift) <= kMaxFistShift))
     throw_input_error(file, at("fist_shift"), "fist_shift must be within +-" + std::to_string(kMaxFistShift) + " m");

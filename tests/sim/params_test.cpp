@@ -42,3 +42,17 @@ TEST(SimParams, RepeatedKeyAndRangeErrorsNameTheirLines) {
   e = error_of("bend 0.5\n\nsupport_lateral -0.5\n");
   EXPECT_NE(e.find("p.txt:3: support_lateral must be within"), std::string::npos) << e;
 }
+
+// areal_density and arm_compliance are held to the calibration file's limits (core/
+// person_limits.h): 145 (g/m^2 by mistake) and 1000 m/N were taken.
+TEST(SimParams, DensityAndComplianceWithinTheCalibrationsLimits) {
+  std::string e = error_of("areal_density 145\n");
+  EXPECT_NE(e.find("areal_density must be within 0.01 and 1 kg/m^2"), std::string::npos) << e;
+  e = error_of("areal_density 0.005\n");
+  EXPECT_NE(e.find("areal_density must be within"), std::string::npos) << e;
+  e = error_of("arm_compliance 1000\n");
+  EXPECT_NE(e.find("arm_compliance cannot be negative (0 is a fixed arm) nor above 1 m/N"), std::string::npos) << e;
+  const ClothParams p = parse_params("areal_density 1\narm_compliance 1\n", "p.txt");  // the limits themselves
+  EXPECT_EQ(p.areal_density, 1.0);
+  EXPECT_EQ(p.arm_compliance, 1.0);
+}
