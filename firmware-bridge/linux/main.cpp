@@ -123,7 +123,16 @@ int main(int argc, char** argv) {
     }
   }
   // Both endpoints are checked now, not when the first stop must go out.
-  if (const std::string why = parse_endpoint(sensor_ep.spec); !why.empty()) return bad("--sensor: " + why);
+  EndpointParts sensor_parts;
+  if (const std::string why = parse_endpoint(sensor_ep.spec, &sensor_parts); !why.empty()) return bad("--sensor: " + why);
+  // A serial line too slow for the period: readings come late, and the sample counter (the
+  // predictor's logical time, one count per reading) runs slower than the model's 100 Hz.
+  if (const double line_ms = rtu_reading_ms(sensor_parts); line_ms > cfg.sample_period_ms)
+    std::fprintf(stderr,
+                 "dressguard-bridge: warning: at %d baud one reading takes at least %.1f ms on the line, more "
+                 "than --period-ms %d: readings will come late and the predictor's logical time will run slow "
+                 "(set the sensor to a faster baud rate)\n",
+                 sensor_parts.number, line_ms, cfg.sample_period_ms);
   if (!robot_spec.empty())
     if (const std::string why = parse_endpoint(robot_spec); !why.empty()) return bad("--robot: " + why);
   try {

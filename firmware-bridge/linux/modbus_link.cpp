@@ -23,6 +23,13 @@ const char* read_result_name(ReadResult r) {
   return "unknown";
 }
 
+double rtu_reading_ms(const EndpointParts& p) {
+  if (p.tcp || p.number <= 0) return 0.0;
+  const double characters = 8 + 17 + 2 * 3.5;
+  const double bits = p.parity == 'N' ? 10.0 : 11.0;
+  return 1000.0 * characters * bits / p.number;
+}
+
 std::string parse_endpoint(const std::string& spec, EndpointParts* out) {
   std::vector<std::string> parts;
   std::stringstream in(spec);

@@ -471,6 +471,21 @@ TEST(BridgeModbus, StopFrameWritesTheRobotsStopCoil) {
   EXPECT_NE(mbpoll(coil).find("[7]: \t1"), std::string::npos) << mbpoll(coil);
 }
 
+// The least line time of one reading, in closed form: (8 + 17 characters + 2 x 3.5 of silence)
+// x 10 bits (11 with parity) / baud. 100 Hz polling needs 38400 baud or more.
+TEST(BridgeModbus, RtuLineTimeOfOneReading) {
+  EndpointParts p;
+  ASSERT_EQ(parse_endpoint("rtu:/dev/ttyUSB0:19200:N", &p), "");
+  EXPECT_NEAR(rtu_reading_ms(p), 32.0 * 10 / 19200 * 1000, 1e-9);
+  EXPECT_GT(rtu_reading_ms(p), 10.0);
+  ASSERT_EQ(parse_endpoint("rtu:/dev/ttyUSB0:19200:E", &p), "");
+  EXPECT_NEAR(rtu_reading_ms(p), 32.0 * 11 / 19200 * 1000, 1e-9);
+  ASSERT_EQ(parse_endpoint("rtu:/dev/ttyUSB0:38400:N", &p), "");
+  EXPECT_LT(rtu_reading_ms(p), 10.0);
+  ASSERT_EQ(parse_endpoint("tcp:127.0.0.1:502", &p), "");
+  EXPECT_EQ(rtu_reading_ms(p), 0.0);
+}
+
 // A null-modem cable made of two pseudo-terminals: bytes written to one end's slave come out of
 // the other end's slave (a thread copies between the two masters), so libmodbus's RTU code runs
 // on real tty devices with termios, as on the FT 300's RS-485 adapter.
