@@ -329,6 +329,12 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
   // A folder holds one synthesis: resuming with other settings would mix two datasets.
   const std::string record = settings_record(cal, options);
   const fs::path record_path = out / "synthesis.json";
+  // Nor may it be another dataset: saving replaces the manifest and removes the files only the
+  // old one named (a measured dataset's trials, gone without a word).
+  if (!fs::exists(record_path) && fs::exists(out / "manifest.csv"))
+    throw_input_error(out / "manifest.csv", 0,
+                      "this folder holds a dataset that is not a synthesis (no synthesis.json beside it); "
+                      "choose another folder or remove it");
   if (fs::exists(record_path) && stored_record(record_path) != record)
     throw_input_error(record_path, 0,
                       "this folder holds a synthesis with other settings (calibration, count, noise or seed); "

@@ -1,5 +1,7 @@
 #include "args.h"
 
+#include <cstdlib>
+
 #include <charconv>
 #include <cmath>
 #include <ctime>
@@ -20,6 +22,36 @@ std::vector<std::string> split_in_order(const std::string& s) {
 std::set<std::string> split_list(const std::string& s) {
   const auto items = split_in_order(s);
   return {items.begin(), items.end()};
+}
+
+std::filesystem::path plot_script(const std::string& name) {
+  namespace fs = std::filesystem;
+  const fs::path rel = fs::path("tools") / "plot" / name;
+  if (const char* src = std::getenv("DRESSGUARD_SOURCE_DIR"); src && fs::exists(fs::path(src) / rel))
+    return fs::path(src) / rel;
+  std::error_code ec;
+  for (fs::path p = fs::read_symlink("/proc/self/exe", ec).parent_path(); !ec && p.has_relative_path();
+       p = p.parent_path())
+    if (fs::exists(p / rel)) return p / rel;
+  if (fs::exists(rel)) return fs::absolute(rel);
+  return {};
+}
+
+namespace {
+
+// One word for the shell, whatever it holds: single-quoted, each ' as '\''.
+std::string shell_quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+}  // namespace
+
+int run_plot_script(const std::filesystem::path& script, const std::vector<std::string>& args) {
+  std::string cmd = "/usr/bin/python3 " + shell_quote(script.string());
+  for (const std::string& a : args) cmd += " " + shell_quote(a);
+  return std::system(cmd.c_str());
 }
 
 void require_known_participants(const std::string& option, const std::set<std::string>& given,

@@ -6,6 +6,7 @@
 
 #include <climits>
 #include <cstddef>
+#include <filesystem>
 #include <map>
 #include <optional>
 #include <set>
@@ -32,6 +33,14 @@ std::vector<std::string> split_in_order(const std::string& s);
 // participant "4" while its model said it excluded p4).
 void require_known_participants(const std::string& option, const std::set<std::string>& given,
                                 const std::set<std::string>& known, const std::string& data);
+
+// tools/plot/<name> of the sources this binary was built from: under $DRESSGUARD_SOURCE_DIR, else
+// in a folder above the binary, else under the working directory; empty when absent.
+std::filesystem::path plot_script(const std::string& name);
+
+// Runs `/usr/bin/python3 SCRIPT ARGS...` through the shell, every word quoted (a path may hold a
+// quote or a blank); its exit status, 0 when it succeeded.
+int run_plot_script(const std::filesystem::path& script, const std::vector<std::string>& args);
 
 // --threads N: 0 is every core; more than this is no machine's.
 inline constexpr long kMaxThreads = 1024;

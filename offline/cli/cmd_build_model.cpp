@@ -14,6 +14,7 @@
 #include "dataset.h"
 #include "discrepancy.h"
 #include "files.h"
+#include "json.h"
 #include "synthesis.h"
 #ifdef DRESSGUARD_HAVE_SIM
 #include "sim_bridge.h"
@@ -29,6 +30,9 @@ using namespace dressguard::calib;
 SynthesisOptions synthesis_options_from(const Args& args);
 SynthesisSummary run_synthesis(const Calibration& cal, const std::string& gown, const SynthesisOptions& o,
                                const std::string& out);
+
+// The file --training-out leaves beside its manifest: this folder's dataset is build-model's.
+constexpr const char* kTrainingOutMark = "training-set.txt";
 
 int run_build_model(int argc, char** argv) {
   Args args(argc - 1, argv + 1, {"help", "json", "no-gown-noise", "no-arm-noise"});
@@ -65,7 +69,8 @@ int run_build_model(int argc, char** argv) {
         "  --training-out DIR   also write the trials the HMMs learnt, as a dataset: after\n"
         "               --label-margin and with --discrepancy's correction added, which the\n"
         "               synthesized set on disk does not hold. What `classify --weigh-on` weighs\n"
-        "               this model's fellow members on. One training set only\n"
+        "               this model's fellow members on. One training set only. It replaces\n"
+        "               only a dataset it wrote itself (marked by training-set.txt)\n"
         "  --priors P   uniform (default: the paper's highest likelihood, and a caught arm's HMM\n"
         "               as likely as the others before any force is read) | training: each\n"
         "               class's share of the training trials (the Bayes decision for trials\n"
@@ -96,6 +101,19 @@ int run_build_model(int argc, char** argv) {
     throw UsageError("--training-out writes one training set: give one --data (several pool their sets)");
   if (args.has("discrepancy") && !args.has("calibration"))
     throw UsageError("--discrepancy needs --calibration: it is a calibrated simulator's error on its own sequences");
+  // The synthesis's options with --data would be ignored without a word.
+  for (const char* o : {"per-height", "seed", "gown", "synth-dir", "middle", "high-low", "no-gown-noise",
+                        "no-arm-noise", "threads"})
+    if (args.has("data") && args.has(o))
+      throw UsageError(std::string("--") + o + " needs --calibration: it sets the synthesis, and --data trains on "
+                       "the datasets as they are");
+  // --training-out replaces the dataset in its folder: only one it wrote itself (its mark beside
+  // the manifest), never, say, the measured trials.
+  const auto training_out = args.get("training-out");
+  if (training_out && std::filesystem::exists(std::filesystem::path(*training_out) / "manifest.csv") &&
+      !std::filesystem::exists(std::filesystem::path(*training_out) / kTrainingOutMark))
+    throw UsageError("--training-out " + *training_out + " holds a dataset build-model did not write (no " +
+                     kTrainingOutMark + " beside its manifest): choose another folder or remove it");
   // The training sets: one per calibration (synthesized here) or the datasets given.
   std::vector<std::filesystem::path> sets;
   std::vector<std::pair<std::string, Discrepancy>> discrepancies;  // per set (calibration file), with --discrepancy
@@ -169,7 +187,11 @@ int run_build_model(int argc, char** argv) {
       for (auto& t : one.trials) apply_discrepancy(discrepancies[i].second, t);
     std::move(one.trials.begin(), one.trials.end(), std::back_inserter(ds.trials));
   }
-  if (auto dir = args.get("training-out")) save_dataset(ds, *dir);
+  if (training_out) {
+    save_dataset(ds, *training_out);
+    write_file_atomic(std::filesystem::path(*training_out) / kTrainingOutMark,
+                      "written by dressguard build-model --training-out for " + out + "\n");
+  }
   if (!discrepancies.empty()) {
     write_file_atomic(out + ".discrepancy.csv", discrepancy_csv(discrepancies));
     data += " + discrepancy from " + *args.get("discrepancy");
@@ -204,10 +226,10 @@ int run_build_model(int argc, char** argv) {
   model::write_model(out, m);
   const double acc = accuracy(m, trials, std::numeric_limits<double>::infinity());
   if (args.has("json")) {
-    std::printf("{\"model\": \"%s\", \"classes\": %zu, \"training_trials\": %zu, \"training_sets\": %zu, "
+    std::printf("{\"model\": %s, \"classes\": %zu, \"training_trials\": %zu, \"training_sets\": %zu, "
                 "\"training_accuracy\": %.4f, \"forces\": \"%s\", \"priors\": \"%s\", \"label_margin\": %.6g, "
                 "\"left_out\": %d}\n",
-                out.c_str(), m.classes.size(), labelled, sets.size(), acc, stc_forces_name(axes.second_axis),
+                json_string(out).c_str(), m.classes.size(), labelled, sets.size(), acc, stc_forces_name(axes.second_axis),
                 priors.c_str(), label_margin, left_out);
   } else {
     std::printf("wrote %s: %zu classes (", out.c_str(), m.classes.size());

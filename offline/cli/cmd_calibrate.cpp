@@ -12,6 +12,7 @@
 #include "commands.h"
 #include "dataset.h"
 #include "files.h"
+#include "json.h"
 #ifdef DRESSGUARD_HAVE_SIM
 #include "sim_bridge.h"
 #endif
@@ -358,8 +359,8 @@ int run_calibrate(int argc, char** argv) {
   if (!r.complete) {
     if (comm.is_root()) {
       if (args.has("json"))
-        std::printf("{\"complete\": false, \"generations_done\": %d, \"checkpoint\": \"%s\"}\n", r.generations_done,
-                    o.checkpoint.c_str());
+        std::printf("{\"complete\": false, \"generations_done\": %d, \"checkpoint\": %s}\n", r.generations_done,
+                    json_string(o.checkpoint.string()).c_str());
       else
         std::printf("stopped after %d generations; run the same command again to resume from %s\n",
                     r.generations_done, o.checkpoint.c_str());

@@ -49,24 +49,6 @@ std::vector<double> parse_sweep(const std::string& s) {
   return out;
 }
 
-// tools/plot/hmm_sweep.py: beside the sources this binary was built from, else under the
-// working directory; empty when absent.
-std::filesystem::path find_plot_script() {
-  std::vector<std::filesystem::path> cands;
-  if (const char* s = std::getenv("DRESSGUARD_SOURCE_DIR")) cands.emplace_back(std::filesystem::path(s) / "tools/plot/hmm_sweep.py");
-  char exe[4096];
-  const ssize_t n = ::readlink("/proc/self/exe", exe, sizeof exe - 1);
-  if (n > 0) {
-    exe[n] = '\0';
-    auto p = std::filesystem::path(exe).parent_path();
-    for (int up = 0; up < 5 && !p.empty(); ++up, p = p.parent_path()) cands.push_back(p / "tools/plot/hmm_sweep.py");
-  }
-  cands.emplace_back(std::filesystem::current_path() / "tools/plot/hmm_sweep.py");
-  for (const auto& c : cands)
-    if (std::filesystem::exists(c)) return c;
-  return {};
-}
-
 // The accuracy line (with its 95 % Wilson interval: on the study's 22 trials a few trials either
 // way are noise, hmm.h) and the confusion matrix.
 // One line per trial whose recording starts late, saying how the HMMs scored it (hmm.h,
@@ -284,17 +266,17 @@ int run_classify(int argc, char** argv) {
     }
     write_file_atomic(prefix + ".csv", csv);
     std::string png;
+    // A picture of an earlier sweep under this prefix would pass for this one's: it goes first,
+    // so that what is on disk is what the summary says.
+    std::filesystem::remove(prefix + ".png");
     if (!args.has("no-plot")) {
-      const auto script = find_plot_script();
+      const auto script = plot_script("hmm_sweep.py");
       if (script.empty()) {
         std::fprintf(stderr, "classify: tools/plot/hmm_sweep.py not found; wrote only %s.csv\n", prefix.c_str());
+      } else if (run_plot_script(script, {prefix + ".csv", prefix + ".png"}) == 0) {
+        png = prefix + ".png";
       } else {
-        const std::string cmd = "/usr/bin/python3 '" + script.string() + "' '" + prefix + ".csv' '" + prefix + ".png'";
-        if (std::system(cmd.c_str()) == 0) {
-          png = prefix + ".png";
-        } else {
-          std::fprintf(stderr, "classify: plotting failed (%s); wrote only %s.csv\n", cmd.c_str(), prefix.c_str());
-        }
+        std::fprintf(stderr, "classify: plotting failed (%s); wrote only %s.csv\n", script.c_str(), prefix.c_str());
       }
     }
     if (json) {

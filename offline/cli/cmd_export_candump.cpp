@@ -13,6 +13,7 @@
 #include "dataset.h"
 #include "dg_protocol.h"
 #include "files.h"
+#include "json.h"
 
 namespace dressguard::cli {
 namespace {
@@ -265,12 +266,11 @@ int run_export_candump(int argc, char** argv) {
       const std::string label = t.label ? std::string(outcome_name(*t.label)) : "unlabelled";
       p = std::filesystem::path(out) / (t.id + "-" + label + ".log");
     }
-    char buf[512];
-    std::snprintf(buf, sizeof buf,
-                  "%s{\"file\": \"%s\", \"trial\": \"%s\", \"trial_id\": %ld, \"samples\": %zu, \"limit_sample\": %ld, \"frames\": %zu}",
-                  k ? ", " : "", p.string().c_str(), t.id.c_str(), trial_id + static_cast<long>(k), sum.samples_sent,
-                  sum.limit_sample, sum.frames);
-    json += buf;
+    char buf[160];
+    std::snprintf(buf, sizeof buf, ", \"trial_id\": %ld, \"samples\": %zu, \"limit_sample\": %ld, \"frames\": %zu}",
+                  trial_id + static_cast<long>(k), sum.samples_sent, sum.limit_sample, sum.frames);
+    json += (k ? ", " : "") + std::string("{\"file\": ") + json_string(p.string()) + ", \"trial\": " +
+            json_string(t.id) + buf;
     if (!args.has("json"))
       std::printf("%s: %zu samples, %zu frames%s\n", p.string().c_str(), sum.samples_sent, sum.frames,
                   sum.limit_sample >= 0 ? (", rig limit at sample " + std::to_string(sum.limit_sample)).c_str() : "");

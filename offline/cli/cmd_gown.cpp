@@ -15,8 +15,8 @@
 #include "files.h"
 #include "gown.h"
 #include "grip_option.h"
+#include "json.h"
 #include "placement.h"
-#include "report.h"
 
 namespace dressguard::cli {
 namespace {
@@ -71,24 +71,6 @@ std::string scene_dump(const GownMesh& m, const gown::PaperScene& s, const std::
 
 // tools/plot/gown.py: from $DRESSGUARD_SOURCE_DIR, else from the folders above the executable
 // (build/<preset>/offline/cli/dressguard), else from the working directory.
-fs::path plot_script() {
-  const fs::path rel = fs::path("tools") / "plot" / "gown.py";
-  if (const char* src = std::getenv("DRESSGUARD_SOURCE_DIR"); src && fs::exists(fs::path(src) / rel))
-    return fs::path(src) / rel;
-  std::error_code ec;
-  for (fs::path p = fs::read_symlink("/proc/self/exe", ec).parent_path(); !ec && p.has_relative_path();
-       p = p.parent_path())
-    if (fs::exists(p / rel)) return p / rel;
-  if (fs::exists(rel)) return fs::absolute(rel);
-  return {};
-}
-
-std::string shell_quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
 }  // namespace
 
 int run_gown(int argc, char** argv) {
@@ -174,20 +156,18 @@ int run_gown(int argc, char** argv) {
         dump ? fs::path(*dump) : fs::temp_directory_path() / ("dressguard-gown-" + std::to_string(::getpid()) + ".json");
     write_file_atomic(dump_path, scene_dump(mesh, opt.scene, grasp, args.has("hang")));
     if (picture) {
-      const fs::path script = plot_script();
+      const fs::path script = plot_script("gown.py");
       if (script.empty()) throw std::runtime_error("tools/plot/gown.py not found (set DRESSGUARD_SOURCE_DIR)");
-      const std::string cmd = "/usr/bin/python3 " + shell_quote(script.string()) + " " +
-                              shell_quote(dump_path.string()) + " " + shell_quote(*picture);
-      const int rc = std::system(cmd.c_str());
+      const int rc = run_plot_script(script, {dump_path.string(), *picture});
       if (!dump) fs::remove(dump_path);
-      if (rc != 0) throw std::runtime_error("the picture script failed: " + cmd);
+      if (rc != 0) throw std::runtime_error("the picture script failed: " + script.string() + " " + *picture);
     }
   }
 
   if (args.has("json")) {
     std::printf("{\"source\": %s, \"vertices\": %zu, \"triangles\": %zu, \"area_m2\": %.5f, \"mass_kg\": %.5f, "
                 "\"mean_edge_m\": %.5f, \"min_angle_deg\": %.2f, \"seconds\": %.3f, \"hung\": %s, \"loops\": [",
-                hmm::json_string(source).c_str(), mesh.x.size(), mesh.triangles.size(), area, mass, mean_edge,
+                json_string(source).c_str(), mesh.x.size(), mesh.triangles.size(), area, mass, mean_edge,
                 min_angle_deg, seconds, args.has("hang") ? "true" : "false");
     for (size_t l = 0; l < mesh.boundary_loops.size(); ++l)
       std::printf("%s{\"vertices\": %zu, \"perimeter_m\": %.5f, \"centroid\": %s}", l ? ", " : "",

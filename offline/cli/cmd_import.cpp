@@ -5,6 +5,7 @@
 #include "commands.h"
 #include "dataset.h"
 #include "files.h"
+#include "json.h"
 
 namespace dressguard::cli {
 
@@ -28,8 +29,8 @@ int run_import(int argc, char** argv) {
   int per[kOutcomeCount] = {};
   for (const auto& t : ds.trials) per[static_cast<int>(*t.label)]++;
   if (args.has("json")) {
-    std::printf("{\"trials\": %zu, \"good\": %d, \"missed\": %d, \"caught\": %d, \"out\": \"%s\"}\n",
-                ds.trials.size(), per[0], per[1], per[2], out.c_str());
+    std::printf("{\"trials\": %zu, \"good\": %d, \"missed\": %d, \"caught\": %d, \"out\": %s}\n",
+                ds.trials.size(), per[0], per[1], per[2], json_string(out).c_str());
   } else {
     std::printf("imported %zu trials (%d good, %d missed, %d caught) into %s\n", ds.trials.size(), per[0], per[1],
                 per[2], out.c_str());

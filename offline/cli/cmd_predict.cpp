@@ -10,6 +10,7 @@
 #include "dataset.h"
 #include "discrepancy.h"
 #include "files.h"
+#include "json.h"
 #include "prediction.h"
 #ifdef DRESSGUARD_HAVE_SIM
 #include "sim_bridge.h"
@@ -108,7 +109,7 @@ int run_predict(int argc, char** argv) {
   }
   const std::vector<PredictionSummary> sum = summarize(p);
   if (args.has("json")) {
-    std::printf("{\"participant\": \"%s\", \"trials\": %zu, \"heights\": [", p.participant.c_str(), p.trials.size());
+    std::printf("{\"participant\": %s, \"trials\": %zu, \"heights\": [", json_string(p.participant).c_str(), p.trials.size());
     bool first = true;
     for (const auto& s : sum) {
       if (s.trials == 0) continue;

@@ -13,9 +13,9 @@
 #include "gown.h"
 #include "gown_scene.h"
 #include "grip_option.h"
+#include "json.h"
 #include "model.h"
 #include "params.h"
-#include "report.h"
 #include "sim_bridge.h"
 #include "trial.h"
 
@@ -222,7 +222,7 @@ int run_simulate(int argc, char** argv) {
                 r.settle_speed, r.settled ? "true" : "false", rigidity, sim::bending_length(rigidity, params.areal_density),
                 r.opening.depth, r.opening.height, r.opening.width, r.opening.centre_y, r.opening.perimeter_ratio,
                 r.opening.rim_low_above_fist, held.depth, held.rim_ahead) +
-                        hmm::json_string(out.string()) + ", \"params\": " + sim::params_json(params) + "}";
+                        json_string(out.string()) + ", \"params\": " + sim::params_json(params) + "}";
   write_file_atomic(side.meta, b + "\n");
   write_file_atomic(side.scene, sim::scene_json(scene, params, spec, r));
   write_file_atomic(side.arm, arm_parts_csv(scene, r));

@@ -6,6 +6,7 @@
 #include "calibration.h"
 #include "commands.h"
 #include "files.h"
+#include "json.h"
 #include "synthesis.h"
 #ifdef DRESSGUARD_HAVE_SIM
 #include "sim_bridge.h"
@@ -111,7 +112,8 @@ int run_synthesize(int argc, char** argv) {
         "  Writes DATASET/labels.csv beside the manifest: each trial's arm offset, travel at the end\n"
         "  and the label's evidence (paper V-A: how far the sleeve opening's lower half ended behind\n"
         "  and past the elbow centre; good within 7 cm on either side).\n"
-        "  Resumable: trials already in DATASET (from the same settings) are kept.");
+        "  Resumable: trials already in DATASET (from the same settings) are kept. A folder that holds\n"
+        "  another dataset (no synthesis.json beside its manifest) is refused, never replaced.");
     return 0;
   }
   args.allow_only({"help", "json", "no-gown-noise", "no-arm-noise", "calibration", "out", "per-height", "seed",
@@ -137,11 +139,11 @@ int run_synthesize(int argc, char** argv) {
       std::printf("{\"trials\": %d, \"resumed\": %d, \"good\": %d, \"missed\": %d, \"caught\": %d, "
                   "\"per_height\": {%s}, "
                   "\"middle\": \"%s\", \"middle_base_m\": %.6f, \"high_low\": \"%s\", \"high_band_m\": [%.6f, %.6f], "
-                  "\"low_band_m\": [%.6f, %.6f], \"out\": \"%s\"}\n",
+                  "\"low_band_m\": [%.6f, %.6f], \"out\": %s}\n",
                   s.trials, s.resumed, s.per_label[g], s.per_label[m], s.per_label[c], heights.c_str(),
                   middle_arm_name(o.middle), o.middle == MiddleArm::CaughtEdge ? s.edge.offset : 0.0,
                   high_low_arm_name(o.high_low), s.high_band.lower, s.high_band.upper, s.low_band.lower,
-                  s.low_band.upper, out.c_str());
+                  s.low_band.upper, json_string(out).c_str());
     } else {
       std::printf("synthesized %d trials (%d kept from an earlier run): %d good, %d missed, %d caught -> %s\n",
                   s.trials, s.resumed, s.per_label[g], s.per_label[m], s.per_label[c], out.c_str());

@@ -6,14 +6,14 @@
 #include <string_view>
 
 #include "dgm.h"
+#include "json.h"
 #include "hmm.h"
 
 namespace dressguard::hmm {
 
-// A JSON string literal (quotes included), with control characters escaped.
-std::string json_string(std::string_view s);
-// A JSON number; non-finite values become null (JSON has no NaN).
-std::string json_number(double v);
+// core/json.h's, under the names this module's callers have always used.
+using dressguard::json_number;
+using dressguard::json_string;
 // The whole model as one JSON object (metadata, features, stop policy, every class's parameters).
 std::string model_json(const model::OutcomeModel& m);
 // The confusion matrix as aligned text, rows = truth, columns = predicted.

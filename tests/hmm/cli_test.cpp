@@ -8,9 +8,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "dgm.h"
+#include "files.h"
 #include "fixtures.h"
 
 using namespace dressguard;
@@ -290,6 +292,20 @@ TEST_F(CliTest, SweepWritesCsvAndPng) {
   while (std::getline(csv, line)) ++rows;
   EXPECT_EQ(rows, 5);
   EXPECT_TRUE(fs::exists(dir / "sw.png")) << sw.err;
+  // A prefix with a quote and a blank is plotted too (it broke the plot command's quoting), and
+  // a picture of an earlier sweep under the prefix does not outlive a sweep that draws none.
+  const std::string odd = (dir / "it's a sweep").string();
+  const std::string sweep = "classify --model " + (dir / "m.dgm").string() + " --data " + (dir / "d").string() +
+                            " --sweep 0.05:0.25:0.05 --json --sweep-out \"" + odd + "\"";
+  auto r = run(sweep);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(odd + ".png")) << r.err;
+  r = run(sweep + " --no-plot");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_FALSE(fs::exists(odd + ".png")) << "an earlier sweep's picture stayed beside this one's CSV";
+  EXPECT_NE(r.out.find("\"png\": null"), std::string::npos) << r.out;
+  for (const auto& e : fs::directory_iterator(dir))
+    EXPECT_EQ(e.path().filename().string().find(".it's a sweep.png"), std::string::npos) << "a temporary was left";
 }
 
 // A cut before every trial's first sample (trials recorded from 0.2 m on) scores no trial: its
@@ -396,6 +412,62 @@ TEST_F(CliTest, TrainingCountsOnlyTheLabelledTrials) {
   r = run("build-model" + data);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find(") from 9 trials of "), std::string::npos) << r.out;
+}
+
+// The outputs that write a dataset replace the one in their folder (the manifest is the commit
+// point, and files only the old manifest named go): synthesize and build-model --training-out
+// refuse a folder that holds a dataset they did not write, where they deleted the measured
+// trials without a word; build-model --data refuses the synthesis's options it would ignore.
+TEST_F(CliTest, OutputsNeverReplaceAnotherDataset) {
+  save_dataset(fx::synthetic_dataset(3, 100, 120, 54, 3), dir / "d");
+  save_dataset(fx::synthetic_dataset(2, 100, 120, 61, 3, "m"), dir / "measured");
+  const auto files_of = [](const fs::path& d) {
+    std::set<std::string> names;
+    for (const auto& e : fs::directory_iterator(d)) names.insert(e.path().filename().string());
+    return names;
+  };
+  const auto measured = files_of(dir / "measured");
+  const std::string manifest = read_file(dir / "measured" / "manifest.csv");
+  const std::string data = " --data " + (dir / "d").string() + " --states 3 --out " + (dir / "m.dgm").string();
+  auto r = run("build-model" + data + " --training-out " + (dir / "measured").string());
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("--training-out " + (dir / "measured").string() + " holds a dataset build-model did not write"),
+            std::string::npos) << r.err;
+  r = run("synthesize --calibration " DG_SOURCE_DIR "/models/default-simulator.json --per-height 2 --out " +
+          (dir / "measured").string());
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("measured/manifest.csv: this folder holds a dataset that is not a synthesis"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(files_of(dir / "measured"), measured) << "the measured dataset's files changed";
+  EXPECT_EQ(read_file(dir / "measured" / "manifest.csv"), manifest);
+  // Its own folder it writes, marks, and writes again.
+  for (int k = 0; k < 2; ++k) {
+    r = run("build-model" + data + " --training-out " + (dir / "t").string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(dir / "t" / "training-set.txt"));
+    EXPECT_EQ(load_dataset(dir / "t").trials.size(), 9u);
+  }
+  for (const char* o : {"--per-height 5", "--seed 9", "--gown bogus", "--synth-dir zzz", "--middle caught-edge",
+                        "--high-low repeat-band", "--no-arm-noise", "--no-gown-noise", "--threads 2"}) {
+    r = run("build-model" + data + " " + o);
+    EXPECT_EQ(r.code, 2) << o;
+    const std::string option = std::string(o).substr(0, std::string(o).find(' '));
+    EXPECT_NE(r.err.find(option + " needs --calibration"), std::string::npos) << o << ": " << r.err;
+  }
+}
+
+// --json summaries carry paths as JSON strings whatever they hold: a '"' or a '\\' in a folder
+// name went out raw (build-model's "model", export-candump's "file"), which no JSON reader takes.
+TEST_F(CliTest, JsonSummariesEscapeThePaths) {
+  save_dataset(fx::synthetic_dataset(1, 100, 120, 54, 3), dir / "d");
+  const fs::path odd = dir / "q\"x\\y";
+  fs::create_directories(odd);
+  auto r = run("build-model --data " + (dir / "d").string() + " --states 3 --json --out '" + (odd / "m.dgm").string() + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("{\"model\": \"" + dir.string() + "/q\\\"x\\\\y/m.dgm\", "), std::string::npos) << r.out;
+  r = run("export-candump --data " + (dir / "d").string() + " --json --out '" + (odd / "logs").string() + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("{\"file\": \"" + dir.string() + "/q\\\"x\\\\y/logs/"), std::string::npos) << r.out;
 }
 
 // Leave-one-participant-out on the measured study (good vs missed; it has no caught trials):
