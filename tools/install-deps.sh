@@ -19,7 +19,7 @@ packages=(
   # libFuzzer for the model-file loader fuzz test
   clang libclang-rt-14-dev
   # real SocketCAN tests: Debian's kernel under qemu, busybox initramfs, can-utils
-  qemu-system-x86 busybox-static cpio can-utils kmod iproute2
+  qemu-system-x86 busybox-static cpio can-utils kmod iproute2 file
   # independent Modbus peers for the bridge tests
   python3-pymodbus mbpoll
   # plots

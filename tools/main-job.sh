@@ -3,14 +3,22 @@
 # Each stage writes into OUT_DIR and prints where; everything runs without ../shared, and uses
 # the measured data when it is there.
 set -euo pipefail
+# OUT as the caller wrote it (relative to where they stand); the default out/ is the repository's.
+if [ $# -ge 1 ]; then out=$(realpath -m -- "$1"); else out=""; fi
 cd "$(dirname "$0")/.."
-out="${1:-out}"
+out="${out:-out}"
 dg=build/release/offline/cli/dressguard
 mkdir -p "$out"
-if "$dg" import --out "$out/measured" 2>/dev/null; then
-  :
-else
-  echo "main-job: shared/data not present, skipping the import of the measured trials"
+# The measured trials, imported afresh: a copy from an earlier run must not stand in for data
+# that is gone, and a broken file is an error to show, not "not present".
+rm -rf "$out/measured"
+if ! import_error=$("$dg" import --out "$out/measured" 2>&1 >/dev/null); then
+  if [[ "$import_error" == *"shared/data is not present"* ]]; then
+    echo "main-job: shared/data not present, skipping the import of the measured trials"
+  else
+    echo "main-job: the import of the measured trials failed: $import_error" >&2
+    exit 1
+  fi
 fi
 
 # Simulation (offline/sim): the three outcome trials, one per arm height, on the reduced gown

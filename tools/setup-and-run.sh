@@ -2,6 +2,8 @@
 # One command from a fresh Debian 12 machine to the main job's results:
 # installs the dependencies (as root), builds the release preset, runs tools/main-job.sh.
 set -euo pipefail
+# OUT as the caller wrote it (relative to where they stand); the default out/ is the repository's.
+if [ $# -ge 1 ]; then out=$(realpath -m -- "$1"); else out=out; fi
 cd "$(dirname "$0")/.."
 if [ "$(id -u)" -eq 0 ]; then
   ./tools/install-deps.sh
@@ -13,4 +15,4 @@ else
 fi
 cmake --preset release >/dev/null
 cmake --build --preset release
-./tools/main-job.sh "${1:-out}"
+./tools/main-job.sh "$out"

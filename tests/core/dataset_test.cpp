@@ -225,7 +225,7 @@ TEST(Dataset, AFailedSaveLeavesThePreviousDatasetWhole) {
 TEST(DatasetRejects, IdsTheManifestCouldNotReadBack) {
   const TempDir tmp("ids");
   const fs::path& dir = tmp.path;
-  for (const std::string id : {std::string(), std::string("a,b"), std::string("a/b"), std::string(".hidden"), std::string("a\nb")}) {
+  for (const std::string& id : {std::string(), std::string("a,b"), std::string("a/b"), std::string(".hidden"), std::string("a\nb")}) {
     Dataset ds;
     ds.trials.push_back(ramp_trial(id, 0.1));
     EXPECT_THROW(save_dataset(ds, dir / "out"), InputError) << "id '" << id << "'";

@@ -8,9 +8,9 @@ Modes:
             the simulator calibrated without arm offsets (blue, dotted), as in Fig. 9. With
             --compare-label TEXT, --compare's simulated curves are drawn blue and dotted under that
             label whatever they are called (e.g. one calibration's `--rescore` on the other gown).
-  dataset:  calib_overlay.py dataset SYNTH_DIR --measured STUDY_DIR --participant P --out data.png
+  dataset:  calib_overlay.py dataset SYNTH_DIR --measured DATASET --participant P --out data.png
             All synthesized trials per outcome (thin) with the participant's measured trials (bold),
-            as in Fig. 7 and 8.
+            as in Fig. 7 and 8; DATASET is an imported one (`dressguard import`), not the study folder.
   predict:  calib_overlay.py predict PREFIX --out predict.png
             `dressguard predict --out PREFIX`: per arm height, the other participants' measured
             curves (one colour per trial) with the calibrated simulator's curve of each (black,

@@ -13,6 +13,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+from figure_file import save_figure
 
 
 def read(path):
@@ -43,7 +44,7 @@ def main(argv):
     if len(curves) > 1:
         ax.legend()
     fig.tight_layout()
-    fig.savefig(argv[2], dpi=120)
+    save_figure(fig, argv[2], dpi=120)
     return 0
 
 

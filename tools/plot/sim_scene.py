@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Pictures of a simulated trial (dressguard simulate's FILE.scene.json): the gown, the arm and
-the gripper at the start of the pull, at first contact with the arm, and at the end; three 3-D
-panels and a side view; and the sleeve opening seen from the fist at the start and at contact,
+the gripper at the start of the pull, 5 cm of travel after first contact with the arm, and at
+the end; three 3-D panels and a side view; and the sleeve opening seen from the fist at the
+start and after contact,
 with the fist at each of the three arm heights (where the rim hangs decides the outcome before
 any force does). Usage: sim_scene.py SCENE.json OUT.png"""
 import json
@@ -135,7 +136,8 @@ def main():
     start = min(frames, key=lambda f: abs(f["t"]))
     ct = sc.get("contact_t", -1)
     samples = np.array(sc["samples"]) if sc["samples"] else np.zeros((0, 5))
-    # contact: first frame where the travel passes the first arm contact (summary field), else middle
+    # contact: the frame nearest 5 cm of travel after the first arm contact (summary field), where
+    # the sleeve has taken the arm and the picture shows how; else the middle frame
     ctr = sc.get("contact_travel", -1)
     later = [f for f in frames if f["t"] > 0]
     if ctr is not None and ctr >= 0 and later:
@@ -144,7 +146,7 @@ def main():
         contact = later[len(later) // 2] if later else start
     end = frames[-1]
     fig = plt.figure(figsize=(21, 10))
-    for k, (f, name) in enumerate([(start, "start of the pull"), (contact, "contact"), (end, "end")]):
+    for k, (f, name) in enumerate([(start, "start of the pull"), (contact, "5 cm after contact" if ctr is not None and ctr >= 0 and later else "middle"), (end, "end")]):
         ax = fig.add_subplot(2, 4, k + 1, projection="3d")
         draw(ax, sc, f, f"{name}: t = {f['t']:.2f} s, travel = {f['travel']:.3f} m")
         side(fig.add_subplot(2, 4, k + 5), sc, f)
