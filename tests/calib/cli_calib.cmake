@@ -77,12 +77,7 @@ expect_fail("build-model --discrepancy on a dataset" "--discrepancy needs --cali
             build-model --data ${WORK} --discrepancy ${WORK} --out ${WORK}/m.dgm)
 expect_fail("predict without --calibration" "--calibration" predict --data ${WORK})
 expect_fail("predict with a bad calibration file" "bad.json" predict --calibration ${WORK}/bad.json --data ${WORK})
-# A calibration as `calibrate` writes it: participant 4, the plausibility grid's cloth, on the coarse gown.
-file(WRITE ${WORK}/cal4.json "{\"format\": \"dressguard-calibration 1\", \"participant\": \"4\",
- \"cloth\": {\"stretch\": 0.2, \"shear\": 0.5, \"bend\": 0.7, \"friction\": 0.35, \"self_friction\": 0.2, \"arm_compliance\": 0.004},
- \"arm_offsets\": {\"high\": {\"offset_m\": 0.0, \"calibrated\": true}, \"middle\": {\"offset_m\": 0.0, \"calibrated\": false},
-                   \"low\": {\"offset_m\": 0.0, \"calibrated\": true}},
- \"objective_kind\": \"area\", \"objective\": 1.0, \"sequences\": [], \"gown\": \"coarse\", \"rig_travel_m\": 0.72}\n")
+write_cal4(${WORK}/cal4.json)
 expect_fail("predict with a bad --gown" "--gown" predict --calibration ${WORK}/cal4.json --data ${WORK} --gown fine)
 expect_fail("predict with a bad --window" "--window" predict --calibration ${WORK}/cal4.json --data ${WORK} --window 0)
 

@@ -9,6 +9,7 @@ if(NOT STUDY)
 endif()
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
+write_cal4(${WORK}/cal4.json)
 execute_process(COMMAND ${DG} import --study ${STUDY} --out ${WORK}/study RESULT_VARIABLE rc)
 # The people's outcomes over travel in all three forces, as a picture.
 execute_process(COMMAND /usr/bin/python3 ${PLOT} classes ${WORK}/study --out ${WORK}/classes.png
