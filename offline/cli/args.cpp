@@ -54,8 +54,10 @@ int run_plot_script(const std::filesystem::path& script, const std::vector<std::
   return std::system(cmd.c_str());
 }
 
-void require_known_participants(const std::string& option, const std::set<std::string>& given,
-                                const std::set<std::string>& known, const std::string& data) {
+void require_known_participants(const std::string& option, const std::set<std::string>& given, const Dataset& ds,
+                                const std::string& data) {
+  std::set<std::string> known;
+  for (const auto& t : ds.trials) known.insert(t.participant);
   std::string unknown, names;
   int n = 0;
   for (const auto& p : given)

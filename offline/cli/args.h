@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "dataset.h"
+
 namespace dressguard::cli {
 
 class UsageError : public std::runtime_error {
@@ -27,12 +29,12 @@ std::set<std::string> split_list(const std::string& s);
 // a pooled training set (--data A,B), whose order is the order of the trials HMM training sums.
 std::vector<std::string> split_in_order(const std::string& s);
 
-// UsageError naming every name of `given` (option --`option`'s list) that is not in `known` (the
-// participants of the dataset `data`), and the known ones: a name that matches nobody would
+// UsageError naming every name of `given` (option --`option`'s list) that is no participant of
+// `ds` (the dataset `data`), and the participants it has: a name that matches nobody would
 // select or leave out nothing without a word (train --exclude-participant p4 once trained on
 // participant "4" while its model said it excluded p4).
-void require_known_participants(const std::string& option, const std::set<std::string>& given,
-                                const std::set<std::string>& known, const std::string& data);
+void require_known_participants(const std::string& option, const std::set<std::string>& given, const Dataset& ds,
+                                const std::string& data);
 
 // tools/plot/<name> of the sources this binary was built from: under $DRESSGUARD_SOURCE_DIR, else
 // in a folder above the binary, else under the working directory; empty when absent.

@@ -212,9 +212,7 @@ int run_classify(int argc, char** argv) {
     return weigh_on.empty() ? std::vector<double>{} : hmm::simulation_weights(committee, weigh_on, d, among);
   };
   const Dataset ds = load_dataset(data);
-  std::set<std::string> participants;
-  for (const auto& t : ds.trials) participants.insert(t.participant);
-  require_known_participants("participant", only, participants, data);
+  require_known_participants("participant", only, ds, data);
   std::vector<const HapticSequence*> trials;
   for (const auto& t : ds.trials)
     if (only.empty() || only.count(t.participant)) trials.push_back(&t);

@@ -61,9 +61,7 @@ int run_train(int argc, char** argv) {
   if (dirs.empty()) throw UsageError("--data names no dataset");
 
   const Dataset ds = load_datasets({dirs.begin(), dirs.end()});
-  std::set<std::string> participants;
-  for (const auto& t : ds.trials) participants.insert(t.participant);
-  require_known_participants("exclude-participant", excluded, participants, data);
+  require_known_participants("exclude-participant", excluded, ds, data);
   std::vector<const HapticSequence*> trials;
   for (const auto& t : ds.trials)
     if (!excluded.count(t.participant)) trials.push_back(&t);
