@@ -12,8 +12,14 @@ HERE=$(cd "$(dirname "$0")" && pwd)
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 /usr/bin/python3 "$HERE/synthetic_trials.py" --out "$tmp/syn" --per-class 3 --seed 2 >/dev/null
-rm -rf "$OUT"
+# Only the logs are replaced: the folder's README stays, and a folder holding anything else is
+# not a test-log folder (refused rather than cleared).
 mkdir -p "$OUT"
+for f in "$OUT"/* "$OUT"/.[!.]*; do
+  [ -e "$f" ] || continue
+  case "$(basename "$f")" in *.log|README.md) ;; *) echo "make_test_logs.sh: $OUT holds $f: not a test-log folder" >&2; exit 2;; esac
+done
+rm -f "$OUT"/*.log
 "$DG" export-candump --data "$tmp/syn" --out "$OUT" --trial-id 1 >/dev/null
 g0="$tmp/syn/syn2-good-0.csv"
 c0="$tmp/syn/syn2-caught-0.csv"
@@ -30,4 +36,4 @@ c0="$tmp/syn/syn2-caught-0.csv"
 # (stop_consecutive = 100000): the hard limit must stop it at the first sample above 10 N.
 "$DG" export-candump --trial "$c0" --speed 0.1 --height middle --trial-id 104 --rig-limit 0 \
   --out "$OUT/fault-nocaughtrule-caught-expect-hard_limit.log" >/dev/null
-ls "$OUT" | wc -l | xargs echo "test logs written to $OUT:"
+ls "$OUT" | grep -c '\.log$' | xargs echo "test logs written to $OUT:"

@@ -154,7 +154,8 @@ def main():
         for f in sorted(os.listdir(logs_dir)):
             shutil.copy(os.path.join(logs_dir, f), os.path.join(data, "logs", f))
         shutil.copy(args.model, os.path.join(data, "model.dgm"))
-        initrd = os.path.join(cache, "initramfs.gz")
+        # Per run: the release and sanitize builds share the kernel cache, not their initramfs.
+        initrd = os.path.join(tmp, "initramfs.gz")
         cmd = [os.path.join(args.source, "tools", "vm", "build_initramfs.sh"), "--cache", cache, "--out", initrd,
                "--data", data, "--script", os.path.join(args.source, "tools", "vm", "vm_tests.sh")]
         for b in bins:
@@ -186,12 +187,21 @@ def main():
     print(f"VM ran {boot_s:.1f} s ({'KVM' if args.kvm else 'software emulation'})")
     m = re.search(r"DG-VM: kernel (\S+) (.*)", console)
     check(m is not None, "the VM booted Debian's kernel: " + (m.group(1) + " " + m.group(2).strip() if m else "no"))
+    # The RT flavour is the one asked for; the generic one is fetch_kernel.sh's fallback when the
+    # archive lacks it. Either way the booted kernel must be the flavour its release names.
+    if m:
+        rt_release, rt_booted = "-rt-" in m.group(1), "PREEMPT_RT" in m.group(2)
+        check(rt_release == rt_booted, f"the kernel's release and build agree on PREEMPT_RT ({rt_booted})")
+        if not rt_booted:
+            print("  NOTE  generic kernel (linux-image-rt-amd64 could not be had): not a PREEMPT_RT run")
     check("DG-VM: done" in console, "the in-VM script ran to its end")
     check("DG-VM: insmod" not in console, "can, can-raw, can-dev, vcan loaded")
     late = re.findall(r"scenario (\S+): daemon not listening", console)
     check(not late, "every scenario's daemon was listening before the play" + (f" (not: {', '.join(late)})" if late else ""))
     sec = sections(console)
     check("scenario unconfirmed: tc" not in console, "unconfirmed: tc dropped 0x080 on its way out of vcan0")
+    played = re.findall(r"PLAYFAIL (.*)", console)
+    check(not played, "every log was played" + (f" (not: {'; '.join(p.strip() for p in played)})" if played else ""))
     for name in ("clean", "hardlimit", "gap", "nomodel", "unconfirmed", "latency"):
         m = re.search(rf"DG-VM: \[[\d.]+\] scenario {name} daemon_exit (\d+)", console)
         check(m is not None and m.group(1) == "0", f"{name}: the daemon exited 0 on SIGTERM")
@@ -205,11 +215,19 @@ def main():
     stops = stops_in(rec)
     check(all(s["ok"] for s in stops), f"clean: every stop frame passes its E2E CRC ({len(stops)} frames)")
     first = first_stop_per_trial(stops)
+    # The trials the bus carried (TrialStart 0x180 and TrialEnd 0x181, by trial id): a trial that
+    # never reached the daemon must not pass as "not stopped".
+    starts, ends = set(), set()
+    for line in rec.splitlines():
+        fr = parse_frame(line)
+        if fr and fr[1] in (0x180, 0x181) and len(fr[2]) == 8:
+            (starts if fr[1] == 0x180 else ends).add(u16(fr[2], 2))
     margins = []
     for f, fa in sorted(facts.items()):
         if not f.startswith("syn2-") and not f.startswith("fault-isolated") and not f.startswith("fault-burst"):
             continue
         s = first.get(fa["trial"])
+        check(fa["trial"] in starts and fa["trial"] in ends, f"{f}: trial {fa['trial']} started and ended on the bus")
         if f.endswith("-caught.log"):
             ok = s is not None and s["reason"] == "caught" and s["sample"] < fa["samples"]
             margin = (fa["samples"] - s["sample"]) * 0.01 if s else float("nan")
@@ -294,7 +312,12 @@ def main():
     # --- latency ---
     lat = sec.get("latency.out", "")
     print("  " + "\n  ".join(l for l in lat.splitlines() if l.strip()))
-    check("0 without a stop" in lat, "latency: every probe trial got its stop frame")
+    m = re.search(r"(\d+) trials, (\d+) without a stop", lat)
+    check(m is not None and m.group(1) == "1000" and m.group(2) == "0",
+          "latency: every probe trial got its stop frame" + (f" ({m.group(2)} of {m.group(1)} without)" if m else " (no result)"))
+    m = re.search(r"e2e_socketcan: n=(\d+)", lat)
+    check(m is not None and m.group(1) == "1000", f"latency: 1000 latencies measured ({m.group(1) if m else 'none'})")
+    check(re.search(r"^bench_exit 0$", lat, re.M) is not None, "latency: the probe exited 0")
     m = re.search(r"processing latency \(frame read to decision\): n=(\d+) median=(\d+) ns p99.9=(\d+) ns", sec.get("clean.log", ""))
     if m:
         print(f"  daemon processing in the VM (clean scenario): n={m.group(1)} median={m.group(2)} ns p99.9={m.group(3)} ns")

@@ -56,7 +56,14 @@ scenario() {
 play_fast() {
   awk -v k=4 '/^\(/ { split(substr($1, 2, length($1) - 2), p, "."); t = p[1] + p[2] / 1e6;
     if (t0 == "") t0 = t; u = (t - t0) / k; printf("(%d.%06d) %s %s\n", int(u), (u - int(u)) * 1e6, $2, $3) }' "$1" > /tmp/fast.log
-  canplayer -I /tmp/fast.log
+  play_log /tmp/fast.log "$1"
+}
+
+# play_log LOG NAME: canplayer with the log's timestamps; says so when nothing was played, as the
+# host counts a trial the daemon never saw as failed, not as "not stopped".
+play_log() {
+  [ -s "$1" ] || say "PLAYFAIL $2: nothing to play"
+  canplayer -I "$1" || say "PLAYFAIL $2: canplayer exit $?"
 }
 
 # A: every clean trial and two fault logs; the assertions use the payloads' counters.
@@ -67,7 +74,8 @@ play_clean() {
     sleep 1.1   # > 1 s: the robot's trial counters restart with each log (see PROTOCOL.md)
   done
 }
-scenario clean "--model $MODEL" ",080:7FF,300:7FF"
+# The trial frames (0x180, 0x181) are recorded too: each played trial must appear on the bus.
+scenario clean "--model $MODEL" ",080:7FF,300:7FF,180:7FF,181:7FF"
 
 # B: a caught trial past the 10 N limit with the caught rule disabled: the hard limit stops it.
 play_hardlimit() { play_fast $D/logs/fault-nocaughtrule-*.log; }
@@ -75,7 +83,7 @@ scenario hardlimit "--model $MODEL --set stop_consecutive=100000" ",080:7FF"
 
 # C: the sensor goes silent for 300 ms, played in real time (timestamps honoured); the
 # recording keeps the force frames to time the stop against the last one.
-play_gap() { head -n 500 $D/logs/fault-gap-*.log > /tmp/gap.log; canplayer -I /tmp/gap.log; }
+play_gap() { head -n 500 $D/logs/fault-gap-*.log > /tmp/gap.log; play_log /tmp/gap.log gap; }
 scenario gap "--model $MODEL" ",080:7FF,100:7FF"
 
 # D: a model that does not load: the first trial is refused.
@@ -103,5 +111,9 @@ scenario unconfirmed "--model $MODEL --set stop_consecutive=100000 --set sensor_
 
 # E: end-to-end latency through the kernel: frame in (the probe's send) to stop frame out (the
 # probe's receive), hard-limit trials back to back.
-play_latency() { bench_predictor --e2e vcan0 --trials 1000 > /tmp/latency.out 2>&1; section latency.out /tmp/latency.out; }
+play_latency() {
+  bench_predictor --e2e vcan0 --trials 1000 > /tmp/latency.out 2>&1
+  echo "bench_exit $?" >> /tmp/latency.out
+  section latency.out /tmp/latency.out
+}
 scenario latency "--model $MODEL" ",7FF:7FF"
