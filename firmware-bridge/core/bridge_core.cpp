@@ -87,9 +87,21 @@ BridgeAction bridge_on_frame(BridgeCore& c, const Frame& f, uint32_t now_ms) {
       }
       c.predictor_seen = true;
       c.last_predictor_ms = now_ms;
+      if (protocol::HeartbeatPredictor hb; protocol::decode(f, hb)) {
+        c.predictor_state = hb.state;
+        c.predictor_trial = hb.trial_id;
+      }
       return BridgeAction::None;
     default: return BridgeAction::None;
   }
+}
+
+BridgeAction bridge_on_shutdown(BridgeCore& c) {
+  if (c.stop_cause != StopCause::None || c.predictor_state != protocol::PredictorState::InTrial)
+    return BridgeAction::None;
+  c.stop_cause = StopCause::BridgeShutdown;
+  c.stop_written = false;
+  return BridgeAction::StopRobot;
 }
 
 int bridge_on_tick(BridgeCore& c, uint32_t now_ms, Frame* out, BridgeAction* action) {

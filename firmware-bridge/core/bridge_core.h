@@ -16,7 +16,10 @@
 //   - trial starts and the predictor's heartbeat are sporadic streams whose sender may restart:
 //     their E2E checkers resynchronise after protocol::kSporadicResyncMs of silence;
 //   - optionally, a predictor whose heartbeat is silent for predictor_timeout_ms is itself a
-//     reason to stop (the robot must not run unguarded).
+//     reason to stop (the robot must not run unguarded);
+//   - a bridge that shuts down while the predictor's last heartbeat said "in trial" latches a
+//     stop itself: without the bridge no sample reaches the predictor and no stop reaches the
+//     robot, so the trial would run on unguarded.
 #pragma once
 
 #include <cstdint>
@@ -43,7 +46,7 @@ enum class BridgeAction : uint8_t {
   StopRobot = 1,     // newly latched: write the stop to the robot controller now
 };
 
-enum class StopCause : uint8_t { None = 0, StopFrame = 1, PredictorSilent = 2 };
+enum class StopCause : uint8_t { None = 0, StopFrame = 1, PredictorSilent = 2, BridgeShutdown = 3 };
 
 struct BridgeCore {
   BridgeConfig cfg;
@@ -64,6 +67,8 @@ struct BridgeCore {
   uint32_t last_predictor_ms = 0;     // the last accepted predictor heartbeat (or the start)
   uint32_t last_trial_frame_ms = 0;   // the last TrialStart frame, accepted or not (or the start)
   bool predictor_seen = false;
+  protocol::PredictorState predictor_state = protocol::PredictorState::Idle;  // its last heartbeat's
+  uint16_t predictor_trial = 0;                                                // ... and trial id
   bool stop_written = false;          // the latched stop reached the robot (bridge_on_stop_written)
 };
 
@@ -88,6 +93,9 @@ BridgeAction bridge_on_frame(BridgeCore& c, const Frame& f, uint32_t now_ms);
 // *action becomes StopRobot when the predictor's heartbeat timed out.
 int bridge_on_tick(BridgeCore& c, uint32_t now_ms, Frame* out, BridgeAction* action);
 
+// The port is shutting down: StopRobot when the predictor's last accepted heartbeat said a trial
+// is running and no stop is latched yet (the latch's cause is then BridgeShutdown).
+BridgeAction bridge_on_shutdown(BridgeCore& c);
 inline bool bridge_stop_latched(const BridgeCore& c) { return c.stop_cause != StopCause::None; }
 
 // What the heartbeat reports: StopLatched while a stop is latched, else SensorLost from a failed

@@ -181,8 +181,24 @@ void BridgeApp::drain_can(uint32_t t) {
   try_stop(t);  // in the same wakeup as the stop frame
 }
 
+void BridgeApp::begin_shutdown(uint32_t t) {
+  // A stop already on the bus is taken first (the predictor's own shutdown stop comes this way
+  // when both services are stopped together) ...
+  drain_can(t);
+  // ... and a trial still running gets the bridge's own: it is the only way to the robot.
+  if (bridge_on_shutdown(core_) == BridgeAction::StopRobot) {
+    say("shutting down during the predictor's trial %u: stopping the robot first",
+        static_cast<unsigned>(core_.predictor_trial));
+    stop_pending_ = true;
+    next_stop_try_ms_ = t;
+    try_stop(t);
+  }
+}
+
 int BridgeApp::run() {
   epoll_event evs[4];
+  bool shutting_down = false;
+  uint32_t give_up_ms = 0;
   for (;;) {
     const int n = epoll_wait(epoll_fd_, evs, 4, -1);
     if (n < 0) {
@@ -191,12 +207,29 @@ int BridgeApp::run() {
     }
     const uint32_t t = now_ms();
     for (int i = 0; i < n; ++i) {
-      if (evs[i].data.u64 == kShutdown) return 0;
+      if (evs[i].data.u64 == kShutdown) {
+        uint64_t v;
+        [[maybe_unused]] ssize_t r = ::read(shutdown_fd_, &v, sizeof v);
+        if (!shutting_down) {
+          shutting_down = true;
+          give_up_ms = t + static_cast<uint32_t>(cfg_.shutdown_grace_ms);
+          begin_shutdown(t);
+        }
+      }
       if (evs[i].data.u64 == kCan) drain_can(t);
       if (evs[i].data.u64 == kTimer) {
         uint64_t exp;
         [[maybe_unused]] ssize_t r = ::read(timer_fd_, &exp, sizeof exp);
-        on_timer(t);
+        if (shutting_down) try_stop(t);  // no more readings: only the stop's retries
+        else on_timer(t);
+      }
+    }
+    if (shutting_down) {
+      if (!stop_pending_) return 0;
+      if (due(t, give_up_ms)) {
+        say("shutting down with a stop not written to the robot controller after %d ms (%llu failed writes): "
+            "the robot may not be stopped", cfg_.shutdown_grace_ms, static_cast<unsigned long long>(stop_failures_));
+        return 1;
       }
     }
   }

@@ -22,6 +22,10 @@ struct BridgeAppConfig {
   int backoff_min_ms = 50;         // first reconnect delay, doubled per failure ...
   int backoff_max_ms = 2000;       // ... up to this
   int stop_retry_ms = 10;          // an unacknowledged stop write is retried this often
+  // On shutdown a stop not yet written (one on the bus, one pending, or the bridge's own when
+  // the predictor is in a trial: bridge_on_shutdown) is retried this long before the bridge
+  // gives up and exits 1; well inside a service manager's stop timeout (systemd: 90 s).
+  int shutdown_grace_ms = 1000;
   // Where the bridge says what went wrong (null: nowhere). A failing sensor or stop write is
   // reported at its 1st, 2nd, 4th, 8th, ... consecutive failure with libmodbus's reason, and
   // once when it recovers; every stop is reported.
@@ -38,7 +42,9 @@ class BridgeApp {
   // `robot` may be null (no robot controller: stops are only logged).
   BridgeApp(const BridgeAppConfig& cfg, ModbusSensor& sensor, RobotStopWriter* robot, can::CanPort& port);
   ~BridgeApp();
-  int run();                        // until request_shutdown(); 0 = clean
+  // Until request_shutdown(), then until no stop is left unwritten: 0, or 1 when the grace ran
+  // out with a stop unwritten (said on the log) or epoll failed.
+  int run();
   void request_shutdown() noexcept; // async-signal-safe
   const BridgeStats& stats() const { return stats_; }
   const BridgeCore& core() const { return core_; }  // read only from the loop's thread or after run()
@@ -49,6 +55,7 @@ class BridgeApp {
   void drain_can(uint32_t now_ms);
   void send(const Frame& f);
   void try_stop(uint32_t now_ms);
+  void begin_shutdown(uint32_t now_ms);
   void say(const char* fmt, ...) __attribute__((format(printf, 2, 3)));
   void sensor_failed(const char* what);
 

@@ -43,12 +43,39 @@ const char* kUsage =
     "  --stop-coil ADDR        write the stop as coil ADDR = ON (default: coil 0)\n"
     "  --stop-register ADDR=V  write the stop as holding register ADDR = V instead\n"
     "  --predictor-timeout-ms N  stop the robot when the predictor's heartbeat is silent this long (0: off)\n"
+    "  --shutdown-grace-ms N   on SIGTERM/SIGINT, a stop not yet written (one on the bus, or the bridge's\n"
+    "                          own when the predictor is in a trial) is retried this long (default 1000)\n"
     "  --help                  this text\n"
-    "Exit codes: 0 clean shutdown (SIGTERM/SIGINT), 1 runtime error, 2 bad arguments.";
+    "Exit codes: 0 clean shutdown (SIGTERM/SIGINT), 1 runtime error or a stop still unwritten at the\n"
+    "end of the shutdown grace, 2 bad arguments.";
 
 int bad(const std::string& why) {
   std::fprintf(stderr, "dressguard-bridge: %s (see --help)\n", why.c_str());
   return 2;
+}
+
+// Whole-number options and their ranges: Modbus addresses are 16 bits (the six sensor registers
+// must fit), unit ids 0-255 (libmodbus refuses above 247 on a serial line), and a response
+// timeout or a period beyond a second is no sampling of a 100 Hz sensor.
+struct Range { const char* name; long lo, hi; };
+constexpr Range kRanges[] = {
+    {"--sensor-slave", 0, 255},   {"--sensor-register", 0, 65530}, {"--timeout-ms", 1, 1000},
+    {"--period-ms", 1, 1000},     {"--robot-slave", 0, 255},       {"--stop-coil", 0, 65535},
+    {"--predictor-timeout-ms", 0, 60000}, {"--shutdown-grace-ms", 0, 60000},
+};
+constexpr const char* kTextOptions[] = {"--interface", "--sensor", "--robot", "--force-scale", "--torque-scale",
+                                        "--stop-register"};
+
+const Range* range_of(const std::string& a) {
+  for (const auto& k : kRanges)
+    if (a == k.name) return &k;
+  return nullptr;
+}
+
+bool takes_value(const std::string& a) {
+  for (const char* k : kTextOptions)
+    if (a == k) return true;
+  return range_of(a) != nullptr;
 }
 
 bool to_int(const std::string& s, long& v) {
@@ -78,6 +105,7 @@ int main(int argc, char** argv) {
       map.input_registers = true;
       continue;
     }
+    if (!takes_value(a)) return bad("unknown option '" + a + "'");
     if (i + 1 >= argc) return bad(a + " needs a value");
     const std::string v = argv[++i];
     long n = 0;
@@ -98,19 +126,7 @@ int main(int argc, char** argv) {
         return bad("--stop-register: '" + v + "' is not ADDR=VALUE");
       target = {false, static_cast<int>(addr), static_cast<int>(val)};
     } else {
-      // Whole-number options and their ranges: Modbus addresses are 16 bits (the six sensor
-      // registers must fit), unit ids 0-255 (libmodbus refuses above 247 on a serial line),
-      // and a response timeout or a period beyond a second is no sampling of a 100 Hz sensor.
-      struct Range { const char* name; long lo, hi; };
-      static constexpr Range kRanges[] = {
-          {"--sensor-slave", 0, 255},   {"--sensor-register", 0, 65530}, {"--timeout-ms", 1, 1000},
-          {"--period-ms", 1, 1000},     {"--robot-slave", 0, 255},       {"--stop-coil", 0, 65535},
-          {"--predictor-timeout-ms", 0, 60000},
-      };
-      const Range* r = nullptr;
-      for (const auto& k : kRanges)
-        if (a == k.name) r = &k;
-      if (!r) return bad("unknown option '" + a + "'");
+      const Range* r = range_of(a);
       if (!is_int || n < r->lo || n > r->hi)
         return bad(a + ": '" + v + "' is not a whole number in " + std::to_string(r->lo) + "-" + std::to_string(r->hi));
       if (a == "--sensor-slave") sensor_ep.slave = static_cast<int>(n);
@@ -119,6 +135,7 @@ int main(int argc, char** argv) {
       else if (a == "--period-ms") cfg.sample_period_ms = static_cast<int>(n);
       else if (a == "--robot-slave") robot_ep.slave = static_cast<int>(n);
       else if (a == "--stop-coil") target = {true, static_cast<int>(n), 1};
+      else if (a == "--shutdown-grace-ms") cfg.shutdown_grace_ms = static_cast<int>(n);
       else cfg.core.predictor_timeout_ms = static_cast<uint32_t>(n);
     }
   }

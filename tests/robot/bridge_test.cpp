@@ -181,6 +181,31 @@ TEST(BridgeCore, SilentPredictorStopsWhenConfigured) {
   FAIL() << "no stop for a predictor silent 300 ms";
 }
 
+// Shutdown latches the bridge's own stop exactly when the predictor's last accepted heartbeat
+// said "in trial" and no stop is latched; a corrupted heartbeat changes nothing.
+TEST(BridgeCore, ShutdownStopsOnlyARunningTrial) {
+  using protocol::PredictorState;
+  for (const auto state : {PredictorState::Idle, PredictorState::InTrial, PredictorState::Stopped, PredictorState::Fault}) {
+    BridgeCore c;
+    bridge_init(c, {}, 0);
+    bridge_on_frame(c, protocol::encode(protocol::HeartbeatPredictor{0, state, 1, 9, 0}), 10);
+    Frame bad = protocol::encode(protocol::HeartbeatPredictor{1, PredictorState::Idle, 1, 9, 0});
+    bad.data[0] ^= 0x5A;  // CRC broken: not taken
+    bridge_on_frame(c, bad, 20);
+    const bool in_trial = state == PredictorState::InTrial;
+    EXPECT_EQ(bridge_on_shutdown(c), in_trial ? BridgeAction::StopRobot : BridgeAction::None) << int(state);
+    EXPECT_EQ(c.stop_cause, in_trial ? StopCause::BridgeShutdown : StopCause::None);
+    EXPECT_EQ(bridge_on_shutdown(c), BridgeAction::None) << "latched once";
+  }
+  BridgeCore c;  // a stop already latched by a Stop frame stays that stop
+  bridge_init(c, {}, 0);
+  bridge_on_frame(c, protocol::encode(protocol::HeartbeatPredictor{0, PredictorState::InTrial, 1, 9, 0}), 10);
+  EXPECT_EQ(bridge_on_frame(c, protocol::encode(protocol::Stop{0, protocol::StopReason::Caught, 200, 9, 40}), 20),
+            BridgeAction::StopRobot);
+  EXPECT_EQ(bridge_on_shutdown(c), BridgeAction::None);
+  EXPECT_EQ(c.stop_cause, StopCause::StopFrame);
+}
+
 TEST(BridgeCore, HeartbeatCarriesSensorState) {
   BridgeCore c;
   bridge_init(c, {}, 0);
@@ -293,9 +318,12 @@ struct BridgeRig {
   std::unique_ptr<RobotStopWriter> robot;
   std::unique_ptr<BridgeApp> app;
   std::thread loop;
+  std::atomic<int> rc{-1};          // what run() returned
   std::FILE* log = std::tmpfile();  // what the bridge says
-  BridgeRig() {
-    bridge_port = bus.open({{protocol::id_of(protocol::MsgId::Stop), protocol::id_of(protocol::MsgId::TrialStart)}, false, true});
+  explicit BridgeRig(int shutdown_grace_ms = 1000) {
+    // The identifiers dressguard-bridge's main subscribes to.
+    bridge_port = bus.open({{protocol::id_of(protocol::MsgId::Stop), protocol::id_of(protocol::MsgId::TrialStart),
+                             protocol::id_of(protocol::MsgId::HeartbeatPredictor)}, false, true});
     listener = bus.open({{protocol::id_of(protocol::MsgId::FtForce), protocol::id_of(protocol::MsgId::FtTorque),
                           protocol::id_of(protocol::MsgId::HeartbeatBridge)}, false, true});
     predictor = bus.open({{}, false, true});
@@ -305,13 +333,21 @@ struct BridgeRig {
     cfg.backoff_min_ms = 20;
     cfg.backoff_max_ms = 160;
     cfg.log = log;
+    cfg.shutdown_grace_ms = shutdown_grace_ms;
     app = std::make_unique<BridgeApp>(cfg, *sensor, robot.get(), *bridge_port);
-    loop = std::thread([this] { app->run(); });
+    loop = std::thread([this] { rc = app->run(); });
   }
   ~BridgeRig() {
-    app->request_shutdown();
-    loop.join();
+    shut_down();
     if (log) std::fclose(log);
+  }
+  // Asks the bridge to shut down (as SIGTERM does) and waits for run() to return: its value.
+  int shut_down() {
+    if (loop.joinable()) {
+      app->request_shutdown();
+      loop.join();
+    }
+    return rc;
   }
   // What the bridge has logged so far (read through its own descriptor).
   std::string logged() const {
@@ -469,6 +505,61 @@ TEST(BridgeModbus, StopFrameWritesTheRobotsStopCoil) {
   EXPECT_EQ(rig.app->stats().stops_written.load(), 1u);
   // Read back by mbpoll, an independent Modbus client.
   EXPECT_NE(mbpoll(coil).find("[7]: \t1"), std::string::npos) << mbpoll(coil);
+}
+
+// Shutdown with a stop that the robot controller has not received: the bridge is the only way
+// to the robot, so it keeps retrying the write through its grace instead of returning at once.
+// The robot controller is dark for 300 ms (emulator mode 3) when the stop comes and SIGTERM
+// follows; it comes back inside the 1 s grace and gets the stop.
+TEST(BridgeModbus, ShutdownWritesAStopTheRobotHasNotReceived) {
+  BridgeRig rig;
+  ASSERT_GT(rig.robot_emu.port(), 0);
+  ASSERT_TRUE(rig.robot_emu.write(901, {300}));
+  ASSERT_TRUE(rig.robot_emu.write(900, {3}));
+  rig.predictor->send(protocol::encode(protocol::Stop{0, protocol::StopReason::Shutdown, 0, 3, 250}));
+  for (int i = 0; i < 200 && rig.app->stats().stop_write_failures.load() == 0; ++i) std::this_thread::sleep_for(1ms);
+  ASSERT_GT(rig.app->stats().stop_write_failures.load(), 0u) << "the dark robot controller took the write";
+  EXPECT_EQ(rig.shut_down(), 0) << rig.logged();
+  EXPECT_EQ(rig.app->stats().stops_written.load(), 1u) << rig.logged();
+  const std::string coil = "-p " + std::to_string(rig.robot_emu.port()) + " -a 1 -r 7 -c 1 -t 0 127.0.0.1";
+  EXPECT_NE(mbpoll(coil).find("[7]: \t1"), std::string::npos) << mbpoll(coil);
+}
+
+// A stop that cannot be written within the grace: the bridge exits 1 and says the robot may not
+// be stopped (a clean 0 would hide it from the service manager).
+TEST(BridgeModbus, ShutdownSaysWhenAStopStaysUnwritten) {
+  BridgeRig rig(/*shutdown_grace_ms=*/150);
+  ASSERT_GT(rig.robot_emu.port(), 0);
+  ASSERT_TRUE(rig.robot_emu.write(901, {3000}));
+  ASSERT_TRUE(rig.robot_emu.write(900, {3}));
+  rig.predictor->send(protocol::encode(protocol::Stop{0, protocol::StopReason::Caught, 240, 3, 250}));
+  for (int i = 0; i < 200 && rig.app->stats().stop_write_failures.load() == 0; ++i) std::this_thread::sleep_for(1ms);
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_EQ(rig.shut_down(), 1);
+  EXPECT_GE(std::chrono::steady_clock::now() - t0, 150ms);  // it did retry through the grace
+  EXPECT_EQ(rig.app->stats().stops_written.load(), 0u);
+  EXPECT_NE(rig.logged().find("the robot may not be stopped"), std::string::npos) << rig.logged();
+}
+
+// Shutdown while the predictor says a trial is running: once the bridge is gone no sample reaches
+// the predictor and no stop reaches the robot, so the bridge stops the robot itself first.
+// Idle, it writes nothing.
+TEST(BridgeModbus, ShutdownDuringATrialStopsTheRobot) {
+  for (const auto state : {protocol::PredictorState::Idle, protocol::PredictorState::InTrial}) {
+    const bool in_trial = state == protocol::PredictorState::InTrial;
+    BridgeRig rig;
+    ASSERT_GT(rig.robot_emu.port(), 0);
+    rig.predictor->send(protocol::encode(protocol::HeartbeatPredictor{0, state, 1, 12, 5}));
+    std::this_thread::sleep_for(30ms);  // the bridge's loop takes it
+    EXPECT_EQ(rig.shut_down(), 0) << rig.logged();
+    EXPECT_EQ(rig.app->stats().stops_written.load(), in_trial ? 1u : 0u) << rig.logged();
+    EXPECT_EQ(bridge_stop_latched(rig.app->core()), in_trial);
+    if (in_trial) {
+      EXPECT_NE(rig.logged().find("during the predictor's trial 12"), std::string::npos) << rig.logged();
+    }
+    const std::string coil = "-p " + std::to_string(rig.robot_emu.port()) + " -a 1 -r 7 -c 1 -t 0 127.0.0.1";
+    EXPECT_NE(mbpoll(coil).find(in_trial ? "[7]: \t1" : "[7]: \t0"), std::string::npos) << mbpoll(coil);
+  }
 }
 
 // The least line time of one reading, in closed form: (8 + 17 characters + 2 x 3.5 of silence)

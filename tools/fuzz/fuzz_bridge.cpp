@@ -55,6 +55,7 @@ struct Shadow {
   uint8_t sample_counter = 0;
   bool sampled = false;
   uint32_t last_predictor = 0;
+  protocol::PredictorState predictor_state = protocol::PredictorState::Idle;  // last accepted heartbeat's
   uint32_t last_trial = 0;  // the last TrialStart frame, accepted or not
   uint32_t next_heartbeat = 0;
   uint32_t start = 0;
@@ -119,7 +120,10 @@ void other_frame(const Frame& f, BridgeCore& c, Shadow& sh, long op) {
   const bool hb_ok = is(f, MsgId::HeartbeatPredictor) && protocol::accepted(sh.hb_e2e.check(f, lost));
   if (bridge::bridge_on_frame(c, f, sh.now) != BridgeAction::None) broken("a frame other than a stop stopped the robot", op);
   if (trial_ok && (!sh.latched || sh.written)) sh.latched = false;
-  if (hb_ok) sh.last_predictor = sh.now;
+  if (hb_ok) {
+    sh.last_predictor = sh.now;
+    if (protocol::HeartbeatPredictor m; protocol::decode(f, m)) sh.predictor_state = m.state;
+  }
   if (bridge::bridge_stop_latched(c) != sh.latched)
     broken(!trial_ok ? "a frame other than a stop or a trial start changed the latch"
            : sh.latched ? "an accepted trial start released a stop not yet written"
@@ -207,7 +211,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       case BridgeOp::PredictorHeartbeat: {
         if (!in.take(1)) return 0;
         const uint8_t ctl = in.u8();
-        Frame f = protocol::encode(protocol::HeartbeatPredictor{counter_for(ctl, sh.c_phb, ctl), protocol::PredictorState::Idle, 1, 0, 0});
+        const auto state = static_cast<protocol::PredictorState>((ctl >> 4 & 1) | (ctl >> 6 & 2));
+        Frame f = protocol::encode(protocol::HeartbeatPredictor{counter_for(ctl, sh.c_phb, ctl), state, 1, 0, 0});
         damage(f, ctl);
         other_frame(f, c, sh, op);
         break;
@@ -223,6 +228,20 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         sh.written = true;
         if (bridge::bridge_stop_latched(c) != sh.latched) broken("a written stop changed the latch", op);
         break;
+      case BridgeOp::Shutdown: {
+        // The bridge's own stop exactly when the predictor last said "in trial" and none is latched.
+        const bool expect = !sh.latched && sh.predictor_state == protocol::PredictorState::InTrial;
+        const bool asks = bridge::bridge_on_shutdown(c) == BridgeAction::StopRobot;
+        if (asks != expect)
+          broken(expect ? "a shutdown during a trial did not stop the robot" : "a shutdown stopped the robot outside a trial "
+                                                                               "or while latched", op);
+        if (asks) {
+          sh.latched = true;
+          sh.written = false;
+        }
+        if (bridge::bridge_stop_latched(c) != sh.latched) broken("a shutdown changed the latch other than for a trial", op);
+        break;
+      }
       case BridgeOp::Wait:
         if (!in.take(1)) return 0;
         sh.now += in.u8() * fuzz::kBridgeTimeUnitMs;

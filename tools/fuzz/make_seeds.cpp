@@ -275,6 +275,16 @@ int bridge_seeds(const std::filesystem::path& dir) {
     seeds.emplace_back("sensor_lost", w);
   }
   {
+    BridgeWriter w(plain);  // the predictor in a trial (state bit 4), then the bridge shuts down
+    readings(w, 10, -2.0);
+    w.op(BridgeOp::PredictorHeartbeat, 1, {0x10});
+    readings(w, 10, -2.0);
+    w.op(BridgeOp::Shutdown, 1);
+    w.op(BridgeOp::StopWritten, 1);
+    w.op(BridgeOp::Shutdown, 1);
+    seeds.emplace_back("shutdown_in_trial", w);
+  }
+  {
     BridgeWriter w(plain);  // a sensor that keeps failing: its error count saturates at 255
     for (int i = 0; i < 300; ++i) w.op(BridgeOp::SensorError, 1);
     w.tick(1);
