@@ -55,6 +55,10 @@ class SocketCanPort final : public CanPort {
         setsockopt(fd_, SOL_SOCKET, SO_RCVBUFFORCE, &opt.receive_buffer, sizeof opt.receive_buffer) < 0 &&
         setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &opt.receive_buffer, sizeof opt.receive_buffer) < 0)
       fail_close("setsockopt(SO_RCVBUF) on " + iface);
+    // The kernel reports twice what it grants as payload (socket(7): the rest is bookkeeping).
+    int granted = 0;
+    socklen_t len = sizeof granted;
+    if (getsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &granted, &len) == 0) rcvbuf_ = granted / 2;
     ifreq ifr{};
     std::strncpy(ifr.ifr_name, iface.c_str(), IFNAMSIZ - 1);
     if (ioctl(fd_, SIOCGIFINDEX, &ifr) < 0) fail_close("no CAN interface '" + iface + "' (SIOCGIFINDEX)");
@@ -67,6 +71,7 @@ class SocketCanPort final : public CanPort {
     if (fd_ >= 0) ::close(fd_);
   }
   int fd() const override { return fd_; }
+  int receive_buffer() const override { return rcvbuf_; }
 
   int receive(protocol::Frame& f, RxInfo& info) noexcept override {
     can_frame cf;
@@ -120,6 +125,7 @@ class SocketCanPort final : public CanPort {
   }
   std::string iface_;
   int fd_ = -1;
+  int rcvbuf_ = 0;
   uint32_t drops_ = 0;
 };
 

@@ -52,6 +52,9 @@ class CanPort {
   // 1: a frame (or error frame) was read; 0: nothing waiting; -1: error (errno set).
   virtual int receive(protocol::Frame& f, RxInfo& info) noexcept = 0;
   virtual SendResult send(const protocol::Frame& f) noexcept = 0;
+  // The receive buffer the kernel granted, in bytes of payload (0: not a kernel socket). Without
+  // CAP_NET_ADMIN, SO_RCVBUFFORCE fails and SO_RCVBUF is capped at net.core.rmem_max.
+  virtual int receive_buffer() const { return 0; }
 };
 
 // A raw SocketCAN socket bound to `iface` with exact-id filters. Throws std::system_error naming

@@ -24,6 +24,7 @@ const char* event_kind_name(EventKind k) {
     case EventKind::StopConfirmed: return "stop_confirmed";
     case EventKind::StopRetry: return "stop_retry";
     case EventKind::TxError: return "tx_error";
+    case EventKind::ReceiveError: return "receive_error";
     case EventKind::BusError: return "bus_error";
     case EventKind::ModelMissing: return "model_missing";
     case EventKind::StopDropped: return "stop_dropped";
@@ -323,12 +324,14 @@ void Predictor::on_trial_start(const Frame& f, int64_t now_ns) noexcept {
   trial_start_ns_ = now_ns;
   last_sample_ns_ = now_ns;  // the deadline runs from the trial start until the first sample
   emit(make_event(EventKind::TrialStarted, now_ns));
-  if (filter_) {
-    filter_->reset();
-    if (unconfirmed) stop(StopReason::StopUnconfirmed, now_ns);
-  } else {
+  if (filter_) filter_->reset();
+  if (shutting_down_) {
+    stop(StopReason::Shutdown, now_ns);
+  } else if (!filter_) {
     emit(make_event(EventKind::ModelMissing, now_ns));
     stop(StopReason::ModelError, now_ns);
+  } else if (unconfirmed) {
+    stop(StopReason::StopUnconfirmed, now_ns);
   }
 }
 
@@ -460,6 +463,7 @@ void Predictor::on_bus_error(uint32_t error_class, int64_t now_ns) noexcept {
 }
 
 void Predictor::on_shutdown(int64_t now_ns) noexcept {
+  shutting_down_ = true;
   if (decision_.state == PredictorState::InTrial) stop(StopReason::Shutdown, now_ns);
 }
 

@@ -100,6 +100,7 @@ enum class EventKind : uint8_t {
   TrialStarted, TrialEnded, BadFrame, LostFrames, KernelDrops, StopSent, StopConfirmed, StopRetry,
   TxError, BusError, ModelMissing, Posteriors,
   StopDropped,  // a stop still unconfirmed when the next trial started (younger than a retry period)
+  ReceiveError,  // the host port's recvmsg failed: value = errno, sample = failures so far, can_id = socket
 };
 const char* event_kind_name(EventKind k);
 
@@ -156,7 +157,9 @@ class Predictor {
   void on_kernel_drops(uint32_t cumulative, int64_t now_ns) noexcept;
   // A controller error frame (bus-off, ...): counted and logged; a pending stop keeps retrying.
   void on_bus_error(uint32_t error_class, int64_t now_ns) noexcept;
-  // SIGTERM: stops the robot if a trial is running (the guard is going away).
+  // SIGTERM: stops the robot if a trial is running (the guard is going away), and refuses every
+  // trial that starts after it with a Shutdown stop (the daemon may still be waiting for the
+  // echo of its last stop then; a trial it let run would be unguarded once it has gone).
   void on_shutdown(int64_t now_ns) noexcept;
 
   const Decision& decision() const noexcept { return decision_; }
@@ -217,6 +220,7 @@ class Predictor {
   // Stop transmission.
   bool stop_pending_ = false;
   bool trial_ended_ = false;  // the robot ended the trial (TrialEnd); a stop's echo then rests it
+  bool shutting_down_ = false;  // on_shutdown was called: every later trial is refused
   Frame stop_frame_;
   int64_t stop_decided_ns_ = 0;  // first transmission
   int64_t stop_sent_ns_ = 0;     // latest transmission

@@ -122,6 +122,13 @@ void EventLogger::log_one(const Event& e) {
       log_->warn("stop of trial {} ({}) not confirmed {} us after it was sent: dropped, a new trial started", e.trial,
                  protocol::stop_reason_name(e.reason), e.value);
       break;
+    case EventKind::ReceiveError:
+      // An interface taken down (ENETDOWN) reports once per socket; one unregistered (ENODEV, a
+      // USB adapter unplugged) ends the loop (PredictorDaemon::run).
+      if (power_of_two(e.sample))
+        log_->error("receive on the {} socket failed: {} ({} failures so far)", e.can_id ? "stop" : "frame",
+                    std::strerror(static_cast<int>(e.value)), e.sample);
+      break;
     case EventKind::Posteriors: break;
   }
 }
@@ -174,7 +181,30 @@ uint8_t PredictorDaemon::transmit_stop(const Frame& f) noexcept {
   return static_cast<uint8_t>(stop_port_.send(f));
 }
 
-uint8_t PredictorDaemon::transmit(const Frame& f) noexcept { return static_cast<uint8_t>(rx_.send(f)); }
+uint8_t PredictorDaemon::transmit(const Frame& f) noexcept {
+  // Heartbeats, status pages and posteriors: a failure is not retried (the next one supersedes
+  // it) but logged, at each doubling, as a stop's is: an interface down must not go unsaid.
+  const can::SendResult r = rx_.send(f);
+  if (r != can::SendResult::Ok) {
+    Event e;
+    e.kind = EventKind::TxError;
+    e.can_id = f.id;
+    e.send_result = static_cast<uint8_t>(r);
+    events_.push(e);
+  }
+  return static_cast<uint8_t>(r);
+}
+
+void PredictorDaemon::receive_failed(int err, bool stop_socket, int64_t now) noexcept {
+  Event e;
+  e.kind = EventKind::ReceiveError;
+  e.time_ns = now;
+  e.value = static_cast<uint32_t>(err);
+  e.sample = ++receive_errors_;
+  e.can_id = stop_socket ? 1 : 0;
+  events_.push(e);
+  if (err == ENODEV) interface_gone_ = true;
+}
 
 void PredictorDaemon::event(const Event& e) noexcept { events_.push(e); }
 
@@ -184,6 +214,7 @@ void PredictorDaemon::drain_rx(int64_t) noexcept {
   // Bounded: a babbling bus cannot starve the timer and the stop socket.
   for (int n = 0; n < 64; ++n) {
     const int r = rx_.receive(f, info);
+    if (r < 0) receive_failed(errno, false, now_ns());
     if (r <= 0) break;
     if (info.error_frame) {
       predictor_.on_bus_error(info.error_class, info.rx_time_ns);
@@ -203,7 +234,9 @@ void PredictorDaemon::drain_stop(int64_t now) noexcept {
   Frame f;
   can::RxInfo info;
   for (int n = 0; n < 64; ++n) {
-    if (stop_port_.receive(f, info) <= 0) break;
+    const int r = stop_port_.receive(f, info);
+    if (r < 0) receive_failed(errno, true, now);
+    if (r <= 0) break;
     if (info.error_frame) {
       predictor_.on_bus_error(info.error_class, now);
       continue;
@@ -247,8 +280,16 @@ int PredictorDaemon::run() {
         predictor_.on_shutdown(now);
       }
     }
-    // Clean shutdown: once no stop is waiting for its echo, or after the grace period.
-    if (shutdown_at >= 0 && (!predictor_.stop_pending() || now - shutdown_at > opt_.shutdown_grace_ns)) return 0;
+    // The interface was unregistered (ENODEV): the sockets are unbound and hear nothing again.
+    // Exit 1 so that the service manager restarts the daemon on the interface when it is back.
+    if (interface_gone_) {
+      predictor_.on_shutdown(now);
+      return 1;
+    }
+    // Clean shutdown once no stop is waiting for its echo; 1 when the grace ran out with one
+    // waiting (the robot may not be stopped: said by main, and the service manager sees it).
+    if (shutdown_at >= 0 && !predictor_.stop_pending()) return 0;
+    if (shutdown_at >= 0 && now - shutdown_at > opt_.shutdown_grace_ns) return 1;
   }
 }
 

@@ -73,7 +73,9 @@ class EventLogger {
 
 struct DaemonOptions {
   int64_t tick_ns = 1'000'000;         // timerfd period: deadline resolution, stop retry pacing
-  int64_t shutdown_grace_ns = 50'000'000;  // wait this long for a shutdown stop's echo
+  // Wait this long for a shutdown stop's echo (bus-off recovery takes ~100 ms), well inside the
+  // unit's TimeoutStopSec=5.
+  int64_t shutdown_grace_ns = 1'000'000'000;
 };
 
 class PredictorDaemon final : private PredictorSink {
@@ -85,7 +87,8 @@ class PredictorDaemon final : private PredictorSink {
   ~PredictorDaemon() override;
 
   // The event loop; returns 0 after a clean shutdown, 1 on an unrecoverable error (logged via
-  // the queue). Call from the thread that should be real-time.
+  // the queue: the interface unregistered) or when the grace ran out with a stop unconfirmed
+  // (predictor().stop_pending() then). Call from the thread that should be real-time.
   int run();
   // Async-signal-safe: a write to an eventfd.
   void request_shutdown() noexcept;
@@ -105,6 +108,7 @@ class PredictorDaemon final : private PredictorSink {
   void event(const Event& e) noexcept override;
   void drain_rx(int64_t now) noexcept;
   void drain_stop(int64_t now) noexcept;
+  void receive_failed(int err, bool stop_socket, int64_t now) noexcept;
 
   can::CanPort& rx_;
   can::CanPort& stop_port_;
@@ -114,6 +118,8 @@ class PredictorDaemon final : private PredictorSink {
   int epoll_fd_ = -1, timer_fd_ = -1, shutdown_fd_ = -1;
   LatencyHistogram processing_, processing_stop_;
   uint32_t stops_sent_ = 0;
+  uint32_t receive_errors_ = 0;
+  bool interface_gone_ = false;
 };
 
 // Real-time setup, each step optional: a step that is not permitted yields a warning string

@@ -39,7 +39,8 @@ const char* kUsage =
     "sensor_timeout_ms, bad_frame_budget, bad_frame_weight, max_delta_counter, status_period_ms,\n"
     "heartbeat_period_ms, posteriors_period_ms, stop_retry_ms, sample_period_ms, acceleration_m_s2,\n"
     "mount_axes, mount_bias.\n"
-    "Exit codes: 0 clean shutdown (SIGTERM/SIGINT), 1 runtime error, 2 bad arguments or config.";
+    "Exit codes: 0 clean shutdown (SIGTERM/SIGINT), 1 runtime error (the interface gone, or a stop\n"
+    "not confirmed on the bus when the daemon exited), 2 bad arguments or config.";
 
 std::string read_text(const std::string& path) {
   FILE* f = std::fopen(path.c_str(), "rb");
@@ -174,8 +175,15 @@ int main(int argc, char** argv) {
     can::PortOptions stop_opt;
     stop_opt.ids = {protocol::id_of(protocol::MsgId::Stop)};
     stop_opt.receive_own = true;
+    // Controller error frames come to every socket that asks: only the receive socket does, so
+    // that one bus-off is counted and logged once.
+    stop_opt.error_frames = false;
     auto rx = can::open_socketcan(iface, rx_opt);
     auto stop_port = can::open_socketcan(iface, stop_opt);
+    if (rx->receive_buffer() < rx_opt.receive_buffer)
+      log->warn("receive buffer {} bytes, not the {} asked: a late loop thread loses frames sooner; grant "
+                "CAP_NET_ADMIN (SO_RCVBUFFORCE) or raise net.core.rmem_max",
+                rx->receive_buffer(), rx_opt.receive_buffer);
     static EventQueue events;  // 4096 events: static storage, not on the stack
     EventLogger logger(events, log, names);  // before the RT setup: it must not inherit SCHED_FIFO
     PredictorDaemon daemon(model.get(), cfg, *rx, *stop_port, events, dopt);
@@ -191,9 +199,15 @@ int main(int argc, char** argv) {
     log->info("listening on {} (threshold {}, k {}, hard limit {} N, sensor timeout {} ms)", iface,
               daemon.predictor().threshold(), daemon.predictor().consecutive(), cfg.hard_limit_n,
               cfg.sensor_timeout_ns / 1000000);
-    const int rc = daemon.run();
+    int rc = daemon.run();
     g_daemon = nullptr;
     logger.stop();
+    if (daemon.predictor().stop_pending()) {
+      const auto& d = daemon.predictor().decision();
+      log->error("the stop of trial {} ({}) was not confirmed on the bus when the daemon exited: the robot may not be "
+                 "stopped", d.trial, protocol::stop_reason_name(d.reason));
+      rc = 1;
+    }
     std::string counters;
     for (int c = 0; c < static_cast<int>(protocol::StatusCounter::Count); ++c)
       counters += std::string(c ? " " : "") + protocol::status_counter_name(static_cast<protocol::StatusCounter>(c)) + "=" +

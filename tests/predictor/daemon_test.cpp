@@ -4,7 +4,10 @@
 // what happened through spdlog, and the loop thread allocates nothing after start-up.
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <spdlog/sinks/ostream_sink.h>
 #include <spdlog/spdlog.h>
 #include <sstream>
@@ -193,6 +196,77 @@ TEST(Daemon, ShutdownDuringATrialStopsTheRobotFirst) {
   protocol::Stop s{};
   ASSERT_TRUE(rig.wait_stop(s, 100ms));
   EXPECT_EQ(s.reason, protocol::StopReason::Shutdown);
+}
+
+// The shutdown stop never confirmed (no echo: bus-off, no ACK): the daemon retries it through its
+// 1 s grace, then exits 1 with the stop still pending (main says "the robot may not be
+// stopped"); it used to exit 0 after 50 ms.
+TEST(Daemon, AShutdownStopNeverConfirmedIsAFailedExit) {
+  Rig rig;
+  rig.bus.set_echo(false);
+  rig.sensor->send(rig.src.trial_start(7));
+  for (int i = 0; i < 3; ++i) rig.send_sample(-2.0, 0.0);
+  std::this_thread::sleep_for(5ms);
+  const auto t0 = std::chrono::steady_clock::now();
+  rig.shutdown();
+  EXPECT_GE(std::chrono::steady_clock::now() - t0, 1000ms);
+  EXPECT_EQ(rig.rc, 1);
+  EXPECT_TRUE(rig.daemon->predictor().stop_pending());
+  EXPECT_GE(rig.daemon->predictor().counter(protocol::StatusCounter::TxRetries), 100u) << "retried through the grace";
+}
+
+// A port whose next receive fails with a chosen errno (as SocketCAN reports an interface taken
+// down, ENETDOWN, or unregistered, ENODEV, once on the socket); otherwise the in-process port.
+class FailingPort final : public can::CanPort {
+ public:
+  explicit FailingPort(std::unique_ptr<can::CanPort> inner) : inner_(std::move(inner)) {}
+  int fd() const override { return inner_->fd(); }
+  int receive(protocol::Frame& f, can::RxInfo& info) noexcept override {
+    if (const int e = fail_with.exchange(0)) {
+      errno = e;
+      return -1;
+    }
+    return inner_->receive(f, info);
+  }
+  can::SendResult send(const protocol::Frame& f) noexcept override { return inner_->send(f); }
+  std::atomic<int> fail_with{0};
+
+ private:
+  std::unique_ptr<can::CanPort> inner_;
+};
+
+// An interface taken down is said on the log, and the daemon goes on; one unregistered (a USB
+// adapter unplugged: the sockets are unbound for good) ends it with exit 1 for the service
+// manager to restart it. Both used to pass in silence.
+TEST(Daemon, ReceiveErrorsAreLoggedAndAVanishedInterfaceEndsTheLoop) {
+  can::InProcBus bus;
+  FailingPort rx(bus.open({PredictorDaemon::receive_ids(), false, true}));
+  auto stop_port = bus.open({{protocol::id_of(protocol::MsgId::Stop)}, true, true});
+  auto sensor = bus.open({{}, false, true});
+  const model::OutcomeModel model = testkit::test_model();
+  EventQueue events;
+  std::ostringstream text;
+  auto log = std::make_shared<spdlog::logger>("test", std::make_shared<spdlog::sinks::ostream_sink_mt>(text));
+  EventLogger logger(events, log, {"good", "missed", "caught"});
+  PredictorDaemon daemon(&model, PredictorConfig{}, rx, *stop_port, events);
+  std::atomic<int> rc{-1};
+  std::thread loop([&] { rc = daemon.run(); });
+  testkit::FrameSource src;
+  rx.fail_with = ENETDOWN;
+  sensor->send(src.trial_start(3));  // wakes the loop: its receive fails, the frame waits
+  for (int i = 0; i < 200 && daemon.predictor().decision().trial != 3; ++i) std::this_thread::sleep_for(1ms);
+  EXPECT_EQ(daemon.predictor().decision().trial, 3) << "the frame after the failure was still read";
+  EXPECT_EQ(rc.load(), -1) << "an interface down is not the end";
+  rx.fail_with = ENODEV;
+  sensor->send(src.trial_end(3, 0));
+  for (int i = 0; i < 1000 && rc.load() < 0; ++i) std::this_thread::sleep_for(1ms);
+  if (rc.load() < 0) daemon.request_shutdown();
+  loop.join();
+  logger.stop();
+  EXPECT_EQ(rc.load(), 1);
+  EXPECT_NE(text.str().find("receive on the frame socket failed: " + std::string(std::strerror(ENETDOWN)) +
+                            " (1 failures so far)"), std::string::npos) << text.str();
+  EXPECT_NE(text.str().find(std::strerror(ENODEV)), std::string::npos) << text.str();
 }
 
 TEST(Daemon, WithoutAModelEveryTrialIsRefused) {

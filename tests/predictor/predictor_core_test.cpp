@@ -397,6 +397,30 @@ TEST(StopTransmission, AStopJustSentIsDroppedAtTheNextTrialStart) {
   EXPECT_EQ(h.p->decision().state, PredictorState::InTrial);
 }
 
+// SIGTERM stops the running trial, and a trial that starts while the daemon still waits for that
+// stop's echo is refused with its own Shutdown stop (it used to run, unguarded once the daemon
+// had gone, and the pending stop was dropped); later trials too.
+TEST(StopTransmission, ATrialStartingAfterShutdownIsRefused) {
+  Harness h;
+  h.start(1);
+  h.sample(-2.0, 0.0);
+  h.p->on_shutdown(h.now);
+  ASSERT_TRUE(h.p->stop_pending());
+  EXPECT_EQ(h.last_stop().reason, protocol::StopReason::Shutdown);
+  h.p->on_frame(h.src.trial_start(2), h.now + kMs / 2);  // before the first stop's echo
+  EXPECT_EQ(h.p->decision().state, PredictorState::Stopped);
+  EXPECT_EQ(h.p->decision().trial, 2);
+  EXPECT_EQ(h.p->decision().reason, protocol::StopReason::Shutdown);
+  EXPECT_TRUE(h.p->stop_pending()) << "the refusal waits for its echo: the daemon does not exit before it";
+  EXPECT_EQ(h.last_stop().trial_id, 2);
+  EXPECT_EQ(h.last_stop().reason, protocol::StopReason::Shutdown);
+  h.p->on_stop_echo(h.sink.stops.back(), h.now + kMs);
+  EXPECT_FALSE(h.p->stop_pending());
+  h.p->on_frame(h.src.trial_start(3), h.now + 10 * kMs);  // confirmed, idle: still refused
+  EXPECT_EQ(h.p->decision().reason, protocol::StopReason::Shutdown);
+  EXPECT_EQ(h.last_stop().trial_id, 3);
+}
+
 // The heartbeat's uptime is whole seconds since the predictor's first frame or tick, saturating
 // at 65,535 s (18.2 h) rather than wrapping to a freshly restarted daemon's. (Out of
 // fuzz_predictor's reach.)

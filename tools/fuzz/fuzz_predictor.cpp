@@ -192,6 +192,7 @@ struct Shadow {
   protocol::E2EChecker e2e;
   uint32_t sample = 0;
   bool started = false;
+  bool shut_down = false;      // SIGTERM came: every later trial is refused
   explicit Shadow(uint8_t max_delta) : e2e(MsgId::FtForce, max_delta) {}
 };
 
@@ -311,7 +312,7 @@ bool run_one(Reader& in, Predictor& p, RecordingSink& sink, Shadow& sh, Call& c,
     }
     case TrafficOp::KernelDrops: p.on_kernel_drops(p.counter(StatusCounter::KernelDrops) + in.u8(), sh.now); break;
     case TrafficOp::BusError: p.on_bus_error(in.u8(), sh.now); break;
-    case TrafficOp::Shutdown: p.on_shutdown(sh.now), c.shut_down = true; break;
+    case TrafficOp::Shutdown: p.on_shutdown(sh.now), c.shut_down = sh.shut_down = true; break;
     case TrafficOp::Wait:
       sh.now += in.u8() * 1'000'000LL;
       sink.now_ns = sh.now;
@@ -352,11 +353,14 @@ void check_trial_start(const Call& c, const Predictor& p, const RecordingSink& s
   const predictor::Decision& d = p.decision();
   // The last stop unconfirmed for a retry period or more: the stop socket cannot send.
   const bool unconfirmed = c.pending_before && sh.now - sh.stop_decided_ns >= r.cfg.stop_retry_ns;
-  if (r.has_model && !unconfirmed && d.state != PredictorState::InTrial)
+  if (sh.shut_down) {
+    if (d.state != PredictorState::Stopped || d.reason != StopReason::Shutdown)
+      broken("a trial start after SIGTERM was not refused with shutdown", op);
+  } else if (r.has_model && !unconfirmed && d.state != PredictorState::InTrial)
     broken("a trial start with a model did not run the trial", op);
-  if (r.has_model && unconfirmed && (d.state != PredictorState::Stopped || d.reason != StopReason::StopUnconfirmed))
+  if (!sh.shut_down && r.has_model && unconfirmed && (d.state != PredictorState::Stopped || d.reason != StopReason::StopUnconfirmed))
     broken("a trial start with the last stop unconfirmed was not refused with stop_unconfirmed", op);
-  if (!r.has_model && (d.state != PredictorState::Stopped || d.reason != StopReason::ModelError))
+  if (!sh.shut_down && !r.has_model && (d.state != PredictorState::Stopped || d.reason != StopReason::ModelError))
     broken("a trial start without a model was not refused", op);
   // A younger pending stop is dropped, and says so once, naming the finished trial.
   if (unconfirmed && sink.dropped != 0) broken("a stale stop was reported dropped, not refused", op);

@@ -211,6 +211,8 @@ int predictor_seeds(const std::filesystem::path& dir) {
     w.op(TrafficOp::Heartbeat, 0);
     w.op(TrafficOp::Shutdown, 0);
     w.tick(2);
+    w.start(9);  // a trial that starts during the shutdown's grace: refused
+    samples(w, 3, -2.0, 0.0);
     seeds.emplace_back("shutdown", w);
   }
   return write_seeds(dir, seeds);

@@ -108,6 +108,9 @@ PREDICTOR_FAULTS = [
      "void Predictor::on_force(const Frame& f, int64_t now_ns) noexcept {\n  uint32_t lost = 0;",
      "void Predictor::on_force(const Frame& f, int64_t now_ns) noexcept {\n  uint32_t lost = 0;\n"
      "  { std::vector<int> v(100); asm volatile(\"\" :: \"r\"(v.data()) : \"memory\"); }"),
+    ("a trial starting after SIGTERM runs",
+     "  shutting_down_ = true;\n",
+     ""),
 ]
 
 BRIDGE_FAULTS = [
