@@ -3,8 +3,8 @@
 // For the reduced (~5k triangles) and the full (~20k) gown, with bending, self-collision and
 // arm collision on, it reports the wall time per second of simulated time for the pull alone
 // and for the whole trial (grasp, settling, pull at the high arm), the whole trial's wall time,
-// and the peak memory of one simulation (each configuration runs in its own child process, so
-// ru_maxrss is that simulation's). Baselines, measured in the same run on the same scene over the
+// and the peak memory (each configuration runs in its own child process; its ru_maxrss holds the
+// three scenes of the comparison below, so it bounds one simulation's from above). Baselines, measured in the same run on the same scene over the
 // same window (0.5 s of settling): the solver with its constraints in mesh order (no colouring,
 // scalar: the solver as it was before the colour order), and the colour-ordered solver with the
 // scalar kernels (SceneOptions::simd off), so the ratios show what the colour order and the AVX2
@@ -140,9 +140,9 @@ int main(int argc, char** argv) {
   std::printf("times are CPU seconds of this process (one core); the trial's wall time is shown too\n");
   std::printf("window: CPU s per simulated s over 0.5 s of settling, for the mesh-order scalar solver, the\n"
               "colour-ordered scalar kernels and the default path, and the default path's speedup over each\n");
-  std::printf("%-8s %6s %6s | %-24s | %-24s | %-18s | %-41s | %7s | %s\n", "gown", "verts", "tris", "pull: s per sim s (x RT)",
+  std::printf("%-8s %6s %6s | %-24s | %-24s | %-18s | %-41s | %9s | %s\n", "gown", "verts", "tris", "pull: s per sim s (x RT)",
               "trial: s per sim s (x RT)", "trial CPU (wall) s", "window: mesh / scalar / default, speedups",
-              "peak MB", "outcome");
+              "MB, 3 scn", "outcome");
   for (GownResolution res : {GownResolution::Reduced, GownResolution::Full}) {
     if (quick && res == GownResolution::Full) continue;
     Figures f;
@@ -152,7 +152,7 @@ int main(int argc, char** argv) {
       return 1;
     }
     const double pull = f.pull_wall / f.pull_sim, trial = (f.settle_wall + f.pull_wall) / (f.settle_sim + f.pull_sim);
-    std::printf("%-8s %6d %6d | %8.3f (%6.2fx RT)      | %8.3f (%6.2fx RT)      | %7.1f (%7.1f)  | %6.3f / %6.3f / %6.3f %-6s %5.2fx %5.2fx | %7.1f | %s at %.3f m (load %.1f s)\n",
+    std::printf("%-8s %6d %6d | %8.3f (%6.2fx RT)      | %8.3f (%6.2fx RT)      | %7.1f (%7.1f)  | %6.3f / %6.3f / %6.3f %-6s %5.2fx %5.2fx | %9.1f | %s at %.3f m (load %.1f s)\n",
                 res == GownResolution::Full ? "full" : "reduced", f.vertices, f.triangles, pull, 1 / pull, trial, 1 / trial,
                 f.trial_cpu, f.trial_wall, f.base_wall / f.window_sim, f.scalar_wall / f.window_sim,
                 f.fast_wall / f.window_sim, f.avx2 ? "(avx2)" : "(scal)", f.base_wall / f.fast_wall,
