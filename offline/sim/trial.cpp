@@ -541,6 +541,7 @@ void pull_together(const std::vector<GownModel>& models, const std::vector<size_
     p.r.arm_offset = out[b].arm_offset;
     p.r.settle_shared = out[b].settle_shared;
     p.r.wall_settle = out[b].wall_settle;
+    p.r.opening = out[b].opening;
     if (k > 0) p.r.wall_pull = 0;
     p.r.seq.height = specs[b].height;
     p.r.seq.id = std::string("sim-") + std::string(arm_height_name(specs[b].height)) + "-" + std::to_string(specs[b].seed);
@@ -598,6 +599,8 @@ std::vector<TrialResult> simulate_trials(const Scene& scene, const ClothParams& 
       done[b] = 1;
       GownModel mb = m;
       place_arm(mb, dz_b);
+      // The opening was measured against a's fist: b's own lies dz_b - dz_a away.
+      if (!sc.opening.empty()) out[b].opening = opening_shape(mb, s);
       if (same_pull(specs[a], specs[b])) {
         if (models.empty()) models.push_back(m);
         together.push_back(b);

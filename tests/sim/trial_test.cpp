@@ -420,6 +420,20 @@ TEST(SimTrial, OpeningIsMeasuredFromTheTrialsFist) {
   EXPECT_EQ(r[0].opening.depth, r[1].opening.depth);
   EXPECT_NEAR(r[0].opening.rim_low_above_fist - r[1].opening.rim_low_above_fist, opt.arm.z_rel[2] - opt.arm.z_rel[0],
               1e-9);
+  // The same two trials run together (the low one reuses the high one's settling, no arm touched
+  // it): each keeps its own opening, as run alone (the low one used to report the high one's).
+  TrialSpec specs[2];
+  for (int k = 0; k < 2; ++k) {
+    specs[k].height = heights[k];
+    specs[k].max_travel = 1e-4;
+    specs[k].arm_offset = -2.0;
+  }
+  const std::vector<TrialResult> both = simulate_trials(coarse_scene(), ClothParams{}, {specs[0], specs[1]});
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_EQ(both[k].opening.rim_low_above_fist, r[k].opening.rim_low_above_fist) << k;
+    EXPECT_EQ(both[k].opening.depth, r[k].opening.depth) << k;
+  }
+  EXPECT_TRUE(both[1].settle_shared) << "the case under test: the low trial reused the high one's settling";
 }
 
 // Paper V-A: after the perturbation the robot waits for the gown to settle before it pulls. With
