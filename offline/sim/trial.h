@@ -162,7 +162,8 @@ struct TrialSpec {
   double speed = 0.1;           // [m/s] pull speed (0.1 or 0.15 in the study)
   double acceleration = kRigAcceleration;  // [m/s^2] the rig's acceleration up to `speed`
   uint64_t seed = 0;            // drives the perturbation force
-  bool gown_noise = false;      // paper V-A: uniform X/lateral force up to 6 N over all vertices
+  bool gown_noise = false;      // paper V-A: X and lateral force each uniform in [-6, 6] N over all vertices
+                                // (the paper's "maximum magnitude 6 N" read per direction: |F| up to 8.5 N)
   bool arm_noise = false;       // paper V-A: arm height + U[-1.5, 1.5] cm (high, low), U[-6, 0] cm (middle)
   double max_travel = 0.85;     // [m] end of the rig's travel
   double force_limit = 10.0;    // [N] stop when |f_motion| or |f_vertical| reaches it
