@@ -50,24 +50,41 @@ bool parse_candump_line(std::string_view line, LoggedFrame& out, std::string& wh
   }
   std::string_view rest = line.substr(close + 1);
   if (rest.empty() || rest[0] != ' ') return why = "expected a space after the timestamp", false;
-  rest.remove_prefix(1);
+  // candump -l on several interfaces pads each name to the longest ("%*s"): one or more spaces.
+  while (!rest.empty() && rest[0] == ' ') rest.remove_prefix(1);
   const size_t sp = rest.find(' ');
   if (sp == std::string_view::npos || sp == 0) return why = "expected an interface name", false;
   if (sp > kMaxInterfaceName) return why = "interface name longer than 15 characters (IFNAMSIZ)", false;
   out.iface = std::string(rest.substr(0, sp));
   std::string_view fr = rest.substr(sp + 1);
+  // candump -x appends the direction, " R" (received) or " T" (sent by this host): both are
+  // frames on the bus, and the reader takes them alike. Anything else after the frame is not a
+  // candump line.
+  if (const size_t end = fr.find(' '); end != std::string_view::npos) {
+    const std::string_view extra = fr.substr(end);
+    if (extra != " R" && extra != " T")
+      return why = "unexpected text after the frame (only candump -x's direction, R or T)", false;
+    fr = fr.substr(0, end);
+  }
   const size_t hash = fr.find('#');
   if (hash == std::string_view::npos) return why = "frame has no '#'", false;
-  if (hash != 3) return why = "identifier is not 3 hex digits (only classic 11-bit frames)", false;
   uint32_t id = 0;
   for (size_t i = 0; i < hash; ++i) {
+    if (i == 8) return why = "identifier is not 3 hex digits (only classic 11-bit frames)", false;
     const int v = hex_value(fr[i]);
     if (v < 0) return why = "identifier is not hex", false;
     id = id * 16 + static_cast<uint32_t>(v);
   }
+  // 8 digits: can-utils' 29-bit identifier, or with CAN_ERR_FLAG (0x20000000) an error frame,
+  // which candump logs when error frames are subscribed (-e, or an error mask in a filter).
+  if (hash == 8 && (id & 0x20000000u)) return why = "error frame (candump -e) not supported", false;
+  if (hash == 8) return why = "extended (29-bit) identifier not supported (only classic 11-bit frames)", false;
+  if (hash != 3) return why = "identifier is not 3 hex digits (only classic 11-bit frames)", false;
   if (id > 0x7FF) return why = "identifier above 0x7FF", false;
   const std::string_view hex = fr.substr(hash + 1);
-  if (!hex.empty() && (hex[0] == '#' || hex[0] == 'R')) return why = "CAN FD or remote frames are not part of the protocol", false;
+  if (!hex.empty() && hex[0] == '#') return why = "CAN FD frame (##) not supported (only classic frames)", false;
+  if (!hex.empty() && (hex[0] == 'R' || hex[0] == 'r'))
+    return why = "remote frame (RTR) not supported: the protocol has none", false;
   if (hex.size() % 2 != 0 || hex.size() > 16) return why = "data is not 0..8 bytes of hex", false;
   Frame f;
   f.id = id;
@@ -87,6 +104,7 @@ std::vector<LoggedFrame> parse_candump_log(std::string_view text, const std::str
   std::vector<LoggedFrame> frames;
   long line_no = 0;
   size_t pos = 0;
+  long first_skipped = 0;  // the first line with text that is not a frame line
   std::string why;
   while (pos < text.size()) {
     size_t nl = text.find('\n', pos);
@@ -94,7 +112,12 @@ std::vector<LoggedFrame> parse_candump_log(std::string_view text, const std::str
     std::string_view line = text.substr(pos, nl - pos);
     pos = nl + 1;
     ++line_no;
-    if (line.find_first_not_of(" \t\r") == std::string_view::npos) continue;
+    // canplayer skips every line that does not begin with '(': comments, candump -d's
+    // "DROPCOUNT:" notes (what they report shows up here as lost frames anyway), blank lines.
+    if (line.empty() || line[0] != '(') {
+      if (!first_skipped && line.find_first_not_of(" \t\r") != std::string_view::npos) first_skipped = line_no;
+      continue;
+    }
     LoggedFrame lf;
     if (!parse_candump_line(line, lf, why)) throw std::runtime_error(name + ":" + std::to_string(line_no) + ": " + why);
     if (!frames.empty() && lf.time_us < frames.back().time_us) {
@@ -106,6 +129,10 @@ std::vector<LoggedFrame> parse_candump_log(std::string_view text, const std::str
     lf.line = line_no;
     frames.push_back(std::move(lf));
   }
+  // Text without a single frame line is no log at all (candump without -l, say): not an empty one.
+  if (frames.empty() && first_skipped)
+    throw std::runtime_error(name + ":" + std::to_string(first_skipped) +
+                             ": not a candump -l log: no line starts with '(' and a timestamp");
   return frames;
 }
 

@@ -4,8 +4,16 @@
 //   (1700000000.012345) vcan0 100#A5010A00F6FF3200
 //   (seconds.microseconds) interface id#data-in-hex
 //
-// Classic frames only (3 hex digits of identifier, 0..8 data bytes), timestamps of at most 12
-// digits of seconds, interface names of at most 15 characters. Host side: allocates.
+// candump writes "(%010lu.%06lu) %*s %s%s": with several interfaces the names are padded to the
+// longest, so one or more spaces may come before a name; with -x the line ends in the
+// direction, " R" (received) or " T" (sent by the recording host). Both are read, and the
+// direction is dropped: either way the frame was on the bus.
+//
+// Classic frames only (3 hex digits of identifier, 0..8 data bytes), timestamps of at most 10
+// digits of seconds, interface names of at most 15 characters. What candump writes beyond that
+// is refused with its name: error frames (8 digits with 0x20000000, candump -e), 29-bit
+// identifiers (8 digits), remote frames (id#R), CAN FD frames (id##flags+data). Host side:
+// allocates.
 #pragma once
 
 #include <cstddef>
@@ -38,9 +46,11 @@ bool parse_candump_line(std::string_view line, LoggedFrame& out, std::string& wh
 // The latest timestamp a line may carry [s] (the year 2255): its nanoseconds fit an int64_t.
 inline constexpr int64_t kMaxLogSeconds = 9'000'000'000;
 
-// Whole log text. Blank lines are skipped; anything else malformed throws std::runtime_error
-// with "name:line: what" (callers pass the file name for the message); so does a timestamp
-// earlier than the line before's (a clock step: candump stamps with the wall clock).
+// Whole log text. As canplayer does, lines that do not begin with '(' are skipped (blank lines,
+// comments, candump -d's DROPCOUNT notes); a line that does and is not a frame line above
+// throws std::runtime_error with "name:line: what" (callers pass the file name for the
+// message); so does a timestamp earlier than the line before's (a clock step: candump stamps
+// with the wall clock), and text with lines but no frame line at all (not a candump -l log).
 std::vector<LoggedFrame> parse_candump_log(std::string_view text, const std::string& name);
 
 }  // namespace dressguard::protocol

@@ -245,6 +245,72 @@ TEST(CandumpLog, BadLinesNameFileAndLine) {
   EXPECT_FALSE(parse_candump_line("(1.000000) vcan0 100##100", lf, why));
 }
 
+// What can-utils' candump writes, verbatim ("(%010lu.%06lu) %*s %s%s"): `candump -l can0 vcan0`
+// pads the shorter name to the longer one, `candump -l -x` ends a line with the direction, R or
+// T. Both were refused ("expected an interface name", "data is not 0..8 bytes of hex"), so a
+// log recorded on two interfaces or with -x could not be replayed at all (session 84's review).
+TEST(CandumpLog, ReadsPaddedNamesAndDirection) {
+  const auto frames = parse_candump_log(
+      "(1700000000.000100)  can0 100#A5010A00F6FF3200\n"
+      "(1700000000.000200) vcan0 080#0102 R\n"
+      "(1700000000.000300)  can0 080# T\n",
+      "x.log");
+  ASSERT_EQ(frames.size(), 3u);
+  EXPECT_EQ(frames[0].iface, "can0");
+  EXPECT_EQ(frames[0].frame.id, 0x100u);
+  EXPECT_EQ(frames[0].frame.len, 8);
+  EXPECT_EQ(frames[1].iface, "vcan0");
+  EXPECT_EQ(frames[1].frame.len, 2);
+  EXPECT_EQ(frames[1].frame.data[1], 0x02);
+  EXPECT_EQ(frames[2].iface, "can0");
+  EXPECT_EQ(frames[2].frame.len, 0);
+  // Nothing else may follow the frame.
+  const std::string e = log_error("(1.000000) vcan0 100#00 X\n", "x.log");
+  EXPECT_NE(e.find("x.log:1: unexpected text after the frame"), std::string::npos) << e;
+}
+
+// What candump writes but the protocol has no use for is refused, and the reason says what it
+// is: an error frame was "identifier is not 3 hex digits", a lower-case remote frame "data is not
+// 0..8 bytes of hex".
+TEST(CandumpLog, RefusedFramesAreNamed) {
+  auto why_of = [](const std::string& frame) {
+    LoggedFrame lf;
+    std::string why;
+    EXPECT_FALSE(parse_candump_line("(1700000000.012345) vcan0 " + frame, lf, why)) << frame;
+    return why;
+  };
+  EXPECT_EQ(why_of("20000040#0000000000000000"), "error frame (candump -e) not supported");
+  EXPECT_EQ(why_of("20000004#0004000000000000 R"), "error frame (candump -e) not supported");
+  EXPECT_NE(why_of("12345678#00").find("extended (29-bit) identifier"), std::string::npos);
+  EXPECT_NE(why_of("100#r").find("remote frame"), std::string::npos);
+  EXPECT_NE(why_of("100#R").find("remote frame"), std::string::npos);
+  EXPECT_NE(why_of("100##1A5").find("CAN FD frame (##)"), std::string::npos);
+  EXPECT_NE(why_of("123456789#00").find("not 3 hex digits"), std::string::npos);
+  EXPECT_NE(why_of("10#00").find("not 3 hex digits"), std::string::npos);
+}
+
+// canplayer skips every line that does not begin with '(' (its -h says so): comments, candump
+// -d's DROPCOUNT notes. They were refused ("expected '(' starting a timestamp"); now they are
+// skipped as canplayer skips them, and the frames keep their own line numbers. Text with no frame
+// line at all is still an error: it is not an empty log.
+TEST(CandumpLog, SkipsLinesCanplayerSkips) {
+  const auto frames = parse_candump_log(
+      "# recorded with candump -l -d vcan0\n"
+      "(1700000000.000100) vcan0 100#00\n"
+      "DROPCOUNT: dropped 1 CAN frame on 'vcan0' socket (total drops 1)\n"
+      " (1700000000.000150) vcan0 100#01\n"
+      "(1700000000.000200) vcan0 100#02\n",
+      "c.log");
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_EQ(frames[0].line, 2);
+  EXPECT_EQ(frames[1].line, 5);
+  EXPECT_EQ(frames[1].frame.data[0], 0x02);
+  const std::string e = log_error("\n  vcan0  100   [1]  00\n", "plain.log");
+  EXPECT_NE(e.find("plain.log:2: not a candump -l log"), std::string::npos) << e;
+  EXPECT_TRUE(parse_candump_log("", "empty.log").empty());
+  EXPECT_TRUE(parse_candump_log("\n \n", "blank.log").empty());
+}
+
 // Found by fuzz_candump (session 80): 13 or more digits of seconds overflowed the microseconds
 // (undefined behaviour), and a long interface name written back overran the line's buffer.
 // (Session 82: a replay's nanoseconds overflowed from 9.2e9 s.)

@@ -5,7 +5,10 @@
 //   errors      a log that does not parse throws std::runtime_error "NAME:LINE: what", LINE a
 //               line of the text (1-based), naming what is wrong;
 //   round trip  every frame of a log that parses, written back by format_candump_line, parses
-//               to the same time, interface, identifier, length and data.
+//               to the same time, interface, identifier, length and data;
+//   lines       a log that parses has one frame per line beginning with '(', in order, and no
+//               other: the rest are skipped, as canplayer skips them.
+#include <algorithm>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -26,6 +29,17 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     fuzz::check_error_names_line(e.what(), "trial.log", text);
     return 0;
   }
+  long line = 0, k = 0;
+  for (size_t pos = 0; pos < text.size(); ++line) {
+    const size_t nl = std::min(text.find('\n', pos), text.size());
+    if (text[pos] == '(') {
+      if (k >= static_cast<long>(frames.size()) || frames[k].line != line + 1)
+        broken("a line beginning with '(' is not a frame of the parsed log", line + 1);
+      ++k;
+    }
+    pos = nl + 1;
+  }
+  if (k != static_cast<long>(frames.size())) broken("a frame of the parsed log from a line not beginning with '('", 0);
   for (const auto& lf : frames) {
     const std::string again = protocol::format_candump_line(lf.time_us, lf.iface, lf.frame);
     protocol::LoggedFrame back;

@@ -9,7 +9,9 @@
 //              latched and released by a trial start, a predictor that falls silent, failed
 //              reads around a stop;
 //   candump    fuzz_candump: `candump -l` logs of each message of the protocol, with blank
-//              lines, CRLF endings and a short frame;
+//              lines, CRLF endings and a short frame; one as candump -l -x -d writes it on two
+//              interfaces (padded names, R/T, a comment and a DROPCOUNT line), and one line each
+//              of what stays refused (an error frame, a 29-bit id, a remote and a CAN FD frame);
 //   inputs     fuzz_inputs: a dataset trial CSV, a study trial, an OBJ with every face form,
 //              and each with a value that is not finite or an index out of range;
 //   config     fuzz_config: the daemon's configuration with every key (as shipped), a --set
@@ -316,7 +318,19 @@ int candump_seeds(const std::filesystem::path& dir) {
   p::Frame shorty;
   shorty.id = 0x080;
   all += p::format_candump_line(t, "can0", shorty) + "\n";
-  const std::vector<std::pair<std::string, std::string>> seeds = {{"trial.log", all}, {"crlf.log", crlf}};
+  const std::string two_ifaces =
+      "# candump -l -x -d can0 vcan0\n"
+      "(1700000000.000100)  can0 100#A5010A00F6FF3200 R\n"
+      "DROPCOUNT: dropped 2 CAN frames on 'can0' socket (total drops 2)\n"
+      "(1700000000.000200) vcan0 080#0102030405 T\n";
+  const std::vector<std::pair<std::string, std::string>> seeds = {
+      {"trial.log", all},
+      {"crlf.log", crlf},
+      {"two_ifaces.log", two_ifaces},
+      {"error_frame.log", "(1700000000.000100) vcan0 20000040#0000000000000000\n"},
+      {"extended.log", "(1700000000.000100) vcan0 12345678#00\n"},
+      {"remote.log", "(1700000000.000100) vcan0 100#R\n"},
+      {"fd.log", "(1700000000.000100) vcan0 100##1A5\n"}};
   return write_texts(dir, seeds);
 }
 int input_seeds(const std::filesystem::path& dir) {
