@@ -254,7 +254,8 @@ TEST(ReplayCli, JsonReportsTheStop) {
   EXPECT_EQ(WEXITSTATUS(rc), 2);
   EXPECT_NE(bad.find("/nonexistent.dgm"), std::string::npos) << bad;
   fs::path tmp = fs::temp_directory_path() / "dg_replay_badlog.log";
-  std::ofstream(tmp) << "(1700000000.000000) vcan0 100#00\nnot a frame\n";
+  // A line that begins with '(' and is no frame (a line that does not is skipped, as canplayer does).
+  std::ofstream(tmp) << "(1700000000.000000) vcan0 100#00\n(1700000000.000100) vcan0 100#0\n";
   const std::string bad2 = run(std::string(DG_CLI) + " replay --model " + DG_TEST_MODEL + " --log " + tmp.string() + " 2>&1", rc);
   EXPECT_EQ(WEXITSTATUS(rc), 2);
   EXPECT_NE(bad2.find(tmp.string() + ":2:"), std::string::npos) << bad2;
