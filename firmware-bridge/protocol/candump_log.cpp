@@ -16,6 +16,15 @@ int hex_value(char c) {
 
 }  // namespace
 
+const char* interface_name_error(std::string_view name) {
+  if (name.empty()) return "expected an interface name";
+  if (name.size() > kMaxInterfaceName) return "interface name longer than 15 characters (IFNAMSIZ)";
+  for (const char c : name)
+    if (c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f')
+      return "interface name has whitespace in it";
+  return nullptr;
+}
+
 std::string format_candump_line(int64_t time_us, std::string_view iface, const Frame& f) {
   // The timestamp and the frame in fixed buffers of known size; the interface name as given.
   char ts[48];
@@ -53,8 +62,8 @@ bool parse_candump_line(std::string_view line, LoggedFrame& out, std::string& wh
   // candump -l on several interfaces pads each name to the longest ("%*s"): one or more spaces.
   while (!rest.empty() && rest[0] == ' ') rest.remove_prefix(1);
   const size_t sp = rest.find(' ');
-  if (sp == std::string_view::npos || sp == 0) return why = "expected an interface name", false;
-  if (sp > kMaxInterfaceName) return why = "interface name longer than 15 characters (IFNAMSIZ)", false;
+  if (sp == std::string_view::npos) return why = "expected an interface name and a frame", false;
+  if (const char* bad = interface_name_error(rest.substr(0, sp))) return why = bad, false;
   out.iface = std::string(rest.substr(0, sp));
   std::string_view fr = rest.substr(sp + 1);
   // candump -x appends the direction, " R" (received) or " T" (sent by this host): both are

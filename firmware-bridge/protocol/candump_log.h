@@ -30,6 +30,11 @@ namespace dressguard::protocol {
 // Linux interface names are at most IFNAMSIZ - 1 characters; a longer one is not a log line.
 inline constexpr size_t kMaxInterfaceName = 15;
 
+// Why `name` cannot be a log line's interface name, or nullptr when it can: 1 to 15 characters
+// and no whitespace (a space ends the name in the line, canplayer's "%s" stops at any). The
+// reader checks each line's name with it, a writer its name before the first line.
+const char* interface_name_error(std::string_view name);
+
 struct LoggedFrame {
   int64_t time_us = 0;  // timestamp in microseconds
   std::string iface;
@@ -37,7 +42,8 @@ struct LoggedFrame {
   long line = 0;        // 1-based line in the log (0 when built in memory)
 };
 
-// "(sec.usec) iface id#data" (no newline).
+// "(sec.usec) iface id#data" (no newline). Writes `iface` as given: a writer that takes the
+// name from its user checks it with interface_name_error first.
 std::string format_candump_line(int64_t time_us, std::string_view iface, const Frame& f);
 
 // Parses one line; returns false with `why` set when it is not a classic candump frame line.

@@ -30,9 +30,11 @@ const char* kHelp =
     "  --trial CSV        one trial CSV (t,travel,f_motion,f_lateral,f_vertical); --out FILE.log\n"
     "  --speed M/S        speed for --trial (default 0.1); --height high|middle|low (default middle)\n"
     "  --only ID[,ID..]   with --data: only these trial ids\n"
-    "  --iface NAME       interface name in the log (default vcan0)\n"
-    "  --trial-id N       TrialStart's trial number (default 1; --data numbers trials from N)\n"
-    "  --start S          timestamp of the first frame [s] (default 1700000000)\n"
+    "  --iface NAME       interface name in the log (default vcan0; 1-15 characters, no whitespace)\n"
+    "  --trial-id N       TrialStart's trial number (default 1; --data numbers trials from N, the\n"
+    "                     last at most 65535)\n"
+    "  --start S          timestamp of the first frame [s] (default 1700000000; from 0, and the\n"
+    "                     last frame by 9000000000 s, the latest a log may carry)\n"
     "  --counter-start N  first alive counter of the F/T frames (default 0)\n"
     "  --rig-limit N      end the trial like the study's rig: the first sample with |F_motion| or\n"
     "                     |F_vertical| above N newtons is not sent and the trial ends there\n"
@@ -101,6 +103,7 @@ struct ExportSummary {
   size_t samples_sent = 0;
   long limit_sample = -1;  // index of the first sample above the rig limit (not sent), -1 none
   size_t frames = 0;
+  int64_t last_us = 0;     // the last frame's timestamp
 };
 
 ExportSummary export_trial(const HapticSequence& trial, uint16_t trial_id, const ExportOptions& o, std::string& out) {
@@ -174,6 +177,7 @@ ExportSummary export_trial(const HapticSequence& trial, uint16_t trial_id, const
                    [](const Timed& a, const Timed& b) { return a.t_us != b.t_us ? a.t_us < b.t_us : a.order < b.order; });
   for (const auto& f : frames) out += proto::format_candump_line(f.t_us, o.iface, f.f) + "\n";
   sum.frames = frames.size();
+  sum.last_us = frames.back().t_us;
   return sum;
 }
 
@@ -190,8 +194,15 @@ int run_export_candump(int argc, char** argv) {
   if (args.has("data") == args.has("trial")) throw UsageError("give exactly one of --data DATASET or --trial CSV");
   const std::string out = args.require("out");
   ExportOptions o;
+  // What is written must read back (dressguard replay, canplayer): the reader's own rules for the
+  // interface name and the timestamps (--start's upper bound is checked per trial, below).
   o.iface = args.get("iface").value_or("vcan0");
-  o.start_us = static_cast<int64_t>(std::llround(args.number("start", 1700000000.0) * 1e6));
+  if (const char* bad = proto::interface_name_error(o.iface))
+    throw UsageError("--iface '" + o.iface + "': " + bad);
+  const double start = args.number("start", 1700000000.0);
+  if (!(start >= 0 && start <= static_cast<double>(proto::kMaxLogSeconds)))
+    throw UsageError("--start must be in 0.." + std::to_string(proto::kMaxLogSeconds) + " s (a log's timestamps)");
+  o.start_us = static_cast<int64_t>(std::llround(start * 1e6));
   const long cs = args.integer("counter-start", 0);
   if (cs < 0 || cs > 255) throw UsageError("--counter-start must be 0..255");
   o.counter_start = static_cast<uint8_t>(cs);
@@ -253,6 +264,12 @@ int run_export_candump(int argc, char** argv) {
       if (only.empty() || only.count(t.id)) trials.push_back(std::move(t));
     if (!only.empty() && trials.size() != only.size()) throw UsageError("--only names a trial id that is not in the dataset");
   }
+  // TrialStart and TrialEnd carry the id in 16 bits: a wrapped id would name another trial than
+  // the log's name and --json say.
+  if (trial_id + static_cast<long>(trials.size()) - 1 > 65535)
+    throw UsageError("--trial-id " + std::to_string(trial_id) + " with " + std::to_string(trials.size()) +
+                     " trials numbers past 65535 (a trial id is 16 bits): at most " +
+                     std::to_string(65536 - static_cast<long>(trials.size())));
   // Everything is built in memory first, then written atomically: no half-written logs.
   std::vector<std::pair<std::filesystem::path, std::string>> files;
   std::string json = "{\"logs\": [";
@@ -261,6 +278,19 @@ int run_export_candump(int argc, char** argv) {
     if (t.samples.empty()) throw InputError("trial " + t.id + " has no samples");
     std::string text;
     const auto sum = export_trial(t, static_cast<uint16_t>(trial_id + static_cast<long>(k)), o, text);
+    // The reader takes timestamps up to kMaxLogSeconds (a replay's nanoseconds fit an int64_t).
+    if (sum.last_us / 1000000 > proto::kMaxLogSeconds) {
+      const int64_t length_us = sum.last_us - o.start_us, latest_us = proto::kMaxLogSeconds * 1000000 + 999999;
+      const int64_t max_start_us = latest_us - length_us;
+      if (max_start_us < 0) throw InputError("trial " + t.id + " lasts longer than a log's timestamps can reach");
+      char buf[200];
+      std::snprintf(buf, sizeof buf, "--start must be at most %lld.%06lld for trial %s (%lld.%06lld s of frames; "
+                    "a log's timestamps end at %lld s)",
+                    static_cast<long long>(max_start_us / 1000000), static_cast<long long>(max_start_us % 1000000),
+                    t.id.c_str(), static_cast<long long>(length_us / 1000000),
+                    static_cast<long long>(length_us % 1000000), static_cast<long long>(proto::kMaxLogSeconds));
+      throw UsageError(buf);
+    }
     std::filesystem::path p = out;
     if (!one_file) {
       const std::string label = t.label ? std::string(outcome_name(*t.label)) : "unlabelled";

@@ -267,6 +267,63 @@ TEST(ReplayCli, JsonReportsTheStop) {
   EXPECT_FALSE(fs::exists("/tmp/dg_never.log"));
 }
 
+// export-candump wrote logs that its own reader refuses: an interface name with a space or of
+// more than 15 characters, a negative --start ("(0.-990000)") or one whose last frame is past
+// kMaxLogSeconds; and trial ids past 65535 wrapped on the wire while --json reported them
+// unwrapped (session 84's review). Each is now refused naming the option, exit 2, nothing written;
+// what is accepted reads back, up to the last id and the last second.
+TEST(ExportCandumpCli, WritesOnlyWhatItsReaderReads) {
+  const fs::path syn1 = fs::path(DG_TEST_MODEL).parent_path() / "syn1";  // 30 trials (robot_test_model)
+  const fs::path tmp = fs::temp_directory_path() / ("dg_export_bounds_" + std::to_string(::getpid()));
+  fs::create_directories(tmp);
+  const std::string one = std::string(DG_CLI) + " export-candump --trial " + (syn1 / "syn1-good-0.csv").string() +
+                          " --out " + (tmp / "t.log").string();
+  int rc = 0;
+  for (const auto& [option, reason] : std::vector<std::pair<std::string, std::string>>{
+           {"--iface 'my can'", "--iface 'my can': interface name has whitespace"},
+           {"--iface abcdefghijklmnop", "--iface 'abcdefghijklmnop': interface name longer than 15"},
+           {"--start -1", "--start must be in 0..9000000000"},
+           {"--start 1e300", "--start must be in 0..9000000000"},
+           {"--start 8999999999", "--start must be at most 8999999994."}}) {
+    const std::string out = run(one + " " + option + " 2>&1", rc);
+    EXPECT_EQ(WEXITSTATUS(rc), 2) << option << ": " << out;
+    EXPECT_NE(out.find(reason), std::string::npos) << option << ": " << out;
+    EXPECT_FALSE(fs::exists(tmp / "t.log")) << option;
+  }
+  // The longest name and the latest start the trial's 6.05 s allow are read back.
+  const std::string ok = run(one + " --iface abcdefghijklmno --start 8999999994 2>&1", rc);
+  ASSERT_EQ(rc, 0) << ok;
+  const auto frames = load(tmp / "t.log");
+  ASSERT_FALSE(frames.empty());
+  EXPECT_EQ(frames.front().iface, "abcdefghijklmno");
+  EXPECT_EQ(frames.back().time_us / 1'000'000, protocol::kMaxLogSeconds);
+  // 30 trials from 65510 would end at 65539; from 65506 the last is 65535, on the wire as in --json.
+  const std::string data = std::string(DG_CLI) + " export-candump --data " + syn1.string() + " --out " +
+                           (tmp / "logs").string() + " --json";
+  const std::string wraps = run(data + " --trial-id 65510 2>&1", rc);
+  EXPECT_EQ(WEXITSTATUS(rc), 2) << wraps;
+  EXPECT_NE(wraps.find("--trial-id 65510 with 30 trials numbers past 65535"), std::string::npos) << wraps;
+  EXPECT_FALSE(fs::exists(tmp / "logs"));
+  const std::string json = run(data + " --trial-id 65506", rc);
+  ASSERT_EQ(rc, 0) << json;
+  EXPECT_NE(json.find("\"trial_id\": 65535,"), std::string::npos) << json;
+  int logs = 0;
+  for (const auto& e : fs::directory_iterator(tmp / "logs")) {
+    // Each log's TrialStart carries the id --json gives for its file.
+    const auto at = json.find("{\"file\": \"" + e.path().string() + "\"");
+    ASSERT_NE(at, std::string::npos) << e.path();
+    const long said = std::stol(json.substr(json.find("\"trial_id\": ", at) + 12));
+    protocol::TrialStart ts;
+    for (const auto& lf : load(e.path()))
+      if (protocol::decode(lf.frame, ts)) {
+        EXPECT_EQ(ts.trial_id, said) << e.path();
+        ++logs;
+      }
+  }
+  EXPECT_EQ(logs, 30);
+  fs::remove_all(tmp);
+}
+
 TEST(ReplayCli, LogsFolderTalliesTheStopsPerOutcome) {
   // The same logs and model as ReplayLogs above, replayed by `replay --logs`: its table must say
   // what the per-log test asserts (every caught trial stopped by the caught rule ahead of its
