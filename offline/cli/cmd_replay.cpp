@@ -175,22 +175,18 @@ int run_replay(int argc, char** argv) {
   args.allow_only({"help", "json", "model", "log", "logs", "config", "set", "tick-ms", "allow-model-error"});
   const std::string model_path = args.require("model");
   if (args.has("log") == args.has("logs")) throw UsageError("give exactly one of --log FILE.log or --logs DIR");
-  std::string cfg_text;
-  std::string cfg_name = "--set";
-  if (auto c = args.get("config")) {
-    cfg_text = read_file(*c);
-    cfg_name = *c;
-  }
-  for (const auto& s : args.all("set")) cfg_text += "\n" + s + "\n";
+  const std::string cfg_name = args.get("config").value_or("");
   predictor::PredictorConfig cfg;
   try {
+    // As the daemon reads them: the file, then the --set lines; errors name the line or "--set N".
     std::vector<predictor::ConfigEntry> others;  // the daemon's own keys: not replay's business
-    cfg = predictor::parse_predictor_config(cfg_text, cfg_name, &others);
+    cfg = predictor::parse_config_with_sets(cfg_name.empty() ? std::string() : read_file(cfg_name), cfg_name,
+                                            args.all("set"), &others);
     for (const auto& e : others) {
       // A typo (stop_treshold) would otherwise replay the default policy without a word.
       const auto& keys = predictor::kDaemonConfigKeys;
       if (std::find_if(std::begin(keys), std::end(keys), [&](const char* k) { return e.key == k; }) == std::end(keys))
-        throw InputError(cfg_name + ":" + std::to_string(e.line) + ": unknown key '" + e.key + "'");
+        throw InputError(e.where + ": unknown key '" + e.key + "'");
     }
   } catch (const std::runtime_error& e) {
     throw InputError(e.what());

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <sstream>
 #include <stdexcept>
 
@@ -46,8 +47,11 @@ double commanded_travel(double speed, double accel, double t) noexcept {
 
 namespace {
 
-[[noreturn]] void config_error(const std::string& name, long line, const std::string& what) {
-  throw std::runtime_error(name + ":" + std::to_string(line) + ": " + what);
+// Names line `line` of the text being parsed: "FILE:LINE", or "--set N" for an override.
+using LineName = std::function<std::string(long)>;
+
+[[noreturn]] void config_error(const LineName& name, long line, const std::string& what) {
+  throw std::runtime_error(name(line) + ": " + what);
 }
 
 // The largest period or deadline (10 min) and force (1 kN: three times a Robotiq FT 300's range).
@@ -61,7 +65,7 @@ std::string config_text(double d) {
   return buf;
 }
 
-double config_number(const std::string& name, long line, const std::string& key, const std::string& v) {
+double config_number(const LineName& name, long line, const std::string& key, const std::string& v) {
   size_t used = 0;
   double d = 0;
   try {
@@ -80,9 +84,7 @@ std::string trim(const std::string& s) {
   return s.substr(a, b - a + 1);
 }
 
-}  // namespace
-
-PredictorConfig parse_predictor_config(const std::string& text, const std::string& name, std::vector<ConfigEntry>* others) {
+PredictorConfig parse_config_text(const std::string& text, const LineName& name, std::vector<ConfigEntry>* others) {
   PredictorConfig c;
   std::istringstream in(text);
   std::string raw;
@@ -168,7 +170,7 @@ PredictorConfig parse_predictor_config(const std::string& text, const std::strin
       }
       bias_line = line;
     } else if (others) {
-      others->push_back({key, v, line});
+      others->push_back({key, v, line, name(line)});
     } else {
       config_error(name, line, "unknown key '" + key + "'");
     }
@@ -186,6 +188,34 @@ PredictorConfig parse_predictor_config(const std::string& text, const std::strin
                      " N where the protocol's forces saturate (a saturated reading would never pass it)");
   }
   return c;
+}
+
+}  // namespace
+
+PredictorConfig parse_predictor_config(const std::string& text, const std::string& name, std::vector<ConfigEntry>* others) {
+  return parse_config_text(text, [&](long line) { return name + ":" + std::to_string(line); }, others);
+}
+
+PredictorConfig parse_config_with_sets(const std::string& file_text, const std::string& file_name,
+                                       const std::vector<std::string>& sets, std::vector<ConfigEntry>* others) {
+  // One text, so that the cross-key checks (hard_limit_n against mount_bias) see the final
+  // values, and a line-by-line name for it. A file without a final newline would otherwise join
+  // the first --set to its last line.
+  std::string text = file_text;
+  if (!text.empty() && text.back() != '\n') text += '\n';
+  std::vector<std::string> names;  // names[i]: line i + 1
+  for (char ch : text)
+    if (ch == '\n') names.push_back(file_name + ":" + std::to_string(names.size() + 1));
+  for (size_t k = 0; k < sets.size(); ++k) {
+    text += sets[k] + "\n";
+    const std::string set = "--set " + std::to_string(k + 1);
+    for (char ch : sets[k] + "\n")  // a value with a newline in it is still that --set
+      if (ch == '\n') names.push_back(set);
+  }
+  auto name = [&](long line) {
+    return line >= 1 && line <= static_cast<long>(names.size()) ? names[line - 1] : file_name;
+  };
+  return parse_config_text(text, name, others);
 }
 
 // ---------------------------------------------------------------------------------------------

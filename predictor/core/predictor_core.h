@@ -83,9 +83,16 @@ struct PredictorConfig {
 struct ConfigEntry {
   std::string key, value;
   long line;
+  std::string where;  // "NAME:LINE", or "--set N" (parse_config_with_sets): for its errors
 };
 PredictorConfig parse_predictor_config(const std::string& text, const std::string& name,
                                        std::vector<ConfigEntry>* others = nullptr);
+// The daemon's configuration as dressguard-predictor and `dressguard replay` both take it: the
+// file's text (empty without --config), then each --set KEY=VALUE on a line of its own, a later
+// entry winning. As parse_predictor_config, but an error, and each entry's `where`, names the
+// file's line or "--set N" (the Nth --set), never a line past the file's end.
+PredictorConfig parse_config_with_sets(const std::string& file_text, const std::string& file_name,
+                                       const std::vector<std::string>& sets, std::vector<ConfigEntry>* others);
 // The keys of the daemon's config file that are not the predictor's (predictor/daemon/main.cpp
 // reads them). A replay of the same file accepts and ignores them; any other key is an error.
 inline constexpr const char* kDaemonConfigKeys[] = {"interface", "model", "rt_priority", "cpu",

@@ -59,7 +59,8 @@ std::string read_text(const std::string& path) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string config_path, config_text, iface_arg, model_arg;
+  std::string config_path, iface_arg, model_arg;
+  std::vector<std::string> sets;
   bool no_rt = false, latency_report = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -80,7 +81,7 @@ int main(int argc, char** argv) {
     } else if (a == "--model") {
       model_arg = value();
     } else if (a == "--set") {
-      config_text += value() + "\n";
+      sets.push_back(value());
     } else if (a == "--no-rt") {
       no_rt = true;
     } else if (a == "--latency-report") {
@@ -99,18 +100,12 @@ int main(int argc, char** argv) {
   RtOptions rt;
   DaemonOptions dopt;
   try {
-    // The file, then the --set lines: later entries win. The --set lines alone are parsed first
-    // so that their errors name "--set" and which one, not a line past the file's end.
-    std::string text = config_path.empty() ? std::string() : read_text(config_path);
-    if (!text.empty() && text.back() != '\n') text += '\n';  // else the first --set joins its last line
-    const long file_lines = static_cast<long>(std::count(text.begin(), text.end(), '\n'));
-    std::vector<ConfigEntry> set_only;
-    parse_predictor_config(config_text, "--set", &set_only);
+    // The file, then the --set lines: later entries win; errors name the file's line or "--set N".
     std::vector<ConfigEntry> others;
-    cfg = parse_predictor_config(text + config_text, config_path.empty() ? "--set" : config_path, &others);
+    cfg = parse_config_with_sets(config_path.empty() ? std::string() : read_text(config_path), config_path, sets,
+                                 &others);
     for (const auto& e : others) {
-      const std::string where =
-          e.line > file_lines ? "--set " + std::to_string(e.line - file_lines) : config_path + ":" + std::to_string(e.line);
+      const std::string& where = e.where;
       auto integer = [&](long lo, long hi) {
         try {
           size_t used = 0;

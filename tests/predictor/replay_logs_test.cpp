@@ -242,6 +242,14 @@ std::string run(const std::string& cmd, int& rc) {
   return out;
 }
 
+// `cmd` is refused: exit 2, and its message says `want`.
+void expect_refused(const std::string& cmd, const std::string& want) {
+  int rc = 0;
+  const std::string out = run(cmd + " 2>&1", rc);
+  EXPECT_EQ(WEXITSTATUS(rc), 2) << cmd << ": " << out;
+  EXPECT_NE(out.find(want), std::string::npos) << cmd << ": " << out;
+}
+
 TEST(ReplayCli, JsonReportsTheStop) {
   int rc = 0;
   const std::string out =
@@ -285,9 +293,7 @@ TEST(ExportCandumpCli, WritesOnlyWhatItsReaderReads) {
            {"--start -1", "--start must be in 0..9000000000"},
            {"--start 1e300", "--start must be in 0..9000000000"},
            {"--start 8999999999", "--start must be at most 8999999994."}}) {
-    const std::string out = run(one + " " + option + " 2>&1", rc);
-    EXPECT_EQ(WEXITSTATUS(rc), 2) << option << ": " << out;
-    EXPECT_NE(out.find(reason), std::string::npos) << option << ": " << out;
+    expect_refused(one + " " + option, reason);
     EXPECT_FALSE(fs::exists(tmp / "t.log")) << option;
   }
   // The longest name and the latest start the trial's 6.05 s allow are read back.
@@ -386,6 +392,28 @@ TEST(ReplayCli, EverySetOverridesItsKey) {
   EXPECT_NE(typo.find("unknown key 'stop_treshold'"), std::string::npos) << typo;
   const std::string daemon_key = run(base + " --set rt_priority=80 --json", rc);
   EXPECT_EQ(rc, 0) << daemon_key;
+}
+
+// replay appended each --set to the file's text with blank lines around it: a bad --set was
+// named as a line past the file's end, or "--set:4" for the second (session 84's review). Errors
+// now name "--set N" as the daemon's do (one helper, parse_config_with_sets), also when the
+// fault lies between a --set and the file (the hard limit against the mount bias).
+TEST(ReplayCli, SetErrorsNameTheSet) {
+  const fs::path conf = fs::temp_directory_path() / ("dg_replay_set_" + std::to_string(::getpid()) + ".conf");
+  std::ofstream(conf) << "# three lines\nstop_consecutive = 5\nmount_bias = 300 0 0\n";
+  const std::string base = std::string(DG_CLI) + " replay --model " + DG_TEST_MODEL + " --log " +
+                           (kLogs / "syn2-good-0-good.log").string() + " --config " + conf.string();
+  for (const auto& [sets, want] : std::vector<std::pair<std::string, std::string>>{
+           {"--set stop_threshold=2", "replay: --set 1: stop_threshold must be in (0, 1)"},
+           {"--set stop_consecutive=7 --set stop_threshold=2", "replay: --set 2: stop_threshold must be in (0, 1)"},
+           {"--set stop_consecutive=7 --set stop_treshold=0.5", "replay: --set 2: unknown key 'stop_treshold'"},
+           {"--set hard_limit_n=50", "replay: --set 1: hard_limit_n 50 N plus the mount bias's 300 N"},
+           {"--set stop_consecutive=x", "replay: --set 1: stop_consecutive: 'x' is not a number"}})
+    expect_refused(base + " " + sets, want);
+  // The file's own lines keep their names.
+  std::ofstream(conf) << "# three lines\nstop_consecutive = 5\nstop_threshold = 2\n";
+  expect_refused(base + " --set stop_consecutive=7", conf.string() + ":3: stop_threshold must be in (0, 1)");
+  fs::remove(conf);
 }
 
 // The study's measured trials as candump logs in tmp/logs (`import`, then `export-candump --data`
