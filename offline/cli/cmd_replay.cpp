@@ -30,10 +30,12 @@ const char* kHelp =
     "                     --data names them) is that outcome, any other is 'unlabelled'. What a\n"
     "                     stop policy costs (good and missed pulls stopped) against what it buys\n"
     "                     (caught pulls stopped, and how long before their own end)\n"
-    "  --config FILE      the daemon's config file (its predictor keys; others are ignored)\n"
+    "  --config FILE      the daemon's config file (its predictor keys and tick_ms; the daemon's\n"
+    "                     other keys are ignored)\n"
     "  --set KEY=VALUE    override one predictor key, after --config's; repeat it for several,\n"
     "                     e.g. --set stop_threshold=0.99 --set stop_consecutive=10\n"
-    "  --tick-ms N        the daemon's timer period (default 1)\n"
+    "  --tick-ms N        the daemon's timer period [ms] (default: the config's tick_ms, else 1;\n"
+    "                     1..sensor_timeout_ms, as in the daemon)\n"
     "  --json             {stopped, stop_time, travel, reason, posteriors at the stop, ...}\n"
     "  Times are logical: stop_time = the deciding sample's index x the sample period; travel is\n"
     "  the commanded travel at that time (TrialStart's speed, the configured acceleration).";
@@ -177,9 +179,9 @@ int run_replay(int argc, char** argv) {
   if (args.has("log") == args.has("logs")) throw UsageError("give exactly one of --log FILE.log or --logs DIR");
   const std::string cfg_name = args.get("config").value_or("");
   predictor::PredictorConfig cfg;
+  std::vector<predictor::ConfigEntry> others;  // the daemon's own keys: replay takes tick_ms from them
   try {
     // As the daemon reads them: the file, then the --set lines; errors name the line or "--set N".
-    std::vector<predictor::ConfigEntry> others;  // the daemon's own keys: not replay's business
     cfg = predictor::parse_config_with_sets(cfg_name.empty() ? std::string() : read_file(cfg_name), cfg_name,
                                             args.all("set"), &others);
     for (const auto& e : others) {
@@ -191,10 +193,18 @@ int run_replay(int argc, char** argv) {
   } catch (const std::runtime_error& e) {
     throw InputError(e.what());
   }
-  const long tick_ms = args.integer("tick-ms", 1);
-  // The sensor deadline is judged on each tick, as in the daemon (tick_ms there has the same bound).
-  if (tick_ms < 1 || tick_ms > std::max<int64_t>(1, cfg.sensor_timeout_ns / 1'000'000))
-    throw UsageError("--tick-ms must be in 1-" + std::to_string(std::max<int64_t>(1, cfg.sensor_timeout_ns / 1'000'000)) +
+  // The daemon's timer period: the config's tick_ms (the last given), unless --tick-ms says
+  // otherwise. The sensor deadline is judged on each tick, so the same file must tick alike here.
+  long tick_ms = 1;
+  try {
+    for (const auto& e : others)
+      if (e.key == "tick_ms") tick_ms = predictor::config_whole_number(e, 1, predictor::max_tick_ms(cfg));
+  } catch (const std::runtime_error& e) {
+    throw InputError(e.what());
+  }
+  tick_ms = args.integer("tick-ms", tick_ms);
+  if (tick_ms < 1 || tick_ms > predictor::max_tick_ms(cfg))
+    throw UsageError("--tick-ms must be in 1-" + std::to_string(predictor::max_tick_ms(cfg)) +
                      " (no longer than sensor_timeout_ms)");
 
   std::unique_ptr<model::OutcomeModel> m;

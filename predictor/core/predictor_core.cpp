@@ -1,6 +1,7 @@
 // The predictor's logic (see predictor_core.h for the per-sample steps and the real-time contract).
 #include "predictor_core.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -216,6 +217,21 @@ PredictorConfig parse_config_with_sets(const std::string& file_text, const std::
     return line >= 1 && line <= static_cast<long>(names.size()) ? names[line - 1] : file_name;
   };
   return parse_config_text(text, name, others);
+}
+
+long config_whole_number(const ConfigEntry& e, long lo, long hi) {
+  try {
+    size_t used = 0;
+    const long v = std::stol(e.value, &used);
+    if (used == e.value.size() && v >= lo && v <= hi) return v;
+  } catch (const std::exception&) {
+  }
+  throw std::runtime_error(e.where + ": " + e.key + ": '" + e.value + "' is not a whole number in " +
+                           std::to_string(lo) + "-" + std::to_string(hi));
+}
+
+long max_tick_ms(const PredictorConfig& cfg) {
+  return std::max<long>(1, static_cast<long>(cfg.sensor_timeout_ns / 1'000'000));
 }
 
 // ---------------------------------------------------------------------------------------------

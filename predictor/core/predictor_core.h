@@ -97,6 +97,13 @@ PredictorConfig parse_config_with_sets(const std::string& file_text, const std::
 // reads them). A replay of the same file accepts and ignores them; any other key is an error.
 inline constexpr const char* kDaemonConfigKeys[] = {"interface", "model", "rt_priority", "cpu",
                                                     "mlock",     "tick_ms", "log_level"};
+// A daemon key's value as a whole number in lo..hi; else std::runtime_error
+// "WHERE: KEY: 'VALUE' is not a whole number in LO-HI".
+long config_whole_number(const ConfigEntry& e, long lo, long hi);
+// The longest timer period, tick_ms (and replay's --tick-ms), that `cfg` allows: the sensor
+// deadline is checked on each tick, so a tick longer than sensor_timeout_ms would let a silent
+// sensor run on for up to a tick. At least 1.
+long max_tick_ms(const PredictorConfig& cfg);
 
 // Commanded travel [m] after t seconds of a pull at `speed` with ramp `accel` (trapezoid start):
 //   x(t) = a t^2 / 2                      for t < v/a

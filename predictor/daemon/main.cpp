@@ -106,24 +106,13 @@ int main(int argc, char** argv) {
                                  &others);
     for (const auto& e : others) {
       const std::string& where = e.where;
-      auto integer = [&](long lo, long hi) {
-        try {
-          size_t used = 0;
-          const long v = std::stol(e.value, &used);
-          if (used == e.value.size() && v >= lo && v <= hi) return v;
-        } catch (const std::exception&) {
-        }
-        throw std::runtime_error(where + ": " + e.key + ": '" + e.value + "' is not a whole number in " +
-                                 std::to_string(lo) + "-" + std::to_string(hi));
-      };
+      auto integer = [&](long lo, long hi) { return config_whole_number(e, lo, hi); };
       if (e.key == "interface") iface = e.value;
       else if (e.key == "model") model_path = e.value;
       else if (e.key == "rt_priority") rt.fifo_priority = static_cast<int>(integer(0, 99));
       else if (e.key == "cpu") rt.cpu = static_cast<int>(integer(-1, 4095));
       else if (e.key == "mlock") rt.lock_memory = integer(0, 1) != 0;
-      // The sensor deadline is checked on each tick: a tick longer than it would let a silent
-      // sensor run on for up to a tick.
-      else if (e.key == "tick_ms") dopt.tick_ns = integer(1, std::max<long>(1, cfg.sensor_timeout_ns / 1000000)) * 1000000;
+      else if (e.key == "tick_ms") dopt.tick_ns = integer(1, max_tick_ms(cfg)) * 1000000;
       else if (e.key == "log_level") {
         // spdlog turns a name it does not know into "off": a typo would silence every error.
         const auto level = spdlog::level::from_str(e.value);

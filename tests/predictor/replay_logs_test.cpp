@@ -416,6 +416,43 @@ TEST(ReplayCli, SetErrorsNameTheSet) {
   fs::remove(conf);
 }
 
+// replay accepted the config's tick_ms and dropped it: a sensor gap replayed with 1 ms ticks
+// under a config of 50 ms, so the same file gave another stop and sample than in the daemon
+// (session 84's review). The config's tick_ms (file or --set) is now the default of --tick-ms,
+// bounded as in the daemon, and an explicit --tick-ms wins.
+TEST(ReplayCli, TheConfigsTickIsTheDefault) {
+  const fs::path syn1 = fs::path(DG_TEST_MODEL).parent_path() / "syn1";
+  const fs::path tmp = fs::temp_directory_path() / ("dg_replay_tick_" + std::to_string(::getpid()));
+  fs::create_directories(tmp);
+  int rc = 0;
+  // A 60 ms silence from sample 20: with 1 ms ticks the 50 ms deadline fires within the gap.
+  const std::string made = run(std::string(DG_CLI) + " export-candump --trial " + (syn1 / "syn1-good-0.csv").string() +
+                                   " --gap 20:60 --out " + (tmp / "gap.log").string() + " 2>&1",
+                               rc);
+  ASSERT_EQ(rc, 0) << made;
+  std::ofstream(tmp / "tick50.conf") << "tick_ms = 50\n";
+  const std::string base = std::string(DG_CLI) + " replay --model " + DG_TRAINED_MODEL + " --log " +
+                           (tmp / "gap.log").string() + " --json";
+  const std::string conf = " --config " + (tmp / "tick50.conf").string();
+  const std::string tick1 = run(base + " --tick-ms 1", rc);
+  ASSERT_EQ(rc, 0) << tick1;
+  const std::string tick50 = run(base + " --tick-ms 50", rc);
+  ASSERT_EQ(rc, 0) << tick50;
+  ASSERT_NE(tick1, tick50) << "the gap must tell 1 ms ticks from 50 ms ones";
+  EXPECT_NE(tick1.find("\"reason\": \"sensor_timeout\""), std::string::npos) << tick1;
+  EXPECT_EQ(run(base + conf, rc), tick50);
+  EXPECT_EQ(run(base + " --set tick_ms=50", rc), tick50);
+  EXPECT_EQ(run(base + conf + " --set tick_ms=1", rc), tick1) << "a later --set wins, as in the daemon";
+  EXPECT_EQ(run(base + conf + " --tick-ms 1", rc), tick1) << "an explicit --tick-ms wins";
+  // The daemon's bound: no longer than sensor_timeout_ms, named where it was given.
+  expect_refused(base + conf + " --set sensor_timeout_ms=40",
+                 (tmp / "tick50.conf").string() + ":1: tick_ms: '50' is not a whole number in 1-40");
+  std::ofstream(tmp / "tick51.conf") << "tick_ms = 51\n";
+  expect_refused(base + " --config " + (tmp / "tick51.conf").string(),
+                 (tmp / "tick51.conf").string() + ":1: tick_ms: '51' is not a whole number in 1-50");
+  fs::remove_all(tmp);
+}
+
 // The study's measured trials as candump logs in tmp/logs (`import`, then `export-candump --data`
 // with `export_options`); "" when shared/data is not here. Logs are generated at test time, never
 // committed (the data is not redistributable).
