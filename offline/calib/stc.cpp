@@ -84,11 +84,15 @@ StcAxes choose_stc_axes(const std::vector<SequenceFit>& fits, bool lateral_fitte
 
 int count_correct(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials, double truncate_at,
                   int* counted, const std::vector<std::string>& among, std::vector<hmm::TrialResult>* per_trial) {
+  // hmm::evaluate's rule, and its count: a trial with no sample before the cut (a recording that
+  // starts late, cut early) is skipped, not counted wrong, so that bench, build-model and
+  // classify score one model on one cut alike.
   std::vector<const HapticSequence*> labelled;
   for (const auto* t : trials)
     if (t->label && !t->samples.empty()) labelled.push_back(t);
-  if (counted) *counted = static_cast<int>(labelled.size());
-  return labelled.empty() ? 0 : hmm::evaluate(m, labelled, truncate_at, per_trial, among).correct;
+  const hmm::Evaluation ev = hmm::evaluate(m, labelled, truncate_at, per_trial, among);
+  if (counted) *counted = ev.total;
+  return ev.correct;
 }
 
 double accuracy(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials, double truncate_at,

@@ -55,13 +55,15 @@ model::OutcomeModel build_outcome_model(const std::vector<const HapticSequence*>
 // `truncate_at` metres of travel (infinity: whole), deciding `among` the named classes only
 // (empty: all; hmm::classify). A trial whose label is not a class of the model counts as wrong
 // (a model trained on simulated data without any "good" trial cannot be right about a good
-// trial); `counted` receives the number of labelled trials, `per_trial` (may be null) each labelled
-// trial's result (hmm::evaluate).
+// trial). The trials counted are hmm::evaluate's: the labelled ones with a sample before the cut;
+// one without (a recording that starts late, cut before its start) is skipped, not counted wrong,
+// so that this and `classify` score one model on one cut alike. `counted` receives their number,
+// `per_trial` (may be null) each labelled trial's result, skipped ones included (hmm::evaluate).
 int count_correct(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials,
                   double truncate_at, int* counted = nullptr, const std::vector<std::string>& among = {},
                   std::vector<hmm::TrialResult>* per_trial = nullptr);
 
-// The same as a fraction of the labelled trials (0 when there are none).
+// The same as a fraction of the trials counted (0 when none was: check `counted`).
 double accuracy(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials,
                 double truncate_at, int* counted = nullptr);
 

@@ -68,7 +68,7 @@ void print_summary(const hmm::Evaluation& ev, size_t models) {
     std::snprintf(buf, sizeof buf, "; 95 %% interval %.2f-%.2f", iv.lower, iv.upper);
     interval = buf;
   }
-  std::printf("\naccuracy %.4f (%d/%d)%s%s%s\n", ev.accuracy(), ev.correct, ev.total,
+  std::printf("\naccuracy %s (%d/%d)%s%s%s\n", hmm::accuracy_text(ev).c_str(), ev.correct, ev.total,
               models > 1 ? (", a vote of " + std::to_string(models) + " models").c_str() : "",
               ev.skipped ? (", " + std::to_string(ev.skipped) + " trials skipped (unlabelled, or no sample before the cut)").c_str() : "",
               interval.c_str());
@@ -248,11 +248,10 @@ int run_classify(int argc, char** argv) {
       const auto ev = evaluate_at(d);
       // A cut that leaves no trial scored has no accuracy (not 0): empty in the CSV, null in the
       // JSON, "-" in the text, and the plot leaves it out.
-      char acc[32] = "", acc_json[32] = "null", acc_text[32] = "-";
+      char acc[32] = "", acc_json[32] = "null";
       if (ev.total > 0) {
         std::snprintf(acc, sizeof acc, "%.6f", ev.accuracy());
         std::snprintf(acc_json, sizeof acc_json, "%.6f", ev.accuracy());
-        std::snprintf(acc_text, sizeof acc_text, "%.4f", ev.accuracy());
       }
       char line[160];
       std::snprintf(line, sizeof line, "%.6g,%s,%d,%d\n", d, acc, ev.correct, ev.total);
@@ -260,7 +259,8 @@ int run_classify(int argc, char** argv) {
       std::snprintf(line, sizeof line, "%s{\"travel_m\": %.6g, \"accuracy\": %s, \"correct\": %d, \"total\": %d}",
                     rows_json.empty() ? "" : ", ", d, acc_json, ev.correct, ev.total);
       rows_json += line;
-      if (!json) std::printf("travel %.3f m: accuracy %s (%d/%d)\n", d, acc_text, ev.correct, ev.total);
+      if (!json)
+        std::printf("travel %.3f m: accuracy %s (%d/%d)\n", d, hmm::accuracy_text(ev).c_str(), ev.correct, ev.total);
     }
     write_file_atomic(prefix + ".csv", csv);
     std::string png;

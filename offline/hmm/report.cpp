@@ -71,6 +71,13 @@ std::string confusion_text(const Evaluation& ev) {
   return o.str();
 }
 
+std::string accuracy_text(const Evaluation& ev) {
+  if (ev.total == 0) return "-";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4f", ev.accuracy());
+  return buf;
+}
+
 std::string evaluation_json(const Evaluation& ev) {
   std::ostringstream o;
   o << "{\"classes\": " << json_array(ev.classes.begin(), ev.classes.end(), [](const std::string& s) { return json_string(s); })
@@ -79,7 +86,7 @@ std::string evaluation_json(const Evaluation& ev) {
     o << (r ? ", " : "")
       << json_array(ev.confusion[r].begin(), ev.confusion[r].end(), [](int v) { return std::to_string(v); });
   o << "], \"correct\": " << ev.correct << ", \"total\": " << ev.total << ", \"skipped\": " << ev.skipped
-    << ", \"accuracy\": " << json_number(ev.accuracy());
+    << ", \"accuracy\": " << (ev.total > 0 ? json_number(ev.accuracy()) : "null");
   if (ev.total > 0) {  // how sure that accuracy is on this many trials (hmm.h, wilson_interval)
     const AccuracyInterval iv = wilson_interval(ev.correct, ev.total);
     o << ", \"accuracy_interval\": [" << json_number(iv.lower) << ", " << json_number(iv.upper) << "]";

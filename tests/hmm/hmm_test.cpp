@@ -12,6 +12,7 @@
 #include "fixtures.h"
 #include "hmm.h"
 #include "report.h"
+#include "stc.h"
 
 using namespace dressguard;
 using dressguard::hmm::FeatureSequence;
@@ -656,6 +657,40 @@ TEST(HmmEvaluate, ALabelTheModelLacksCountsAsWrong) {
   EXPECT_EQ(vev.correct, 1);
   EXPECT_EQ(vev.total, 3);
   EXPECT_EQ(vev.confusion, ev.confusion);
+}
+
+// A trial with no sample before the cut (a recording that starts late, cut before its start) is
+// skipped alike by hmm::evaluate and calib::count_correct / accuracy: neither scored nor wrong
+// (calib's count once held it, wrong, in the denominator: 7/22 where classify said 7/21).
+TEST(HmmEvaluate, ATrialCutBeforeItsFirstSampleIsSkippedByBothCounts) {
+  const auto m = one_state_model(0, 3);
+  HapticSequence right = one_sample(0.2, Outcome::Good), late = one_sample(0.2, Outcome::Good);
+  late.samples[0].travel = 0.1;
+  const std::vector<const HapticSequence*> trials = {&right, &late};
+  const auto ev = hmm::evaluate(m, trials, 0.05);
+  EXPECT_EQ(ev.total, 1);
+  EXPECT_EQ(ev.skipped, 1);
+  int counted = -1;
+  EXPECT_EQ(calib::count_correct(m, trials, 0.05, &counted), 1);
+  EXPECT_EQ(counted, ev.total);
+  EXPECT_DOUBLE_EQ(calib::accuracy(m, trials, 0.05, &counted), ev.accuracy());
+  EXPECT_EQ(counted, 1);
+}
+
+// An evaluation that scored no trial has no accuracy: null in the JSON and "-" in the text, as
+// classify's sweep writes it (0 read as every trial wrong).
+TEST(HmmEvaluate, NoTrialScoredHasNoAccuracy) {
+  const auto m = one_state_model(0, 3);
+  HapticSequence unlabelled = one_sample(0.2, Outcome::Good);
+  unlabelled.label.reset();
+  const auto ev = hmm::evaluate(m, {&unlabelled});
+  ASSERT_EQ(ev.total, 0);
+  const std::string json = hmm::evaluation_json(ev);
+  EXPECT_NE(json.find("\"accuracy\": null"), std::string::npos) << json;
+  EXPECT_EQ(json.find("accuracy_interval"), std::string::npos) << json;
+  EXPECT_EQ(hmm::accuracy_text(ev), "-");
+  HapticSequence good = one_sample(0.2, Outcome::Good);
+  EXPECT_EQ(hmm::accuracy_text(hmm::evaluate(m, {&good})), "1.0000");
 }
 
 // Deciding among some classes: a trial at x = 8 is caught for a model with means good 0,
