@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Accuracy against travel distance (paper Fig. 6) from `dressguard classify --sweep`'s CSV.
 
-usage: hmm_sweep.py SWEEP.csv OUT.png [SWEEP2.csv LABEL2 ...]
+usage: hmm_sweep.py SWEEP.csv OUT.png [SWEEP2.csv LABEL2 ...] [--title TEXT]
+--title replaces the title (e.g. to say the trials were in the model's training: in-sample).
 The CSV has columns travel_m,accuracy,correct,total (accuracy empty where no trial was scored:
 left out). Extra CSV/label pairs add curves (e.g. a
 simulation-trained and a measured-data-trained classifier on one plot).
@@ -28,6 +29,14 @@ def read(path):
 
 
 def main(argv):
+    title = "Outcome classification on truncated sequences"
+    if "--title" in argv:
+        k = argv.index("--title")
+        if k + 1 >= len(argv):
+            sys.stderr.write(__doc__)
+            return 2
+        title = argv[k + 1]
+        argv = argv[:k] + argv[k + 2:]
     if len(argv) < 3 or len(argv) % 2 == 0:
         sys.stderr.write(__doc__)
         return 2
@@ -40,7 +49,7 @@ def main(argv):
     ax.set_ylabel("accuracy [%]")
     ax.set_ylim(0, 100)
     ax.grid(True, alpha=0.3)
-    ax.set_title("Outcome classification on truncated sequences")
+    ax.set_title(title, fontsize=10)
     if len(curves) > 1:
         ax.legend()
     fig.tight_layout()
