@@ -71,8 +71,10 @@ Discrepancy measure_discrepancy(const std::vector<HapticSequence>& inputs,
       const double x = j * o.step;
       std::array<double, 3> m{}, s{};
       // Near x = 0 the window holds the rig's first samples; a window with no sample on either
-      // side keeps the previous grid point's value (the curves are continuous).
-      if (window_mean(measured, x - o.window / 2, x + o.window / 2, m) &&
+      // side, or one that begins before a late-starting recording does (its mean would hold only
+      // the window's end against the simulator's whole window: records_from), keeps the previous
+      // grid point's value (the curves are continuous).
+      if (records_from(measured, x - o.window / 2) && window_mean(measured, x - o.window / 2, x + o.window / 2, m) &&
           window_mean(sim, x - o.window / 2, x + o.window / 2, s)) {
         r.push_back({m[0] - s[0], m[1] - s[1], m[2] - s[2]});
       } else {

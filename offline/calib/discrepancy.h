@@ -11,6 +11,8 @@
 //   r_h(x) = mean of measured F over [x - w/2, x + w/2)  -  the same mean of the simulated F
 //
 // per arm height h with an input, per force (motion, lateral, vertical), on a grid of travel x.
+// A grid point whose window begins before a late-starting input's recording does (haptic.h,
+// records_from) keeps the previous point's value (0 before the first), as a window without samples.
 // It uses only the calibrating person's inputs: a classifier tested on other people never sees
 // their data through it.
 #pragma once

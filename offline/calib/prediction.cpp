@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <sstream>
 #include <stdexcept>
@@ -20,11 +21,24 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // A simulated curve travels through run_batch's fixed-size blocks of doubles (so that the
 // prediction spreads over ranks like every other batch): the scores, the sample count, then the
-// samples' t, travel, F_motion, F_vertical, F_lateral in five fixed-size columns. The longest pull the rig
-// makes, 0.85 m at 0.1 m/s after a 1 m/s^2 start, is 8.55 s: 856 samples at 100 Hz.
-constexpr int kMaxSamples = 1500;
+// samples' t, travel, F_motion, F_vertical, F_lateral in five columns of one length, sized before
+// simulating from the slowest and longest target (block_samples): the rig's longest pull, 0.85 m
+// at 0.1 m/s after a 1 m/s^2 start, is 8.55 s, 856 samples at 100 Hz, but a dataset may hold
+// pulls down to kMinSpeed over up to kMaxTravel (a fixed 1500 once stopped one at 0.04 m/s with
+// an internal error after the whole batch had been simulated).
 enum Slot { kObjective, kSign, kSimEnd, kOutcome, kCount, kColumns };
-constexpr int kBlock = kColumns + 5 * kMaxSamples;  // t, travel, F_motion, F_vertical, F_lateral
+constexpr int kColumnCount = 5;      // t, travel, F_motion, F_vertical, F_lateral
+constexpr double kSampleRate = 100;  // [Hz] the sensor's and the simulator's (sim/trial.h)
+// [s] a simulated pull may run past its time to the end of travel (pull_time_at): the cloth
+// simulator gives up 5 s after it (sim::max_time_of), and the sample at t = 0 comes on top.
+constexpr double kSpareTime = 5.0;
+
+// The most samples one target's simulated pull can have: the time to its end of travel at its
+// speed (request_for) and the spare, at 100 Hz. Ample for the study (8.55 s + 5 s: 1357 samples
+// a target); at the reader's extremes (kMaxTravel at kMinSpeed) 2005 s, 8 MB a target.
+int samples_for(const TrialRequest& r) {
+  return static_cast<int>(std::ceil((pull_time_at(r.max_travel, r.speed) + kSpareTime) * kSampleRate)) + 1;
+}
 
 double median_of(std::vector<double> v) {
   v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return std::isnan(x); }), v.end());
@@ -82,6 +96,8 @@ std::pair<double, int> real_person_median(const Dataset& ds, const HapticSequenc
   return {median_of(l), static_cast<int>(l.size())};
 }
 
+std::string simulated_source(const Prediction& p) { return p.discrepancy ? "simulated+discrepancy" : "simulated"; }
+
 void add_discrepancy(Prediction& p, const Discrepancy& d, const Dataset& ds, ObjectiveKind kind) {
   for (auto& t : p.trials) {
     const HapticSequence* measured = find_trial(ds, t.trial_id);
@@ -92,6 +108,7 @@ void add_discrepancy(Prediction& p, const Discrepancy& d, const Dataset& ds, Obj
     if (std::isfinite(t.objective)) t.objective = sequence_objective(kind, t.simulated, measured->samples);
     t.vertical_sign = vertical_sign_agreement(t.simulated, measured->samples);
   }
+  p.discrepancy = true;
 }
 
 Prediction predict_others(const Calibration& cal, const Dataset& ds, const TrialSimulator& sim, int threads,
@@ -108,6 +125,15 @@ Prediction predict_others(const Calibration& cal, const Dataset& ds, const Trial
                      cal.participant + "' to predict");
   const ObjectiveKind kind = parse_objective(cal.objective_kind).value_or(ObjectiveKind::Area);
   const int n = static_cast<int>(targets.size());
+  // Every target's request, and the block's columns sized for the longest of them, before any
+  // simulation.
+  std::vector<TrialRequest> requests;
+  int samples = 0;
+  for (const HapticSequence* t : targets) {
+    requests.push_back(request_for(*t, cal.offsets));
+    samples = std::max(samples, samples_for(requests.back()));
+  }
+  const int per_target = kColumns + kColumnCount * samples;
   const std::vector<std::vector<int>> groups = groups_by_height(targets, thread_count(threads) * comm.size());
   std::size_t per_group = 0;
   std::vector<std::size_t> slot_of(static_cast<std::size_t>(n));  // target -> its block in `out`
@@ -120,21 +146,24 @@ Prediction predict_others(const Calibration& cal, const Dataset& ds, const Trial
     mine += static_cast<int>(groups[g].size());
   int done = 0;
   std::mutex progress_mutex;
-  const int block = static_cast<int>(per_group) * kBlock;
+  const int block = static_cast<int>(per_group) * per_target;
   const std::vector<double> out = run_batch(static_cast<int>(groups.size()), block, threads, comm, [&](int g, double* group_block) {
     const std::vector<int>& members = groups[static_cast<std::size_t>(g)];
-    std::vector<TrialRequest> requests;
-    for (int k : members) requests.push_back(request_for(*targets[static_cast<std::size_t>(k)], cal.offsets));
-    const std::vector<SimulatedTrial> sims = sim(cal.cloth, requests);
-    if (sims.size() != requests.size())
+    std::vector<TrialRequest> group;
+    for (int k : members) group.push_back(requests[static_cast<std::size_t>(k)]);
+    const std::vector<SimulatedTrial> sims = sim(cal.cloth, group);
+    if (sims.size() != group.size())
       throw std::logic_error("predict_others: the batch simulator returned " + std::to_string(sims.size()) +
-                             " trials for " + std::to_string(requests.size()));
+                             " trials for " + std::to_string(group.size()));
     for (std::size_t j = 0; j < members.size(); ++j) {
       const HapticSequence& target = *targets[static_cast<std::size_t>(members[j])];
       const SimulatedTrial& st = sims[j];
-      if (st.samples.empty() || static_cast<int>(st.samples.size()) > kMaxSamples)
-        throw std::logic_error("predict_others: a simulated pull of " + std::to_string(st.samples.size()) + " samples");
-      double* b = group_block + j * kBlock;
+      if (st.samples.empty() || static_cast<int>(st.samples.size()) > samples)
+        throw std::logic_error("predict_others: the simulated pull of trial '" + target.id + "' has " +
+                               std::to_string(st.samples.size()) + " samples, outside [1, " + std::to_string(samples) +
+                               "] (its speed " + format_number(target.speed) + " m/s, end of travel " +
+                               format_number(group[j].max_travel) + " m)");
+      double* b = group_block + j * per_target;
       b[kObjective] = st.finite ? sequence_objective(kind, st.samples, target.samples)
                                 : std::numeric_limits<double>::infinity();
       b[kSign] = vertical_sign_agreement(st.samples, target.samples);
@@ -144,10 +173,10 @@ Prediction predict_others(const Calibration& cal, const Dataset& ds, const Trial
       double* col = b + kColumns;
       for (std::size_t i = 0; i < st.samples.size(); ++i) {
         col[i] = st.samples[i].t;
-        col[kMaxSamples + i] = st.samples[i].travel;
-        col[2 * kMaxSamples + i] = st.samples[i].f_motion;
-        col[3 * kMaxSamples + i] = st.samples[i].f_vertical;
-        col[4 * kMaxSamples + i] = st.samples[i].f_lateral;
+        col[samples + i] = st.samples[i].travel;
+        col[2 * samples + i] = st.samples[i].f_motion;
+        col[3 * samples + i] = st.samples[i].f_vertical;
+        col[4 * samples + i] = st.samples[i].f_lateral;
       }
     }
     // Counted under the lock, so that the reports come in order.
@@ -164,9 +193,10 @@ Prediction predict_others(const Calibration& cal, const Dataset& ds, const Trial
   });
   Prediction p;
   p.participant = cal.participant;
+  p.gown = cal.gown;
   for (int k = 0; k < n; ++k) {
     const HapticSequence& target = *targets[static_cast<std::size_t>(k)];
-    const double* b = out.data() + slot_of[static_cast<std::size_t>(k)] * kBlock;
+    const double* b = out.data() + slot_of[static_cast<std::size_t>(k)] * per_target;
     PredictedTrial t;
     t.trial_id = target.id;
     t.participant = target.participant;
@@ -181,7 +211,7 @@ Prediction predict_others(const Calibration& cal, const Dataset& ds, const Trial
     const double* col = b + kColumns;
     for (int i = 0; i < static_cast<int>(b[kCount]); ++i)
       t.simulated.push_back(
-          {col[i], col[kMaxSamples + i], col[2 * kMaxSamples + i], col[4 * kMaxSamples + i], col[3 * kMaxSamples + i]});
+          {col[i], col[samples + i], col[2 * samples + i], col[4 * samples + i], col[3 * samples + i]});
     p.trials.push_back(std::move(t));
   }
   return p;
@@ -213,11 +243,12 @@ std::string prediction_csv(const Prediction& p) {
   std::ostringstream o;
   o.precision(9);
   o << "trial_id,participant,height,speed,objective,real_median,real_count,vertical_sign,simulated_end,measured_end,"
-       "simulated_outcome\n";
+       "simulated_outcome,gown,discrepancy\n";
   for (const auto& t : p.trials)
     o << t.trial_id << ',' << t.participant << ',' << arm_height_name(t.height) << ',' << t.speed << ',' << t.objective
       << ',' << t.real_median << ',' << t.real_count << ',' << t.vertical_sign << ',' << t.simulated_end << ','
-      << t.measured_end << ',' << outcome_name(t.simulated_outcome) << '\n';
+      << t.measured_end << ',' << outcome_name(t.simulated_outcome) << ',' << p.gown << ',' << (p.discrepancy ? 1 : 0)
+      << '\n';
   return o.str();
 }
 
@@ -225,12 +256,13 @@ std::string prediction_curves_csv(const Prediction& p, const Dataset& ds) {
   std::ostringstream o;
   o.precision(7);
   o << "trial_id,source,travel,f_motion,f_vertical\n";
-  auto rows = [&](const std::string& id, const char* source, const std::vector<HapticSample>& s) {
+  const std::string simulated = simulated_source(p);
+  auto rows = [&](const std::string& id, const std::string& source, const std::vector<HapticSample>& s) {
     for (const auto& x : s) o << id << ',' << source << ',' << x.travel << ',' << x.f_motion << ',' << x.f_vertical << '\n';
   };
   for (const auto& t : p.trials) {
     if (const HapticSequence* m = find_trial(ds, t.trial_id)) rows(t.trial_id, "measured", m->samples);
-    rows(t.trial_id, "simulated", t.simulated);
+    rows(t.trial_id, simulated, t.simulated);
   }
   return o.str();
 }
@@ -239,7 +271,7 @@ std::string prediction_curves_csv(const Prediction& p, const Dataset& ds) {
 
 bool ResidualWindow::outside(int axis) const {
   const double r = residual(axis);
-  return trials >= kResidualMinTrials && std::isfinite(r) && std::fabs(r) > std::max(spread[axis], kResidualFloor);
+  return people >= kResidualMinPeople && std::isfinite(r) && std::fabs(r) > std::max(spread[axis], kResidualFloor);
 }
 
 namespace {
@@ -266,6 +298,7 @@ std::vector<ResidualWindow> residual_windows(const Prediction& p, const Dataset&
   if (!(window > 0)) throw std::invalid_argument("residual_windows: the window must be positive");
   struct Pair {
     ArmHeight height;
+    const std::string* participant;
     const std::vector<HapticSample>* measured;
     const std::vector<HapticSample>* simulated;
   };
@@ -274,7 +307,7 @@ std::vector<ResidualWindow> residual_windows(const Prediction& p, const Dataset&
   for (const auto& t : p.trials) {
     const HapticSequence* m = find_trial(ds, t.trial_id);
     if (m == nullptr || m->samples.empty() || t.simulated.empty()) continue;
-    pairs.push_back({t.height, &m->samples, &t.simulated});
+    pairs.push_back({t.height, &t.participant, &m->samples, &t.simulated});
     longest = std::max(longest, m->samples.back().travel);
   }
   // Window k is [k w, (k + 1) w): computed from k, not accumulated, so the edges are exact
@@ -288,31 +321,50 @@ std::vector<ResidualWindow> residual_windows(const Prediction& p, const Dataset&
       w.height = h;
       w.from = k * window;
       w.to = (k + 1) * window;
-      std::vector<double> meas[kForces];
-      double sim_sum[kForces] = {};
+      // Per person: the sums of their trials' window means, measured and simulated, and how many.
+      struct Person {
+        double measured[kForces] = {}, simulated[kForces] = {};
+        int trials = 0;
+      };
+      std::map<std::string, Person> people;
       for (const Pair& q : pairs) {
-        if (q.height != h || q.measured->back().travel < w.to || q.simulated->back().travel < w.to) continue;
+        // Both curves through the whole window: a recording that starts late (haptic.h) covers
+        // it only from its start, which its mean would pair with the simulator's whole window.
+        if (q.height != h || !records_from(*q.measured, w.from) || q.measured->back().travel < w.to ||
+            q.simulated->back().travel < w.to)
+          continue;
         double a[kForces], b[kForces];
         if (!window_mean(*q.measured, w.from, w.to, a) || !window_mean(*q.simulated, w.from, w.to, b)) continue;
+        Person& person = people[*q.participant];
         for (int ax = 0; ax < kForces; ++ax) {
-          meas[ax].push_back(a[ax]);
-          sim_sum[ax] += b[ax];
+          person.measured[ax] += a[ax];
+          person.simulated[ax] += b[ax];
         }
+        ++person.trials;
+        ++w.trials;
       }
-      w.trials = static_cast<int>(meas[0].size());
+      w.people = static_cast<int>(people.size());
       for (int ax = 0; ax < kForces; ++ax) {
-        if (w.trials == 0) {
+        if (w.people == 0) {
           w.measured[ax] = w.spread[ax] = w.simulated[ax] = kNaN;
           continue;
         }
+        // Each person's mean over their trials first, so that a person with two trials counts
+        // once in the mean, the spread and n (prediction.h).
+        std::vector<double> meas;
+        double sim_sum = 0;
+        for (const auto& [id, person] : people) {
+          meas.push_back(person.measured[ax] / person.trials);
+          sim_sum += person.simulated[ax] / person.trials;
+        }
         double mean = 0;
-        for (double v : meas[ax]) mean += v;
-        mean /= w.trials;
+        for (double v : meas) mean += v;
+        mean /= w.people;
         double ss = 0;
-        for (double v : meas[ax]) ss += (v - mean) * (v - mean);
+        for (double v : meas) ss += (v - mean) * (v - mean);
         w.measured[ax] = mean;
-        w.spread[ax] = w.trials > 1 ? std::sqrt(ss / (w.trials - 1)) : kNaN;
-        w.simulated[ax] = sim_sum[ax] / w.trials;
+        w.spread[ax] = w.people > 1 ? std::sqrt(ss / (w.people - 1)) : kNaN;
+        w.simulated[ax] = sim_sum / w.people;
       }
       out.push_back(w);
     }
@@ -358,20 +410,23 @@ std::vector<ResidualFinding> residual_findings(const std::vector<ResidualWindow>
       f.from = a.from;
       f.to = windows[j - 1].to;
       f.trials = a.trials;
+      f.people = a.people;
       for (std::size_t k = i; k < j; ++k) {
         f.residual += windows[k].residual(ax) / static_cast<double>(j - i);
         f.measured += windows[k].measured[ax] / static_cast<double>(j - i);
         f.spread += windows[k].spread[ax] / static_cast<double>(j - i);
         f.trials = std::min(f.trials, windows[k].trials);
+        f.people = std::min(f.people, windows[k].people);
       }
       const char* what = ax == 0   ? (f.residual > 0 ? "too little drag" : "too much drag")
                          : ax == 1 ? (f.residual > 0 ? "pulls the gripper up too much" : "pulls the gripper down too much")
                                    : (f.residual > 0 ? "pulls the gripper toward the person too much"
                                                      : "pulls the gripper away from the person too much");
-      char buf[256];
+      char buf[320];
       std::snprintf(buf, sizeof buf, "%s arm, %s, %.2f-%.2f m: %s, simulated %+.2f N from the people's mean %.2f N "
-                    "(their spread %.2f N, %d trials)", std::string(arm_height_name(f.height)).c_str(),
-                    force_name(ax), f.from, f.to, what, f.residual, f.measured, f.spread, f.trials);
+                    "(their spread %.2f N over %d people, %d trials averaged per person)",
+                    std::string(arm_height_name(f.height)).c_str(), force_name(ax), f.from, f.to, what, f.residual,
+                    f.measured, f.spread, f.people, f.trials);
       f.text = buf;
       out.push_back(f);
     });
@@ -385,12 +440,12 @@ std::vector<ResidualFinding> residual_findings(const std::vector<ResidualWindow>
 std::string residual_csv(const std::vector<ResidualWindow>& windows) {
   std::ostringstream o;
   o.precision(7);
-  o << "height,from,to,trials";
+  o << "height,from,to,trials,people";
   for (int ax = 0; ax < kForces; ++ax)
     for (const char* k : {"measured", "spread", "simulated", "residual", "outside"}) o << ',' << k << '_' << force_column(ax);
   o << '\n';
   for (const auto& w : windows) {
-    o << arm_height_name(w.height) << ',' << w.from << ',' << w.to << ',' << w.trials;
+    o << arm_height_name(w.height) << ',' << w.from << ',' << w.to << ',' << w.trials << ',' << w.people;
     for (int ax = 0; ax < kForces; ++ax)
       o << ',' << w.measured[ax] << ',' << w.spread[ax] << ',' << w.simulated[ax] << ',' << w.residual(ax) << ','
         << (w.outside(ax) ? 1 : 0);
@@ -451,12 +506,14 @@ std::vector<HeightContrast> height_contrasts(const std::vector<ResidualWindow>& 
       c.to = lo.to;
       c.trials_high = hi->trials;
       c.trials_lower = lo.trials;
-      const bool enough = hi->trials >= kResidualMinTrials && lo.trials >= kResidualMinTrials;
+      c.people_high = hi->people;
+      c.people_lower = lo.people;
+      const bool enough = hi->people >= kResidualMinPeople && lo.people >= kResidualMinPeople;
       for (int ax = 0; ax < kForces; ++ax) {
         c.measured[ax] = hi->measured[ax] - lo.measured[ax];
         c.simulated[ax] = hi->simulated[ax] - lo.simulated[ax];
-        c.standard_error[ax] = enough ? std::sqrt(hi->spread[ax] * hi->spread[ax] / hi->trials +
-                                                  lo.spread[ax] * lo.spread[ax] / lo.trials)
+        c.standard_error[ax] = enough ? std::sqrt(hi->spread[ax] * hi->spread[ax] / hi->people +
+                                                  lo.spread[ax] * lo.spread[ax] / lo.people)
                                       : kNaN;
         c.verdict[ax] = judge_contrast(c.measured[ax], c.standard_error[ax], c.simulated[ax], enough);
       }
@@ -524,12 +581,13 @@ ContrastTally tally_contrasts(const std::vector<HeightContrast>& contrasts, doub
 std::string contrast_csv(const std::vector<HeightContrast>& contrasts) {
   std::ostringstream o;
   o.precision(7);
-  o << "lower,from,to,trials_high,trials_lower";
+  o << "lower,from,to,trials_high,trials_lower,people_high,people_lower";
   for (int ax = 0; ax < kForces; ++ax)
     for (const char* k : {"measured", "standard_error", "simulated", "verdict"}) o << ',' << k << '_' << force_column(ax);
   o << '\n';
   for (const auto& c : contrasts) {
-    o << arm_height_name(c.lower) << ',' << c.from << ',' << c.to << ',' << c.trials_high << ',' << c.trials_lower;
+    o << arm_height_name(c.lower) << ',' << c.from << ',' << c.to << ',' << c.trials_high << ',' << c.trials_lower
+      << ',' << c.people_high << ',' << c.people_lower;
     for (int ax = 0; ax < kForces; ++ax)
       o << ',' << c.measured[ax] << ',' << c.standard_error[ax] << ',' << c.simulated[ax] << ','
         << contrast_verdict_name(c.verdict[ax]);

@@ -42,7 +42,16 @@ struct PredictedTrial {
 struct Prediction {
   std::string participant;  // the calibrated one
   std::vector<PredictedTrial> trials;  // in the dataset's order
+  // What simulated the curves, carried into every output so that a corrected prediction's files
+  // are not taken for the plain simulator's: the gown (predict_others: the calibration's; a
+  // caller that simulates on another sets it) and whether add_discrepancy corrected them.
+  std::string gown;
+  bool discrepancy = false;
 };
+
+// "simulated", or "simulated+discrepancy" after add_discrepancy: the curves' source in
+// prediction_curves_csv.
+std::string simulated_source(const Prediction& p);
 
 // Per height: the medians over the predicted trials of that height (NaN where there are none).
 struct PredictionSummary {
@@ -87,7 +96,8 @@ Prediction predict_others(const Calibration& cal, const Dataset& ds, const Trial
 // simulated curve of `p`, and each trial's objective (the calibration's `kind`) and vertical
 // sign are scored again against its measured trial in `ds`. Whether that lowers L on *other*
 // people says how much of the error belongs to the simulator rather than to the person
-// (`dressguard predict --discrepancy`). Outcomes and ends stay the simulator's.
+// (`dressguard predict --discrepancy`). Outcomes and ends stay the simulator's; `p` is marked
+// corrected (Prediction::discrepancy).
 struct Discrepancy;
 void add_discrepancy(Prediction& p, const Discrepancy& d, const Dataset& ds, ObjectiveKind kind);
 
@@ -101,8 +111,10 @@ std::pair<double, int> real_person_median(const Dataset& ds, const HapticSequenc
 std::vector<PredictionSummary> summarize(const Prediction& p);
 
 // Per-trial table (CSV: trial_id,participant,height,speed,objective,real_median,real_count,
-// vertical_sign,simulated_end,measured_end,simulated_outcome) and the curves for the overlay
-// plot (CSV: trial_id,source,travel,f_motion,f_vertical; source "measured" or "simulated").
+// vertical_sign,simulated_end,measured_end,simulated_outcome,gown,discrepancy; the last two the
+// same on every row, discrepancy 0 or 1, for the plots' titles) and the curves for the overlay
+// plot (CSV: trial_id,source,travel,f_motion,f_vertical; source "measured" or
+// simulated_source(p)).
 std::string prediction_csv(const Prediction& p);
 std::string prediction_curves_csv(const Prediction& p, const Dataset& ds);
 
@@ -110,19 +122,25 @@ std::string prediction_curves_csv(const Prediction& p, const Dataset& ds);
 //
 // L says how far a prediction is off; the residual says where and which way. Per height and
 // travel window [from, to), over the predicted trials whose measured and simulated curves both
-// reach `to`: each trial's mean force over the window (samples with from <= travel < to), then
-// over those trials the measured mean, the people's spread (the sample standard deviation of
-// the measured window means: how much the real people differ from each other there) and the
-// simulated mean. residual = simulated - measured; F_motion is negative for drag, so a positive
-// F_motion residual is too little drag, and a positive F_vertical one too much upward force on
-// the gripper (or too little downward).
+// cover it (the measured one recorded from `from` on, records_from, and both reaching `to`): each
+// trial's mean force over the window (samples with from <= travel < to), then each person's
+// mean over their trials there, then over those people the measured mean, the people's spread
+// (the sample standard deviation of the people's means: how much the real people differ from
+// each other there) and the simulated mean (of the people's simulated means). Per person first,
+// because a person's repeats are not other people: counted per trial, the study's four people
+// with two trials of one height each counted twice in the mean, and their repeats, closer to
+// each other than to anyone else, shrank the spread and, as two in n, the contrast's standard
+// error (3 of 84 windows of participant 4's prediction were outside the trials' spread and
+// inside the people's). residual = simulated - measured; F_motion is negative for drag, so a
+// positive F_motion residual is too little drag, and a positive F_vertical one too much upward
+// force on the gripper (or too little downward).
 //
-// A window is *outside* the people when at least kResidualMinTrials trials cover it and
+// A window is *outside* the people when at least kResidualMinPeople people cover it and
 // |residual| exceeds both the people's spread and kResidualFloor: there the simulated mean is
 // further from the measured mean than a typical person is. (The floor keeps windows where every
 // person measures nearly the same, 0.02-0.05 N apart at the start of a pull, from flagging
 // differences of the size of the sensor's drift; it is six times the sensor's noise, 0.017 N.)
-inline constexpr int kResidualMinTrials = 3;
+inline constexpr int kResidualMinPeople = 3;
 inline constexpr double kResidualFloor = 0.1;  // [N]
 
 // The forces the residual and the contrast look at, by index: [0] F_motion, [1] F_vertical (the
@@ -136,7 +154,8 @@ const char* force_column(int axis);  // "motion", "vertical", "lateral" (the CSV
 struct ResidualWindow {
   ArmHeight height = ArmHeight::High;
   double from = 0, to = 0;  // [m] travel
-  int trials = 0;
+  int trials = 0;           // the trials that cover the window
+  int people = 0;           // and their participants: the n of the mean and the spread
   // by force (kForces); NaN when no trial covers the window
   double measured[kForces] = {}, spread[kForces] = {}, simulated[kForces] = {};
   double residual(int axis) const { return simulated[axis] - measured[axis]; }
@@ -150,18 +169,18 @@ std::vector<ResidualWindow> residual_windows(const Prediction& p, const Dataset&
 
 // Runs of consecutive outside windows of one height and axis whose residuals share a sign, as
 // findings: the run's travel, its mean residual, measured mean and spread (means over the run's
-// windows), the fewest trials of its windows, and one line of text. Sorted by |residual| times
+// windows), the fewest trials and people of its windows, and one line of text. Sorted by |residual| times
 // the run's length (its share of eq. 3's area), largest first.
 struct ResidualFinding {
   ArmHeight height = ArmHeight::High;
   int axis = 0;  // force_name(axis)
   double from = 0, to = 0, residual = 0, measured = 0, spread = 0;
-  int trials = 0;
+  int trials = 0, people = 0;
   std::string text;
 };
 std::vector<ResidualFinding> residual_findings(const std::vector<ResidualWindow>& windows);
 
-// CSV: height,from,to,trials, then measured/spread/simulated/residual/outside for F_motion, for
+// CSV: height,from,to,trials,people, then measured/spread/simulated/residual/outside for F_motion, for
 // F_vertical and for F_lateral (tools/plot/calib_overlay.py residual).
 std::string residual_csv(const std::vector<ResidualWindow>& windows);
 
@@ -176,10 +195,11 @@ std::string residual_csv(const std::vector<ResidualWindow>& windows);
 // Per travel window, force and lower height (middle, low), from the residual windows:
 //   contrast = mean(high) - mean(lower height),
 // for the people (measured) and for the simulator (its predictions of the same trials). The
-// people show a contrast where both heights hold kResidualMinTrials trials and
+// people show a contrast where both heights hold kResidualMinPeople people and
 //   |contrast| > max(kResidualFloor, 2 SE),  SE = sqrt(s_high^2 / n_high + s_low^2 / n_low)
-// (s the people's spread of each height's window: the difference of two means is then more than
-// twice its standard error, and above the sensor's drift). The simulator then
+// (s the people's spread of each height's window and n its people, each person's trials
+// averaged first: the difference of two means is then more than twice its standard error, and
+// above the sensor's drift). The simulator then
 //   agrees     same sign and |simulated contrast| > kResidualFloor,
 //   misses it  |simulated contrast| <= kResidualFloor (no cue: the classifier learns nothing here),
 //   reverses   opposite sign and |simulated contrast| > kResidualFloor (a wrong cue).
@@ -190,6 +210,7 @@ struct HeightContrast {
   ArmHeight lower = ArmHeight::Low;  // the height compared with the high arm
   double from = 0, to = 0;           // [m] travel
   int trials_high = 0, trials_lower = 0;
+  int people_high = 0, people_lower = 0;  // the SE's n
   // by force (kForces): high minus lower [N]; NaN where either height has no trial
   double measured[kForces] = {}, standard_error[kForces] = {}, simulated[kForces] = {};
   ContrastVerdict verdict[kForces] = {ContrastVerdict::NoContrast, ContrastVerdict::NoContrast,
@@ -222,7 +243,8 @@ struct ContrastTally {
 };
 ContrastTally tally_contrasts(const std::vector<HeightContrast>& contrasts, double up_to = kLatestCut);
 
-// CSV: lower,from,to,trials_high,trials_lower, then measured/standard_error/simulated/verdict for
+// CSV: lower,from,to,trials_high,trials_lower,people_high,people_lower, then
+// measured/standard_error/simulated/verdict for
 // F_motion, for F_vertical and for F_lateral (tools/plot/calib_overlay.py contrast).
 std::string contrast_csv(const std::vector<HeightContrast>& contrasts);
 

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <string>
+#include <vector>
 
 #include "args.h"
 #include "calibration.h"
@@ -40,7 +42,7 @@ int run_predict(int argc, char** argv) {
         "  Also the share of the travel where the simulated vertical force has the measured sign,\n"
         "  and what the simulation gets wrong: per height, travel window and force (F_motion,\n"
         "  F_vertical, F_lateral), the simulated mean force against the measured mean and the\n"
-        "  people's spread; the runs of windows where the\n"
+        "  people's spread (over people, each one's trials averaged first); the runs of windows where the\n"
         "  simulation is further from the people's mean than they are from each other are listed,\n"
         "  largest first (offline/calib/prediction.h, residual_windows). Then the heights' contrast:\n"
         "  where the people's high arm (good) differs from their middle or low arm (missed), whether\n"
@@ -48,7 +50,8 @@ int run_predict(int argc, char** argv) {
         "  classifier trained on it learns from cut sequences (prediction.h, height_contrasts).\n"
         "  --out PREFIX   write PREFIX.csv (per trial), PREFIX.curves.csv, PREFIX.residual.csv and\n"
         "                 PREFIX.contrast.csv (for tools/plot/calib_overlay.py predict, residual and\n"
-        "                 contrast)\n"
+        "                 contrast; the gown and --discrepancy are recorded in them). Refused when one\n"
+        "                 of them would replace the dataset's manifest or trials or the calibration\n"
         "  --discrepancy  add what the calibrated simulator gets wrong on its own person's\n"
         "                 sequences (in DATASET too) to every simulated curve before scoring\n"
         "                 (offline/calib/discrepancy.h): how much of the error is the simulator's\n"
@@ -72,21 +75,38 @@ int run_predict(int argc, char** argv) {
   const std::size_t targets = prediction_targets(ds, cal.participant).size();
   if (targets == 0)
     throw InputError(data + ": no labelled, non-caught trial of a participant other than '" + cal.participant + "'");
+  // The outputs, refused before any simulation when one would replace an input (--out
+  // DATASET/manifest wrote the prediction over the dataset's manifest).
+  const auto prefix = args.get("out");
+  std::vector<std::string> outputs;
+  if (prefix)
+    for (const char* suffix : {".csv", ".curves.csv", ".residual.csv", ".contrast.csv"})
+      outputs.push_back(*prefix + suffix);
+  std::vector<std::filesystem::path> inputs = ds.files;
+  inputs.push_back(cal_path);
+  for (const std::string& o : outputs)
+    for (const auto& in : inputs)
+      if (same_file(o, in))
+        throw UsageError("--out " + *prefix + " would write " + o + " over the input " + in.string() +
+                         ": choose a prefix outside the dataset's and the calibration's files");
 #ifndef DRESSGUARD_HAVE_SIM
   (void)threads, (void)targets;
   throw UsageError("this dressguard was built without the cloth simulator (offline/sim); predict needs it");
 #else
   const Comm& comm = Comm::world();
+  const bool with_discrepancy = args.has("discrepancy");
   if (comm.is_root())
-    std::fprintf(stderr, "predict: the calibration of participant '%s' on %zu trials of other participants, gown %s\n",
-                 cal.participant.c_str(), targets, gown.c_str());
+    std::fprintf(stderr,
+                 "predict: the calibration of participant '%s' on %zu trials of other participants, gown %s%s\n",
+                 cal.participant.c_str(), targets, gown.c_str(), with_discrepancy ? ", with its discrepancy" : "");
   const ClothSimulator sim = make_cloth_simulator(gown);
   Prediction p = predict_others(cal, ds, sim.trials, threads, comm, [](const PredictionProgress& pp) {
     std::fprintf(stderr, "predict: %d/%d trials on this rank, elapsed %.0f s, ETA %.0f s\n", pp.done, pp.total,
                  pp.elapsed_s, pp.eta_s);
   });
   if (!comm.is_root()) return 0;
-  if (args.has("discrepancy")) {
+  p.gown = gown;
+  if (with_discrepancy) {
     // The calibrating person's own sequences are in the same dataset.
     const Discrepancy d =
         discrepancy_of(cal, calibration_inputs(cal, cal_path, ds, std::filesystem::path(data) / "manifest.csv"), sim.trials);
@@ -94,22 +114,24 @@ int run_predict(int argc, char** argv) {
     std::fprintf(stderr, "predict: every simulated curve corrected by participant '%s''s discrepancy\n",
                  cal.participant.c_str());
   }
-  if (const auto prefix = args.get("out")) {
-    write_file_atomic(*prefix + ".csv", prediction_csv(p));
-    write_file_atomic(*prefix + ".curves.csv", prediction_curves_csv(p, ds));
+  if (prefix) {
+    write_file_atomic(outputs[0], prediction_csv(p));
+    write_file_atomic(outputs[1], prediction_curves_csv(p, ds));
   }
   const std::vector<ResidualWindow> windows = residual_windows(p, ds, window);
   const std::vector<ResidualFinding> findings = residual_findings(windows);
   const std::vector<HeightContrast> contrasts = height_contrasts(windows);
   const std::vector<ContrastFinding> contrast = contrast_findings(contrasts);
   const ContrastTally early = tally_contrasts(contrasts);  // up to issue 4's latest cut
-  if (const auto prefix = args.get("out")) {
-    write_file_atomic(*prefix + ".residual.csv", residual_csv(windows));
-    write_file_atomic(*prefix + ".contrast.csv", contrast_csv(contrasts));
+  if (prefix) {
+    write_file_atomic(outputs[2], residual_csv(windows));
+    write_file_atomic(outputs[3], contrast_csv(contrasts));
   }
   const std::vector<PredictionSummary> sum = summarize(p);
   if (args.has("json")) {
-    std::printf("{\"participant\": %s, \"trials\": %zu, \"heights\": [", json_string(p.participant).c_str(), p.trials.size());
+    std::printf("{\"participant\": %s, \"gown\": %s, \"discrepancy\": %s, \"trials\": %zu, \"heights\": [",
+                json_string(p.participant).c_str(), json_string(p.gown).c_str(), p.discrepancy ? "true" : "false",
+                p.trials.size());
     bool first = true;
     for (const auto& s : sum) {
       if (s.trials == 0) continue;
@@ -145,8 +167,10 @@ int run_predict(int argc, char** argv) {
                 number(kLatestCut).c_str(), early.agrees, early.misses, early.reverses);
     return 0;
   }
-  std::printf("the simulator calibrated on participant '%s', on %zu trials of other participants (L: %s objective)\n",
-              p.participant.c_str(), p.trials.size(), cal.objective_kind.c_str());
+  std::printf("the simulator calibrated on participant '%s' (gown %s, %s), on %zu trials of other participants "
+              "(L: %s objective)\n", p.participant.c_str(), p.gown.c_str(),
+              p.discrepancy ? "corrected by its discrepancy term" : "without a discrepancy term", p.trials.size(),
+              cal.objective_kind.c_str());
   std::printf("  %-18s %-6s %8s %12s %10s %9s %9s  %s\n", "trial", "height", "L sim", "L real (med)", "Fv sign",
               "sim end", "meas end", "sim label");
   for (const auto& t : p.trials)
@@ -159,12 +183,14 @@ int run_predict(int argc, char** argv) {
       std::printf("%-6s median L %.3f against %.3f between real people; no worse on %d of %d; Fv sign %.0f%%\n",
                   std::string(arm_height_name(s.height)).c_str(), s.objective_median, s.real_median, s.no_worse,
                   s.trials, 100 * s.vertical_sign_median);
+  // The people's mean and spread are over people, each person's trials averaged first
+  // (prediction.h, residual_windows).
   if (findings.empty())
     std::printf("what the simulation gets wrong: no %.2f m window where it is further from the people's mean than "
-                "they are from each other\n", window);
+                "they are from each other (each person's trials averaged first)\n", window);
   else
     std::printf("what the simulation gets wrong (%.2f m windows where it is further from the people's mean than they are "
-                "from each other; largest first):\n", window);
+                "from each other, each person's trials averaged first; largest first):\n", window);
   // The largest few on the terminal; all of them in --json and, per window, in PREFIX.residual.csv.
   constexpr std::size_t kShown = 8;
   for (std::size_t i = 0; i < findings.size() && i < kShown; ++i) std::printf("  %s\n", findings[i].text.c_str());
@@ -182,7 +208,7 @@ int run_predict(int argc, char** argv) {
   std::printf("up to %.2f m of travel (issue 4's latest cut), where the people's heights differ: the simulator "
               "agrees in %d, misses %d and reverses %d of the window forces\n",
               kLatestCut, early.agrees, early.misses, early.reverses);
-  if (const auto prefix = args.get("out"))
+  if (prefix)
     std::printf("wrote %s.csv, %s.curves.csv, %s.residual.csv and %s.contrast.csv\n", prefix->c_str(), prefix->c_str(),
                 prefix->c_str(), prefix->c_str());
   return 0;

@@ -149,6 +149,7 @@ Dataset load_dataset(const fs::path& dir) {
   const std::string text = read_file(manifest);
   if (text.empty()) throw_input_error(manifest, 0, std::string("empty file (expected the header '") + kManifestHeader + "')");
   Dataset ds;
+  ds.files.push_back(manifest);
   std::map<std::string, long> seen, files;
   for_each_line(text, [&](std::string_view line, long n) {
     if (n == 1) {
@@ -182,7 +183,8 @@ Dataset load_dataset(const fs::path& dir) {
     if (auto [it, fresh] = files.emplace(std::string(f[5]), n); !fresh) {
       throw_input_error(manifest, n, "file '" + it->first + "' repeats line " + std::to_string(it->second));
     }
-    seq.samples = read_trial_csv(dir / std::string(f[5]));
+    ds.files.push_back(dir / std::string(f[5]));
+    seq.samples = read_trial_csv(ds.files.back());
     if (const size_t k = unrecorded_samples(seq); k > kMaxUnrecordedSamples)
       throw_input_error(manifest, n,
                         "trial '" + seq.id + "' would start " + std::to_string(k) +
@@ -206,6 +208,7 @@ Dataset load_datasets(const std::vector<fs::path>& dirs) {
     Dataset one = load_dataset(dir);
     all.trials.insert(all.trials.end(), std::make_move_iterator(one.trials.begin()),
                       std::make_move_iterator(one.trials.end()));
+    all.files.insert(all.files.end(), one.files.begin(), one.files.end());
   }
   return all;
 }

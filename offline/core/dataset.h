@@ -36,6 +36,9 @@ inline constexpr std::size_t kMaxUnrecordedSamples = 100000;  // 1000 s at 100 H
 
 struct Dataset {
   std::vector<HapticSequence> trials;
+  // The files it was read from (load_dataset: the manifest, then each trial's file), so that a
+  // command can refuse to write over its own input (same_file); empty for one made in memory.
+  std::vector<std::filesystem::path> files;
 };
 
 // Trial CSV (header then rows). Throws InputError naming file and line on malformed rows.

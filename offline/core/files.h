@@ -31,6 +31,11 @@ std::string read_file(const std::filesystem::path& path);
 // reader sees either the old file or the whole new one, never a torn one. Creates parent folders.
 void write_file_atomic(const std::filesystem::path& path, std::string_view content);
 
+// Whether two paths name one file: the same file (std::filesystem::equivalent) when both exist,
+// else the same path once made absolute and normal (weakly_canonical, through symlinks as far as
+// they exist). What a command checks before writing an output over one of its inputs.
+bool same_file(const std::filesystem::path& a, const std::filesystem::path& b);
+
 // The study's shared/ folder: $DRESSGUARD_SHARED_DIR, else the build-time default, else
 // ../shared relative to the working directory. Empty when none of them holds data/.
 // A non-empty $DRESSGUARD_SHARED_DIR is taken at its word: one without data/ means the data is

@@ -51,4 +51,8 @@ std::size_t unrecorded_samples(const HapticSequence& trial) {
   return static_cast<std::size_t>(std::lround(pull_time_at(trial.samples.front().travel, trial.speed) / period));
 }
 
+bool records_from(const std::vector<HapticSample>& samples, double travel) {
+  return !samples.empty() && samples.front().travel <= std::max(travel, 0.0) + kLateStart;
+}
+
 }  // namespace dressguard

@@ -70,4 +70,12 @@ struct HapticSequence {
 // two samples). s0-middlemiss-10: 0.0958 m at 0.15 m/s is 0.714 s, 71 samples of 10.0 ms.
 std::size_t unrecorded_samples(const HapticSequence& trial);
 
+// Whether a recording holds its pull from `travel` [m] on: its first sample at most kLateStart
+// past it (past 0 for a `travel` before the pull's start). A mean over a window of travel that
+// begins before a late start would hold only its last samples and be set against another curve's
+// whole window (prediction.h, residual_windows; discrepancy.h); such a window is not covered.
+// The slack is kLateStart's, not less: the study's recordings that start with the pull do so up
+// to 1.02 mm in. False for an empty recording.
+bool records_from(const std::vector<HapticSample>& samples, double travel);
+
 }  // namespace dressguard

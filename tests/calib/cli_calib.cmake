@@ -80,6 +80,25 @@ expect_fail("predict with a bad calibration file" "bad.json" predict --calibrati
 write_cal4(${WORK}/cal4.json)
 expect_fail("predict with a bad --gown" "--gown" predict --calibration ${WORK}/cal4.json --data ${WORK} --gown fine)
 expect_fail("predict with a bad --window" "--window" predict --calibration ${WORK}/cal4.json --data ${WORK} --window 0)
+# --out PREFIX never writes over its input: the dataset's manifest or a trial file (PREFIX.csv),
+# refused before any simulation (`--out DATASET/manifest` once replaced the manifest).
+file(MAKE_DIRECTORY ${WORK}/tiny)
+file(WRITE ${WORK}/tiny/manifest.csv "trial_id,participant,height,speed,label,file\n"
+           "p4,4,high,0.1,good,p4.csv\np5,5,high,0.1,good,p5.csv\n")
+foreach(t p4 p5)
+  file(WRITE ${WORK}/tiny/${t}.csv "t,travel,f_motion,f_lateral,f_vertical\n0,0,0,0,0\n0.01,0.001,-0.1,0,0.1\n"
+             "0.02,0.002,-0.2,0,0.2\n")
+endforeach()
+file(READ ${WORK}/tiny/manifest.csv manifest_before)
+expect_fail("predict --out over its dataset's manifest"
+            "--out ${WORK}/tiny/manifest would write ${WORK}/tiny/manifest.csv over the input"
+            predict --calibration ${WORK}/cal4.json --data ${WORK}/tiny --out ${WORK}/tiny/manifest)
+expect_fail("predict --out over a trial of its dataset" "over the input ${WORK}/tiny/p5.csv"
+            predict --calibration ${WORK}/cal4.json --data ${WORK}/tiny --out ${WORK}/tiny/../tiny/p5)
+file(READ ${WORK}/tiny/manifest.csv manifest_after)
+if(NOT manifest_after STREQUAL manifest_before)
+  message(FATAL_ERROR "predict --out wrote over the dataset's manifest:\n${manifest_after}")
+endif()
 
 # The pooled STC (paper VII: simulators of several people): build-model with two calibrations
 # synthesizes one set per calibration, each the very set `synthesize` makes alone, into a folder

@@ -257,6 +257,11 @@ endforeach()
 if(NOT err MATCHES "corrected by participant '4''s discrepancy" OR l_plain STREQUAL l_discrepancy)
   message(FATAL_ERROR "predict --discrepancy scored the plain simulator (${l_plain}, ${l_discrepancy}):\n${err}")
 endif()
+# And says so in its summary (the two runs' files were once alike but for L).
+if(NOT out_plain MATCHES "\"gown\": \"[a-z]+\", \"discrepancy\": false,"
+   OR NOT out_discrepancy MATCHES "\"gown\": \"[a-z]+\", \"discrepancy\": true,")
+  message(FATAL_ERROR "predict --json does not record the gown and --discrepancy:\n${out_plain}\n${out_discrepancy}")
+endif()
 # The residual table: a header and one row per 0.05 m window to the longest measured travel
 # (0.85 m: 17 windows) for each of the three heights.
 file(STRINGS ${WORK}/pred.residual.csv rows)

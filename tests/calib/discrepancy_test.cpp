@@ -4,6 +4,7 @@
 // The same on the real simulator and the study's data: sim_calibration_test.cpp.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "dataset.h"
@@ -53,6 +54,23 @@ TEST(Discrepancy, GivesBackTheDifferenceItWasMadeWith) {
     for (int k = 0; k < 3; ++k)
       EXPECT_NEAR(r[j][k], g(x)[k], std::abs(slope[k]) * 1e-3) << "grid point " << j << ", force " << k;
   }
+}
+
+// An input whose recording starts 0.0958 m into the pull (s0-middlemiss-10), made as the
+// simulated curve plus 1 N of F_motion: a grid point whose window begins before that start would
+// set the recording's last few samples against the simulator's whole window (here the high arm's
+// drag, steep in travel); it keeps the previous point's value (0: none before) instead. From
+// x = 0.11 m (window [0.10, 0.12)) both curves cover the window: 1 N.
+TEST(Discrepancy, AWindowBeforeALateStartIsNotMeasured) {
+  const auto sim = simulated_curve(ArmHeight::High);
+  HapticSequence late = measured_from(sim, ArmHeight::High, [](double) { return std::array<double, 3>{1.0, 0, 0}; });
+  late.samples.erase(late.samples.begin(), std::find_if(late.samples.begin(), late.samples.end(),
+                                                        [](const HapticSample& x) { return x.travel >= 0.0958; }));
+  const auto d = measure_discrepancy({late}, {sim});
+  const auto& r = d.by_height[static_cast<int>(ArmHeight::High)];
+  ASSERT_GE(r.size(), 12u);
+  for (int j : {8, 9, 10}) EXPECT_EQ(r[static_cast<std::size_t>(j)][0], 0.0) << "grid point " << j;
+  EXPECT_NEAR(r[11][0], 1.0, 1e-9);
 }
 
 TEST(Discrepancy, AddedToTheSimulatedCurveGivesTheMeasuredOne) {

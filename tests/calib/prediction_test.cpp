@@ -232,6 +232,23 @@ std::vector<HapticSample> curve(double end, F f) {
   return s;
 }
 
+// A labelled high-arm trial of `participant` in `ds`, with its simulated curve in `p`.
+void add_high_pair(Dataset& ds, Prediction& p, const std::string& id, const std::string& participant,
+                   std::vector<HapticSample> measured, std::vector<HapticSample> simulated) {
+  HapticSequence m;
+  m.id = id;
+  m.participant = participant;
+  m.height = ArmHeight::High;
+  m.label = Outcome::Good;
+  m.samples = std::move(measured);
+  ds.trials.push_back(std::move(m));
+  PredictedTrial t;
+  t.trial_id = id;
+  t.participant = participant;
+  t.simulated = std::move(simulated);
+  p.trials.push_back(std::move(t));
+}
+
 // The residual by hand: four people at the high arm pull F_motion -1, -2, -3, -2 N (mean -2, sample
 // spread sqrt(2/3) N) and F_vertical 0.1 N to 0.41 m; the simulation matches them to 0.2 m (F_motion)
 // and 0.1 m (F_vertical), then drags 2 N more, and its F_vertical is 0.4 N higher to 0.3 m and 0.4 N
@@ -318,7 +335,7 @@ TEST(Prediction, ResidualWindowsAndFindingsByHand) {
   // The CSV has a header and one row per window; a window that is not positive is refused.
   const std::string csv = residual_csv(w);
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 19);
-  EXPECT_EQ(csv.rfind("height,from,to,trials,measured_motion", 0), 0u);
+  EXPECT_EQ(csv.rfind("height,from,to,trials,people,measured_motion", 0), 0u);
   EXPECT_THROW(residual_windows(p, ds, 0.0), std::invalid_argument);
   // A simulation that matches every person's mean everywhere has nothing to report.
   for (auto& t : p.trials) t.simulated = find(ds, t.trial_id).samples;
@@ -442,7 +459,7 @@ TEST(Prediction, HeightContrastsByHand) {
   // The CSV: a header and one row per entry. A simulator that is the people has no finding.
   const std::string csv = contrast_csv(c);
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 11);
-  EXPECT_EQ(csv.rfind("lower,from,to,trials_high,trials_lower,measured_motion", 0), 0u);
+  EXPECT_EQ(csv.rfind("lower,from,to,trials_high,trials_lower,people_high,people_lower,measured_motion", 0), 0u);
   for (auto& t : p.trials) t.simulated = find(ds, t.trial_id).samples;
   EXPECT_TRUE(contrast_findings(height_contrasts(residual_windows(p, ds, 0.1))).empty());
 }
@@ -525,6 +542,92 @@ TEST(Prediction, LateralForceInTheResidualAndTheContrast) {
 // simulation of constant +0.5 N has its sign on half of that travel, one of -0.5 N on the other
 // half; a simulation that ends at 0.2 m is asked only about its own travel; a measurement that
 // never exceeds the threshold asks nothing.
+// A target slower than the rig's pulls: 0.85 m at 0.04 m/s is 2126 samples of the stand-in, more
+// than the 1500 a fixed block once held (predict stopped with an internal error after simulating
+// every target). The block is sized from the targets: the whole curve comes back.
+TEST(Prediction, ASlowPullComesBackWhole) {
+  Dataset ds = people({kB});
+  ds.trials[2].speed = 0.04;  // p2-low: the stand-in's low arm pulls to the end of travel
+  TrialRequest r = request_for(ds.trials[2], kA.offsets);
+  const std::size_t expected = testing::fake_simulate(kA.cloth, r).samples.size();
+  ASSERT_GT(expected, 1500u);
+  const Prediction p = predict_others(calibration_of(kA), ds, testing::fake_simulate, 2, Comm::world());
+  ASSERT_EQ(p.trials.size(), 3u);
+  EXPECT_EQ(p.trials[2].simulated.size(), expected);
+  EXPECT_NEAR(p.trials[2].simulated.back().travel, r.max_travel, 1e-9);
+}
+
+// High arm, 0.05 m windows: people 2 and 3 pull F_motion -1 N from the start; person 4 pulls -3 N
+// but the recording starts 0.0958 m in (s0-middlemiss-10's start). The simulation pulls -2 N.
+// [0.05, 0.10) holds person 4's last few samples only: that window is not covered by that trial
+// (records_from), [0.10, 0.15) is.
+TEST(Prediction, ResidualWindowsLeaveOutARecordingThatStartsInsideTheWindow) {
+  Dataset ds;
+  Prediction p;
+  p.participant = "1";
+  for (int k = 0; k < 3; ++k) {
+    auto measured = curve(0.3, [&](double) { return std::pair{k == 2 ? -3.0 : -1.0, 0.0}; });
+    if (k == 2)
+      measured.erase(measured.begin(), std::find_if(measured.begin(), measured.end(),
+                                                    [](const HapticSample& x) { return x.travel >= 0.0958; }));
+    add_high_pair(ds, p, "p" + std::to_string(k + 2) + "-high", std::to_string(k + 2), measured,
+                  curve(0.3, [](double) { return std::pair{-2.0, 0.0}; }));
+  }
+  const std::vector<ResidualWindow> w = residual_windows(p, ds, 0.05);
+  ASSERT_GE(w.size(), 3u);
+  EXPECT_EQ(w[0].trials, 2);
+  EXPECT_EQ(w[1].trials, 2) << "[0.05, 0.10): the late recording holds only 0.0958-0.10 m of it";
+  EXPECT_NEAR(w[1].measured[0], -1.0, 1e-12);
+  EXPECT_EQ(w[2].trials, 3);
+  EXPECT_NEAR(w[2].measured[0], -5.0 / 3, 1e-12);
+}
+
+// The people's spread is over people: person 2 has two trials (F_motion -1 and -1 N), persons 3
+// and 4 one each (-3 and -2 N). Per person the means are -1, -3, -2: mean -2, spread 1, n 3 (over
+// the four trials it was mean -1.75 and spread 0.957). The simulated mean is weighed alike:
+// person 2's two simulated trials (-4 and -2 N) count once, as -3.
+TEST(Prediction, ResidualSpreadAndMeanAreOverPeopleNotTrials) {
+  Dataset ds;
+  Prediction p;
+  p.participant = "1";
+  const std::pair<const char*, double> trials[4] = {{"2", -1.0}, {"2", -1.0}, {"3", -3.0}, {"4", -2.0}};
+  const double simulated[4] = {-4.0, -2.0, -2.0, -2.0};
+  for (int k = 0; k < 4; ++k) {
+    const double f = trials[k].second, g = simulated[k];
+    add_high_pair(ds, p, "t" + std::to_string(k), trials[k].first, curve(0.1, [f](double) { return std::pair{f, 0.0}; }),
+                  curve(0.1, [g](double) { return std::pair{g, 0.0}; }));
+  }
+  const std::vector<ResidualWindow> w = residual_windows(p, ds, 0.05);
+  ASSERT_EQ(w.size(), 2u);
+  EXPECT_EQ(w[0].trials, 4);
+  EXPECT_EQ(w[0].people, 3);
+  EXPECT_NEAR(w[0].measured[0], -2.0, 1e-12);
+  EXPECT_NEAR(w[0].spread[0], 1.0, 1e-12);
+  EXPECT_NEAR(w[0].simulated[0], -7.0 / 3, 1e-12);
+  EXPECT_EQ(residual_csv(w).rfind("height,from,to,trials,people,", 0), 0u);
+}
+
+// --discrepancy and --gown leave their trace: the curves' source and the per-trial table's last
+// columns.
+TEST(Prediction, OutputsSayWhatSimulatedTheCurves) {
+  const Dataset ds = people({kA, kB});
+  Calibration cal = calibration_of(kA);
+  cal.gown = "coarse";
+  Prediction p = predict_others(cal, ds, testing::fake_simulate, 1, Comm::world());
+  EXPECT_EQ(p.gown, "coarse");
+  EXPECT_FALSE(p.discrepancy);
+  EXPECT_NE(prediction_curves_csv(p, ds).find(",simulated,"), std::string::npos);
+  EXPECT_NE(prediction_csv(p).find(",missed,coarse,0\n"), std::string::npos) << prediction_csv(p);
+  Discrepancy d;
+  d.by_height[0] = {{0.1, 0.0, 0.0}};
+  add_discrepancy(p, d, ds, ObjectiveKind::Area);
+  EXPECT_TRUE(p.discrepancy);
+  const std::string curves = prediction_curves_csv(p, ds);
+  EXPECT_NE(curves.find(",simulated+discrepancy,"), std::string::npos);
+  EXPECT_EQ(curves.find(",simulated,"), std::string::npos);
+  EXPECT_NE(prediction_csv(p).find(",coarse,1\n"), std::string::npos) << prediction_csv(p);
+}
+
 TEST(Objective, VerticalSignAgreementClosedForm) {
   auto curve = [](double end, auto fv) {
     std::vector<HapticSample> s;

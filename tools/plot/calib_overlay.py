@@ -15,13 +15,15 @@ Modes:
             `dressguard predict --out PREFIX`: per arm height, the other participants' measured
             curves (one colour per trial) with the calibrated simulator's curve of each (black,
             dashed), and per trial the simulator's L against the median L of a real
-            third person (the yardstick; below the diagonal: no worse than a real person).
+            third person (the yardstick; below the diagonal: no worse than a real person). The
+            titles say which gown simulated and whether predict's --discrepancy corrected it.
   residual: calib_overlay.py residual PREFIX --out residual.png
             `dressguard predict --out PREFIX`'s PREFIX.residual.csv: per arm height and force, the
             people's mean force per travel window with their spread (grey band, +-1 standard
-            deviation) and the simulated mean (black); windows where the simulation is further from
-            the people's mean than they are from each other are shaded red (what the simulation
-            gets wrong, offline/calib/prediction.h).
+            deviation between people, each person's trials averaged first) and the simulated mean
+            (black); windows where the simulation is further from the people's mean than they are
+            from each other are shaded red (what the simulation gets wrong,
+            offline/calib/prediction.h).
   contrast: calib_overlay.py contrast PREFIX --out contrast.png
             `dressguard predict --out PREFIX`'s PREFIX.contrast.csv: per lower arm height (middle,
             low) and force, the people's difference high minus that height per travel window with
@@ -181,8 +183,23 @@ def plot_dataset(args):
     save_figure(fig, args.out, dpi=110)
 
 
+def simulated_by(prefix):
+    """What simulated a `dressguard predict --out PREFIX`'s curves, for the titles: the gown and
+    whether its discrepancy term corrected them (PREFIX.csv's gown and discrepancy columns; a file
+    written before they were has neither)."""
+    with open(prefix + ".csv", newline="") as f:
+        first = next(csv.DictReader(f), {})
+    parts = []
+    if first.get("gown"):
+        parts.append(f"{first['gown']} gown")
+    if first.get("discrepancy") == "1":
+        parts.append("+ discrepancy term")
+    return ("simulator: " + " ".join(parts)) if parts else "simulator"
+
+
 def plot_predict(args):
     rows = list(csv.DictReader(open(args.prefix + ".csv", newline="")))
+    by = simulated_by(args.prefix)
     curves = collections.defaultdict(lambda: collections.defaultdict(list))
     with open(args.prefix + ".curves.csv", newline="") as f:
         for r in csv.DictReader(f):
@@ -196,13 +213,15 @@ def plot_predict(args):
             color = plt.cm.tab10(k % 10)
             # The simulated curves of one height are one pull cut at each trial's end of travel
             # (or at another speed): drawn in black, so the measured ones stay apart.
+            sources = curves[r["trial_id"]]
+            simulated = next((src for src in sources if src.startswith("simulated")), "simulated")
             for col, idx in enumerate((1, 2)):
-                for src, c, ls, lw in (("measured", color, "-", 1.1), ("simulated", "black", "--", 1.4)):
-                    pts = curves[r["trial_id"]][src]
+                for src, c, ls, lw in (("measured", color, "-", 1.1), (simulated, "black", "--", 1.4)):
+                    pts = sources[src]
                     axes[i][col].plot([p[0] for p in pts], [p[idx] for p in pts], color=c, ls=ls, lw=lw,
                                       label=r["trial_id"] if src == "measured" and col == 0 else None)
         for col, name in enumerate(("F_motion [N]", "F_vertical [N]")):
-            axes[i][col].set_title(f"{h} arm: measured (colours), simulated (black, dashed)")
+            axes[i][col].set_title(f"{h} arm: measured (colours), {by} (black, dashed)", fontsize=9)
             axes[i][col].set_xlabel("travel [m]")
             axes[i][col].set_ylabel(name)
             axes[i][col].grid(alpha=0.3)
@@ -218,7 +237,7 @@ def plot_predict(args):
         ax.set_ylim(0, top)
         ax.set_xlabel("L of a real third person (median)")
         ax.set_ylabel("L of the calibrated simulator")
-        ax.set_title(f"{h} arm: eq. 3-5, w = 20")
+        ax.set_title(f"{h} arm: eq. 3-5, w = 20 ({by})", fontsize=9)
         ax.grid(alpha=0.3)
     fig.tight_layout()
     save_figure(fig, args.out, dpi=100)
@@ -231,6 +250,7 @@ def present_forces(rows):
 
 def plot_residual(args):
     rows = list(csv.DictReader(open(args.prefix + ".residual.csv", newline="")))
+    by = simulated_by(args.prefix)
     heights = [h for h in ("high", "middle", "low") if any(r["height"] == h for r in rows)]
     forces = present_forces(rows)
     fig, axes = plt.subplots(len(heights), len(forces), figsize=(6 * len(forces), 3.4 * len(heights)), squeeze=False)
@@ -243,14 +263,15 @@ def plot_residual(args):
                 m, sd, sim = (float(r[k + "_" + axis]) for k in ("measured", "spread", "simulated"))
                 if r["outside_" + axis] == "1":
                     ax.axvspan(a, b, color="tab:red", alpha=0.15, lw=0)
-                if sd == sd:  # one trial has no spread
+                if sd == sd:  # one person has no spread
                     ax.fill_between([a, b], [m - sd] * 2, [m + sd] * 2, color="gray", alpha=0.35, lw=0)
                 ax.plot([a, b], [m, m], color="tab:blue", lw=1.5)
                 ax.plot([a, b], [sim, sim], color="black", lw=1.5)
-            ax.plot([], [], color="tab:blue", label="people's mean (+-1 sd, grey)")
+            ax.plot([], [], color="tab:blue", label="people's mean (+-1 sd between people, grey; "
+                    "each person's trials averaged first)")
             ax.plot([], [], color="black", label="simulated mean")
             ax.fill_between([], [], [], color="tab:red", alpha=0.15, label="outside the people")
-            ax.set_title(f"{h} arm: residual per travel window")
+            ax.set_title(f"{h} arm: residual per travel window ({by})", fontsize=9)
             ax.set_xlabel("travel [m]")
             ax.set_ylabel(name)
             ax.grid(alpha=0.3)
@@ -261,6 +282,7 @@ def plot_residual(args):
 
 def plot_contrast(args):
     rows = list(csv.DictReader(open(args.prefix + ".contrast.csv", newline="")))
+    by = simulated_by(args.prefix)
     lowers = [h for h in ("middle", "low") if any(r["lower"] == h for r in rows)]
     shade = {"reverses": ("tab:red", "simulator reverses it"), "misses": ("tab:orange", "simulator misses it")}
     forces = present_forces(rows)
@@ -279,11 +301,11 @@ def plot_contrast(args):
                 ax.plot([a, b], [m, m], color="tab:blue", lw=1.5)
                 ax.plot([a, b], [sim, sim], color="black", lw=1.5)
             cut_axes(ax, f"{name} difference [N]")
-            ax.plot([], [], color="tab:blue", label="people (+-2 standard errors, grey)")
-            ax.plot([], [], color="black", label="simulator")
+            ax.plot([], [], color="tab:blue", label="people (+-2 standard errors over people, grey)")
+            ax.plot([], [], color="black", label=by)
             for colour, label in shade.values():
                 ax.fill_between([], [], [], color=colour, alpha=0.2, label=label)
-            ax.set_title(f"{name}: high arm (good) minus {h} arm (missed)")
+            ax.set_title(f"{name}: high arm (good) minus {h} arm (missed) ({by})", fontsize=9)
             ax.legend(fontsize=7, loc="lower left")
     fig.tight_layout()
     save_figure(fig, args.out, dpi=100)
