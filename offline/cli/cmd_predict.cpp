@@ -129,9 +129,9 @@ int run_predict(int argc, char** argv) {
   }
   const std::vector<PredictionSummary> sum = summarize(p);
   if (args.has("json")) {
-    std::printf("{\"participant\": %s, \"gown\": %s, \"discrepancy\": %s, \"trials\": %zu, \"heights\": [",
-                json_string(p.participant).c_str(), json_string(p.gown).c_str(), p.discrepancy ? "true" : "false",
-                p.trials.size());
+    std::printf("{\"participant\": %s, \"trials\": %zu, \"gown\": %s, \"discrepancy\": %s, \"heights\": [",
+                json_string(p.participant).c_str(), p.trials.size(), json_string(p.gown).c_str(),
+                p.discrepancy ? "true" : "false");
     bool first = true;
     for (const auto& s : sum) {
       if (s.trials == 0) continue;
@@ -146,10 +146,10 @@ int run_predict(int argc, char** argv) {
     first = true;
     for (const auto& f : findings) {
       std::printf("%s{\"height\": \"%s\", \"force\": \"%s\", \"from_m\": %s, \"to_m\": %s, \"residual_n\": %s, "
-                  "\"measured_n\": %s, \"spread_n\": %s, \"trials\": %d}",
+                  "\"measured_n\": %s, \"spread_n\": %s, \"trials\": %d, \"people\": %d}",
                   first ? "" : ", ", std::string(arm_height_name(f.height)).c_str(), force_column(f.axis),
                   number(f.from).c_str(), number(f.to).c_str(), number(f.residual).c_str(), number(f.measured).c_str(),
-                  number(f.spread).c_str(), f.trials);
+                  number(f.spread).c_str(), f.trials, f.people);
       first = false;
     }
     std::printf("], \"contrast_findings\": [");
