@@ -424,7 +424,7 @@ std::vector<ResidualFinding> residual_findings(const std::vector<ResidualWindow>
                                                      : "pulls the gripper away from the person too much");
       char buf[320];
       std::snprintf(buf, sizeof buf, "%s arm, %s, %.2f-%.2f m: %s, simulated %+.2f N from the people's mean %.2f N "
-                    "(their spread %.2f N over %d people, %d trials averaged per person)",
+                    "(their spread %.2f N over %d people; %d trials, each person's averaged first)",
                     std::string(arm_height_name(f.height)).c_str(), force_name(ax), f.from, f.to, what, f.residual,
                     f.measured, f.spread, f.people, f.trials);
       f.text = buf;
