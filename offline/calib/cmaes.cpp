@@ -215,8 +215,12 @@ void Cmaes::tell(const std::vector<double>& f_in) {
   if (static_cast<int>(f_in.size()) != lambda) throw std::invalid_argument("cmaes: tell() needs lambda values");
   asked_ = false;
   std::vector<double> f(f_in);
-  for (double& v : f)
-    if (!std::isfinite(v)) v = std::numeric_limits<double>::max();  // failures rank last
+  std::vector<char> failed(static_cast<std::size_t>(lambda), 0);
+  for (int k = 0; k < lambda; ++k)
+    if (!std::isfinite(f[k])) {
+      f[k] = std::numeric_limits<double>::max();  // failures rank last
+      failed[k] = 1;
+    }
   state_.evaluations += lambda;
   state_.generations_total += 1;
   for (int k = 0; k < lambda; ++k) {
@@ -226,20 +230,31 @@ void Cmaes::tell(const std::vector<double>& f_in) {
     }
   }
   // Ranking values: the repaired point's value plus the boundary penalty (cmaes.h, Appendix B.5).
+  // The penalty's weight is the spread of the values that were evaluated: the IQR of the finite
+  // ones. A failed evaluation has no value; counted as DBL_MAX, a quarter of a generation failing
+  // made the weight DBL_MAX and every repaired candidate's rank value infinite, behind the failures,
+  // which then took positive weights in eq. 41 (session 84's review, finding 6).
   std::vector<double> rank_f(f);
   if (settings_.lower) {
-    std::vector<double> sorted(f);
+    std::vector<double> sorted;
+    for (int k = 0; k < lambda; ++k)
+      if (!failed[k]) sorted.push_back(f[k]);
     std::sort(sorted.begin(), sorted.end());
-    const double iqr = sorted[(3 * (lambda - 1)) / 4] - sorted[(lambda - 1) / 4];
+    const std::size_t m = sorted.size();
+    const double iqr = m == 0 ? 0.0 : sorted[(3 * (m - 1)) / 4] - sorted[(m - 1) / 4];
     const double gamma = std::max(iqr, 1e-12);
     for (int k = 0; k < lambda; ++k) {
       const double d2 = (x_unrepaired_[k] - x_repaired_[k]).squaredNorm();
-      if (d2 > 0) rank_f[k] = f[k] + gamma * d2 / (state_.sigma * state_.sigma);
+      if (d2 > 0 && !failed[k]) rank_f[k] = f[k] + gamma * d2 / (state_.sigma * state_.sigma);
     }
   }
+  // Failures last whatever a penalty adds to the others (a rank value may overflow to infinity),
+  // in their index order.
   std::vector<int> order(lambda);
   std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return rank_f[a] < rank_f[b]; });
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return failed[a] != failed[b] ? failed[b] != 0 : rank_f[a] < rank_f[b];
+  });
 
   // eq. 41: <y>_w = sum_{i<=mu} w_i y_{i:lambda}; eq. 42: m <- m + c_m sigma <y>_w (c_m = 1).
   Eigen::VectorXd y_w = Eigen::VectorXd::Zero(n);
@@ -278,9 +293,10 @@ void Cmaes::tell(const std::vector<double>& f_in) {
   state_.sigma *= std::exp(std::min(1.0, (c_sigma_ / d_sigma_) * (ps_norm / chi_n_ - 1.0)));
   update_eigen();
 
-  // Histories for TolFun and stagnation.
+  // Histories for TolFun and stagnation, and this generation's range (TolFun).
   std::vector<double> sorted(f);
   std::sort(sorted.begin(), sorted.end());
+  const double range = sorted.back() - sorted.front();
   state_.best_history.push_back(sorted.front());
   state_.median_history.push_back(sorted[lambda / 2]);
   state_.generation += 1;
@@ -298,20 +314,22 @@ void Cmaes::tell(const std::vector<double>& f_in) {
     state_.stopped = StopReason::MaxGenerations;
     return;
   }
-  const StopReason local = local_stop();
-  if (local != StopReason::None) {
-    // Range of this generation for TolFun uses the repaired values; fine for a stop test.
-    on_local_stop(local);
-  }
+  // The range of this generation is of the repaired points' values (without the penalty): the
+  // values the objective gave, which is what TolFun asks about.
+  const StopReason local = local_stop(range);
+  if (local != StopReason::None) on_local_stop(local);
 }
 
 // Termination criteria of Appendix B.3 that end one restart.
-StopReason Cmaes::local_stop() const {
+StopReason Cmaes::local_stop(double generation_range) const {
   const int n = state_.n;
   const auto& bh = state_.best_history;
-  // TolFun: range of the best values of the last 10 + ceil(30 n / lambda) generations below tol_fun.
+  // TolFun (Appendix B.3): the range of the best values of the last 10 + ceil(30 n / lambda)
+  // generations and the range of this generation's values both below tol_fun. The first alone
+  // stops on a plateau whose generation still spreads widely (the best stays put while the
+  // samples do not: session 84's review, finding 8).
   const std::size_t window = 10 + static_cast<std::size_t>(std::ceil(30.0 * n / state_.lambda));
-  if (bh.size() >= window) {
+  if (bh.size() >= window && generation_range < settings_.tol_fun) {
     const auto [lo, hi] = std::minmax_element(bh.end() - window, bh.end());
     if (*hi - *lo < settings_.tol_fun) return StopReason::TolFun;
   }

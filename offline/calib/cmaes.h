@@ -56,7 +56,8 @@ struct CmaesSettings {
   // Box bounds (both or neither, size n). Method: a candidate outside the box is evaluated at its
   // projection onto the box (the "repair"), and its value for ranking is f(repaired) plus
   // gamma * ||x - repaired||^2 / sigma^2, gamma the interquartile range of the generation's
-  // values (at least 1e-12); the update uses the unrepaired x. This is the tutorial's
+  // values that are finite (at least 1e-12); the update uses the unrepaired x. A non-finite value
+  // (a failed evaluation) gets no penalty and ranks behind every finite one. This is the tutorial's
   // "repair and penalise" boundary handling (Appendix B.5) with the penalty weight taken from the
   // spread of the generation's values, as Hansen's cmaes.m does for its boundary weights. Points
   // handed out by ask() are always the repaired ones, so the caller never sees an infeasible x.
@@ -132,7 +133,8 @@ class Cmaes {
   struct Strategy;  // weights and learning rates for the current lambda (eq. 49-58)
   void start_restart(int lambda, double sigma, bool reset_mean);
   void update_eigen();
-  StopReason local_stop() const;
+  // The local stop that fires after a tell(); `generation_range`: max f - min f of its values.
+  StopReason local_stop(double generation_range) const;
   void on_local_stop(StopReason r);
 
   CmaesSettings settings_;

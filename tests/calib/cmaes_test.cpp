@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <functional>
+#include <limits>
+#include <numeric>
 #include <vector>
 
 #include "cmaes.h"
@@ -132,6 +134,98 @@ TEST(Cmaes, BoundsRepairKeepsPointsFeasibleAndFindsFaceOptimum) {
   EXPECT_NEAR(es.best_x()[1], 0.3, 1e-4);
   EXPECT_NEAR(es.best_x()[3], 0.9, 1e-4);
   EXPECT_NEAR(es.best_f(), 1.0, 1e-4);
+}
+
+// Failed evaluations (NaN, as a simulation that blew up) in a bounded search: the boundary
+// penalty's weight is the IQR of the finite values, and the failures rank behind every finite
+// candidate, repaired or not. Session 84's review (finding 6): 3 of 8 failing made the weight
+// DBL_MAX, so the repaired candidates ranked behind the failures and two failures were among
+// the mu = 4 that set the mean (eq. 41-42). The mean after tell() must be the one the finite
+// rule predicts: m + sum_{i<=mu} w_i (x_{i:lambda} - m), with the unrepaired points of an
+// unbounded twin (same seed, same samples) and the positive weights of eq. 49.
+TEST(Cmaes, FailedEvaluationsRankLastAndLeaveThePenaltyWeightAlone) {
+  const int n = 2, lambda = 8;
+  CmaesSettings s;
+  s.x0 = Eigen::VectorXd::Constant(n, 0.05);
+  s.sigma0 = 0.3;
+  s.lambda = lambda;
+  s.seed = 3;
+  const CmaesSettings unbounded = s;
+  s.lower = Eigen::VectorXd::Zero(n);
+  s.upper = Eigen::VectorXd::Ones(n);
+  Cmaes es(s), twin(unbounded);
+  const std::vector<Eigen::VectorXd> xr = es.ask(), xu = twin.ask();
+  // f = the sum of the repaired point; the three candidates of the largest first coordinate fail.
+  std::vector<int> by_x0(lambda);
+  std::iota(by_x0.begin(), by_x0.end(), 0);
+  std::sort(by_x0.begin(), by_x0.end(), [&](int a, int b) { return xr[a][0] > xr[b][0]; });
+  std::vector<double> f(lambda);
+  std::vector<char> failed(lambda, 0);
+  for (int k = 0; k < lambda; ++k) f[k] = xr[k].sum();
+  for (int j = 0; j < 3; ++j) {
+    f[by_x0[j]] = std::numeric_limits<double>::quiet_NaN();
+    failed[by_x0[j]] = 1;
+  }
+  int repaired = 0;
+  for (int k = 0; k < lambda; ++k) repaired += !failed[k] && xr[k] != xu[k];
+  ASSERT_GT(repaired, 0) << "no finite candidate was repaired: the case shows nothing";
+  // The finite rule's ranking and mean.
+  std::vector<double> finite;
+  for (int k = 0; k < lambda; ++k)
+    if (!failed[k]) finite.push_back(f[k]);
+  std::sort(finite.begin(), finite.end());
+  const std::size_t m = finite.size();
+  const double gamma = std::max(finite[(3 * (m - 1)) / 4] - finite[(m - 1) / 4], 1e-12);
+  std::vector<double> rank(lambda);
+  for (int k = 0; k < lambda; ++k)
+    rank[k] = failed[k] ? std::numeric_limits<double>::infinity()
+                        : f[k] + gamma * (xu[k] - xr[k]).squaredNorm() / (s.sigma0 * s.sigma0);
+  std::vector<int> order(lambda);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return rank[a] < rank[b]; });
+  const int mu = es.mu();
+  ASSERT_EQ(mu, 4);
+  std::vector<double> w(mu);
+  double sum_w = 0;
+  for (int i = 0; i < mu; ++i) sum_w += w[i] = std::log((lambda + 1) / 2.0) - std::log(i + 1.0);
+  Eigen::VectorXd mean = s.x0;
+  for (int i = 0; i < mu; ++i) mean += w[i] / sum_w * (xu[order[i]] - s.x0);
+  es.tell(f);
+  EXPECT_LT((es.state().mean - mean).norm(), 1e-12) << "mean " << es.state().mean.transpose() << ", the finite rule's "
+                                                    << mean.transpose();
+}
+
+// TolFun is the tutorial's two conditions (Appendix B.3): the recent best values and this
+// generation's values each within tol_fun. On a plateau (f = 0 for |x|_inf < 0.5, |x|_inf
+// outside) the best stays 0 while some samples may still fall outside: with the recent bests
+// alone, seed 4 stopped after 21 generations with that generation's values 0.75 apart (session
+// 84's review, finding 8); now after 23, once every sample is on the plateau. Seeds 1-3 and 5
+// stop where they did, their last generation already flat.
+TEST(Cmaes, TolFunNeedsThisGenerationsRangeToo) {
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    CmaesSettings s;
+    s.x0 = Eigen::VectorXd::Zero(2);
+    s.sigma0 = 1.0;
+    s.lambda = 6;
+    s.seed = seed;
+    s.max_generations = 2000;
+    Cmaes es(s);
+    double range = 0;
+    while (!es.stopped()) {
+      const std::vector<Eigen::VectorXd> xs = es.ask();
+      std::vector<double> f;
+      for (const Eigen::VectorXd& x : xs) {
+        const double a = x.cwiseAbs().maxCoeff();
+        f.push_back(a < 0.5 ? 0.0 : a);
+      }
+      range = *std::max_element(f.begin(), f.end()) - *std::min_element(f.begin(), f.end());
+      es.tell(f);
+    }
+    std::printf("  plateau, seed %d: stopped by %s after %ld generations, their last range %g\n",
+                static_cast<int>(seed), stop_reason_name(es.stop_reason()), es.state().generations_total, range);
+    EXPECT_EQ(es.stop_reason(), StopReason::TolFun) << seed;
+    EXPECT_LT(range, s.tol_fun) << seed;
+  }
 }
 
 // Rastrigin in 5-D has many local optima; the default population usually ends in one (TolFun).
