@@ -1,6 +1,8 @@
 // Minimal JSON, see json.h.
 #include "json.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -174,7 +176,10 @@ struct Parser {
           case 'b': out += '\b'; break;
           case 'f': out += '\f'; break;
           case 'u': {
-            if (i + 4 > s.size()) fail("bad \\u escape");
+            // Exactly four hex digits (strtol alone took "00zz" as 0).
+            if (i + 4 > s.size() || !std::all_of(s.begin() + static_cast<long>(i), s.begin() + static_cast<long>(i) + 4,
+                                                 [](char h) { return std::isxdigit(static_cast<unsigned char>(h)); }))
+              fail("\\u needs four hex digits");
             const long code = std::strtol(s.substr(i, 4).c_str(), nullptr, 16);
             i += 4;
             if (code > 0x7f) fail("non-ASCII \\u escape not supported");
@@ -191,41 +196,79 @@ struct Parser {
     ++i;
     return out;
   }
+  // A number as JSON spells it (RFC 8259, section 6): -? (0 | [1-9][0-9]*) (.[0-9]+)? ([eE][+-]?[0-9]+)?
+  // and within a double's range. strtod alone also took nan, inf, hex and a leading '+' (a NaN arm
+  // offset passed read_calibration: session 84's review, finding 4), and made 1e999 infinite.
+  Json number() {
+    const std::size_t from = i;
+    auto digits = [&] {
+      const std::size_t d = i;
+      while (i < s.size() && s[i] >= '0' && s[i] <= '9') ++i;
+      return i > d;
+    };
+    if (i < s.size() && s[i] == '-') ++i;
+    if (i < s.size() && s[i] == '0') ++i;
+    else if (!(i < s.size() && s[i] >= '1' && s[i] <= '9' && digits())) {
+      i = from;
+      fail(std::string("unexpected character '") + s[i] + "'");
+    }
+    if (i < s.size() && s[i] == '.') {
+      ++i;
+      if (!digits()) fail("a digit must follow the decimal point");
+    }
+    if (i < s.size() && (s[i] == 'e' || s[i] == 'E')) {
+      ++i;
+      if (i < s.size() && (s[i] == '+' || s[i] == '-')) ++i;
+      if (!digits()) fail("a digit must follow the exponent's 'e'");
+    }
+    const double v = std::strtod(s.substr(from, i - from).c_str(), nullptr);
+    if (!std::isfinite(v)) fail("number " + s.substr(from, i - from) + " is beyond a double's range");
+    return Json(v);
+  }
+  // Arrays and objects nest at most this deep: each level is a frame of value()'s recursion,
+  // and 200000 '[' overflowed the stack (SIGSEGV) instead of naming the file (finding 7). A
+  // calibration file nests 6 deep (provenance "rescored").
+  static constexpr int kMaxDepth = 256;
+  int depth = 0;
   Json value() {
     ws();
     if (i >= s.size()) fail("unexpected end");
     const char c = s[i];
+    if ((c == '{' || c == '[') && depth == kMaxDepth)
+      fail("arrays and objects nested deeper than " + std::to_string(kMaxDepth));
     if (c == '{') {
       ++i;
+      ++depth;
       Json o = Json::object();
-      if (eat('}')) return o;
-      do {
-        ws();
-        std::string k = str();
-        expect(':');
-        o.set(k, value());
-      } while (eat(','));
-      expect('}');
+      if (!eat('}')) {
+        do {
+          ws();
+          std::string k = str();
+          expect(':');
+          o.set(k, value());
+        } while (eat(','));
+        expect('}');
+      }
+      --depth;
       return o;
     }
     if (c == '[') {
       ++i;
+      ++depth;
       Json a = Json::array();
-      if (eat(']')) return a;
-      do a.push(value());
-      while (eat(','));
-      expect(']');
+      if (!eat(']')) {
+        do a.push(value());
+        while (eat(','));
+        expect(']');
+      }
+      --depth;
       return a;
     }
     if (c == '"') return Json(str());
     if (s.compare(i, 4, "true") == 0) { i += 4; return Json(true); }
     if (s.compare(i, 5, "false") == 0) { i += 5; return Json(false); }
     if (s.compare(i, 4, "null") == 0) { i += 4; return Json(); }
-    char* end = nullptr;
-    const double v = std::strtod(s.c_str() + i, &end);
-    if (end == s.c_str() + i) fail(std::string("unexpected character '") + c + "'");
-    i = static_cast<std::size_t>(end - s.c_str());
-    return Json(v);
+    return number();
   }
 };
 }  // namespace

@@ -2,7 +2,9 @@
 //
 // Only what dg_calib writes: objects, arrays, strings (with \" \\ \n \t \uXXXX for ASCII),
 // numbers, true/false/null. Numbers are written with 17 significant digits, so a value read back
-// is the same double. Parse errors throw InputError naming the file and line.
+// is the same double. Parse errors throw InputError naming the file and line; among them a
+// number not spelt as JSON spells it (nan, inf, hex, a leading '+') or beyond a double's range,
+// a \u without four hex digits, and arrays and objects nested more than 256 deep.
 #pragma once
 
 #include <filesystem>
