@@ -95,21 +95,37 @@ Bounds read_bounds(const std::filesystem::path& path) {
   std::istringstream in(read_file(path));
   std::string line;
   long n = 0;
+  std::map<std::string, long> seen;  // each name's line: a second box for it is refused
   while (std::getline(in, line)) {
     ++n;
     if (const auto hash = line.find('#'); hash != std::string::npos) line.resize(hash);
     std::istringstream row(line);
     std::string name;
     if (!(row >> name)) continue;  // blank or comment
-    ParamBound pb;
-    if (!(row >> pb.lower >> pb.upper)) throw_input_error(path, n, "expected 'name lower upper [initial]'");
-    if (!(pb.lower < pb.upper)) throw_input_error(path, n, "lower bound must be below upper bound for " + name);
-    double initial = 0;
-    pb.initial = (row >> initial) ? initial : 0.5 * (pb.lower + pb.upper);
+    // Each number a whole finite word: `row >> double` stopped at "initial=0.4" and the line was
+    // taken with its midpoint as the start (session 84's review, finding 3).
+    std::vector<std::string> words;
+    for (std::string w; words.size() < 3 && row >> w;) words.push_back(w);
+    if (words.size() < 2) throw_input_error(path, n, "expected 'name lower upper [initial]'");
     std::string extra;
     if (row >> extra) throw_input_error(path, n, "unexpected '" + extra + "' after the bounds of " + name);
+    auto number = [&](const std::string& word, const char* what) {
+      char* end = nullptr;
+      const double v = std::strtod(word.c_str(), &end);
+      if (end != word.c_str() + word.size() || !std::isfinite(v))
+        throw_input_error(path, n, std::string(what) + " of " + name + ": '" + word + "' is not a number");
+      return v;
+    };
+    ParamBound pb;
+    pb.lower = number(words[0], "lower bound");
+    pb.upper = number(words[1], "upper bound");
+    if (!(pb.lower < pb.upper)) throw_input_error(path, n, "lower bound must be below upper bound for " + name);
+    pb.initial = words.size() == 3 ? number(words[2], "initial value") : 0.5 * (pb.lower + pb.upper);
+    pb.line = n;
     if (pb.initial < pb.lower || pb.initial > pb.upper)
       throw_input_error(path, n, "initial value of " + name + " is outside its bounds");
+    if (const auto [at, fresh] = seen.emplace(name, n); !fresh)
+      throw_input_error(path, n, name + " was given on line " + std::to_string(at->second) + " already");
     // The heights share one box, named "arm_offset" here; find_param knows each height's name.
     std::optional<ParamRef> ref = ParamRef{ParamRef::Kind::Offset, 0};
     if (name != "arm_offset") {
@@ -259,6 +275,29 @@ bool set_person_param(ParameterSpace& space, int i, const std::string& word) {
       return false;
   }
   space.person[i] = {false, v};
+  return true;
+}
+
+bool fit_rim_shift_to_gown(ParameterSpace& space, double rim_ahead, const std::filesystem::path& bounds_file) {
+  const PersonParamInfo& info = kPersonParamInfo[kRimShift];
+  const ParameterSpace::Person& p = space.person[kRimShift];
+  ParamBound& box = space.bounds.person[kRimShift];
+  const double lowest = -rim_ahead;
+  const std::string why = "this gown's sleeve opening is held " + format_number(rim_ahead) +
+                          " m ahead of the jaws, so a rim_shift below " + format_number(lowest) +
+                          " m puts it behind them";
+  if (!p.fit) {
+    if (p.value < lowest) throw std::invalid_argument(why + ", not " + format_number(p.value) + " m");
+    return false;
+  }
+  if (box.lower >= lowest) return false;
+  if (box.line > 0)
+    throw_input_error(bounds_file, box.line, std::string(info.name) + "'s box starts at " +
+                                                 format_number(box.lower) + " m: " + why);
+  if (box.initial < lowest)
+    throw std::invalid_argument("its start " + format_number(box.initial) + " m is below " + format_number(lowest) +
+                                " m: " + why);
+  box.lower = lowest;
   return true;
 }
 
@@ -462,6 +501,10 @@ std::string hexd(double v) {
   return buf;
 }
 
+// Whether the search has scored any candidate finitely: CMA-ES keeps its initial best_f (1e300)
+// until then, as it ranks a failed evaluation as DBL_MAX.
+bool found(const Cmaes& es) { return es.best_f() < CmaesState{}.best_f; }
+
 // [s] the cloth time a candidate's simulated inputs cost (SimulatedTrial::simulated_s).
 double simulated_time(const std::vector<SimulatedTrial>& sts) {
   double s = 0.0;
@@ -581,11 +624,12 @@ Checkpoint decode_checkpoint(const std::string& text, const std::filesystem::pat
   c.best_fits.resize(nfits);
   for (auto& v : c.best_fits) {
     if (!(in >> word)) throw_input_error(path, 4, "truncated best_fits");
-    // A fit is an area between curves (eq. 3-5): finite and not negative.
+    // A fit is an area between curves (eq. 3-5): not negative; infinite until the search found a
+    // candidate it could simulate.
     char* end = nullptr;
     v = std::strtod(word.c_str(), &end);
-    if (end != word.c_str() + word.size() || !std::isfinite(v) || v < 0)
-      throw_input_error(path, 4, "best_fits: '" + word + "' is not a fit (a finite number of 0 or more)");
+    if (end != word.c_str() + word.size() || !(v >= 0))
+      throw_input_error(path, 4, "best_fits: '" + word + "' is not a fit (a number of 0 or more, or inf)");
   }
   if (!(in >> word) || word != "cmaes") throw_input_error(path, 5, "expected 'cmaes'");
   in.get();
@@ -596,6 +640,23 @@ Checkpoint decode_checkpoint(const std::string& text, const std::filesystem::pat
 }
 
 }  // namespace
+
+void probe_checkpoint(const std::filesystem::path& path, const Comm& comm) {
+  std::string failed;
+  if (comm.is_root()) {
+    try {
+      if (std::filesystem::is_directory(path)) throw std::runtime_error("it is a folder");
+      std::filesystem::path probe = path;
+      probe += ".probe";
+      write_file_atomic(probe, "");
+      std::filesystem::remove(probe);
+    } catch (const std::exception& e) {
+      failed = *e.what() ? e.what() : "unknown error";
+    }
+  }
+  comm.broadcast(failed);
+  if (!failed.empty()) throw_input_error(path, 0, "cannot write a checkpoint there: " + failed);
+}
 
 TrialBatchSimulator one_by_one(TrialSimulator sim) {
   return [sim = std::move(sim)](const ClothValues& c, const std::vector<TrialRequest>& rs) {
@@ -682,11 +743,15 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   // on the rest of the fingerprint, as it did.
   const std::string fp_before_hash = fingerprint(inputs, space, options);
   const std::string fp = fp_before_hash + ";samples=" + samples_hash(inputs);
-  std::vector<double> best_fits(static_cast<std::size_t>(T), 0.0);
+  // The search's best candidate's terms; infinite until a candidate scores a finite objective
+  // (they were zeros, which a search where every simulation failed reported as L = 0 for each
+  // sequence: session 84's review, finding 5).
+  std::vector<double> best_fits(static_cast<std::size_t>(T), std::numeric_limits<double>::infinity());
   int done = 0;
   bool resumed = false;
   // Resume: every rank reads rank 0's checkpoint text (broadcast), so all start from one state.
   if (!options.checkpoint.empty()) {
+    probe_checkpoint(options.checkpoint, comm);
     std::string text;
     if (comm.is_root() && std::filesystem::exists(options.checkpoint)) text = read_file(options.checkpoint);
     comm.broadcast(text);
@@ -866,16 +931,29 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
       for (int k = 0; k < T; ++k) best_fits[k] = per[static_cast<std::size_t>(arg) * W + k];
     ++done;
     ++done_here;
-    if (comm.is_root()) {
-      if (!options.checkpoint.empty()) {
-        Checkpoint c{fp, done, best_fits, es.save_state()};
-        write_file_atomic(options.checkpoint, encode_checkpoint(c));
+    if (!options.checkpoint.empty()) {
+      // Rank 0 writes it, and every rank learns whether it could: a failure ends them all. The
+      // other ranks used to go on to the next generation and wait in its MPI_Allreduce for a rank
+      // 0 that had died (a full quota held a Slurm job to its time limit: finding 1).
+      std::string failed;
+      if (comm.is_root()) {
+        try {
+          write_file_atomic(options.checkpoint, encode_checkpoint(Checkpoint{fp, done, best_fits, es.save_state()}));
+        } catch (const std::exception& e) {
+          failed = *e.what() ? e.what() : "unknown error";
+        }
       }
+      comm.broadcast(failed);
+      if (!failed.empty())
+        throw std::runtime_error("the checkpoint of generation " + std::to_string(done) + " could not be written: " +
+                                 failed);
+    }
+    if (comm.is_root()) {
       if (progress) {
         GenerationProgress p;
         p.generation = done;
         p.generations = options.generations;
-        const bool start_best = !(es.best_f() <= start_f);  // as the result chooses, below
+        const bool start_best = !found(es) || !(es.best_f() <= start_f);  // as the result chooses, below
         p.best = start_best ? start_f : es.best_f();
         p.best_fits = start_best ? start_fits : best_fits;
         p.best_contrast = ic >= 0 ? p.best_fits[static_cast<std::size_t>(ic)] : 0.0;
@@ -903,7 +981,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   r.resimulated = resimulated_total;
   r.simulated_s = simulated_total;
   r.start_objective = start_f;
-  const bool keep_start = !(es.best_f() <= start_f);  // also when the search found nothing finite
+  const bool keep_start = !found(es) || !(es.best_f() <= start_f);
   r.objective = keep_start ? start_f : es.best_f();
   r.best_unit = keep_start ? start : es.best_x();
   r.cloth = space.cloth(r.best_unit);
@@ -915,6 +993,12 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   if (ic >= 0) r.contrast = terms[static_cast<std::size_t>(ic)];
   if (il >= 0) r.lateral = terms[static_cast<std::size_t>(il)];
   r.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // Nothing to calibrate to: the start and every candidate failed (calibration.h). A stopped
+  // run may still find something when it resumes.
+  if (r.complete && !std::isfinite(r.objective))
+    throw std::runtime_error("no candidate could be simulated: the start and all " +
+                             std::to_string(r.evaluations - 1) + " candidates of the search failed (a simulation "
+                             "that blew up or gave no samples scores infinity)");
   return r;
 }
 
@@ -1043,9 +1127,14 @@ Calibration calibration_from_json(const Json& j, const std::filesystem::path& so
     if (!j.has("format") || j.at("format").string() != "dressguard-calibration 1")
       throw std::runtime_error("not a dressguard calibration file (format \"dressguard-calibration 1\")");
     c.participant = j.at("participant").string();
+    // The simulator's limits, the ones read_bounds and `simulate --params` hold a value to: a
+    // file with stretch 7 or friction -1 was read and simulated (session 84's review, finding 4).
     for (int i = 0; i < kClothParams; ++i) {
       const double v = j.at("cloth").at(kClothParamNames[i]).number();
+      const ClothParamLimits& lim = kClothParamLimits[i];
       if (!std::isfinite(v)) throw std::runtime_error(std::string("cloth.") + kClothParamNames[i] + " is not finite");
+      if (!(v >= lim.lowest && v <= lim.highest))
+        throw std::runtime_error(std::string("cloth.") + kClothParamNames[i] + " " + lim.range);
       set_cloth_value(c.cloth, i, v);
     }
     // Files without one have the paper's arm and gown they were calibrated with.
@@ -1073,7 +1162,10 @@ Calibration calibration_from_json(const Json& j, const std::filesystem::path& so
       const Json& e = j.at("arm_offsets").at(std::string(arm_height_name(h)));
       c.offsets[static_cast<int>(h)] = e.at("offset_m").number();
       c.offset_calibrated[static_cast<int>(h)] = e.at("calibrated").boolean();
-      if (std::abs(c.offsets[static_cast<int>(h)]) > kMaxArmOffset) throw std::runtime_error("arm offset beyond 0.5 m");
+      // Written so that NaN fails too (abs(NaN) > 0.5 is false).
+      if (!(std::abs(c.offsets[static_cast<int>(h)]) <= kMaxArmOffset))
+        throw std::runtime_error("arm_offsets." + std::string(arm_height_name(h)) +
+                                 ".offset_m must be a number within +-0.5 m");
     }
     c.objective_kind = j.at("objective_kind").string();
     c.objective = j.at("objective").number();

@@ -194,6 +194,7 @@ TrialBatchSimulator one_by_one(TrialSimulator sim);
 // A box per parameter. Read from a bounds file (read_bounds) or the documented defaults.
 struct ParamBound {
   double lower = 0, upper = 1, initial = 0.5;
+  long line = 0;  // the bounds file's line that gave this box (read_bounds); 0: a default
 };
 struct Bounds {
   std::array<ParamBound, kClothParams> cloth;
@@ -224,8 +225,9 @@ struct Bounds {
 Bounds default_bounds();
 // Bounds file: one "name lower upper [initial]" per line, '#' starts a comment, names as in
 // kClothParamNames plus "arm_offset" and kPersonParamInfo's; unnamed parameters keep their
-// defaults. InputError names the file and line of a malformed row (unknown name, lower >= upper,
-// initial outside the box, a person parameter's box outside its range).
+// defaults. InputError names the file and line of a malformed row (unknown name, a bound or
+// initial value that is not a finite number, lower >= upper, initial outside the box, a person
+// parameter's box outside its range, a name given a second time).
 Bounds read_bounds(const std::filesystem::path& path);
 
 // The search vector: the five cloth parameters, one offset per used height (high, middle, low
@@ -279,6 +281,18 @@ double param_value(const ParamRef& p, const ClothValues& c, const std::array<dou
 void set_param_value(const ParamRef& p, ClothValues& c, std::array<double, 3>& offsets, double v);
 const ParamBound& box_of(const Bounds& b, const ParamRef& p);
 ParamBound& box_of(Bounds& b, const ParamRef& p);  // read_bounds fills a box through it
+
+// The rim_shift a gown can take: its sleeve opening's rim is held `rim_ahead` [m] ahead of the
+// jaws (sim_bridge.h, gown_rim_ahead: 4 cm on the measured gown, 1 cm on the parametric one),
+// and a shift below -rim_ahead puts the rim behind them, a grasp the simulator cannot build
+// (grasp_of throws). A search would stop at its first such candidate, after the start and part
+// of a generation were simulated (session 84's review, finding 2), so before it: a value held
+// below -rim_ahead throws std::invalid_argument (the caller names --rim-shift); a fitted box that
+// a bounds file gave (ParamBound::line) reaching below it throws InputError naming `bounds_file`
+// and the line; the default box, made for the measured gown, is clipped to start at -rim_ahead,
+// and then the function returns true (the caller says so). The box's initial value must then
+// still lie within it (std::invalid_argument otherwise).
+bool fit_rim_shift_to_gown(ParameterSpace& space, double rim_ahead, const std::filesystem::path& bounds_file);
 
 // Person parameter i of `space` from a command line's word: "fit" (search bounds.person[i]),
 // "fixed" (kPersonParamInfo[i].paper), or a value held during the search. False when the word is
@@ -505,12 +519,28 @@ double lateral_term(const std::vector<HapticSequence>& inputs, const std::vector
 // go by it, and the boundary penalty's scale (the values' inter-quartile range) uses it, so a
 // pruned search is not the unpruned one to the bit. It is deterministic, the same on any thread
 // or rank count, and resumes to the same bits.
+//
+// Failures. options.checkpoint is probed before the start is simulated (probe_checkpoint), and a
+// checkpoint that cannot be written after a generation ends every rank with std::runtime_error
+// (rank 0 alone would leave the others waiting for it in the next generation). A simulation that
+// blows up or gives no samples scores infinity and ranks last (cmaes.h); when the start and every
+// candidate of a finished search did, there is no calibration, and std::runtime_error says so.
+// A simulator that throws ends the run (under MPI through MPI_Abort, runner.h): it is not taken
+// as a failed simulation, because a candidate inside the box that the simulator cannot build is
+// a box the search should not have been given, which is checked before the search
+// (fit_rim_shift_to_gown), or a defect that ranking it last would hide.
 CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const ParameterSpace& space,
                             const TrialSimulator& sim, const CalibrationOptions& options, const Comm& comm,
                             const std::function<void(const GenerationProgress&)>& progress = {});
 CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const ParameterSpace& space,
                             const TrialBatchSimulator& sim, const CalibrationOptions& options, const Comm& comm,
                             const std::function<void(const GenerationProgress&)>& progress = {});
+
+// Whether a checkpoint can be written at `path`, asked before a search, which writes its first
+// only after a generation (20 minutes into a run on the full gown): rank 0 makes its folder and
+// writes and removes a file beside it. Collective (every rank of `comm` calls it): every rank
+// throws InputError naming the path and the reason when rank 0 could not.
+void probe_checkpoint(const std::filesystem::path& path, const Comm& comm);
 
 // The request that reproduces a measured input sequence with candidate offsets (no gown noise,
 // fixed seed: calibration compares deterministic simulations). The travel limit is the measured

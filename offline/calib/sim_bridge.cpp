@@ -171,6 +171,8 @@ std::optional<gown::OpeningGrip> grasp_of(double rim_shift, bool parametric) {
   return g;
 }
 
+double gown_rim_ahead() { return gown::own_grip(gown::measured_gown_path().empty()).rim_ahead; }
+
 ClothSimulator make_cloth_simulator(const std::string& gown) {
   sim::GownResolution res;
   if (gown == "full") res = sim::GownResolution::Full;

@@ -41,6 +41,12 @@ sim::ClothParams cloth_params_of(const ClothValues& c);
 // Throws std::invalid_argument when that puts the rim behind the jaws.
 std::optional<gown::OpeningGrip> grasp_of(double rim_shift, bool parametric);
 
+// [m] How far ahead of the jaws the gown the simulator runs on holds its sleeve opening's rim
+// at rim_shift 0: the measured gown's (gown::OpeningGrip{}) when shared/data holds it, else the
+// parametric gown's (gown::kParametricGrip), as make_cloth_simulator chooses. What a rim_shift
+// may take away (fit_rim_shift_to_gown).
+double gown_rim_ahead();
+
 // True (this file is only compiled with dg_sim); lets tests ask without the macro.
 bool cloth_simulator_available();
 

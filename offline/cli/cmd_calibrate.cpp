@@ -124,7 +124,8 @@ int run_calibrate(int argc, char** argv) {
         "  --rim-shift fit|fixed|M   the robot's grasp: fit how much further ahead of the jaws\n"
         "                      the sleeve opening's rim hangs than the gown's placement puts it\n"
         "                      (4 cm on the measured gown; one more parameter, in [-0.04, 0.04] m by\n"
-        "                      default), hold it there (the default) or shift it by M metres\n"
+        "                      default, from -0.01 m on the parametric gown, which holds it 1 cm\n"
+        "                      ahead), hold it there (the default) or shift it by M metres\n"
         "  --hem W,R           the gown's cuff: bending R x stiffer within W metres of the sleeve\n"
         "                      opening (held, not fitted; recorded in CAL.json, so synthesis uses\n"
         "                      it too; offline/sim/MEASUREMENTS.md, \"How stiff the gown is\").\n"
@@ -243,6 +244,15 @@ int run_calibrate(int argc, char** argv) {
     space.friction_scheme = *f;
   }
   space.bounds = args.get("bounds") ? read_bounds(*args.get("bounds")) : default_bounds();
+  bool rim_clipped = false;  // the default rim_shift box, clipped to the gown's rim (said below)
+#ifdef DRESSGUARD_HAVE_SIM
+  // Before --start moves the initial values within the box, and before anything is simulated.
+  try {
+    rim_clipped = fit_rim_shift_to_gown(space, gown_rim_ahead(), args.get("bounds").value_or(""));
+  } catch (const std::invalid_argument& e) {
+    throw UsageError("--rim-shift " + args.get("rim-shift").value_or("") + ": " + e.what());
+  }
+#endif
   std::optional<Calibration> start_cal;
   if (const auto start = args.get("start")) {
     try {
@@ -274,6 +284,12 @@ int run_calibrate(int argc, char** argv) {
 #else
   const Comm& comm = Comm::world();
   const ClothSimulator sim = make_cloth_simulator(gown);
+  // Now, not after the first generation (20 minutes on the full gown), and on every rank.
+  try {
+    probe_checkpoint(o.checkpoint, comm);
+  } catch (const InputError& e) {
+    throw UsageError("--checkpoint " + std::string(e.what()));
+  }
   if (comm.is_root()) {
     std::string ids;  // the selected sequences, "s4-good-3, s4-miss-2"
     for (const HapticSequence& s : inputs) ids += (ids.empty() ? "" : ", ") + s.id;
@@ -284,6 +300,10 @@ int run_calibrate(int argc, char** argv) {
                  space.friction_scheme == kFrictionSchemes[0] ? "" : space.friction_scheme.c_str());
     // Said before the first generation (minutes away at the paper's budget): whether this run
     // starts afresh or continues a stopped one. A checkpoint of another command is refused then.
+    if (rim_clipped)
+      std::fprintf(stderr, "calibrate: note: rim_shift's box is [%g, %g] m on this gown, whose sleeve opening is "
+                   "held %g m ahead of the jaws (the default box is the measured gown's)\n",
+                   space.bounds.person[kRimShift].lower, space.bounds.person[kRimShift].upper, gown_rim_ahead());
     std::fprintf(stderr, "calibrate: checkpoint %s (%s)\n", o.checkpoint.c_str(),
                  std::filesystem::exists(o.checkpoint) ? "exists: resumed if it is this run's"
                                                        : "new: written each generation");

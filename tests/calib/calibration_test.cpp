@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
+#include <mutex>
 #include <set>
 #include <sstream>
 
@@ -32,6 +34,17 @@ fs::path temp_dir(const std::string& name) {
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
+}
+
+// The error read_bounds gives for `text` written to `file`, or "" when it reads it.
+std::string bounds_error(const fs::path& file, const std::string& text) {
+  write_file_atomic(file, text);
+  try {
+    read_bounds(file);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
 }
 
 // "Measured" sequences made by the stand-in at known parameters and offsets.
@@ -959,6 +972,165 @@ TEST(Calibration, CheckpointOfAnotherRunIsRefused) {
   fs::remove_all(dir);
 }
 
+// A checkpoint that cannot be written is found before anything is simulated (the probe), not
+// after the start and a whole generation (20 minutes on the full gown), where it came out as a
+// std::filesystem_error. One that becomes unwritable during the search ends it after that
+// generation with an error that names the checkpoint (under MPI on every rank: mpi_check.cpp).
+TEST(Calibration, CheckpointThatCannotBeWrittenIsFoundBeforeTheSearch) {
+  const auto inputs = fake_inputs(Truth{});
+  const auto space = space_for(inputs);
+  const fs::path dir = temp_dir("unwritable");
+  write_file_atomic(dir / "file", "a file, not a folder\n");
+  std::atomic<int> simulated{0};
+  const TrialSimulator counting = [&](const ClothValues& c, const TrialRequest& r) {
+    ++simulated;
+    return testing::fake_simulate(c, r);
+  };
+  auto o = quick(2, 1);
+  o.population = 4;
+  o.checkpoint = dir / "file" / "run.ckpt";
+  try {
+    calibrate(inputs, space, counting, o, Comm::world());
+    FAIL() << "a checkpoint under a file was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("file/run.ckpt: cannot write a checkpoint there"), std::string::npos)
+        << e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "not an InputError: " << e.what();
+  }
+  EXPECT_EQ(simulated.load(), 0);
+  EXPECT_FALSE(fs::exists(dir / "file" / "run.ckpt.probe"));
+  // Writable at first; its folder turns into a file while generation 1 is simulated.
+  o.checkpoint = dir / "ck" / "run.ckpt";
+  o.candidate_progress = [&](const CandidateProgress& c) {
+    if (c.generation != 1 || c.done != 1) return;
+    fs::remove_all(dir / "ck");
+    write_file_atomic(dir / "ck", "in the checkpoint's folder's place\n");
+  };
+  try {
+    calibrate(inputs, space, counting, o, Comm::world());
+    FAIL() << "an unwritten checkpoint went unnoticed";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("the checkpoint of generation 1 could not be written"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir / "run.ckpt.probe"));
+  fs::remove_all(dir);
+}
+
+// When the start and every candidate fail (a simulation that blows up), there is nothing to
+// calibrate to: calibrate says so instead of returning CMA-ES's initial 1e300 as the objective
+// with every sequence's L 0 (a perfect fit, as the command printed it). The progress reports
+// show the start's infinite terms, not zeros. A stopped run may still find something when it
+// resumes, so it returns; its checkpoint holds infinite fits and resumes.
+TEST(Calibration, EverySimulationFailingIsNoCalibration) {
+  const auto inputs = fake_inputs(Truth{});
+  const auto space = space_for(inputs);
+  const TrialSimulator broken = [](const ClothValues& c, const TrialRequest& r) {
+    SimulatedTrial t = testing::fake_simulate(c, r);
+    t.finite = false;
+    return t;
+  };
+  auto o = quick(2, 1);
+  o.population = 4;
+  std::vector<GenerationProgress> seen;
+  try {
+    calibrate(inputs, space, broken, o, Comm::world(), [&](const GenerationProgress& p) { seen.push_back(p); });
+    FAIL() << "a calibration of failed simulations was returned";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("no candidate could be simulated: the start and all 8 candidates"),
+              std::string::npos) << e.what();
+  }
+  ASSERT_EQ(seen.size(), 2u);
+  for (const GenerationProgress& p : seen) {
+    EXPECT_EQ(p.best, std::numeric_limits<double>::infinity());
+    for (double f : p.best_fits) EXPECT_EQ(f, std::numeric_limits<double>::infinity());
+  }
+  const fs::path dir = temp_dir("allfail");
+  o.checkpoint = dir / "run.ckpt";
+  o.stop_after_generations = 1;
+  const CalibrationResult r = calibrate(inputs, space, broken, o, Comm::world());
+  EXPECT_FALSE(r.complete);
+  EXPECT_NE(read_file(o.checkpoint).find("best_fits 2 inf inf"), std::string::npos) << read_file(o.checkpoint);
+  o.stop_after_generations = 0;
+  EXPECT_THROW(calibrate(inputs, space, broken, o, Comm::world()), std::runtime_error);
+  // One finite candidate is a calibration: the start here, the rest failing.
+  int calls = 0;
+  std::mutex m;
+  const TrialSimulator start_only = [&](const ClothValues& c, const TrialRequest& r) {
+    std::lock_guard<std::mutex> lock(m);
+    SimulatedTrial t = testing::fake_simulate(c, r);
+    t.finite = calls++ < static_cast<int>(inputs.size());
+    return t;
+  };
+  o.checkpoint.clear();
+  const CalibrationResult one = calibrate(inputs, space, start_only, o, Comm::world());
+  EXPECT_TRUE(std::isfinite(one.objective));
+  EXPECT_EQ(one.objective, one.start_objective);
+  fs::remove_all(dir);
+}
+
+// The rim_shift box against the gown's rim (fit_rim_shift_to_gown): the default box, made for
+// the measured gown's 4 cm, is clipped on the parametric gown (1 cm), where a candidate below
+// -0.01 m stopped the whole calibration in its first generation; a bounds file's box reaching
+// below is refused naming its line, and so is a held value; the measured gown keeps the box.
+TEST(Calibration, RimShiftBoxIsFittedToTheGownsRim) {
+  ParameterSpace held;
+  held.bounds = default_bounds();
+  EXPECT_FALSE(fit_rim_shift_to_gown(held, 0.01, ""));  // held at the gown's own grasp
+  ASSERT_TRUE(set_person_param(held, kRimShift, "-0.02"));
+  EXPECT_THROW(fit_rim_shift_to_gown(held, 0.01, ""), std::invalid_argument);
+  EXPECT_FALSE(fit_rim_shift_to_gown(held, 0.04, ""));
+  ParameterSpace fitted;
+  fitted.bounds = default_bounds();
+  ASSERT_TRUE(set_person_param(fitted, kRimShift, "fit"));
+  ParameterSpace measured = fitted;
+  EXPECT_FALSE(fit_rim_shift_to_gown(measured, 0.04, ""));
+  EXPECT_EQ(measured.bounds.person[kRimShift].lower, -0.04);
+  EXPECT_TRUE(fit_rim_shift_to_gown(fitted, 0.01, ""));
+  EXPECT_EQ(fitted.bounds.person[kRimShift].lower, -0.01);
+  EXPECT_EQ(fitted.bounds.person[kRimShift].upper, 0.04);
+  EXPECT_EQ(fitted.bounds.person[kRimShift].initial, 0.0);
+  const fs::path dir = temp_dir("rimbox");
+  write_file_atomic(dir / "b.txt", "friction 0 2\n\nrim_shift -0.03 0.03 0\n");
+  ParameterSpace from_file = fitted;
+  from_file.bounds = read_bounds(dir / "b.txt");
+  try {
+    fit_rim_shift_to_gown(from_file, 0.01, dir / "b.txt");
+    FAIL() << "a bounds file's rim_shift box below the rim was taken";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("b.txt:3: rim_shift's box starts at -0.03 m"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fit_rim_shift_to_gown(from_file, 0.04, dir / "b.txt"));
+  fs::remove_all(dir);
+}
+
+// A bounds file's numbers are whole words: a third word that is not a number was dropped (the
+// start went to the box's midpoint, e.g. friction 1 for `initial=0.4`), and a name given twice
+// kept the later box without a word.
+TEST(Calibration, BoundsFileRefusesAMalformedInitialAndARepeatedName) {
+  const fs::path dir = temp_dir("bounds2");
+  // Each text and the start of the error it must give.
+  const std::vector<std::pair<std::string, std::string>> refused = {
+      {"friction 0 2 initial=0.4\n", "b.txt:1: initial value of friction: 'initial=0.4' is not a number"},
+      {"shear 0 1\nstretch 0.1 0.9 abc\n", "b.txt:2: initial value of stretch: 'abc' is not a number"},
+      {"bend 0 1 nan\n", "b.txt:1: initial value of bend: 'nan' is not a number"},
+      {"bend 0 1x\n", "b.txt:1: upper bound of bend: '1x' is not a number"},
+      {"friction 0 2 0.4 oops\n", "b.txt:1: unexpected 'oops' after the bounds of friction"},
+      {"friction 0 2\nbend 0 1\nfriction 0 1\n", "b.txt:3: friction was given on line 1 already"},
+      {"arm_offset -0.02 0.02\narm_offset -0.01 0.01\n", "b.txt:2: arm_offset was given on line 1 already"},
+  };
+  for (const auto& [text, error] : refused)
+    EXPECT_NE(bounds_error(dir / "b.txt", text).find(error), std::string::npos) << text;
+  EXPECT_EQ(bounds_error(dir / "b.txt", "friction 0 2 0.4\nstretch 0.1 0.9\n"), "");
+  const Bounds b = read_bounds(dir / "b.txt");
+  EXPECT_EQ(b.cloth[3].initial, 0.4);
+  EXPECT_EQ(b.cloth[3].line, 1);
+  EXPECT_EQ(b.cloth[0].initial, 0.5);
+  EXPECT_EQ(b.cloth[1].line, 0);  // a default
+  fs::remove_all(dir);
+}
+
 TEST(Calibration, BoundsFileParsesAndNamesBadLines) {
   const fs::path dir = temp_dir("bounds");
   const fs::path ok = dir / "ok.txt";
@@ -977,15 +1149,7 @@ TEST(Calibration, BoundsFileParsesAndNamesBadLines) {
   EXPECT_EQ(b.arm_offset.lower, -0.03);
   EXPECT_EQ(b.arm_offset.initial, 0.0);           // midpoint when not given
   EXPECT_EQ(b.cloth[0].upper, default_bounds().cloth[0].upper);  // untouched default
-  auto error_of = [&](const std::string& text) {
-    write_file_atomic(dir / "bad.txt", text);
-    try {
-      read_bounds(dir / "bad.txt");
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
+  auto error_of = [&](const std::string& text) { return bounds_error(dir / "bad.txt", text); };
   EXPECT_NE(error_of("stretch 0 1\nstiffness 0 1\n").find("bad.txt:2: unknown parameter 'stiffness'"), std::string::npos);
   EXPECT_NE(error_of("bend 1 0\n").find("bad.txt:1:"), std::string::npos);
   EXPECT_NE(error_of("bend 0 1 2\n").find("outside"), std::string::npos);
@@ -1289,6 +1453,31 @@ TEST(Calibration, CalibrationFileRoundTripAndErrors) {
   EXPECT_EQ(d.fits[0].vertical.error, 0.375);
   EXPECT_FALSE(d.fits[1].vertical.measured());
   EXPECT_EQ(d.rig_travel, 0.72);
+  // Values the simulator refuses are refused here too (kClothParamLimits, what read_bounds and
+  // `simulate --params` hold them to), and an offset must be a number within 0.5 m: NaN passed
+  // `abs(v) > 0.5`. In the file's text NaN is no JSON number (json_test.cpp).
+  expect_refused("cal.json", "cloth.stretch must be within [0, 1]", "\"stretch\": 0.10000000000000001",
+                 "\"stretch\": 7");
+  expect_refused("cal.json", "cloth.friction cannot be negative", "\"friction\": 0.40000000000000002",
+                 "\"friction\": -1");
+  expect_refused("cal.json", "cloth.bend must be within [0, 1]", "\"bend\": 0.29999999999999999", "\"bend\": -0.25");
+  expect_refused("cal.json", "arm_offsets.low.offset_m must be a number within +-0.5 m", "0.010999999999999999", "0.6");
+  expect_refused("cal.json", "JSON: unexpected character 'n'", "0.010999999999999999", "nan");
+  for (const double bad : {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    Json j = calibration_to_json(c);
+    Json offsets = j.at("arm_offsets");
+    Json high = offsets.at("high");
+    high.set("offset_m", bad);
+    offsets.set("high", high);
+    j.set("arm_offsets", offsets);
+    try {
+      calibration_from_json(j, "made.json");
+      ADD_FAILURE() << "an offset of " << bad << " was read";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("made.json: arm_offsets.high.offset_m must be a number"), std::string::npos)
+          << e.what();
+    }
+  }
   write_file_atomic(dir / "bad.json", "{\"format\": \"dressguard-calibration 1\",\n \"participant\": 4}");
   EXPECT_THROW(read_calibration(dir / "bad.json"), InputError);
   write_file_atomic(dir / "bad2.json", "{\"format\": \n");

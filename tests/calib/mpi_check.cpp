@@ -2,7 +2,13 @@
 // the results (exact hex floats, labels, file contents' sizes). tests/calib/mpi_check.cmake runs
 // it once as one process and once under `mpirun -n 2` and requires identical digests: the MPI
 // spreading of generations and trials must not change a single bit.
+//
+// `calib_mpi_check --checkpoint-fails WORKDIR`: a calibration whose checkpoint cannot be written
+// after its first generation (its folder turns into a file while the generation is simulated).
+// Every rank must end with the error, printed as "rank R: ..." with exit 3
+// (mpi_checkpoint.cmake); rank 0 alone used to, and the others waited for it for good.
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <sstream>
 
@@ -14,12 +20,44 @@
 using namespace dressguard;
 using namespace dressguard::calib;
 
+namespace {
+
+// The checkpoint of a calibration on `comm` becomes unwritable during its first generation.
+int checkpoint_fails(const std::filesystem::path& dir, const std::vector<HapticSequence>& inputs,
+                     const ParameterSpace& space, const Comm& comm) {
+  namespace fs = std::filesystem;
+  if (comm.is_root()) fs::remove_all(dir / "ck");
+  comm.barrier();
+  CalibrationOptions o;
+  o.generations = 3;
+  o.population = 6;
+  o.threads = 1;
+  o.checkpoint = dir / "ck" / "run.ckpt";
+  o.candidate_progress = [&](const CandidateProgress& c) {  // rank 0 only
+    if (c.generation != 1 || c.done != 1) return;
+    fs::remove_all(dir / "ck");
+    write_file_atomic(dir / "ck", "in the checkpoint's folder's place\n");
+  };
+  try {
+    calibrate(inputs, space, testing::fake_simulate, o, comm);
+  } catch (const std::exception& e) {
+    std::printf("rank %d: %s\n", comm.rank(), e.what());
+    std::fflush(stdout);
+    return 3;
+  }
+  std::printf("rank %d: calibrated, the checkpoint's failure unnoticed\n", comm.rank());
+  return 0;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
-  if (argc != 2) {
-    std::fprintf(stderr, "usage: calib_mpi_check WORKDIR\n");
+  const bool fails = argc == 3 && std::strcmp(argv[1], "--checkpoint-fails") == 0;
+  if (argc != 2 && !fails) {
+    std::fprintf(stderr, "usage: calib_mpi_check [--checkpoint-fails] WORKDIR\n");
     return 2;
   }
-  const std::filesystem::path dir = argv[1];
+  const std::filesystem::path dir = argv[argc - 1];
   const Comm& comm = Comm::world();
   std::vector<HapticSequence> inputs;
   for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
@@ -35,6 +73,7 @@ int main(int argc, char** argv) {
   ParameterSpace space;
   space.bounds = default_bounds();
   for (const auto& s : inputs) space.offset_heights.push_back(s.height);
+  if (fails) return checkpoint_fails(dir, inputs, space, comm);
   CalibrationOptions o;
   o.generations = 10;
   o.population = 12;
