@@ -308,22 +308,29 @@ if(HMM)
   if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/m.dgm OR NOT out MATCHES "\"classes\": 2")
     message(FATAL_ERROR "build-model --data failed (${rc}):\n${out}\n${err}")
   endif()
+  # build-model --forces FORCES into FILE: its --json must say JSON_FORCES, and `model show` of the
+  # file must match every further argument.
+  function(build_and_show forces file json_forces)
+    execute_process(COMMAND ${DG} build-model --data ${WORK}/study --out ${file} --states 5 --forces ${forces} --json
+                    RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+    execute_process(COMMAND ${DG} model show ${file} RESULT_VARIABLE rc2 OUTPUT_VARIABLE shown ERROR_VARIABLE err2)
+    set(ok TRUE)
+    if(NOT rc EQUAL 0 OR NOT out MATCHES "\"forces\": \"${json_forces}\"" OR NOT rc2 EQUAL 0)
+      set(ok FALSE)
+    endif()
+    foreach(want IN LISTS ARGN)
+      if(NOT shown MATCHES "${want}")
+        set(ok FALSE)
+      endif()
+    endforeach()
+    if(NOT ok)
+      message(FATAL_ERROR "build-model --forces ${forces} (${rc}, ${rc2}):\n${out}\n${err}\n${shown}\n${err2}")
+    endif()
+  endfunction()
   # F_motion alone: a model of format 2 whose second feature is none, shown as such.
-  execute_process(COMMAND ${DG} build-model --data ${WORK}/study --out ${WORK}/m1.dgm --states 5 --forces motion --json
-                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  execute_process(COMMAND ${DG} model show ${WORK}/m1.dgm RESULT_VARIABLE rc2 OUTPUT_VARIABLE shown ERROR_VARIABLE err2)
-  if(NOT rc EQUAL 0 OR NOT out MATCHES "\"forces\": \"motion\"" OR NOT rc2 EQUAL 0
-     OR NOT shown MATCHES "format 2" OR NOT shown MATCHES "feature 1 = none")
-    message(FATAL_ERROR "build-model --forces motion (${rc}, ${rc2}):\n${out}\n${err}\n${shown}\n${err2}")
-  endif()
+  build_and_show(motion ${WORK}/m1.dgm "motion" "format 2" "feature 1 = none")
   # F_motion and F_lateral: a model of format 1 whose second feature is the lateral force.
-  execute_process(COMMAND ${DG} build-model --data ${WORK}/study --out ${WORK}/ml.dgm --states 5 --forces lateral --json
-                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  execute_process(COMMAND ${DG} model show ${WORK}/ml.dgm RESULT_VARIABLE rc2 OUTPUT_VARIABLE shown ERROR_VARIABLE err2)
-  if(NOT rc EQUAL 0 OR NOT out MATCHES "\"forces\": \"motion,lateral\"" OR NOT rc2 EQUAL 0
-     OR NOT shown MATCHES "feature 1 = \\([+-]f_lateral ")
-    message(FATAL_ERROR "build-model --forces lateral (${rc}, ${rc2}):\n${out}\n${err}\n${shown}\n${err2}")
-  endif()
+  build_and_show(lateral ${WORK}/ml.dgm "motion,lateral" "feature 1 = \\([+-]f_lateral ")
   # --priors training: each class's share of the training trials (the study: 8 good, 14 missed),
   # where the default gives each 1/2.
   execute_process(COMMAND ${DG} build-model --data ${WORK}/study --out ${WORK}/mp.dgm --states 5 --priors training --json
