@@ -152,6 +152,16 @@ int main(int argc, char** argv) {
                  sensor_parts.number, line_ms, cfg.sample_period_ms);
   if (!robot_spec.empty())
     if (const std::string why = parse_endpoint(robot_spec); !why.empty()) return bad("--robot: " + why);
+  // Both are right for a bridge that only records; on a robot each leaves a way unguarded, so the
+  // bridge says so once at start rather than only at the first stop.
+  if (robot_spec.empty())
+    std::fprintf(stderr,
+                 "dressguard-bridge: warning: no --robot: a Stop frame is only logged, not written to the robot "
+                 "controller (it must then act on CAN 0x080 itself)\n");
+  if (cfg.core.predictor_timeout_ms == 0)
+    std::fprintf(stderr,
+                 "dressguard-bridge: warning: --predictor-timeout-ms 0: a predictor that goes silent does not "
+                 "stop the robot (a deployment sets it, e.g. 300)\n");
   try {
     can::PortOptions opt;
     opt.ids = {protocol::id_of(protocol::MsgId::Stop), protocol::id_of(protocol::MsgId::TrialStart),

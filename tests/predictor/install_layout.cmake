@@ -19,6 +19,13 @@ if(NOT exec MATCHES "^ExecStart=([^ ]+) --config ([^ ]+) --interface %i$")
 endif()
 set(bin "${CMAKE_MATCH_1}")
 set(conf "${CMAKE_MATCH_2}")
+# `cmake --install` creates no user: a unit that runs as a named one must have systemd make it
+# (DynamicUser=yes), or it cannot start (status 217/USER) and the robot runs without a predictor.
+file(STRINGS "${units}" user REGEX "^User=")
+file(STRINGS "${units}" dynamic REGEX "^DynamicUser=yes$")
+if(user AND NOT dynamic)
+  message(FATAL_ERROR "${units}: ${user} but no DynamicUser=yes: the install creates no such user")
+endif()
 foreach(f "${bin}" "${conf}")
   if(NOT EXISTS "${STAGE}${f}")
     message(FATAL_ERROR "${units} names ${f}, which the install did not put there")
