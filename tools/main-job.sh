@@ -53,7 +53,10 @@ mkdir -p "$model"
 # offline/calib/MEASUREMENTS.md, session 31).
 /usr/bin/python3 tools/plot/label_evidence.py "$model/label-evidence.png" "default simulator=$model/synth"
 "$dg" train --data "$model/synth" --out "$model/stc.dgm"
-"$dg" model show "$model/stc.dgm" | head -8
+# Captured, not piped into head or grep -q: under pipefail a reader that stops early kills a
+# writer with more to write (SIGPIPE, 141) and fails the pipeline (tests/tools/pipefail_readers.py).
+stc_show=$("$dg" model show "$model/stc.dgm")
+sed -n 1,8p <<<"$stc_show"
 if [ -f "$out/measured/manifest.csv" ]; then
   # The measured trials against the model just trained on the default simulator (none of them
   # in its training: held out).
@@ -114,7 +117,7 @@ replay() {  # replay MODEL CSV NAME
   printf 'replay of %-44s' "$3:"
   "$dg" replay --model "$1" --log "$robot/$3.log" | sed -n 2p
 }
-if "$dg" model show "$model/stc.dgm" | grep -q "class 'caught'"; then
+if grep -q "class 'caught'" <<<"$stc_show"; then
   for h in high middle low; do
     replay "$model/stc.dgm" "$sim/trial-$h.csv" "default-parameters-$h ($(sed -n 's/.*"label": "\([a-z]*\)".*/\1/p' "$sim/trial-$h.json"))"
   done

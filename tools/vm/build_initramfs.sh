@@ -23,7 +23,7 @@ HERE=$(cd "$(dirname "$0")" && pwd)
 release=$("$HERE/fetch_kernel.sh" "$CACHE")
 KDIR=$(cd "$CACHE/kernel" && pwd)
 BUSYBOX=$(command -v busybox) || { echo "build_initramfs.sh: busybox-static not installed" >&2; exit 77; }
-file -L "$BUSYBOX" | grep -q "statically linked" || { echo "build_initramfs.sh: $BUSYBOX is not static (install busybox-static)" >&2; exit 77; }
+[[ "$(file -L "$BUSYBOX")" == *"statically linked"* ]] || { echo "build_initramfs.sh: $BUSYBOX is not static (install busybox-static)" >&2; exit 77; }
 root=$(mktemp -d)
 trap 'rm -rf "$root"' EXIT
 mkdir -p "$root"/{bin,sbin,usr/bin,lib,lib64,proc,sys,dev,tmp,data,modules,etc}
@@ -79,7 +79,7 @@ add_module() {
 }
 for m in can can-raw can-dev vcan sch_prio cls_basic em_canid act_gact; do
   rel=$(awk -F: -v m="/$m.ko" 'index($1, m) && substr($1, length($1) - length(m) + 1) == m {print $1; exit}' "$KDIR/lib/modules/$release/modules.dep")
-  rel=${rel:-$(cd "$KDIR/lib/modules/$release" && find kernel -name "$m.ko*" | head -1)}
+  rel=${rel:-$(cd "$KDIR/lib/modules/$release" && find kernel -name "$m.ko*" | sed -n 1p)}  # not head: pipefail
   [ -n "$rel" ] || { echo "build_initramfs.sh: module $m not in the kernel package" >&2; exit 1; }
   add_module "$rel"
 done

@@ -42,7 +42,8 @@ fi
 rm -rf "$CACHE/kernel.new"
 mkdir -p "$CACHE/kernel.new"
 dpkg-deb -x "$CACHE"/deb/"$pkg"_*.deb "$CACHE/kernel.new"
-release=$(ls "$CACHE/kernel.new/lib/modules" | head -1)
+# sed reads to the end: head would leave ls to SIGPIPE, and pipefail to fail the line.
+release=$(ls "$CACHE/kernel.new/lib/modules" | sed -n 1p)
 depmod -b "$CACHE/kernel.new" "$release"
 echo "$release" > "$CACHE/kernel.new/.release"
 rm -rf "$CACHE/kernel"
