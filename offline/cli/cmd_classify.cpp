@@ -129,7 +129,8 @@ int run_classify(int argc, char** argv) {
         "  sum of their posteriors; classes are matched by name.\n"
         "  --truncate-at DIST      cut each trial after the last sample with travel <= DIST metres\n"
         "  --sweep A:B:STEP        accuracy at every truncation distance A, A+STEP, ..., B (metres)\n"
-        "  --sweep-out PREFIX      with --sweep: write PREFIX.csv and PREFIX.png (tools/plot/hmm_sweep.py)\n"
+        "  --sweep-out PREFIX      with --sweep: write PREFIX.csv and PREFIX.png (tools/plot/hmm_sweep.py;\n"
+        "                          if the script fails, the CSV is kept and classify exits 1)\n"
         "  --no-plot               with --sweep: write only the CSV\n"
         "  --participant P[,Q...]  only these participants' trials (leave-one-participant-out)\n"
         "  --among C[,C...]        decide among these classes only, e.g. good,missed: the question a\n"
@@ -264,6 +265,7 @@ int run_classify(int argc, char** argv) {
     }
     write_file_atomic(prefix + ".csv", csv);
     std::string png;
+    bool plot_failed = false;
     // A picture of an earlier sweep under this prefix would pass for this one's: it goes first,
     // so that what is on disk is what the summary says.
     std::filesystem::remove(prefix + ".png");
@@ -274,7 +276,11 @@ int run_classify(int argc, char** argv) {
       } else if (run_plot_script(script, {prefix + ".csv", prefix + ".png"}) == 0) {
         png = prefix + ".png";
       } else {
+        // The picture was asked for and the script is there: its failure is an error (exit 1),
+        // not a note a script calling classify would read past (session 85's tools review,
+        // finding 3). The CSV and the summary still come out.
         std::fprintf(stderr, "classify: plotting failed (%s); wrote only %s.csv\n", script.c_str(), prefix.c_str());
+        plot_failed = true;
       }
     }
     if (json) {
@@ -283,7 +289,7 @@ int run_classify(int argc, char** argv) {
     } else {
       std::printf("wrote %s.csv%s\n", prefix.c_str(), png.empty() ? "" : (" and " + png).c_str());
     }
-    return 0;
+    return plot_failed ? 1 : 0;
   }
 
   if (!single) {

@@ -308,6 +308,28 @@ TEST_F(CliTest, SweepWritesCsvAndPng) {
     EXPECT_EQ(e.path().filename().string().find(".it's a sweep.png"), std::string::npos) << "a temporary was left";
 }
 
+// A sweep whose picture was asked for and could not be drawn (here matplotlib fails to import)
+// exits 1: it returned 0 with only a note on stderr, and the main job went on without its PNG
+// (session 85's tools review, finding 3). The CSV and the summary still come out.
+TEST_F(CliTest, SweepPlotFailureExitsOne) {
+  save_dataset(fx::synthetic_dataset(3, 200, 300, 53, 3), dir / "d");
+  const std::string m = (dir / "m.dgm").string();
+  ASSERT_EQ(run("train --data " + (dir / "d").string() + " --out " + m + " --states 3").code, 0);
+  fs::create_directories(dir / "nompl" / "matplotlib");
+  std::ofstream(dir / "nompl" / "matplotlib" / "__init__.py") << "raise ImportError('matplotlib broken (test)')\n";
+  const char* before = std::getenv("PYTHONPATH");
+  const std::string kept = before ? before : "";
+  ::setenv("PYTHONPATH", (dir / "nompl").c_str(), 1);
+  const auto sw = run("classify --model " + m + " --data " + (dir / "d").string() + " --sweep 0.1:0.2:0.1 --json" +
+                      " --sweep-out " + (dir / "sw").string());
+  before ? ::setenv("PYTHONPATH", kept.c_str(), 1) : ::unsetenv("PYTHONPATH");
+  EXPECT_EQ(sw.code, 1) << sw.err;
+  EXPECT_NE(sw.err.find("classify: plotting failed"), std::string::npos) << sw.err;
+  EXPECT_NE(sw.out.find("\"png\": null"), std::string::npos) << sw.out;
+  EXPECT_TRUE(fs::exists(dir / "sw.csv"));
+  EXPECT_FALSE(fs::exists(dir / "sw.png"));
+}
+
 // A cut before every trial's first sample (trials recorded from 0.2 m on) scores no trial: its
 // accuracy is empty in the CSV and null in the JSON, not 0 (it once read as a classifier wrong
 // on everything); the plot leaves it out. A sweep from 0 m is refused, as --truncate-at 0 is.
