@@ -62,8 +62,11 @@ if [ -f "$out/measured/manifest.csv" ]; then
   # in its training: held out).
   echo "main-job: the measured trials classified by $model/stc.dgm"
   "$dg" classify --model "$model/stc.dgm" --data "$out/measured" | tail -5
-  "$dg" classify --model "$model/stc.dgm" --data "$out/measured" --sweep 0.05:0.85:0.05 \
+  # The picture drawn here, as for the in-sample sweep below: a plot that fails ends the job
+  # (set -e) with the script's own error, and the job never ends without it.
+  "$dg" classify --model "$model/stc.dgm" --data "$out/measured" --sweep 0.05:0.85:0.05 --no-plot \
     --sweep-out "$model/accuracy-vs-travel-stc" >/dev/null
+  /usr/bin/python3 tools/plot/hmm_sweep.py "$model/accuracy-vs-travel-stc.csv" "$model/accuracy-vs-travel-stc.png"
   # And against the shipped default model (models/default.dgm: seven people's calibrated
   # simulators, 40 reduced-gown trials per height each). Its calibrations were fitted to most of
   # these trials and its discrepancy term copies their curves into its training, so this figure
