@@ -225,7 +225,6 @@ def plot_predict(args):
             axes[i][col].set_xlabel("travel [m]")
             axes[i][col].set_ylabel(name)
             axes[i][col].grid(alpha=0.3)
-        axes[i][0].legend(fontsize=7, loc="lower left")
         ax = axes[i][2]
         real = [float(r["real_median"]) for r in mine]
         sim = [float(r["objective"]) for r in mine]
@@ -239,6 +238,10 @@ def plot_predict(args):
         ax.set_ylabel("L of the calibrated simulator")
         ax.set_title(f"{h} arm: eq. 3-5, w = 20 ({by})", fontsize=9)
         ax.grid(alpha=0.3)
+        # The trials' colours, for the curves and the points alike, right of the row's last panel:
+        # inside the F_motion panel the legend hid curves (session 85's tools review, finding 5).
+        ax.legend(handles=axes[i][0].get_legend_handles_labels()[0], fontsize=7, loc="upper left",
+                  bbox_to_anchor=(1.02, 1.0), borderaxespad=0)
     fig.tight_layout()
     save_figure(fig, args.out, dpi=100)
 
@@ -246,6 +249,16 @@ def plot_predict(args):
 def present_forces(rows):
     """The forces a residual or contrast table holds, in its order (F_lateral since 2026-11-25)."""
     return [a for a in ("motion", "vertical", "lateral") if rows and "measured_" + a in rows[0]]
+
+
+def below_panels(fig, handles):
+    """The figure's one legend, in a row below all its panels (none of them covered), and the
+    layout that leaves it room."""
+    fig.tight_layout()
+    legend = fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8, frameon=False)
+    fig.canvas.draw()
+    tall = legend.get_window_extent().height / fig.bbox.height
+    fig.tight_layout(rect=(0, tall + 0.01, 1, 1))
 
 
 def plot_residual(args):
@@ -267,16 +280,17 @@ def plot_residual(args):
                     ax.fill_between([a, b], [m - sd] * 2, [m + sd] * 2, color="gray", alpha=0.35, lw=0)
                 ax.plot([a, b], [m, m], color="tab:blue", lw=1.5)
                 ax.plot([a, b], [sim, sim], color="black", lw=1.5)
-            ax.plot([], [], color="tab:blue", label="people's mean (+-1 sd between people, grey; "
-                    "each person's trials averaged first)")
-            ax.plot([], [], color="black", label="simulated mean")
-            ax.fill_between([], [], [], color="tab:red", alpha=0.15, label="outside the people")
             ax.set_title(f"{h} arm: residual per travel window ({by})", fontsize=9)
             ax.set_xlabel("travel [m]")
             ax.set_ylabel(name)
             ax.grid(alpha=0.3)
-            ax.legend(fontsize=7, loc="lower left")
-    fig.tight_layout()
+    # One legend for every panel, below them: inside a panel it hid the windows it covered (the
+    # high arm's worst F_lateral ones; session 85's tools review, finding 5).
+    handles = [plt.Line2D([], [], color="tab:blue", label="people's mean (+-1 sd between people, grey; "
+                          "each person's trials averaged first)"),
+               plt.Line2D([], [], color="black", label="simulated mean"),
+               plt.Rectangle((0, 0), 1, 1, color="tab:red", alpha=0.15, lw=0, label="outside the people")]
+    below_panels(fig, handles)
     save_figure(fig, args.out, dpi=100)
 
 
@@ -404,7 +418,8 @@ def plot_standing(args):
             best[who] = (worst, os.path.basename(path), seqs)
     people = sorted(best, key=lambda w: (len(w), w))
     colours = {"good": "tab:green", "missed": "tab:blue", "middle missed": "tab:purple"}
-    fig, ax = plt.subplots(figsize=(max(6, 1.3 * len(people) + 2), 4.5))
+    # Wider by the legend, which stands right of the bars (inside it covered a bar's top and label).
+    fig, ax = plt.subplots(figsize=(max(6, 1.3 * len(people) + 2) + 2.6, 4.5))
     width, labelled = 0.26, set()
     for i, who in enumerate(people):
         worst, name, seqs = best[who]
@@ -425,8 +440,10 @@ def plot_standing(args):
                 ax.plot(x, paper, "v", color="tab:red", ms=7,
                         label="the paper's simulator (participant 4)" if "paper" not in labelled else None)
                 labelled.add("paper")
-            ax.text(x, q["objective"] + 0.02, f"{q['objective']:.4f}", ha="center", va="bottom", fontsize=6,
-                    rotation=90)
+            # The value above whatever is drawn at the bar: its top, the floor, the paper's mark
+            # (the mark sat on participant 4's 0.1916).
+            top = max(q["objective"], floor, paper if paper is not None else 0.0)
+            ax.text(x, top + 0.02, f"{q['objective']:.4f}", ha="center", va="bottom", fontsize=6, rotation=90)
         print(f"participant {who}: {name}: " +
               ", ".join(f"{q['trial_id']} {q['objective']:.4f}" for q in order) +
               ("  (each <= 0.3)" if worst <= GOAL_L else ""))
@@ -437,7 +454,7 @@ def plot_standing(args):
     ax.set_title("Each participant's best calibration on its own sequences", fontsize=10)
     ax.grid(axis="y", alpha=0.3)
     ax.set_ylim(0, 1.2 * max(b[0] for b in best.values()))
-    ax.legend(fontsize=7, loc="upper right")
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
     fig.tight_layout()
     save_figure(fig, args.out, dpi=110)
 

@@ -1,0 +1,123 @@
+#!/usr/bin/python3
+"""Checks of tools/plot's pictures and errors (session 85's tools review, findings 5, 6 and 8).
+
+usage: plot_checks.py CHECK SOURCE_DIR WORK_DIR
+  legends     calib_overlay.py's residual and predict legends stand outside every panel (inside
+              one they hid the residual's worst windows); standing's legend is outside the bars
+              and no value label sits under the paper's mark
+Drawn in this process with the scripts' own functions; the figure is kept, not saved, where the
+check reads it. Exits 1 naming what failed.
+"""
+import argparse
+import csv
+import glob
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+FAILED = []
+
+
+def check(ok, what):
+    if not ok:
+        FAILED.append(what)
+
+
+def load(src, name):
+    """tools/plot/NAME.py as a module whose save_figure keeps the figure in module.figures."""
+    sys.path.insert(0, os.path.join(src, "tools", "plot"))
+    module = __import__(name)
+    module.figures = []
+    module.save_figure = lambda fig, path, **kw: module.figures.append(fig)
+    return module
+
+
+def extent(artist, fig):
+    return artist.get_window_extent(fig.canvas.get_renderer())
+
+
+def legends_outside_panels(fig, what):
+    fig.canvas.draw()
+    legends = list(fig.legends) + [ax.get_legend() for ax in fig.axes if ax.get_legend()]
+    check(legends, f"{what}: no legend")
+    for legend in legends:
+        box = extent(legend, fig)
+        for ax in fig.axes:
+            check(not box.overlaps(ax.get_window_extent()), f"{what}: a legend covers a panel ({ax.get_title()})")
+        check(fig.bbox.contains(box.x0, box.y0) and fig.bbox.contains(box.x1, box.y1),
+              f"{what}: a legend runs off the figure")
+
+
+def write_csv(path, header, rows):
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(header)
+        w.writerows(rows)
+
+
+def predict_prefix(work):
+    """A `dressguard predict --out PREFIX` of two trials per height, the high arm's F_lateral
+    with its worst windows (-0.8 N) at small travel, where the legend stood."""
+    prefix = os.path.join(work, "predict")
+    ids = {h: [f"s{k}-{h}-1" for k in (1, 2)] for h in ("high", "middle", "low")}
+    write_csv(prefix + ".csv", ["trial_id", "height", "real_median", "objective", "gown", "discrepancy"],
+              [[t, h, 1.0 + k, 0.8 + k, "reduced", "0"] for h in ids for k, t in enumerate(ids[h])])
+    travel = [i / 100 for i in range(61)]
+    write_csv(prefix + ".curves.csv", ["trial_id", "source", "travel", "f_motion", "f_vertical"],
+              [[t, src, x, -8 * x * x - k, 0.3 * x] for h in ids for k, t in enumerate(ids[h])
+               for src in ("measured", "simulated") for x in travel])
+    forces = ("motion", "vertical", "lateral")
+    header = ["height", "from", "to", "trials"] + [f"{k}_{a}" for a in forces
+                                                   for k in ("measured", "spread", "simulated", "outside")]
+    rows = []
+    for h in ids:
+        for i in range(12):
+            a = i * 0.05
+            sim = -0.8 if h == "high" and 0.25 <= a < 0.45 else 0.1
+            rows.append([h, a, a + 0.05, 2] + [v for _ in forces for v in (0.1 * i, 0.05, sim, int(sim < 0))])
+    write_csv(prefix + ".residual.csv", header, rows)
+    return prefix
+
+
+def check_legends(src, work):
+    overlay = load(src, "calib_overlay")
+    prefix = predict_prefix(work)
+    for mode in ("residual", "predict"):
+        getattr(overlay, "plot_" + mode)(argparse.Namespace(prefix=prefix, out=os.path.join(work, mode + ".png")))
+        fig = overlay.figures.pop()
+        legends_outside_panels(fig, mode)
+        if mode == "residual":
+            check(len(fig.legends) == 1 and not any(ax.get_legend() for ax in fig.axes),
+                  "residual: not one legend for all panels")
+    cals = sorted(glob.glob(os.path.join(src, "models", "participant*.json")))
+    overlay.plot_standing(argparse.Namespace(calibrations=cals, out=os.path.join(work, "standing.png")))
+    fig = overlay.figures.pop()
+    legends_outside_panels(fig, "standing")
+    ax = fig.axes[0]
+    marks = [line for line in ax.get_lines() if line.get_marker() == "v"]
+    check(marks, "standing: the paper's marks are not drawn")
+    half = 7 / 2 * fig.dpi / 72  # the marks' size, ms 7, in pixels
+    for line in marks:
+        for x, y in ax.transData.transform(line.get_xydata()):
+            for text in ax.texts:
+                box = extent(text, fig)
+                hit = box.x0 - half < x < box.x1 + half and box.y0 - half < y < box.y1 + half
+                check(not hit, f"standing: the paper's mark covers the label {text.get_text()}")
+
+
+def main(argv):
+    checks = {"legends": check_legends}
+    if len(argv) != 4 or argv[1] not in checks:
+        sys.exit(__doc__)
+    os.makedirs(argv[3], exist_ok=True)
+    checks[argv[1]](argv[2], argv[3])
+    for f in FAILED:
+        print(f)
+    return 1 if FAILED else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
