@@ -5,6 +5,8 @@ usage: plot_checks.py CHECK SOURCE_DIR WORK_DIR
   legends     calib_overlay.py's residual and predict legends stand outside every panel (inside
               one they hid the residual's worst windows); standing's legend is outside the bars
               and no value label sits under the paper's mark
+  threshold   stop_threshold_curve.py without caught logs draws no catches axis (it plotted every
+              threshold at 0 catches) and says so; no label overlaps another or a tick label
 Drawn in this process with the scripts' own functions; the figure is kept, not saved, where the
 check reads it. Exits 1 naming what failed.
 """
@@ -108,8 +110,46 @@ def check_legends(src, work):
                 check(not hit, f"standing: the paper's mark covers the label {text.get_text()}")
 
 
+def points(caught, rows):
+    """stop_threshold_curve's points: (threshold, stopped for nothing, catches) per row."""
+    return [{"threshold": t, "stops": {"caught": [3 if caught else 0, 3 if caught else 0]},
+             "stopped_for_nothing_per_100": x, "catches_stopped_per_100": c if caught else None,
+             "median_lead_s": 0.5 if caught else None} for t, x, c in rows]
+
+
+def labels_apart(fig, ax, what):
+    fig.canvas.draw()
+    ticks = [t for t in ax.get_xticklabels() + (ax.get_yticklabels() if ax.yaxis.get_visible() else [])
+             if t.get_text()]
+    boxes = [(t.get_text(), extent(t, fig)) for t in ax.texts if any(c.isdigit() for c in t.get_text())]
+    check(boxes, f"{what}: no threshold labels")
+    for i, (name, box) in enumerate(boxes):
+        for tick in ticks:
+            check(not box.overlaps(extent(tick, fig)), f"{what}: label {name!r} runs into tick label {tick.get_text()}")
+        for other, box2 in boxes[i + 1:]:
+            check(not box.overlaps(box2), f"{what}: labels {name!r} and {other!r} overlap")
+
+
+def check_threshold(src, work):
+    curve = load(src, "stop_threshold_curve")
+    # The main job's measured pulls (no caught logs): 0.999 and 0.9999 share a point, 0.99 and
+    # 0.95 and 0.8 and 0.7 are close pairs.
+    rows = [(0.5, 38.7, 0), (0.7, 30.3, 0), (0.8, 28.9, 0), (0.9, 24.9, 0), (0.95, 18.1, 0), (0.99, 16.7, 0),
+            (0.999, 12.5, 0), (0.9999, 12.5, 0)]
+    fig = curve.draw(points(False, rows), 5, "default.dgm")
+    ax = fig.axes[0]
+    check(not ax.yaxis.get_visible(), "no caught logs: the catches axis is drawn")
+    check(any("not measured" in t.get_text() for t in ax.texts), "no caught logs: no note that catches were not measured")
+    labels_apart(fig, ax, "no caught logs")
+    # Measured catches, some at 0 (a high threshold that stops none): their labels go above.
+    fig = curve.draw(points(True, [(0.5, 30.0, 25.3), (0.9, 20.0, 25.3), (0.99, 8.0, 0.0), (0.999, 7.0, 0.0)]),
+                     5, "m.dgm")
+    check(fig.axes[0].yaxis.get_visible(), "caught logs: the catches axis is not drawn")
+    labels_apart(fig, fig.axes[0], "caught logs")
+
+
 def main(argv):
-    checks = {"legends": check_legends}
+    checks = {"legends": check_legends, "threshold": check_threshold}
     if len(argv) != 4 or argv[1] not in checks:
         sys.exit(__doc__)
     os.makedirs(argv[3], exist_ok=True)

@@ -82,6 +82,71 @@ def point(args, threshold):
             "median_lead_s": statistics.median(leads) if leads else None}
 
 
+def place_labels(fig, ax, labels, downwards):
+    """Each (x, y) point's label beside it, above or, where downwards(y), below, pushed a row
+    further out until it overlaps no label placed before it and no tick label."""
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    ticks = ax.get_xticklabels() + (ax.get_yticklabels() if ax.yaxis.get_visible() else [])
+    taken = [t.get_window_extent(renderer) for t in ticks if t.get_visible() and t.get_text()]
+    for (x, y), names in sorted(labels.items()):
+        down = downwards(y)
+        for row in range(12):
+            off = 6 + 9 * row
+            text = ax.annotate("\n".join(names), (x, y), textcoords="offset points", xytext=(3, -off if down else off),
+                               va="top" if down else "bottom", fontsize=7)
+            box = text.get_window_extent(renderer)
+            if not any(box.overlaps(t) for t in taken):
+                break
+            text.remove()
+        else:
+            text = ax.annotate("\n".join(names), (x, y), textcoords="offset points", xytext=(3, 6), fontsize=7)
+        taken.append(text.get_window_extent(renderer))
+
+
+def draw(points, consecutive, model):
+    """The operating curve: catches stopped against pulls stopped for nothing per 100 pulls, one
+    point per threshold, labelled with it (and the caught stops' median lead). Without caught logs
+    the catches were not measured: the thresholds lie along the one axis that was, with a note;
+    a catches axis at 0 read as a rule that stops no catch (session 85's tools review, finding 6)."""
+    caught = points[0]["stops"]["caught"][1] > 0
+    xs = [q["stopped_for_nothing_per_100"] for q in points]
+    top = 100 * PROTOCOL["caught"] / TOTAL
+    if caught:
+        fig, ax = plt.subplots(figsize=(6.4, 4.8))
+        ys = [q["catches_stopped_per_100"] for q in points]
+        ax.plot(xs, ys, "o-", color="tab:red")
+        ax.axhline(top, color="grey", ls=":", lw=1)
+        ax.set_ylabel(f"catches stopped per 100 pulls (of {top:.1f})")
+        ax.set_ylim(0, top * 1.08)
+        ax.grid(alpha=0.3)
+    else:
+        fig, ax = plt.subplots(figsize=(6.4, 2.6))
+        ys = [0.0] * len(points)
+        ax.plot(xs, ys, "o", color="tab:red", clip_on=False, zorder=3)
+        ax.set_ylim(0, 1)
+        ax.yaxis.set_visible(False)
+        for side in ("left", "right", "top"):
+            ax.spines[side].set_visible(False)
+        ax.grid(axis="x", alpha=0.3)
+        ax.text(0.5, 1.0, "catches stopped: not measured (no caught logs; the study recorded no caught pull,\n"
+                "--caught-logs adds synthetic ones)", transform=ax.transAxes, ha="center", va="top", fontsize=8,
+                color="0.3")
+    ax.set_xlabel("pulls stopped for nothing per 100 (good, low and middle misses)")
+    ax.set_title(f"stop rule: P(caught) > threshold for {consecutive} samples\n"
+                 f"{os.path.basename(model)}, weighted by the study's protocol (360 pulls)", fontsize=10)
+    ax.set_xlim(left=0, right=max(xs + [1.0]) * 1.12)
+    fig.tight_layout()
+    # Thresholds that land on the same point share one label.
+    labels = {}
+    for q, x, y in zip(points, xs, ys):
+        lead = "" if q["median_lead_s"] is None else f" ({q['median_lead_s']:.2f} s)"
+        labels.setdefault((x, y), []).append(f"{q['threshold']:g}{lead}")
+    # Below a point only where the curve leaves room above the x axis's tick labels.
+    place_labels(fig, ax, labels, lambda y: caught and y > 0.3 * top)
+    return fig
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("out")
@@ -122,34 +187,7 @@ def main():
     if counts["caught"][1] == 0:
         print("no caught logs: no catches column (the study recorded no caught pull; --caught-logs adds synthetic ones)")
 
-    fig, ax = plt.subplots(figsize=(6.4, 4.8))
-    xs = [q["stopped_for_nothing_per_100"] for q in points]
-    if counts["caught"][1]:
-        ys = [q["catches_stopped_per_100"] for q in points]
-        ax.plot(xs, ys, "o-", color="tab:red")
-        ax.axhline(100 * PROTOCOL["caught"] / TOTAL, color="grey", ls=":", lw=1)
-        ax.set_ylabel(f"catches stopped per 100 pulls (of {100 * PROTOCOL['caught'] / TOTAL:.1f})")
-    else:
-        ys = [0.0] * len(points)
-        ax.plot(xs, ys, "o", color="tab:red")
-        ax.set_ylabel("catches stopped per 100 pulls (no caught logs)")
-    # Thresholds that land on the same point share one label.
-    labels = {}
-    for q, x, y in zip(points, xs, ys):
-        lead = "" if q["median_lead_s"] is None else f" ({q['median_lead_s']:.2f} s)"
-        labels.setdefault((x, y), []).append(f"{q['threshold']:g}{lead}")
-    for i, ((x, y), names) in enumerate(sorted(labels.items())):
-        # Neighbouring points' labels alternate above and below the curve; a label below grows
-        # downwards by one line per threshold it holds.
-        below = -14 - 10 * (len(names) - 1)
-        ax.annotate("\n".join(names), (x, y), textcoords="offset points", xytext=(4, below if i % 2 else 8), fontsize=7)
-    ax.set_ylim(0, 100 * PROTOCOL["caught"] / TOTAL * 1.08)
-    ax.set_xlabel("pulls stopped for nothing per 100 (good, low and middle misses)")
-    ax.set_title(f"stop rule: P(caught) > threshold for {args.consecutive} samples\n"
-                 f"{os.path.basename(args.model)}, weighted by the study's protocol (360 pulls)", fontsize=10)
-    ax.set_xlim(left=0)
-    ax.grid(alpha=0.3)
-    fig.tight_layout()
+    fig = draw(points, args.consecutive, args.model)
     save_figure(fig, args.out, dpi=120)
     print(f"wrote {args.out}")
     if args.json_out:
