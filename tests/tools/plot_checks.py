@@ -7,6 +7,8 @@ usage: plot_checks.py CHECK SOURCE_DIR WORK_DIR
               and no value label sits under the paper's mark
   threshold   stop_threshold_curve.py without caught logs draws no catches axis (it plotted every
               threshold at 0 catches) and says so; no label overlaps another or a tick label
+  latency     predictor_latency.py draws every log2 bucket between the first and the last
+              non-empty one (the empty ones at 0), so a tail stands at its distance
 Drawn in this process with the scripts' own functions; the figure is kept, not saved, where the
 check reads it. Exits 1 naming what failed.
 """
@@ -148,8 +150,23 @@ def check_threshold(src, work):
     labels_apart(fig, fig.axes[0], "caught logs")
 
 
+def check_latency(src, work):
+    latency = load(src, "predictor_latency")
+    text = os.path.join(work, "bench.txt")
+    with open(text, "w") as f:
+        f.write("e2e_hist_us [0, 2): 5\ne2e_hist_us [16, 32): 100\ne2e_hist_us [8192, 16384): 1\n")
+    sys.argv = ["predictor_latency.py", text, "--out", os.path.join(work, "latency.png")]
+    check(latency.main() == 0, "latency: the script failed")
+    ax = latency.figures.pop().axes[0]
+    names = [t.get_text() for t in ax.get_xticklabels()]
+    want = ["0-2"] + [f"{2 ** k}-{2 ** (k + 1)}" for k in range(1, 14)]
+    check(names == want, f"latency: buckets {names}, expected {want}")
+    heights = [p.get_height() for p in ax.patches]
+    check(sum(h > 0 for h in heights) == 3 and len(heights) == 14, f"latency: bar heights {heights}")
+
+
 def main(argv):
-    checks = {"legends": check_legends, "threshold": check_threshold}
+    checks = {"legends": check_legends, "threshold": check_threshold, "latency": check_latency}
     if len(argv) != 4 or argv[1] not in checks:
         sys.exit(__doc__)
     os.makedirs(argv[3], exist_ok=True)

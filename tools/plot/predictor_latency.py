@@ -1,6 +1,8 @@
 #!/usr/bin/python3
 """Plots the end-to-end latency histograms that bench_predictor prints (lines
-"<tag>_hist_us [lo, hi): count"), one panel per tag, log-scale bins in microseconds.
+"<tag>_hist_us [lo, hi): count"), one panel per tag, log-scale bins in microseconds; the
+empty bins between the first and the last non-empty one are drawn (at zero), so a tail's
+distance from the body shows.
 
   bench_predictor > bench.txt            (or the VM test's output: ctest -R robot_vm_socketcan -V)
   tools/plot/predictor_latency.py bench.txt --out predictor_latency.png
@@ -14,6 +16,22 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from figure_file import save_figure  # a temporary file, then a rename
+
+
+def every_bucket(rows):
+    """rows ((lo, hi, count), the non-empty buckets bench_predictor prints) with every bucket
+    between the first and the last filled in at count 0: drawn as adjacent categories, a tail
+    bucket such as [8192, 16384) stood right beside [16, 32) (session 85's tools review,
+    finding 8). The buckets are bench_predictor's: [0, 2), then [2^k, 2^(k+1))."""
+    given = {lo: (hi, n) for lo, hi, n in rows}
+    out, lo, last = [], min(given), max(given)
+    while lo <= last:
+        hi, n = given.get(lo, (max(2 * lo, 2), 0))
+        out.append((lo, hi, n))
+        lo = hi
+    if not set(given) <= {lo for lo, _, _ in out}:  # not the doubling buckets: as printed
+        return sorted(rows)
+    return out
 
 
 def main():
@@ -30,12 +48,15 @@ def main():
         return 2
     fig, axes = plt.subplots(1, len(hists), figsize=(5 * len(hists), 3.5), squeeze=False)
     for ax, (tag, rows) in zip(axes[0], sorted(hists.items())):
+        rows = every_bucket(rows)
         total = sum(n for _, _, n in rows)
         ax.bar([f"{lo}-{hi}" for lo, hi, _ in rows], [100.0 * n / total for _, _, n in rows], color="tab:blue")
         ax.set_title(f"{tag} (n={total})")
         ax.set_xlabel("latency [us]")
         ax.set_ylabel("share [%]")
         ax.set_yscale("log")
+        # Room below the smallest share, so that a one-sample tail is a bar, not a sliver.
+        ax.set_ylim(bottom=min(100.0 * n / total for _, _, n in rows if n) / 3)
         ax.tick_params(axis="x", rotation=60)
     fig.tight_layout()
     save_figure(fig, args.out, dpi=120)
