@@ -9,13 +9,17 @@ usage: plot_checks.py CHECK SOURCE_DIR WORK_DIR
               threshold at 0 catches) and says so; no label overlaps another or a tick label
   latency     predictor_latency.py draws every log2 bucket between the first and the last
               non-empty one (the empty ones at 0), so a tail stands at its distance
+  bad_input   arm_parts.py and sim_forces.py on header-only CSVs exit 1 naming the file (no
+              traceback); calib_eval.py draws an eval.json with null accuracies
 Drawn in this process with the scripts' own functions; the figure is kept, not saved, where the
 check reads it. Exits 1 naming what failed.
 """
 import argparse
 import csv
 import glob
+import json
 import os
+import subprocess
 import sys
 
 import matplotlib
@@ -165,8 +169,41 @@ def check_latency(src, work):
     check(sum(h > 0 for h in heights) == 3 and len(heights) == 14, f"latency: bar heights {heights}")
 
 
+def run(src, script, *args):
+    return subprocess.run(["/usr/bin/python3", os.path.join(src, "tools", "plot", script), *args],
+                          capture_output=True, text=True)
+
+
+def check_bad_input(src, work):
+    arm, trial = os.path.join(work, "header-only.arm.csv"), os.path.join(work, "header-only.csv")
+    write_csv(arm, ["t", "travel", "elbow_fx", "elbow_fy", "elbow_fz"], [])
+    write_csv(trial, ["t", "travel", "f_motion", "f_lateral", "f_vertical"], [])
+    good_arm = os.path.join(work, "good.arm.csv")
+    write_csv(good_arm, ["t", "travel", "elbow_fx", "elbow_fy", "elbow_fz"], [[0.01, 0.001, 0.1, 0, -0.1]])
+    png = os.path.join(work, "out.png")
+    for what, r, name in [("arm_parts.py on a header-only arm.csv", run(src, "arm_parts.py", arm, png), arm),
+                          ("arm_parts.py --trial on a header-only trial",
+                           run(src, "arm_parts.py", good_arm, png, "--trial", trial), trial),
+                          ("sim_forces.py on a header-only trial", run(src, "sim_forces.py", png, trial), trial)]:
+        check(r.returncode == 1 and name in r.stderr and "Traceback" not in r.stderr,
+              f"{what}: exit {r.returncode}, stderr {r.stderr.strip()!r}")
+    ev = os.path.join(work, "eval.json")
+    with open(ev, "w") as f:
+        json.dump({"participants": [
+            {"participant": "1", "stc_accuracy_whole_and_cuts": [0.9, None, 0.6, 0.7, 0.8],
+             "bc_accuracy_whole_and_cuts": [0.8, 0.5, 0.6, 0.7, 0.8]},
+            {"participant": "4", "stc_accuracy_whole_and_cuts": [None, 0.4, 0.5, 0.9, 1.0],
+             "bc_accuracy_whole_and_cuts": [0.7, 0.6, 0.6, 0.8, 0.9]}],
+            "one_nn_accuracy_at_cuts": [0.7, None, 0.9, 1.0]}, f)
+    out = os.path.join(work, "eval.png")
+    r = run(src, "calib_eval.py", out, ev)
+    check(r.returncode == 0 and os.path.exists(out), f"calib_eval.py on null accuracies: exit {r.returncode}, "
+          f"stderr {r.stderr.strip()!r}")
+
+
 def main(argv):
-    checks = {"legends": check_legends, "threshold": check_threshold, "latency": check_latency}
+    checks = {"legends": check_legends, "threshold": check_threshold, "latency": check_latency,
+              "bad_input": check_bad_input}
     if len(argv) != 4 or argv[1] not in checks:
         sys.exit(__doc__)
     os.makedirs(argv[3], exist_ok=True)

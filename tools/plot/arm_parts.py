@@ -10,6 +10,7 @@ from the trial CSV are drawn too (dashed), on the gripper's own sign convention.
 """
 import argparse
 import csv
+import sys
 
 import matplotlib
 
@@ -18,25 +19,49 @@ import matplotlib.pyplot as plt  # noqa: E402
 from figure_file import save_figure  # a temporary file, then a rename
 
 
+def read_rows(path, columns, what):
+    """The CSV's rows (the trial CSV's '#' lines left out), each with `columns` as numbers; an
+    empty file, a missing column or a word where a number goes is an error naming the file (a
+    header-only file drew empty panels, or failed with a traceback)."""
+    try:
+        with open(path, newline="") as f:
+            rows = [r for r in csv.DictReader(f) if not (r.get("t") or "").startswith("#")]
+    except OSError as e:
+        sys.exit(f"arm_parts.py: {path}: {e.strerror}")
+    if not rows:
+        sys.exit(f"arm_parts.py: {path}: no rows under the header ({what})")
+    cols = columns(rows[0]) if callable(columns) else columns
+    missing = [c for c in cols if c not in rows[0]]
+    if missing or not cols:
+        sys.exit(f"arm_parts.py: {path}: no column {', '.join(missing) or '<part>_fx'} ({what})")
+    try:
+        return [{c: float(r[c]) for c in cols} for r in rows]
+    except (TypeError, ValueError):
+        sys.exit(f"arm_parts.py: {path}: a row of {', '.join(cols)} that is not all numbers ({what})")
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("arm_csv")
     p.add_argument("out")
     p.add_argument("--trial")
     a = p.parse_args()
-    rows = list(csv.DictReader(open(a.arm_csv, newline="")))
-    parts = [k[:-3] for k in rows[0].keys() if k.endswith("_fx")] if rows else []
-    travel = [float(r["travel"]) for r in rows]
+    def arm_columns(first):
+        parts = [k[:-3] for k in first if k.endswith("_fx")]
+        return ["travel"] + [f"{p}_f{axis}" for p in parts for axis in "xz"] if parts else []
+
+    rows = read_rows(a.arm_csv, arm_columns, "dressguard simulate's FILE.arm.csv")
+    parts = [k[:-3] for k in rows[0] if k.endswith("_fx")]
+    travel = [r["travel"] for r in rows]
+    trial = read_rows(a.trial, ["travel", "f_motion", "f_vertical"], "a trial CSV") if a.trial else None
     fig, axes = plt.subplots(1, 2, figsize=(12, 4))
     for col, (axis, name) in enumerate((("x", "along the pull (x) [N]"), ("z", "vertical (z) [N]"))):
         ax = axes[col]
         for k, part in enumerate(parts):
-            ax.plot(travel, [float(r[f"{part}_f{axis}"]) for r in rows], color=plt.cm.tab10(k), label=part)
-        if a.trial:
-            t = [r for r in csv.DictReader(open(a.trial, newline="")) if not r["t"].startswith("#")]
+            ax.plot(travel, [r[f"{part}_f{axis}"] for r in rows], color=plt.cm.tab10(k), label=part)
+        if trial:
             key = "f_motion" if axis == "x" else "f_vertical"
-            ax.plot([float(r["travel"]) for r in t], [float(r[key]) for r in t], "k--", lw=1,
-                    label=f"gripper {key}")
+            ax.plot([r["travel"] for r in trial], [r[key] for r in trial], "k--", lw=1, label=f"gripper {key}")
         ax.set_xlabel("travel [m]")
         ax.set_ylabel(f"cloth's force on the arm, {name}")
         ax.grid(alpha=0.3)

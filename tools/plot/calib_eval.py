@@ -23,6 +23,12 @@ ONE_NN_REFERENCE = [71, 83, 94, 100]
 WHOLE_X = 0.35  # where "whole sequence" is drawn
 
 
+def percent(accuracy):
+    """An accuracy as a percentage; null (an evaluation that scored no trial: bench_calib_pipeline
+    writes null since it stopped writing 0 there) is NaN, which the lines leave out."""
+    return float("nan") if accuracy is None else 100 * accuracy
+
+
 def main(argv):
     if len(argv) < 3:
         sys.stderr.write(__doc__)
@@ -33,14 +39,14 @@ def main(argv):
             d = json.load(f)
         for r in d["participants"]:
             rows[r["participant"]] = r
-        one_nn = [100 * v for v in d["one_nn_accuracy_at_cuts"]]
+        one_nn = [percent(v) for v in d["one_nn_accuracy_at_cuts"]]
     if not rows:
         sys.stderr.write("no participants in the given files\n")
         return 1
     xs = CUTS + [WHOLE_X]
 
     def series(r, key):  # the file holds whole first, then the cuts
-        v = [100 * a for a in r[key]]
+        v = [percent(a) for a in r[key]]
         return v[1:] + v[:1]
 
     panels = [("stc_accuracy_whole_and_cuts", "STC (trained on simulation)"),
@@ -53,12 +59,18 @@ def main(argv):
                   panels[1]]
     fig, axes = plt.subplots(1, len(panels), figsize=(5.5 * len(panels), 4.2), sharey=True)
     for ax, (key, name) in zip(axes, panels):
-        mean = [0.0] * len(xs)
+        scored = [[] for _ in xs]  # per point, the participants' accuracies that are there
         for p in sorted(rows, key=int):
             ys = series(rows[p], key)
-            mean = [m + y / len(rows) for m, y in zip(mean, ys)]
+            for at, y in zip(scored, ys):
+                if y == y:
+                    at.append(y)
             ax.plot(xs, ys, color="0.75", lw=1)
-            ax.annotate(p, (xs[-1], ys[-1]), fontsize=7, color="0.5", xytext=(3, 0), textcoords="offset points")
+            last = [(x, y) for x, y in zip(xs, ys) if y == y][-1:]  # the line's right end
+            if last:
+                ax.annotate(p, last[0], fontsize=7, color="0.5", xytext=(3, 0), textcoords="offset points")
+        # The mean at each point of the participants scored there (a null is left out, not a 0).
+        mean = [sum(at) / len(at) if at else float("nan") for at in scored]
         ax.plot(xs, mean, marker="o", color="tab:blue", lw=2, label=f"mean of {len(rows)} participants")
         if one_nn:
             ax.plot(CUTS, one_nn, marker="s", color="tab:green", label="1-NN on measured curves (here)")

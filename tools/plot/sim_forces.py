@@ -8,6 +8,7 @@ Two panels, F_motion and F_vertical against travel (the paper's X and Y); simula
 measured dashed; with exactly one simulated and one measured trial, a third panel shows the
 residual (simulated minus measured, on the measured travel grid)."""
 import sys
+import warnings
 
 import matplotlib
 
@@ -18,11 +19,26 @@ from figure_file import save_figure  # a temporary file, then a rename
 
 
 def load(path):
+    """Columns t, travel, f_motion, f_lateral, f_vertical of a trial CSV or a study file. A file
+    without rows or with fewer columns is an error naming it (a header-only CSV failed with an
+    IndexError far from its name)."""
     try:
-        a = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
-    except ValueError:
-        a = np.loadtxt(path, ndmin=2)
-    return a  # columns t, travel, f_motion, f_lateral, f_vertical
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)  # numpy's "input contained no data"
+            try:
+                a = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+            except ValueError:
+                a = np.loadtxt(path, ndmin=2)
+    except FileNotFoundError:
+        sys.exit(f"sim_forces.py: {path}: no such file")
+    except OSError as e:
+        sys.exit(f"sim_forces.py: {path}: {e.strerror or e}")
+    except ValueError as e:
+        sys.exit(f"sim_forces.py: {path}: not a trial CSV or a study file ({e})")
+    if a.shape[0] == 0 or a.shape[1] < 5:
+        sys.exit(f"sim_forces.py: {path}: no rows of t, travel, f_motion, f_lateral, f_vertical "
+                 f"({a.shape[0]} rows of {a.shape[1]} columns)")
+    return a
 
 
 def main():
