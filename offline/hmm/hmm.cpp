@@ -588,19 +588,38 @@ model::FeatureConvention fit_feature_scaling(const std::vector<const HapticSeque
     fc.axis[k] = axes.axis[k];
     fc.sign[k] = axes.sign[k];
   }
-  double n = 0.0, sum[kFeatures] = {}, sq[kFeatures] = {};
-  for (const auto* tr : trials)
-    for (const auto& smp : tr->samples) {
-      double x[kFeatures];
-      fc.apply(smp.f_motion, smp.f_lateral, smp.f_vertical, x);
-      n += 1.0;
-      for (int k = 0; k < kFeatures; ++k) sum[k] += x[k], sq[k] += x[k] * x[k];
-    }
+  const auto each_sample = [&](const auto& f) {
+    for (const auto* tr : trials)
+      for (const auto& smp : tr->samples) {
+        double x[kFeatures];
+        fc.apply(smp.f_motion, smp.f_lateral, smp.f_vertical, x);
+        f(x);
+      }
+  };
+  // Two passes, the mean and then the spread about it. The one-pass E[x^2] - E[x]^2 cancels: a
+  // feature constant at 0.3 N kept ~eps 0.3^2 = 7e-15 N^2 of rounding, was scaled by 8.6e-8, and
+  // a trial 1 N off that constant then sat 1.2e7 feature units from every state, a penalty that
+  // swamped the classes' differences (session 85's review, finding 1).
+  double n = 0.0, sum[kFeatures] = {}, ss[kFeatures] = {}, lo[kFeatures], hi[kFeatures];
+  std::fill(lo, lo + kFeatures, std::numeric_limits<double>::infinity());
+  std::fill(hi, hi + kFeatures, kNegInf);
+  each_sample([&](const double* x) {
+    n += 1.0;
+    for (int k = 0; k < kFeatures; ++k) sum[k] += x[k], lo[k] = std::min(lo[k], x[k]), hi[k] = std::max(hi[k], x[k]);
+  });
   if (n < 2.0) return fc;
+  double mean[kFeatures];
+  for (int k = 0; k < kFeatures; ++k) mean[k] = sum[k] / n;
+  each_sample([&](const double* x) {
+    for (int k = 0; k < kFeatures; ++k) ss[k] += (x[k] - mean[k]) * (x[k] - mean[k]);
+  });
   for (int k = 0; k < kFeatures; ++k) {
-    const double mean = sum[k] / n, var = std::max(0.0, sq[k] / n - mean * mean);
-    fc.offset[k] = mean;
-    fc.scale[k] = var > 1e-18 ? std::sqrt(var) : 1.0;
+    // Constant: every sample the same (offset that value, so the feature is exactly 0), or a
+    // spread below 1e-9 of the feature's size, which is rounding's (~eps |mean|), not the data's.
+    const double sd = std::sqrt(ss[k] / n), tiny = 1e-9 * std::max(1.0, std::fabs(mean[k]));
+    const bool constant = lo[k] == hi[k] || sd <= tiny;
+    fc.offset[k] = lo[k] == hi[k] ? lo[k] : mean[k];
+    fc.scale[k] = constant ? 1.0 : sd;
   }
   return fc;
 }

@@ -125,8 +125,11 @@ FeatureSequence features_of(const HapticSequence& trial, const model::FeatureCon
                             double truncate_at = std::numeric_limits<double>::infinity());
 
 // The axes and signs of `axes` (default F_motion and F_vertical, sign +1), offset/scale = mean/
-// standard deviation over every sample of the trials (scale 1 when a feature is constant); a
-// feature with axis model::kAxisNone gets offset 0 and scale 1.
+// standard deviation over every sample of the trials. A constant feature gets scale 1: one whose
+// samples are all the same value (offset that value, so the feature is 0; a feature with axis
+// model::kAxisNone gets offset 0), or whose standard deviation is at most 1e-9 max(1, |mean|),
+// rounding's size. Scaled by a spread of rounding, a test trial off such a constant by a
+// millinewton would sit 10^4 feature units from every state.
 model::FeatureConvention fit_feature_scaling(const std::vector<const HapticSequence*>& trials,
                                              const model::FeatureConvention& axes = {});
 

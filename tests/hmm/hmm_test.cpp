@@ -483,6 +483,36 @@ TEST(HmmOutcomeModel, MotionOnlyModelIgnoresAVerticalForceThatDiffersFromTrainin
   for (size_t c = 0; c < a.log_likelihood.size(); ++c) EXPECT_EQ(a.log_likelihood[c], b.log_likelihood[c]);
 }
 
+// A force that is constant but not 0 (a sensor axis stuck at its bias) carries no information:
+// scale 1 and offset its value, as hmm.h says, so that a test trial whose constant differs
+// (+1 N) costs every state of every class the same and changes no decision. The one-pass
+// variance once left ~6e-15 N^2 of rounding for 0.1 N, a scale of 7.8e-8: the shifted trials'
+// log-likelihoods were ~-1e17, tied to the bit across classes, and 20 of 30 went to "good".
+TEST(HmmOutcomeModel, AConstantFeatureHasScaleOneAndDecidesNothing) {
+  const auto stuck_at = [](Dataset ds, double f_vertical) {
+    for (auto& t : ds.trials)
+      for (auto& s : t.samples) s.f_vertical = f_vertical;
+    return ds;
+  };
+  const Dataset train = stuck_at(fx::synthetic_dataset(20, 300, 500, 21), 0.1);
+  const Dataset test = stuck_at(fx::synthetic_dataset(10, 300, 500, 22), 0.1);
+  const Dataset shifted = stuck_at(test, 1.1);
+  const auto fc = hmm::fit_feature_scaling(fx::pointers(train));
+  EXPECT_EQ(fc.scale[1], 1.0);
+  EXPECT_EQ(fc.offset[1], 0.1);
+  EXPECT_NE(fc.scale[0], 1.0) << "F_motion varies";
+  hmm::ModelOptions opt;
+  opt.hmm.n_states = 5;
+  const auto m = hmm::train_outcome_model(fx::pointers(train), opt);
+  EXPECT_EQ(m.features.scale[1], 1.0);
+  for (size_t i = 0; i < test.trials.size(); ++i) {
+    const auto a = hmm::classify(m, hmm::features_of(test.trials[i], m.features));
+    const auto b = hmm::classify(m, hmm::features_of(shifted.trials[i], m.features));
+    EXPECT_EQ(a.predicted, b.predicted) << test.trials[i].id;
+  }
+  EXPECT_EQ(hmm::evaluate(m, fx::pointers(shifted)).correct, 30);
+}
+
 // ---- a committee of models (hmm::vote) ----
 
 // A two-class model of F_motion alone with one state per class: class "good" emits N(good_mean, 1),
