@@ -378,7 +378,9 @@ ClassHmm initial_left_right(const std::vector<FeatureSequence>& seqs, const Trai
       s11[j] += x[1] * x[1];
     }
   }
-  if (used == 0) throw std::invalid_argument("no training sequence has at least as many samples as states (" + std::to_string(n) + ")");
+  if (used == 0)
+    throw std::invalid_argument("no training sequence has at least as many samples as the " + std::to_string(n) +
+                                " states (--states)");
   for (int j = 0; j < n; ++j)
     if (cnt[j] == 0)
       throw std::invalid_argument("no training sample falls in state " + std::to_string(j) +
@@ -656,15 +658,25 @@ model::OutcomeModel train_outcome_model(const std::vector<const HapticSequence*>
   std::string summary;
   for (int o = 0; o < kOutcomeCount; ++o) {
     std::vector<FeatureSequence> seqs;
-    size_t samples = 0;
+    size_t samples = 0, longest = 0;
     for (const auto* t : labelled)
       if (static_cast<int>(*t->label) == o) {
         seqs.push_back(features_of(*t, m.features));
         samples += seqs.back().size();
+        longest = std::max(longest, seqs.back().size());
       }
     if (seqs.empty()) continue;
-    TrainResult r = train(seqs, opt.hmm);
-    r.hmm.name = std::string(outcome_name(static_cast<Outcome>(o)));
+    const std::string name(outcome_name(static_cast<Outcome>(o)));
+    TrainResult r;
+    try {
+      r = train(seqs, opt.hmm);
+    } catch (const std::invalid_argument& e) {
+      // train() knows neither the class nor its trials. Without them, three 6-sample caught
+      // trials read as if no trial had 10 samples, beside good and missed ones of 300.
+      throw std::invalid_argument("class '" + name + "' (" + std::to_string(seqs.size()) + " trials, the longest " +
+                                  std::to_string(longest) + " samples): " + e.what());
+    }
+    r.hmm.name = name;
     char buf[256];
     std::snprintf(buf, sizeof buf, "%s: %zu sequences, %zu samples, %d states, %d iterations%s, log-likelihood %.6g (%.4f/sample)",
                   r.hmm.name.c_str(), seqs.size(), samples, opt.hmm.n_states, r.iterations, r.converged ? "" : " (not converged)",

@@ -149,7 +149,8 @@ void set_log_priors(model::OutcomeModel& m, const std::vector<const HapticSequen
 
 // One HMM per outcome label present in `trials` (in Outcome order: good, missed, caught), trained
 // on the labelled trials; unlabelled trials are ignored. `progress` (may be empty) is told each
-// class's result. Throws std::invalid_argument when no trial is labelled.
+// class's result. Throws std::invalid_argument when no trial is labelled, or when a class cannot
+// be trained: train()'s reason after the class's name, its trial count and its longest trial.
 model::OutcomeModel train_outcome_model(const std::vector<const HapticSequence*>& trials, const ModelOptions& opt,
                                         const std::function<void(const std::string&)>& progress = {});
 

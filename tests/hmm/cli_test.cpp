@@ -392,6 +392,21 @@ TEST_F(CliTest, BadInputExitsTwoNamingTheProblem) {
   EXPECT_EQ(r.code, 2);
 }
 
+// One class's trials all shorter than the states (three caught trials of 6 samples, beside good
+// and missed ones of 300): the refusal names the class, its trials and --states. It read "no
+// training sequence has at least as many samples as states (10)", as if no trial had.
+TEST_F(CliTest, AClassTooShortForTheStatesIsNamed) {
+  Dataset d = fx::synthetic_dataset(3, 300, 300, 54, 5);
+  for (auto& t : d.trials)
+    if (t.label == Outcome::Caught) t.samples.resize(6);
+  save_dataset(d, dir / "d");
+  const auto r = run("train --data " + (dir / "d").string() + " --out " + (dir / "m.dgm").string() + " --states 10");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("class 'caught' (3 trials, the longest 6 samples): "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the 10 states (--states)"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "m.dgm"));
+}
+
 // A participant that the data lacks is named, with the ones it has: "p4" (the ids are "4") once
 // left nobody out of training while the model said it excluded p4, and classify ignored p5.
 TEST_F(CliTest, AnUnknownParticipantIsNamed) {
