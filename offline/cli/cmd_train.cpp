@@ -24,7 +24,9 @@ int run_train(int argc, char** argv) {
         "  Several datasets (comma-separated) are pooled, their trials in the order given.\n"
         "  --states N              states per HMM (default 10, the paper; the study's code used 5)\n"
         "  --band W                left-right width: state i may go to i..i+W (default 1)\n"
-        "  --cov-floor V           minimum covariance eigenvalue in scaled feature units (default 0.05)\n"
+        "  --cov-floor V           minimum covariance eigenvalue in scaled feature units squared,\n"
+        "                          at least 1e-9: below it a 2x2 determinant is lost to rounding\n"
+        "                          (default 0.05)\n"
         "  --max-iter N            Baum-Welch iterations at most (default 100)\n"
         "  --tolerance T           stop when the gain per sample is below T nats (default 1e-6)\n"
         "  --uniform-priors        equal class priors instead of the training counts\n"
@@ -49,7 +51,9 @@ int run_train(int argc, char** argv) {
   if (opt.hmm.n_states < 1 || opt.hmm.n_states > model::kMaxStates)
     throw UsageError("--states must be 1.." + std::to_string(model::kMaxStates));
   if (opt.hmm.band < 1 || opt.hmm.band > model::kMaxStates) throw UsageError("--band must be 1..32");
-  if (!(opt.hmm.cov_floor > 0)) throw UsageError("--cov-floor must be positive");
+  if (!(opt.hmm.cov_floor >= hmm::kMinCovFloor))
+    throw UsageError("--cov-floor must be at least 1e-9 (scaled feature units squared): below it a state's "
+                     "covariance determinant is lost to rounding and its log-likelihood is -inf");
   if (opt.hmm.max_iterations < 1) throw UsageError("--max-iter must be >= 1");
   if (!(opt.hmm.tolerance >= 0)) throw UsageError("--tolerance must be >= 0");
   const double stop_threshold = args.number("stop-threshold", 0.9);

@@ -343,6 +343,8 @@ void check_options(const TrainOptions& opt) {
     throw std::invalid_argument("states must be 1.." + std::to_string(model::kMaxStates));
   if (opt.band < 0) throw std::invalid_argument("band must be >= 0");
   if (opt.max_iterations < 1) throw std::invalid_argument("max_iterations must be >= 1");
+  if (!(opt.cov_floor >= kMinCovFloor))
+    throw std::invalid_argument("cov_floor must be at least 1e-9 (hmm.h, kMinCovFloor)");
 }
 
 }  // namespace
@@ -392,7 +394,7 @@ ClassHmm initial_left_right(const std::vector<FeatureSequence>& seqs, const Trai
     e.cov[0][0] = s00[j] / cnt[j] - e.mean[0] * e.mean[0];
     e.cov[1][1] = s11[j] / cnt[j] - e.mean[1] * e.mean[1];
     e.cov[0][1] = e.cov[1][0] = s01[j] / cnt[j] - e.mean[0] * e.mean[1];
-    floor_covariance(e.cov, opt.cov_floor > 0.0 ? opt.cov_floor : 1e-9);
+    floor_covariance(e.cov, opt.cov_floor);
   }
   // Transitions: a segment lasts mean_len/n samples, so leaving has probability n/mean_len.
   const double mean_len = total_len / static_cast<double>(used);
@@ -435,6 +437,14 @@ TrainResult train(const ClassHmm& start, const std::vector<FeatureSequence>& seq
     const double ll = baum_welch_step(cur, seqs, opt.cov_floor, next);
     r.iterations = it + 1;
     r.history.push_back(ll);
+    // -inf and NaN compare false with every likelihood: kept, -inf ended training "converged" and
+    // an all-NaN run returned the 0-state model r.hmm starts as (hmm.h, train).
+    if (!std::isfinite(ll)) {
+      const char* what = std::isnan(ll) ? "NaN" : ll > 0 ? "+inf" : "-inf";
+      throw std::invalid_argument(std::string("the log-likelihood is ") + what + " at iteration " +
+                                  std::to_string(it + 1) + ": a sample is not finite, or so far from every state " +
+                                  "that its squared distance overflows");
+    }
     if (ll > r.log_likelihood) {
       r.log_likelihood = ll;
       r.hmm = cur;

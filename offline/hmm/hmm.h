@@ -64,6 +64,17 @@ struct FeatureSequence {
   const double* at(size_t t) const { return x.data() + t * kFeatures; }
 };
 
+// The smallest covariance floor training takes, in scaled feature units squared. The emission
+// normaliser needs the 2x2 determinant a d - b^2 = l1 l2, which rounding gets wrong by ~eps l1^2:
+// relative error eps l1 / l2. A state spans at most the features' spread (l1 ~ 1 to 100, the
+// features having unit variance), so l2 >= 1e-9 keeps that error below 2e-5 (a log density
+// off by < 1e-4 nats). Floors below 1e-30 let a state fitted to a constant segment (the
+// zero forces before contact) keep a rank-1 covariance of rounding, whose determinant rounds to
+// 0: log-likelihood -inf (session 85's HMM review, finding 2). 1e-9 is also a standard deviation
+// of 3e-5 of a feature's spread (~0.01 mN on the study's forces), far below any force sensor's
+// resolution, so no real floor is refused.
+inline constexpr double kMinCovFloor = 1e-9;
+
 struct TrainOptions {
   int n_states = 10;           // the paper's 10; the study's code used 5
   int band = 1;                // left-right width: A_ij > 0 only for i <= j <= i + band
@@ -72,6 +83,7 @@ struct TrainOptions {
   // lets Baum-Welch shrink states until the online posterior is certain within ~5 samples, and
   // the predictor then stops good trials at once (measured on the replay logs); 0.05 keeps the
   // posteriors calibrated enough for the StopPolicy and costs no accuracy on the study.
+  // At least kMinCovFloor.
   double cov_floor = 0.05;
   int max_iterations = 100;
   double tolerance = 1e-6;     // stop when the log-likelihood gain per sample is below this [nats]
@@ -93,7 +105,10 @@ ClassHmm initial_left_right(const std::vector<FeatureSequence>& seqs, const Trai
 // `cov_floor` <= 0 disables the floor (for comparisons with other libraries).
 double baum_welch_step(const ClassHmm& in, const std::vector<FeatureSequence>& seqs, double cov_floor, ClassHmm& out);
 
-// Trains from `start` (usually initial_left_right) until convergence.
+// Trains from `start` (usually initial_left_right) until convergence. Throws std::invalid_argument
+// naming the iteration when a log-likelihood is not finite (a sample that is not, or one so far
+// from every state that its squared distance overflows): -inf and NaN compare false with every
+// likelihood, so training would otherwise stop "converged" on one or return no model at all.
 TrainResult train(const ClassHmm& start, const std::vector<FeatureSequence>& seqs, const TrainOptions& opt);
 TrainResult train(const std::vector<FeatureSequence>& seqs, const TrainOptions& opt);
 

@@ -407,6 +407,25 @@ TEST_F(CliTest, AClassTooShortForTheStatesIsNamed) {
   EXPECT_FALSE(fs::exists(dir / "m.dgm"));
 }
 
+// --cov-floor below 1e-9 is refused, naming it: with 1e-300, the states fitted to a pull's
+// exactly-zero start (60 samples of 0 N here) kept a rank-1 covariance of rounding whose
+// determinant rounded to 0, and training went on from a log-likelihood of -inf to a model
+// "converged" that classified nothing right. At the bound the same data train.
+TEST_F(CliTest, ACovarianceFloorBelowTheBoundIsRefused) {
+  Dataset d = fx::synthetic_dataset(4, 300, 400, 54, 5);
+  for (auto& t : d.trials)
+    for (size_t i = 0; i < 60; ++i) t.samples[i].f_motion = t.samples[i].f_vertical = t.samples[i].f_lateral = 0.0;
+  save_dataset(d, dir / "d");
+  const std::string train = "train --data " + (dir / "d").string() + " --out " + (dir / "m.dgm").string();
+  auto r = run(train + " --cov-floor 1e-300");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--cov-floor must be at least 1e-9"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "m.dgm"));
+  r = run(train + " --cov-floor 1e-9");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err.find("inf"), std::string::npos) << r.err;
+}
+
 // A participant that the data lacks is named, with the ones it has: "p4" (the ids are "4") once
 // left nobody out of training while the model said it excluded p4, and classify ignored p5.
 TEST_F(CliTest, AnUnknownParticipantIsNamed) {

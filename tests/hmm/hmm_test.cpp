@@ -414,6 +414,51 @@ TEST(HmmTrain, RejectsBadOptions) {
   EXPECT_THROW(hmm::initial_left_right({seq({1, 2})}, opt), std::invalid_argument);
   opt.n_states = 10;
   EXPECT_THROW(hmm::initial_left_right({seq({1, 2, 3, 4})}, opt), std::invalid_argument);
+  // A covariance floor below kMinCovFloor (hmm.h: the determinant is lost to rounding), or NaN.
+  const auto data = fx::draw(fx::known_left_right(3, 0.9), 3, 50, 60, 1);
+  opt.n_states = 3;
+  for (const double floor : {1e-10, 0.0, std::numeric_limits<double>::quiet_NaN()}) {
+    opt.cov_floor = floor;
+    EXPECT_THROW(hmm::train(data, opt), std::invalid_argument) << floor;
+  }
+  opt.cov_floor = hmm::kMinCovFloor;
+  EXPECT_NO_THROW(hmm::train(data, opt));
+}
+
+// A log-likelihood that is not finite ends training with an error naming the iteration (and,
+// from train_outcome_model, the class). A sample of 1e200 is finite, but its squared distance
+// overflows; NaN is NaN. Both once returned "not converged" after 100 iterations with a model of
+// 0 states, and a drop to -inf after a finite start was reported as convergence.
+TEST(HmmTrain, ANonFiniteLikelihoodIsAnError) {
+  const auto truth = fx::known_left_right(5, 0.95);
+  hmm::TrainOptions opt;
+  opt.n_states = 5;
+  for (const double bad : {1e200, std::numeric_limits<double>::quiet_NaN()}) {
+    auto data = fx::draw(truth, 10, 100, 200, 5);
+    data[3].x[2 * 50] = bad;
+    try {
+      hmm::train(data, opt);
+      ADD_FAILURE() << "no error for a sample of " << bad;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(std::isnan(bad) ? "is NaN at iteration 1:" : "is -inf at iteration 1:"),
+                std::string::npos) << e.what();
+    }
+  }
+  Dataset ds = fx::synthetic_dataset(4, 100, 120, 54, 3);
+  ds.trials[1].samples[7].f_motion = std::numeric_limits<double>::quiet_NaN();
+  hmm::ModelOptions mo;
+  mo.hmm.n_states = 3;
+  try {
+    hmm::train_outcome_model(fx::pointers(ds), mo);
+    ADD_FAILURE() << "no error for a good trial's NaN";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("class 'good' (4 trials, the longest "), std::string::npos) << e.what();
+  }
+  // A finite run: a model with its states, every evaluated likelihood finite.
+  const auto r = hmm::train(fx::draw(truth, 10, 100, 200, 5), opt);
+  EXPECT_EQ(r.hmm.n_states, 5);
+  EXPECT_TRUE(std::isfinite(r.log_likelihood));
+  for (double ll : r.history) EXPECT_TRUE(std::isfinite(ll));
 }
 
 // The three-class model of 5 states per class that two tests below train on 20 synthetic trials per
