@@ -26,6 +26,10 @@
 #   bits do not depend on it), CREATED (creation time to record; the shipped model used
 #   CREATED=2026-11-27T04:00:00Z, so the same data and binary give the same bytes),
 #   DRESSGUARD_SHARED_DIR (where shared/data is; default ../shared).
+# The same bytes need the same build and a CPU of the same kind: training runs the AVX2+FMA
+# E-step where the CPU has it and the portable one elsewhere, whose exps differ in the last bit,
+# so on the other kind the model's numbers differ in their last digits (and can take one
+# iteration more or less) and default.dgm.sha256 does not match (offline/hmm/hmm.h, Determinism).
 # Needs shared/data: the calibrations were made on the measured gown, and the discrepancy term is
 # read from the measured trials (imported into build/default-model-study/; neither they nor the
 # discrepancy curves, MODEL.dgm.discrepancy.csv, are kept in models/: no licence to redistribute).

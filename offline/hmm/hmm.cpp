@@ -125,7 +125,7 @@ struct KernelModel {
   int np = 0;
   std::vector<double> diag, m0, m1, ip, iq, ir, lc;
   filter::ClassBlock block;
-  filter::ClassUpdateFn update = filter::class_update_best();
+  filter::ClassUpdateFn update = filter::class_update_best();  // hmm.h, Determinism: the bits per CPU
   explicit KernelModel(const ClassHmm& h, const Band& band) {
     const int n = h.n_states;
     np = (n + 3) & ~3;

@@ -26,6 +26,19 @@
 //   Convergence: stop when the log-likelihood gain per training sample is below `tolerance`, or
 //     at `max_iterations`; the result is the best model whose likelihood was evaluated, with that
 //     exact likelihood (never the likelihood of the model before the last update).
+//
+// Determinism. The same data and options train the same bits on one machine, so `train` and
+// `build-model` with --created fixed write the same bytes there. On another CPU they may not: the
+// E-step runs the filter's best update for the CPU (filter::class_update_best: AVX2+FMA, else
+// portable), and the two kernels' exps differ in the last bit. Trained on the study, the default
+// 10-state model's parameters differ in their last digits (72 of 300 numbers, at most 7e-15
+// relative; session 85's HMM review, finding 3), and so do the model's bytes and SHA-256. A run
+// whose last gain per sample lands within rounding of `tolerance` may also stop one iteration
+// earlier or later on the other kernel; its parameters then differ by that iteration's change.
+// Any two CPUs with AVX2+FMA train the same bits (one build), as do any two without. Why not the
+// portable kernel everywhere: it makes `dressguard train` on the study 28 % slower (0.145 s
+// against 0.114 s, median of 10 runs), and classification agrees across the kernels to 1e-9
+// relative anyway (tests/hmm/filter_test.cpp).
 #pragma once
 
 #include <cstddef>

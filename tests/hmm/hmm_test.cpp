@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -1058,7 +1059,8 @@ TEST(HmmVote, SimulationAnswerModelsCountEachMemberOnTheOthersSets) {
   EXPECT_THROW(hmm::simulation_answer_models(committee, {sims.sets()[0]}), std::invalid_argument);
 }
 
-// Determinism: the same data trains the same bits.
+// Determinism: the same data train the same bits, every parameter and every likelihood
+// evaluated on the way (on one machine: hmm.h, Determinism, says what another CPU changes).
 TEST(HmmTrain, Deterministic) {
   const auto truth = fx::known_left_right(5, 0.95);
   const auto data = fx::draw(truth, 20, 100, 200, 5);
@@ -1066,8 +1068,22 @@ TEST(HmmTrain, Deterministic) {
   opt.n_states = 5;
   const auto a = hmm::train(data, opt);
   const auto b = hmm::train(data, opt);
-  EXPECT_EQ(a.log_likelihood, b.log_likelihood);
-  EXPECT_EQ(a.hmm.transition, b.hmm.transition);
+  // The bits of every number of a training's result, in one order.
+  const auto bits = [](const hmm::TrainResult& r) {
+    std::vector<double> v = r.history;
+    v.push_back(r.log_likelihood);
+    v.insert(v.end(), r.hmm.initial.begin(), r.hmm.initial.end());
+    v.insert(v.end(), r.hmm.transition.begin(), r.hmm.transition.end());
+    for (const auto& e : r.hmm.emission)
+      v.insert(v.end(), {e.mean[0], e.mean[1], e.cov[0][0], e.cov[0][1], e.cov[1][0], e.cov[1][1]});
+    std::vector<uint64_t> out;
+    for (double x : v) out.push_back(std::bit_cast<uint64_t>(x));
+    return out;
+  };
+  EXPECT_EQ(a.iterations, b.iterations);
+  EXPECT_EQ(a.converged, b.converged);
+  ASSERT_EQ(a.hmm.n_states, 5);
+  EXPECT_EQ(bits(a), bits(b));
 }
 
 // ---- two classifiers on the same trials -------------------------------------------------------
