@@ -339,6 +339,40 @@ TEST(HmmRecover, LateStartsAreMarginalisedNotTakenForThePullsStart) {
 TEST(HmmRecover, TenStatesLikeThePaper) { expect_recovered(10, 1, 600, 900, 12); }
 TEST(HmmRecover, TenStatesBandTwo) { expect_recovered(10, 2, 600, 900, 13); }
 
+// EM never lowers the likelihood (Baum's inequality; Rabiner 1989, eq. 40-41), checked at every
+// step of a long run from the equal-segment start with tolerance 0, half the sequences starting
+// late. The recovery tests above start next to the truth and converge in ~4 E-steps, with a slack
+// of 1e-6 |LL| (0.14 nats) larger than the gain at which training stops. Broad states (spread 8:
+// neighbours ~2 standard deviations apart) keep EM climbing: measured, 200 iterations and no
+// step down at all. 1e-9 relative is ~6e-5 nats here, rounding's size.
+TEST(HmmTrain, EmNeverLowersTheLikelihoodOverALongRun) {
+  const auto truth = fx::known_left_right(10, 0.99, 0.0, 8.0);
+  auto data = fx::draw(truth, 20, 600, 1200, 17);
+  // Every other sequence starts late (hmm.h, FeatureSequence::unobserved), 0..199 samples in.
+  size_t samples = 0;
+  for (size_t i = 0; i < data.size(); ++i) {
+    auto& s = data[i];
+    const size_t k = i % 2 ? 0 : (i * 37) % 200;
+    s.x.erase(s.x.begin(), s.x.begin() + static_cast<std::ptrdiff_t>(k * model::kFeatures));
+    s.unobserved = k;
+    samples += s.size();
+  }
+  hmm::TrainOptions opt;
+  opt.n_states = 10;
+  opt.tolerance = 0.0;
+  opt.max_iterations = 200;
+  const auto r = hmm::train(data, opt);
+  for (size_t i = 1; i < r.history.size(); ++i)
+    EXPECT_GE(r.history[i], r.history[i - 1] - 1e-9 * std::fabs(r.history[i - 1])) << "EM decreased at " << i;
+  EXPECT_EQ(r.log_likelihood, *std::max_element(r.history.begin(), r.history.end()));
+  // Tolerance 0 stops only on a loss: a run that is long, as meant, goes to max_iterations.
+  EXPECT_FALSE(r.converged);
+  ASSERT_EQ(r.iterations, 200);
+  ASSERT_EQ(r.history.size(), 200u);
+  EXPECT_GT(r.history[100] - r.history[99], 1e-6 * static_cast<double>(samples))
+      << "the default tolerance would have stopped before iteration 100: not a long run";
+}
+
 // No underflow: a 10,000-sample sequence (p(x) ~ e^-30000) and one with samples 1000 feature
 // standard deviations from every state keep finite log-likelihoods; the scaled forward equals a
 // pure log-space forward (log-sum-exp) to 1e-9 relative, and bounds Viterbi from above.
