@@ -396,7 +396,8 @@ ClassHmm initial_left_right(const std::vector<FeatureSequence>& seqs, const Trai
     e.cov[0][1] = e.cov[1][0] = s01[j] / cnt[j] - e.mean[0] * e.mean[1];
     floor_covariance(e.cov, opt.cov_floor);
   }
-  // Transitions: a segment lasts mean_len/n samples, so leaving has probability n/mean_len.
+  // Transitions: a segment lasts mean_len/n samples, so leaving has probability n/mean_len
+  // (held to [1e-6, 0.5], hmm.h).
   const double mean_len = total_len / static_cast<double>(used);
   const double leave = std::clamp(static_cast<double>(n) / mean_len, 1e-6, 0.5);
   for (int i = 0; i < n; ++i) {

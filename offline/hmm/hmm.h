@@ -11,10 +11,13 @@
 // far out that such a state alone explains it.
 //
 // Training (Rabiner eq. 40, 52-54 for the Gaussian case):
-//   initialisation: every sequence (with the samples it did not record, FeatureSequence::
-//     unobserved) split into n equal segments, segment j feeding state j's mean and covariance;
-//     pi = (1, 0, ..., 0); A_ii = 1 - n / mean length, the rest of the row spread over the band
-//     j = i+1..i+w with weights halving per step (the last state absorbs).
+//   initialisation: every sequence of at least n samples (with the samples it did not record,
+//     FeatureSequence::unobserved) split into n equal segments, segment j feeding state j's mean
+//     and covariance; a shorter sequence cannot give every state a sample and is left out, of
+//     the segments and of the mean length. pi = (1, 0, ..., 0); A_ii = 1 - leave with leave =
+//     n / mean length held to [1e-6, 0.5] (a stay of at least 1/2 for sequences under 2n
+//     samples; never a band transition of 0, which every M-step would keep), the rest of the row
+//     spread over the band j = i+1..i+w with weights halving per step (the last state absorbs).
 //   E-step: scaled forward-backward per sequence, restricted to the band; the forward pass runs
 //     through the online filter's vector update (predictor/filter/emission_update.h), so training
 //     and the robot compute the same recursion.

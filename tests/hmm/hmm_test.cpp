@@ -222,6 +222,25 @@ TEST(HmmInit, EqualSegments) {
   EXPECT_NO_THROW(model::validate_model(m, "init"));
 }
 
+// What initialisation does beyond the formula (hmm.h): leave = n / mean length is held to at most
+// 1/2, and a sequence shorter than the states is left out. One 12-sample sequence and 10 states:
+// 10/12 gives A_00 = 0.5, not 0.17. Three 4-sample sequences far away beside it change nothing;
+// counted, they would pull state 0's mean to 100 and the mean length to 6 (A_00 = 1 - 10/6 < 0).
+TEST(HmmInit, ShortSequencesAreLeftOutAndTheLeaveIsAtMostAHalf) {
+  FeatureSequence s, tiny;
+  for (int t = 0; t < 12; ++t) s.x.insert(s.x.end(), {static_cast<double>(t), static_cast<double>(t % 2)});
+  for (int t = 0; t < 4; ++t) tiny.x.insert(tiny.x.end(), {100.0, 100.0});
+  hmm::TrainOptions opt;
+  opt.n_states = 10;
+  const auto h = hmm::initial_left_right({s}, opt);
+  EXPECT_EQ(h.transition[0], 0.5);
+  EXPECT_EQ(h.transition[1], 0.5);
+  EXPECT_EQ(h.transition[99], 1.0);
+  const auto with_tiny = hmm::initial_left_right({tiny, s, tiny, tiny}, opt);
+  EXPECT_EQ(with_tiny.transition, h.transition);
+  for (int j = 0; j < 10; ++j) EXPECT_EQ(with_tiny.emission[j].mean[0], h.emission[j].mean[0]) << "state " << j;
+}
+
 // Sample from known parameters, retrain, recover them. 200 sequences of 400-900 samples give
 // each state >= 10^4 samples: the standard error of a mean is sqrt(0.3/1e4) = 0.0055, of a
 // covariance entry ~0.005, of a stay probability < 0.001; the tolerances (0.05, 0.05, 0.01) are
