@@ -24,6 +24,24 @@ std::set<std::string> split_list(const std::string& s) {
   return {items.begin(), items.end()};
 }
 
+std::vector<std::filesystem::path> dataset_list(const std::string& option, const std::string& list) {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> dirs;
+  std::map<fs::path, std::string> given;  // canonical path -> as given
+  for (const std::string& d : split_in_order(list)) {
+    std::error_code ec;
+    fs::path key = fs::weakly_canonical(fs::absolute(d), ec);
+    if (ec) key = fs::absolute(d).lexically_normal();
+    if (const auto [it, fresh] = given.emplace(key, d); !fresh)
+      throw UsageError("--" + option + " names the dataset " + d + " twice" +
+                       (it->second == d ? "" : " (as " + it->second + " and " + d + ")") +
+                       ": its trials would count twice");
+    dirs.emplace_back(d);
+  }
+  if (dirs.empty()) throw UsageError("--" + option + " names no dataset");
+  return dirs;
+}
+
 std::filesystem::path plot_script(const std::string& name) {
   namespace fs = std::filesystem;
   const fs::path rel = fs::path("tools") / "plot" / name;

@@ -45,7 +45,8 @@ int run_build_model(int argc, char** argv) {
         "  left-right bivariate HMM per outcome (paper V-B) and writes the model file.\n"
         "  Several calibrations (several people's simulators, paper VII) each synthesize their\n"
         "  own set, into SYNTH-DIR/<calibration file's name>/, and the HMMs learn from all of them.\n"
-        "  With --data: trains on the labelled trials of existing datasets (several are pooled).\n"
+        "  With --data: trains on the labelled trials of existing datasets (several are pooled,\n"
+        "  each folder once).\n"
         "  --states N   hidden states per HMM (default 10, paper VI)\n"
         "  --forces F   auto | both | lateral | motion: the second force beside F_motion\n"
         "               (F_vertical, F_lateral or none). Default auto: with --calibration,\n"
@@ -162,8 +163,7 @@ int run_build_model(int argc, char** argv) {
 #endif
     }
   } else {
-    for (const auto& d : split_in_order(*args.get("data"))) sets.emplace_back(d);
-    if (sets.empty()) throw UsageError("--data names no dataset");
+    sets = dataset_list("data", *args.get("data"));
   }
   if (!Comm::world().is_root()) return 0;  // training is one process's job (seconds)
 #ifndef DRESSGUARD_HAVE_HMM

@@ -21,7 +21,8 @@ int run_train(int argc, char** argv) {
         "usage: dressguard train --data DATASET[,DATASET...] --out MODEL.dgm [options] [--json]\n"
         "  Trains one left-right HMM per labelled outcome (good, missed, caught) on F_motion and\n"
         "  F_vertical (paper V-B): equal-segment initialisation, Baum-Welch to convergence.\n"
-        "  Several datasets (comma-separated) are pooled, their trials in the order given.\n"
+        "  Several datasets (comma-separated, each folder once) are pooled, their trials in the\n"
+        "  order given.\n"
         "  --states N              states per HMM (default 10, the paper; the study's code used 5)\n"
         "  --band W                left-right width: state i may go to i..i+W (default 1)\n"
         "  --cov-floor V           minimum covariance eigenvalue in scaled feature units squared,\n"
@@ -61,10 +62,7 @@ int run_train(int argc, char** argv) {
   if (!(stop_threshold > 0 && stop_threshold < 1)) throw UsageError("--stop-threshold must be in (0, 1)");
   if (stop_consecutive < 1 || stop_consecutive > 100000) throw UsageError("--stop-consecutive must be 1..100000");
   const auto excluded = split_list(args.get("exclude-participant").value_or(""));
-  const auto dirs = split_in_order(data);
-  if (dirs.empty()) throw UsageError("--data names no dataset");
-
-  const Dataset ds = load_datasets({dirs.begin(), dirs.end()});
+  const Dataset ds = load_datasets(dataset_list("data", data));
   require_known_participants("exclude-participant", excluded, ds, data);
   std::vector<const HapticSequence*> trials;
   for (const auto& t : ds.trials)

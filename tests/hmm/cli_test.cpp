@@ -426,6 +426,28 @@ TEST_F(CliTest, ACovarianceFloorBelowTheBoundIsRefused) {
   EXPECT_EQ(r.err.find("inf"), std::string::npos) << r.err;
 }
 
+// A folder that --data names twice, as itself or by another path, is refused, naming it: train
+// pooled study,study as 44 trials, each counted twice. train and build-model read the list alike.
+TEST_F(CliTest, ADatasetPooledTwiceIsRefused) {
+  save_dataset(fx::synthetic_dataset(3, 100, 120, 54, 3), dir / "d");
+  save_dataset(fx::synthetic_dataset(3, 100, 120, 55, 3), dir / "e");
+  const std::string d = (dir / "d").string(), e = (dir / "e").string(), other = (dir / "e" / ".." / "d").string();
+  const std::string out = " --states 3 --out " + (dir / "m.dgm").string();
+  for (const std::string cmd : {"train", "build-model"}) {
+    auto r = run(cmd + " --data " + d + "," + e + "," + d + out);
+    EXPECT_EQ(r.code, 2) << cmd;
+    EXPECT_NE(r.err.find("--data names the dataset " + d + " twice: "), std::string::npos) << cmd << ": " << r.err;
+    r = run(cmd + " --data " + d + "," + other + out);
+    EXPECT_EQ(r.code, 2) << cmd;
+    EXPECT_NE(r.err.find("--data names the dataset " + other + " twice (as " + d + " and " + other + ")"),
+              std::string::npos) << cmd << ": " << r.err;
+    EXPECT_FALSE(fs::exists(dir / "m.dgm")) << cmd;
+  }
+  const auto r = run("train --data " + d + "," + e + out + " --json");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(json_field(r.out, "trials"), 18.0) << r.out;
+}
+
 // A participant that the data lacks is named, with the ones it has: "p4" (the ids are "4") once
 // left nobody out of training while the model said it excluded p4, and classify ignored p5.
 TEST_F(CliTest, AnUnknownParticipantIsNamed) {
