@@ -386,7 +386,9 @@ TEST(SimTrial, SupportAndGripperShareTheGownsWeight) {
     touching += phi < sc.opt.contact_offset + 0.005;
   }
   EXPECT_GT(nearest, sc.opt.contact_offset - 0.001);
-  EXPECT_GT(touching, 10) << "the gown lies on the support";
+  // Several vertices: 6 of the coarse gown's (11 before its hem kept its vertex floor, 64 hem
+  // vertices instead of 56, reduce.cpp); the share of the weight above is what counts.
+  EXPECT_GE(touching, 5) << "the gown lies on the support";
   const TrialResult none = simulate_trial(coarse_scene(), ClothParams{}, spec);
   EXPECT_EQ(none.support_load, 0.0);
 }
