@@ -65,39 +65,4 @@ ClothMesh tube(double r, double x0, double x1, int nu, int nv) {
   return m;
 }
 
-ClothMesh sleeve_gown(int nu, int nv) {
-  const double pi = std::numbers::pi;
-  const double r_cuff = 0.075, r_body = 0.22, sleeve = 0.45, bend_r = 0.15, body = 0.6;
-  const double bend_len = 0.5 * pi * bend_r;
-  const double total = sleeve + bend_len + body;
-  ClothMesh m = ring_mesh(nu, nv, [&](int iv, int iu) {
-    const double s = total * iv / (nv - 1);
-    // Centreline from the cuff centre (0, 0, -r_cuff): along -x, a quarter bend down, then -z.
-    double cx, cz, tx, tz, r;
-    if (s <= sleeve) {
-      cx = -s; cz = -r_cuff; tx = -1; tz = 0; r = r_cuff;
-    } else if (s <= sleeve + bend_len) {
-      const double a = (s - sleeve) / bend_r;  // 0 .. pi/2
-      cx = -sleeve - bend_r * std::sin(a);
-      cz = -r_cuff - bend_r * (1 - std::cos(a));
-      tx = -std::cos(a); tz = -std::sin(a);
-      r = r_cuff + (r_body - r_cuff) * 0.3 * (a / (0.5 * pi));
-    } else {
-      const double b = (s - sleeve - bend_len) / body;
-      cx = -sleeve - bend_r; cz = -r_cuff - bend_r - (s - sleeve - bend_len);
-      tx = 0; tz = -1;
-      r = r_cuff + (r_body - r_cuff) * (0.3 + 0.7 * b);
-    }
-    // Ring frame: e1 = +y, e2 = t x e1 (in the x-z plane); angle 0 at the top of the cuff.
-    const double e2x = -tz, e2z = tx;  // t x ey = (tx,0,tz) x (0,1,0) = (-tz, 0, tx)
-    const double th = 2 * pi * iu / nu;
-    const double c = std::cos(th), sn = std::sin(th);
-    // top of the ring (th = 0) along +z at the cuff: e2 = (0,0,-1) there, so use -e2 for "up".
-    return std::array<double, 3>{cx - r * c * e2x, r * sn, cz - r * c * e2z};
-  });
-  m.name = "sleeve-gown";
-  for (int iu = 0; iu < nu; ++iu) m.sleeve_opening.push_back(iu);
-  return m;
-}
-
 }  // namespace dressguard::sim

@@ -362,9 +362,10 @@ std::vector<std::string> arm_part_names(const Scene& scene);
 // Which gown a default scene uses.
 enum class GownResolution { Full = 0, Reduced = 1, Coarse = 2 };
 
-// The default scene: the measured gown when the gown module and shared/data provide it, else the
-// simulator's own parametric sleeve-and-panel gown (see meshes.h). Coarse is a small version
-// for fast tests.
+// The default scene: the gown module's gown (gown::load_gown), the measured one when
+// shared/data provides it, else the gown module's parametric gown (gown::make_parametric_gown),
+// reduced to the resolution's triangles (gown_scene.h, target_triangles: Reduced 5000, Coarse
+// 1500 for fast tests) and placed like the paper.
 // `parametric`: the gown module's parametric gown even when the measured one is present.
 Scene make_default_scene(GownResolution res = GownResolution::Reduced, bool parametric = false);
 
