@@ -796,6 +796,17 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
     if (il >= 0) out[il] = cut ? 0.0 : lateral_term(inputs, sts, options.lateral_weight);
     out[T] = cut ? 1.0 : 0.0;
   };
+  // A candidate's inputs simulated; one whose scene cannot be built (UnbuildableCandidate) as
+  // failed simulations, which score infinity and rank it last.
+  auto simulate_candidate = [&](const Eigen::VectorXd& x, const std::vector<TrialWatch>& watches) {
+    try {
+      return simulate_inputs(sim, space.cloth(x), space.offsets(x), inputs, watches);
+    } catch (const UnbuildableCandidate&) {
+      std::vector<SimulatedTrial> failed(inputs.size());
+      for (SimulatedTrial& t : failed) t.finite = false;
+      return failed;
+    }
+  };
   auto report = [&](CandidateProgress& cp, std::chrono::steady_clock::time_point began) {
     if (!options.candidate_progress || !comm.is_root()) return;
     std::lock_guard<std::mutex> lock(progress_mutex);
@@ -830,7 +841,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
                        : (so_far.empty() ? std::numeric_limits<double>::infinity() : area_objective(so_far, measured));
             return combined_objective(known.data(), K, T, options.combine) > bound;
           });
-      std::vector<SimulatedTrial> sts = simulate_inputs(sim, space.cloth(xs[c]), space.offsets(xs[c]), inputs, watches);
+      std::vector<SimulatedTrial> sts = simulate_candidate(xs[c], watches);
       score(sts, simulated_time(sts), out);
       if (out[T] != 0.0) held[static_cast<std::size_t>(c)] = std::move(sts);  // each c on one thread
       report(cp, began);
@@ -864,7 +875,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
             work += t.simulated_s;
           }
       } else {
-        sts = simulate_inputs(sim, space.cloth(xs[c]), space.offsets(xs[c]), inputs);
+        sts = simulate_candidate(xs[c], {});
         work = simulated_time(sts);
       }
       score(sts, work, out);
@@ -998,7 +1009,8 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   if (r.complete && !std::isfinite(r.objective))
     throw std::runtime_error("no candidate could be simulated: the start and all " +
                              std::to_string(r.evaluations - 1) + " candidates of the search failed (a simulation "
-                             "that blew up or gave no samples scores infinity)");
+                             "that blew up or gave no samples, or a scene that could not be built, such as a grasp "
+                             "that holds none of the gown, scores infinity)");
   return r;
 }
 

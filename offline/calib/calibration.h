@@ -22,6 +22,7 @@
 #include <Eigen/Dense>
 
 #include "dataset.h"
+#include "files.h"
 #include "haptic.h"
 #include "json.h"
 #include "objective.h"
@@ -188,6 +189,16 @@ using TrialBatchSimulator =
     std::function<std::vector<SimulatedTrial>(const ClothValues&, const std::vector<TrialRequest>&)>;
 // The batch form of a one-trial simulator: its trials one after another.
 TrialBatchSimulator one_by_one(TrialSimulator sim);
+
+// What a simulator throws for values whose scene it cannot build: the cloth simulator's when the
+// gripper's jaws hold none of the gown at the values' rim_shift (sim_bridge.h; gown::NothingGrasped:
+// on the measured gown from rim_shift +0.045 m, the rim 8.5 cm ahead of the jaws). An InputError,
+// so a command that simulates a calibration file's values refuses them (exit 2); calibrate ranks
+// such a candidate last, as a simulation that blew up (calibrate's "Failures").
+class UnbuildableCandidate : public InputError {
+ public:
+  using InputError::InputError;
+};
 
 // ---- parameter space and bounds ------------------------------------------------------------------
 
@@ -523,12 +534,15 @@ double lateral_term(const std::vector<HapticSequence>& inputs, const std::vector
 // Failures. options.checkpoint is probed before the start is simulated (probe_checkpoint), and a
 // checkpoint that cannot be written after a generation ends every rank with std::runtime_error
 // (rank 0 alone would leave the others waiting for it in the next generation). A simulation that
-// blows up or gives no samples scores infinity and ranks last (cmaes.h); when the start and every
-// candidate of a finished search did, there is no calibration, and std::runtime_error says so.
-// A simulator that throws ends the run (under MPI through MPI_Abort, runner.h): it is not taken
-// as a failed simulation, because a candidate inside the box that the simulator cannot build is
-// a box the search should not have been given, which is checked before the search
-// (fit_rim_shift_to_gown), or a defect that ranking it last would hide.
+// blows up or gives no samples scores infinity and ranks last (cmaes.h), and so does a candidate
+// whose scene the simulator cannot build (UnbuildableCandidate: the jaws hold nothing of the gown
+// at its rim_shift, which depends on the mesh's shape and cannot be told from the box before the
+// search; it ended the whole run, session 85's gown review); when the start and every candidate
+// of a finished search did, there is no calibration, and std::runtime_error says so. A simulator
+// that throws anything else ends the run (under MPI through MPI_Abort, runner.h): it is not taken
+// as a failed simulation, because it is a box the search should not have been given, which is
+// checked before the search (a rim behind the jaws: fit_rim_shift_to_gown), or a defect that
+// ranking it last would hide.
 CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const ParameterSpace& space,
                             const TrialSimulator& sim, const CalibrationOptions& options, const Comm& comm,
                             const std::function<void(const GenerationProgress&)>& progress = {});

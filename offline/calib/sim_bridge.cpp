@@ -140,8 +140,14 @@ class SceneCache {
     for (const auto& [shift, scene] : kept_)
       if (shift == rim_shift) return scene;
     // Built under the lock: a thread that wants another grasp waits about 0.3 s, once per
-    // candidate, against the candidate's seconds of simulation.
-    auto scene = std::make_shared<const sim::Scene>(sim::make_default_scene(res_, parametric_, *grip));
+    // candidate, against the candidate's seconds of simulation. A grasp that holds none of the
+    // gown is the candidate's, not a defect: calibrate ranks it last (UnbuildableCandidate).
+    std::shared_ptr<const sim::Scene> scene;
+    try {
+      scene = std::make_shared<const sim::Scene>(sim::make_default_scene(res_, parametric_, *grip));
+    } catch (const gown::NothingGrasped& e) {
+      throw UnbuildableCandidate("rim_shift " + format_number(rim_shift) + " m: " + e.what());
+    }
     if (kept_.size() == kKept) kept_.erase(kept_.begin());
     kept_.emplace_back(rim_shift, scene);
     return scene;

@@ -18,6 +18,8 @@ namespace dressguard::calib {
 // last few; sim::simulate_trial() and simulate_trials() keep their mutable state per call, so
 // both functions may run on any number of threads. `trials` settles a cloth once for all its
 // arm heights where that is exact (sim::simulate_trials) and gives the same bits as `trial`.
+// Both throw UnbuildableCandidate (calibration.h) naming the rim_shift when its grasp holds none
+// of the gown (gown::NothingGrasped).
 struct ClothSimulator {
   TrialSimulator trial;
   TrialBatchSimulator trials;

@@ -67,16 +67,20 @@ SideFiles side_files_of(const std::filesystem::path& out) {
 }
 
 // The default scene, with the jaws where --grip-depth / --rim-ahead put them. A grip that leaves
-// the jaws off the sleeve's top (the rim too far ahead of them, say) grasps nothing; that is the
-// options' fault, so it is reported as a usage error that names them.
+// the jaws off the sleeve's top (the rim too far ahead of them, say) grasps nothing
+// (gown::NothingGrasped); that is the options' fault, so it is reported as a usage error that
+// names them, as a grip out of its range is.
 sim::Scene scene_with_grip(sim::GownResolution res, bool parametric, const std::optional<gown::OpeningGrip>& grip) {
   if (!grip) return sim::make_default_scene(res, parametric);
+  auto named = [&](const std::exception& e) {
+    return UsageError(format_string("--grip-depth %g --rim-ahead %g: %s", grip->depth, grip->rim_ahead, e.what()));
+  };
   try {
     return sim::make_default_scene(res, parametric, *grip);
   } catch (const std::invalid_argument& e) {
-    char b[160];
-    std::snprintf(b, sizeof b, "--grip-depth %g --rim-ahead %g: ", grip->depth, grip->rim_ahead);
-    throw UsageError(b + std::string(e.what()));
+    throw named(e);
+  } catch (const gown::NothingGrasped& e) {
+    throw named(e);
   }
 }
 

@@ -9,10 +9,14 @@
 namespace dressguard::cli {
 
 inline constexpr const char* kGripHelp =
-    "  --grip-depth M    [m] how far below the sleeve's top the jaws reach (default 0.015 for the\n"
-    "                    measured gown, 0.03 for the parametric one): deeper holds the opening\n"
-    "                    wider and shallower (offline/gown/placement.h, OpeningGrip)\n"
-    "  --rim-ahead M     [m] the opening's rim ahead of the jaws (default 0.04; parametric 0.01)\n";
+    "  --grip-depth M    [m] how far below the top of the opening's rim the lower jaw's face is\n"
+    "                    (default 0.015 for the measured gown, 0.03 for the parametric one):\n"
+    "                    deeper holds the opening wider and shallower (offline/gown/placement.h,\n"
+    "                    OpeningGrip)\n"
+    "  --rim-ahead M     [m] the opening's rim ahead of the jaws (default 0.04; parametric 0.01).\n"
+    "                    The measured sleeve's top falls away behind its rim: the further ahead,\n"
+    "                    the less the jaws hold (14 vertices at 0.04, 2 at 0.08, none from 0.085,\n"
+    "                    which is refused)\n";
 
 // The grip the options ask for, starting from `base` (a calibration's grasp) or else the gown's
 // own; nullopt when neither option is given and there is no base.

@@ -35,6 +35,28 @@ GownMesh load_gown(const GownOptions& options) {
     else
       place_like_paper(mesh, options.scene);
   }
+  // The jaws must hold some of the cloth. A file already in W that puts its sleeve elsewhere, or a
+  // grip that misses the measured sleeve's top, which falls away behind its rim (placement.h,
+  // OpeningGrip: nothing from 8.5 cm ahead at the default depth), grasped nothing: `gown` said
+  // "grasped vertices: 0" and exited 0, and the simulator failed later or a calibration ended.
+  // Before the reduction, which keeps the grasped vertices as they are.
+  if (grasp_vertices(mesh, options.scene).empty()) {
+    std::string where;
+    if (path.empty() || (!options.already_in_W && options.placement == GownPlacement::Opening)) {
+      const OpeningGrip g = options.grip.value_or(own_grip(path.empty()));
+      where = "with grip depth " + format_number(g.depth) + " m and rim_ahead " + format_number(g.rim_ahead) +
+              " m (placement.h, OpeningGrip: the sleeve's top behind its rim lies below the lower jaw; hold the "
+              "rim nearer the jaws or grip deeper)";
+    } else {
+      where = options.already_in_W ? "where the file puts it (already in W)" : "in the paper's placement";
+    }
+    const Eigen::Vector3d lo = options.scene.grasp_box_center_W() - options.scene.grasp_box_half_extent_W();
+    const Eigen::Vector3d hi = options.scene.grasp_box_center_W() + options.scene.grasp_box_half_extent_W();
+    throw NothingGrasped(format_string("%s: the gripper's jaws (x %g..%g, y %g..%g, z %g..%g m) hold no vertex of "
+                                       "the gown %s",
+                                       (path.empty() ? std::string("parametric gown") : path.string()).c_str(),
+                                       lo.x(), hi.x(), lo.y(), hi.y(), lo.z(), hi.z(), where.c_str()));
+  }
   mesh.areal_density = options.areal_density;
   if (options.target_triangles > 0) {
     std::vector<bool> frozen(mesh.x.size(), false);

@@ -31,6 +31,7 @@
 
 #include <Eigen/Core>
 
+#include "files.h"
 #include "placement.h"
 
 namespace dressguard::gown {
@@ -66,9 +67,20 @@ struct GownOptions {
 // shared/data/gown/fullgown.obj when shared/data is present, else empty.
 std::filesystem::path measured_gown_path();
 
+// What load_gown throws when the gripper's jaws hold no vertex of the gown: an InputError (the
+// grip or the file is at fault) that a calibration takes for a candidate it cannot simulate
+// (offline/calib, sim_bridge.h) rather than for a defect that ends it.
+class NothingGrasped : public InputError {
+ public:
+  using InputError::InputError;
+};
+
 // The gown the simulator runs on: loaded (or generated), placed in W like the paper's simulator,
-// reduced if asked (keeping the grasped vertices as they are), its boundary loops found and the sleeve opening labelled. Throws InputError
-// for a malformed file or a mesh without at least one boundary loop near the grasp box.
+// reduced if asked (keeping the grasped vertices as they are), its boundary loops found and the
+// sleeve opening labelled. Throws InputError for a malformed file or a mesh with fewer than two
+// boundary loops, and NothingGrasped, naming the mesh and the grip, when the jaws hold none of
+// its vertices: a file already in W that puts its sleeve elsewhere, or a grip that misses the
+// measured sleeve's top (placement.h, OpeningGrip: from 8.5 cm ahead at the default depth).
 GownMesh load_gown(const GownOptions& options);
 
 // Reads v/f lines of an OBJ (polygons fan-triangulated; 1-based and negative indices; "f a/b/c",

@@ -23,7 +23,8 @@
 //    arm height gives a good trial. The data README asks for the opening to hang toward the fist
 //    (paper Fig. 3b): our default, GownPlacement::Opening (place_at_opening), computes the pose
 //    from the mesh itself (the opening's plane, the gown's centroid) and holds the sleeve's top
-//    4 cm behind its rim. That is where our placement differs from the paper's code.
+//    from 4 cm behind its rim (how much of it: OpeningGrip). That is where our placement differs
+//    from the paper's code.
 //  - Also in that code, not here: every particle gets the same mass (total / n; we lump by area)
 //    and the grasped particles' masses are scaled up (grip_massscale).
 //  - The paper's Fig. 3(b) only shows the sleeve hanging toward the fist; the "lower half" of the
@@ -127,19 +128,33 @@ enum class GownPlacement { Opening = 0, Paper = 1 };
 // Moves a mesh read in the file frame (already scaled) into W: x_W = R_WF x + t_W.
 void place_like_paper(GownMesh& mesh, const PaperScene& scene = {});
 
-// How deep below the sleeve's top the jaws reach in the Opening placement [m]: about one edge
-// of the reduced gown, so the jaws hold the sleeve's top layer only, not a wide flattened cap.
+// How far below the highest point of the sleeve opening's rim the lower jaw's face is in the
+// Opening placement [m]: about one edge of the reduced gown, so that the jaws hold the sleeve's
+// top layer only, not a wide flattened cap.
 inline constexpr double kOpeningGripDepth = 0.015;
 // How far the sleeve opening's rim is ahead of the jaws in the Opening placement [m].
 inline constexpr double kOpeningRimAhead = 0.04;
 
-// How the jaws hold the sleeve in the Opening placement. The jaws pick up the top `depth` of the
-// sleeve over their 8 cm behind the rim and hold that cap flattened across their width: the
-// deeper the grip, the more of the opening's perimeter is held open across the jaws and the less
-// hangs below them (a loop of perimeter P with a flat top of width b hangs about (P - b) / 2 deep
-// when slack), so the opening is wider and shallower. `rim_ahead` is how far the opening's rim
-// is ahead of the jaws' front face. The study did not measure either; they are part of the scene
-// a calibration may search (offline/calib) or a user may set (`dressguard simulate --grip-depth`).
+// How the jaws hold the sleeve in the Opening placement. Both numbers place the opening's rim:
+// its highest vertex goes `depth` above the lower jaw's starting face and `rim_ahead` ahead of
+// the jaws' front face; the closing jaws then pick up whatever of the sleeve lies above that face
+// over their 8 cm. Only on a sleeve whose top is level behind its rim (the parametric gown) is
+// that its top `depth` all along the jaws. The measured gown's sleeve top falls away behind its
+// rim (0.5 cm lower 4 cm behind it, 1 cm at 8 cm, then about 1 cm per 2 cm: 3.3 cm at 12 cm), so
+// there the jaws hold less, the further ahead the rim is. At the default depth (0.015 m; every
+// resolution holds the same vertices, load_gown freezes them):
+//   rim_ahead 0     29 vertices, the cloth reaching 1.5 cm above the lower jaw at its front
+//   rim_ahead 0.04  14 vertices, 0.97 cm, over the jaws' front 4.3 cm only (the default)
+//   rim_ahead 0.08   2 vertices, 0.45 cm
+//   from 0.085 m    none (at depth 0.005, none from the default 0.04 on)
+// So on that gown `rim_ahead` changes both when the fist meets the rim and how much of the sleeve
+// is held (offline/calib's rim_shift does both). This is the placement every calibration in
+// models/ was fitted with, kept as it is; load_gown refuses a grip that holds no vertex. What is
+// held stays flattened across the jaws' width: the deeper the grip, the more of the opening's
+// perimeter is held open across the jaws and the less hangs below them (a loop of perimeter P
+// with a flat top of width b hangs about (P - b) / 2 deep when slack), so the opening is wider and
+// shallower. The study did not measure either number; they are part of the scene a calibration
+// may search (offline/calib) or a user may set (`dressguard simulate --grip-depth --rim-ahead`).
 struct OpeningGrip {
   double depth = kOpeningGripDepth;     // [m] > 0
   double rim_ahead = kOpeningRimAhead;  // [m] >= 0
@@ -149,8 +164,8 @@ struct OpeningGrip {
 void check_grip(const OpeningGrip& grip, const PaperScene& scene = {});
 
 // Where the Opening placement puts the sleeve (and where the parametric gown is built): the
-// opening's rim `rim_ahead` ahead of the grasp box, and the sleeve's top `grip_depth` above the
-// lower jaw's starting face, so the closing jaws pick up the top `grip_depth` of the sleeve.
+// opening's rim `rim_ahead` ahead of the grasp box, and the rim's highest point `grip_depth` above
+// the lower jaw's starting face (what the jaws then hold: OpeningGrip).
 inline double opening_rim_x_W(const PaperScene& s, double rim_ahead) {
   return s.grasp_box_center_W().x() + s.grasp_box_half_extent_W().x() + rim_ahead;
 }

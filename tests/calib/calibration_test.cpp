@@ -1070,6 +1070,46 @@ TEST(Calibration, EverySimulationFailingIsNoCalibration) {
   fs::remove_all(dir);
 }
 
+// A candidate whose scene the simulator cannot build (UnbuildableCandidate: the cloth
+// simulator's when the jaws hold none of the gown at its rim_shift) ranks last as a simulation
+// that blew up does, to the bit, and the search goes on: it ended the whole calibration (session
+// 85's gown review, finding 1). When the start and every candidate are, there is no calibration.
+TEST(Calibration, ACandidateThatCannotBeBuiltRanksLast) {
+  const auto inputs = fake_inputs(Truth{});
+  const auto space = space_for(inputs);
+  auto o = quick(3, 2);
+  std::atomic<int> unbuilt{0};
+  const TrialSimulator unbuildable = [&](const ClothValues& c, const TrialRequest& r) {
+    if (c.friction > 0.6) {
+      ++unbuilt;
+      throw UnbuildableCandidate("rim_shift 0.05 m: the jaws hold no vertex");
+    }
+    return testing::fake_simulate(c, r);
+  };
+  const TrialSimulator blown = [](const ClothValues& c, const TrialRequest& r) {
+    SimulatedTrial t = testing::fake_simulate(c, r);
+    t.finite = c.friction <= 0.6;
+    return t;
+  };
+  const CalibrationResult a = calibrate(inputs, space, unbuildable, o, Comm::world());
+  const CalibrationResult b = calibrate(inputs, space, blown, o, Comm::world());
+  EXPECT_GT(unbuilt.load(), 0) << "no candidate was unbuildable: the test proves nothing";
+  EXPECT_TRUE(a.complete);
+  EXPECT_TRUE(std::isfinite(a.objective));
+  EXPECT_LE(a.cloth.friction, 0.6);
+  EXPECT_EQ(a.objective, b.objective);
+  EXPECT_TRUE(a.best_unit == b.best_unit);
+  const TrialSimulator none = [](const ClothValues&, const TrialRequest&) -> SimulatedTrial {
+    throw UnbuildableCandidate("rim_shift 0.05 m: the jaws hold no vertex");
+  };
+  try {
+    calibrate(inputs, space, none, quick(1, 1), Comm::world());
+    FAIL() << "a calibration of candidates that could not be built was returned";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("no candidate could be simulated"), std::string::npos) << e.what();
+  }
+}
+
 // The rim_shift box against the gown's rim (fit_rim_shift_to_gown): the default box, made for
 // the measured gown's 4 cm, is clipped on the parametric gown (1 cm), where a candidate below
 // -0.01 m stopped the whole calibration in its first generation; a bounds file's box reaching
