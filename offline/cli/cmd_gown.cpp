@@ -95,7 +95,7 @@ int run_gown(int argc, char** argv) {
         "  --hang          let the gown hang 3 s from the jaws in a crude check (edges only, no\n"
         "                  bending, no collisions; not the simulator) before reporting where its\n"
         "                  loops are and drawing it (area, mass, edges and --out stay as placed)\n"
-        "  --out MESH.obj  write the placed mesh (atomically; before any --hang)\n"
+        "  --out MESH.obj  write the placed mesh (atomically; before any --hang; never over --obj)\n"
         "  --dump FILE     write the scene (mesh, grasp, loops, arm, gripper) as JSON for plotting\n"
         "  --picture PNG   draw the placed gown with grasp, sleeve opening and arm (needs python3 +\n"
         "                  matplotlib; tools/plot/gown.py)\n"
@@ -124,6 +124,13 @@ int run_gown(int argc, char** argv) {
     else
       throw UsageError("--placement wants opening or paper, not '" + *p + "'");
   }
+
+  // An output over the --obj it reads would replace the user's mesh: --out by the placed one, in
+  // metres, which the default --scale then scales a second time when it is read back.
+  for (const char* o : {"out", "dump", "picture"})
+    if (const auto path = args.get(o); path && !opt.obj.empty() && same_file(*path, opt.obj))
+      throw UsageError(std::string("--") + o + " " + *path + " would write over the input --obj " + opt.obj.string() +
+                       ": choose another file");
 
   const auto t0 = std::chrono::steady_clock::now();
   opt.parametric = args.has("parametric");

@@ -124,3 +124,19 @@ if(NOT rc1 EQUAL 0 OR NOT rc2 EQUAL 0 OR NOT rc3 EQUAL 0 OR NOT sleeve_back STRE
   message(FATAL_ERROR "gown --hang --out did not write the placed mesh: sleeve centre ${sleeve_back} read back, "
                       "${sleeve_placed} placed (rc ${rc1} ${rc2} ${rc3})")
 endif()
+# An output over the --obj it reads is refused before anything is written: --out replaced the
+# user's mesh by the placed one, in metres, which the default --scale then scaled a second time
+# when read back (4.55 m^2). Also through another spelling of the same path, and for --dump.
+set(mine ${CMAKE_CURRENT_BINARY_DIR}/dg_gown_mine.obj)
+execute_process(COMMAND ${DG} gown --parametric --reduced 1500 --out ${mine} RESULT_VARIABLE rc OUTPUT_QUIET)
+file(SHA256 ${mine} before)
+foreach(how "--out;${mine}" "--out;${CMAKE_CURRENT_BINARY_DIR}/./dg_gown_mine.obj" "--dump;${mine}")
+  execute_process(COMMAND ${DG} gown --obj ${mine} ${how} RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+  file(SHA256 ${mine} after)
+  list(GET how 0 opt)
+  if(NOT rc EQUAL 2 OR NOT err MATCHES "${opt} .* would write over the input --obj" OR NOT after STREQUAL before)
+    message(FATAL_ERROR "gown --obj F ${how}: expected exit 2 naming ${opt} and the input unchanged, got rc=${rc}: "
+                        "${err}")
+  endif()
+endforeach()
+file(REMOVE ${mine})
