@@ -88,10 +88,11 @@ GownMesh load_gown(const GownOptions& options);
 // the file's frame (no placement). Boundary loops are found; the sleeve is not labelled.
 // InputError names file:line on a malformed line or an index out of range.
 // A mesh the simulator can take is also checked: every vertex within kMaxObjCoordinate of the
-// file's origin after the scale (a unit slip in `scale` shows here), every triangle at least
-// kMinObjFaceArea, no triangle twice and no edge shared by three or more (a cloth is a
-// 2-manifold). A UTF-8 byte-order mark and leading blanks are skipped; an upper-case keyword
-// ("V", "F") is an error rather than a skipped line that would shift every later index.
+// file's origin after the scale (a unit slip in `scale` shows here) and used by some face, every
+// triangle at least kMinObjFaceArea, no triangle twice, no edge shared by three or more and one
+// fan of triangles around every vertex (a cloth is a 2-manifold: no pinched vertex). A UTF-8
+// byte-order mark and leading blanks are skipped; an upper-case keyword ("V", "F") is an error
+// rather than a skipped line that would shift every later index.
 inline constexpr double kMaxObjCoordinate = 100.0;  // [m]
 inline constexpr double kMinObjFaceArea = 1e-12;    // [m^2]; the measured gown's smallest: 1e-5
 GownMesh read_obj(const std::filesystem::path& path, double scale);

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <map>
 #include <cstdlib>
+#include <numeric>
 #include <string>
 #include <string_view>
 
@@ -51,9 +52,14 @@ int parse_vertex_ref(std::string_view s, int n_vertices_so_far) {
 }
 
 // The mesh must be a cloth the simulator can take: no triangle of (near) zero area (its bending
-// and stretching constraints divide by it), none twice, and no edge shared by more than two
-// triangles (a cloth sheet is a 2-manifold; its boundary loops are only defined then).
-void check_cloth_topology(const GownMesh& mesh, const std::vector<long>& face_line, const std::filesystem::path& path) {
+// and stretching constraints divide by it), none twice, no edge shared by more than two
+// triangles, and around every vertex one fan of triangles (a cloth sheet is a 2-manifold; its
+// boundary loops are only defined then: where two fans meet at a vertex, a hole touching the hem
+// or a bowtie, the boundary walk runs through it twice and two loops come out as one). Every
+// vertex is used by some face: one that is not is a particle without mass (vertex_masses gives
+// it 0) that still counts in the placement's centroid and, in the jaws, as grasped.
+void check_cloth_topology(const GownMesh& mesh, const std::vector<long>& face_line,
+                          const std::vector<long>& vertex_line, const std::filesystem::path& path) {
   std::map<std::array<int, 3>, size_t> faces;
   std::map<std::pair<int, int>, std::vector<size_t>> edges;
   for (size_t f = 0; f < mesh.triangles.size(); ++f) {
@@ -78,6 +84,36 @@ void check_cloth_topology(const GownMesh& mesh, const std::vector<long>& face_li
                                                   std::to_string(face_line[users[1]]) + " and this one)");
     }
   }
+  // The fans: the corners (face, vertex) around a vertex joined across each edge two faces share;
+  // a 2-manifold's vertex ends with one group.
+  std::vector<size_t> root(3 * mesh.triangles.size());
+  std::iota(root.begin(), root.end(), size_t{0});
+  auto find = [&](size_t c) {
+    while (root[c] != c) c = root[c] = root[root[c]];
+    return c;
+  };
+  auto corner = [&](size_t f, int v) {
+    const auto& t = mesh.triangles[f];
+    return 3 * f + static_cast<size_t>(t[0] == v ? 0 : t[1] == v ? 1 : 2);
+  };
+  for (const auto& [e, users] : edges)
+    if (users.size() == 2)
+      for (int v : {e.first, e.second}) root[find(corner(users[0], v))] = find(corner(users[1], v));
+  std::vector<std::vector<size_t>> fans(mesh.x.size());
+  for (size_t c = 0; c < root.size(); ++c) fans[static_cast<size_t>(mesh.triangles[c / 3][c % 3])].push_back(find(c));
+  for (size_t v = 0; v < fans.size(); ++v) {
+    auto& f = fans[v];
+    std::sort(f.begin(), f.end());
+    f.erase(std::unique(f.begin(), f.end()), f.end());
+    if (f.empty())
+      throw_input_error(path, vertex_line[v], "vertex " + std::to_string(v + 1) +
+                                                  " is used by no face (a particle without mass); remove it");
+    if (f.size() > 1)
+      throw_input_error(path, vertex_line[v], "vertex " + std::to_string(v + 1) + " is pinched: its faces form " +
+                                                  std::to_string(f.size()) +
+                                                  " fans that meet only there (the cloth touches itself at a "
+                                                  "point; a cloth's vertex has one fan)");
+  }
 }
 
 }  // namespace
@@ -86,7 +122,8 @@ GownMesh read_obj(const std::filesystem::path& path, double scale) {
   if (!(scale > 0)) throw_input_error(path, 0, "scale must be positive, got " + format_number(scale));
   const std::string text = read_file(path);
   GownMesh mesh;
-  std::vector<long> face_line;  // the line of each triangle, for the topology's messages
+  std::vector<long> face_line;    // the line of each triangle, for the topology's messages
+  std::vector<long> vertex_line;  // the line of each vertex
   long line_no = 0;
   size_t pos = text.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;  // a UTF-8 byte-order mark
   while (pos < text.size()) {
@@ -112,6 +149,7 @@ GownMesh read_obj(const std::filesystem::path& path, double scale) {
                               format_number(p.cwiseAbs().maxCoeff()) + " m out (after the scale " +
                               format_number(scale) + "): a gown spans about a metre");
       mesh.x.push_back(p);
+      vertex_line.push_back(line_no);
     } else if (t[0] == "f") {
       if (t.size() < 4) throw_input_error(path, line_no, "face with fewer than 3 vertices");
       std::vector<int> idx;
@@ -134,7 +172,7 @@ GownMesh read_obj(const std::filesystem::path& path, double scale) {
     }
   }
   if (mesh.triangles.empty()) throw_input_error(path, 0, "no faces");
-  check_cloth_topology(mesh, face_line, path);
+  check_cloth_topology(mesh, face_line, vertex_line, path);
   mesh.boundary_loops = find_boundary_loops(mesh.triangles, static_cast<int>(mesh.x.size()));
   return mesh;
 }

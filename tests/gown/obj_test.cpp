@@ -122,6 +122,47 @@ TEST(ReadObj, RejectsWhatTheSimulatorCannotTake) {
   fs::remove(p);
 }
 
+// What else a cloth cannot be, each named at the vertex's line: a vertex where two fans of
+// triangles meet only at it, and a vertex no face uses. A 3 x 3 grid of unit squares without its
+// centre square and its corner square (2, 2) has a hole that touches the outer boundary at vertex
+// 11: the boundary walk went through it twice and merged the two loops into one; a bowtie (two
+// triangles sharing a vertex) is the same; an unused vertex was a particle without mass that
+// counted in the placement's centroid (finding 5 of session 85's gown review).
+TEST(ReadObj, RejectsPinchedAndUnusedVertices) {
+  // The grid without its centre square, and with `corner` without square (2, 2) and vertex 16.
+  auto holed = [](bool corner) {
+    std::string s;
+    for (int v = 0; v < (corner ? 15 : 16); ++v)
+      s += "v " + std::to_string(v % 4) + " " + std::to_string(v / 4) + " 0\n";
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) {
+        if ((i == 1 && j == 1) || (corner && i == 2 && j == 2)) continue;
+        const std::string a = std::to_string(j * 4 + i + 1), b = std::to_string(j * 4 + i + 2),
+                          c = std::to_string(j * 4 + i + 6), d = std::to_string(j * 4 + i + 5);
+        s += "f " + a + " " + b + " " + c + "\nf " + a + " " + c + " " + d + "\n";
+      }
+    return s;
+  };
+  const std::string square = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n";
+  struct Case { const char* name; std::string text, want; };
+  const Case cases[] = {
+      {"pinch.obj", holed(true), ":11: vertex 11 is pinched: its faces form 2 fans that meet only there"},
+      {"bowtie.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv -1 0 0\nv -1 -1 0\nf 1 2 3\nf 1 4 5\n", ":1: vertex 1 is pinched"},
+      {"unused.obj", square + "v 5 5 5\nf 1 2 3\nf 1 3 4\n", ":5: vertex 5 is used by no face"},
+  };
+  for (const auto& c : cases) {
+    const std::string e = error_of(c.name, c.text);
+    EXPECT_NE(e.find(c.name + std::string(c.want)), std::string::npos) << "want '" << c.want << "', got '" << e << "'";
+  }
+  // A hole that touches nothing is a cloth: two loops, 12 and 4 vertices.
+  const fs::path p = write_obj("annulus.obj", holed(false));
+  const GownMesh m = read_obj(p, 1.0);
+  fs::remove(p);
+  ASSERT_EQ(m.boundary_loops.size(), 2u);
+  EXPECT_EQ(m.boundary_loops[0].size(), 12u);
+  EXPECT_EQ(m.boundary_loops[1].size(), 4u);
+}
+
 TEST(BoundaryLoops, GridHasOneOrderedLoopOfItsPerimeter) {
   const fs::path p = write_obj("grid.obj", grid_obj(5, 0.1));
   const GownMesh m = read_obj(p, 1.0);

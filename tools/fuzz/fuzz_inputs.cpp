@@ -8,7 +8,8 @@
 //            kMaxTravel], never back by more than kTravelJitter; forces within kMaxForce; t
 //            increasing), and a mesh is one gown.h's read_obj promises (vertices within
 //            kMaxObjCoordinate, indices in range, triangles of at least kMinObjFaceArea, none
-//            twice, no edge of three).
+//            twice, no edge of three, every vertex used, around each vertex one fan of triangles
+//            joined by their edges).
 //
 // Readers: 0 a dataset trial CSV (read_trial_csv), 1 a trial of the study's layout
 // (read_study_trial), 2 an OBJ mesh (read_obj, scale 1.679 as the measured gown's).
@@ -68,6 +69,29 @@ void check_mesh(const gown::GownMesh& m) {
     for (int k = 0; k < 3; ++k)
       if (++edges[{std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])}] > 2)
         broken("an OBJ read with an edge of three faces", 0);
+  }
+  // Each vertex's triangles, spread from the first across the edges through the vertex that two
+  // of them share: all reached, or two fans meet only at the vertex.
+  std::vector<std::vector<int>> around(m.x.size());
+  for (int f = 0; f < static_cast<int>(m.triangles.size()); ++f)
+    for (int v : m.triangles[f]) around[v].push_back(f);
+  for (int v = 0; v < static_cast<int>(around.size()); ++v) {
+    const std::vector<int>& fs = around[v];
+    if (fs.empty()) broken("an OBJ read with a vertex no face uses", 0);
+    std::vector<char> reached(fs.size(), 0);
+    reached[0] = 1;
+    for (bool grew = true; grew;) {
+      grew = false;
+      for (size_t a = 0; a < fs.size(); ++a)
+        for (size_t b = 0; b < fs.size(); ++b)
+          if (reached[a] && !reached[b]) {
+            int shared = 0;  // vertices the two triangles share: v and one more is an edge through v
+            const auto& tb = m.triangles[fs[b]];
+            for (int p : m.triangles[fs[a]]) shared += static_cast<int>(std::count(tb.begin(), tb.end(), p));
+            if (shared == 2) reached[b] = 1, grew = true;
+          }
+    }
+    if (std::count(reached.begin(), reached.end(), 0) > 0) broken("an OBJ read with a pinched vertex", 0);
   }
 }
 
