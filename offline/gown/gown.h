@@ -83,16 +83,20 @@ class NothingGrasped : public InputError {
 // measured sleeve's top (placement.h, OpeningGrip: from 8.5 cm ahead at the default depth).
 GownMesh load_gown(const GownOptions& options);
 
-// Reads v/f lines of an OBJ (polygons fan-triangulated; 1-based and negative indices; "f a/b/c",
-// "a//c" and "a/b" forms; other lines ignored). Positions are multiplied by `scale` and stay in
-// the file's frame (no placement). Boundary loops are found; the sleeve is not labelled.
-// InputError names file:line on a malformed line or an index out of range.
+// Reads v/f lines of an OBJ (1-based and negative indices; "f a/b/c", "a//c" and "a/b" forms;
+// polygons fan-triangulated from their first corner, and refused when that fan folds them, as
+// for a concave polygon whose first corner does not see the others; other lines ignored).
+// Positions are multiplied by `scale` and stay in the file's frame (no placement). Boundary loops
+// are found; the sleeve is not labelled. InputError names file:line on a malformed line or an
+// index out of range. Words are split at any isspace blank, '#' starts a comment anywhere on a
+// line, a line ends at LF, CRLF or a lone CR, and a coordinate may be subnormal.
 // A mesh the simulator can take is also checked: every vertex within kMaxObjCoordinate of the
 // file's origin after the scale (a unit slip in `scale` shows here) and used by some face, every
 // triangle at least kMinObjFaceArea, no triangle twice, no edge shared by three or more and one
 // fan of triangles around every vertex (a cloth is a 2-manifold: no pinched vertex). A UTF-8
-// byte-order mark and leading blanks are skipped; an upper-case keyword ("V", "F") is an error
-// rather than a skipped line that would shift every later index.
+// byte-order mark and leading blanks are skipped; a word that begins with v or f but is none of
+// v, vt, vn, vp and f ("V", "F", "v0.5", the old face keyword "fo") is an error rather than a
+// skipped line that would shift every later index or drop faces.
 inline constexpr double kMaxObjCoordinate = 100.0;  // [m]
 inline constexpr double kMinObjFaceArea = 1e-12;    // [m^2]; the measured gown's smallest: 1e-5
 GownMesh read_obj(const std::filesystem::path& path, double scale);

@@ -1,6 +1,9 @@
 // OBJ reading and writing: only what a cloth mesh needs (v and f lines).
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
+#include <cfloat>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <cstdlib>
@@ -14,7 +17,9 @@
 namespace dressguard::gown {
 namespace {
 
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r'; }
+// Every blank isspace knows: a vertical tab or form feed read as part of a word made "v\v0 1 0"
+// one unknown keyword, a skipped line, and every later vertex index shifted.
+bool is_space(char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; }
 
 // Splits a line into whitespace-separated tokens (views into the line).
 std::vector<std::string_view> tokens(std::string_view line) {
@@ -35,7 +40,10 @@ bool parse_double(std::string_view s, double& v) {
   char* end = nullptr;
   errno = 0;
   v = std::strtod(tmp.c_str(), &end);
-  return end == tmp.c_str() + tmp.size() && errno == 0 && !tmp.empty();
+  // ERANGE is also an underflow: a subnormal (1e-320) or a value rounded to 0 is a coordinate
+  // like 0. An overflow (+-HUGE_VAL) stays refused.
+  const bool in_range = errno == 0 || (errno == ERANGE && std::abs(v) <= DBL_MIN);
+  return end == tmp.c_str() + tmp.size() && in_range && !tmp.empty();
 }
 
 // "a", "a/b", "a//c" or "a/b/c": the vertex index a (1-based, or negative counting back from the
@@ -116,6 +124,27 @@ void check_cloth_topology(const GownMesh& mesh, const std::vector<long>& face_li
   }
 }
 
+// Fan triangulation from the polygon's first corner holds for a convex polygon (and a concave one
+// whose first corner sees all the others); otherwise some fan triangles face the other way and
+// overlap the rest, a fold the file does not have. Refused, naming the first such pair. A polygon
+// that repeats a corner is left to its triangles' checks (a repeated vertex, a triangle twice).
+void check_fan(const GownMesh& mesh, const std::vector<int>& idx, const std::filesystem::path& path, long line_no) {
+  std::vector<int> corners = idx;
+  std::sort(corners.begin(), corners.end());
+  if (std::adjacent_find(corners.begin(), corners.end()) != corners.end()) return;
+  std::vector<Eigen::Vector3d> n;
+  for (size_t i = 1; i + 1 < idx.size(); ++i)
+    n.push_back((mesh.x[idx[i]] - mesh.x[idx[0]]).cross(mesh.x[idx[i + 1]] - mesh.x[idx[0]]));
+  for (size_t i = 0; i < n.size(); ++i)
+    for (size_t j = i + 1; j < n.size(); ++j)
+      if (n[i].dot(n[j]) < 0)
+        throw_input_error(path, line_no, "polygon of " + std::to_string(idx.size()) +
+                                             " corners is not convex: fanned from its first corner, triangles 1 " +
+                                             std::to_string(i + 2) + " " + std::to_string(i + 3) + " and 1 " +
+                                             std::to_string(j + 2) + " " + std::to_string(j + 3) +
+                                             " face opposite ways; split it into triangles");
+}
+
 }  // namespace
 
 GownMesh read_obj(const std::filesystem::path& path, double scale) {
@@ -127,16 +156,24 @@ GownMesh read_obj(const std::filesystem::path& path, double scale) {
   long line_no = 0;
   size_t pos = text.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;  // a UTF-8 byte-order mark
   while (pos < text.size()) {
-    size_t eol = text.find('\n', pos);
+    // A line ends at "\n", "\r\n" or a lone "\r" (old Mac files: read as one line, "no faces").
+    size_t eol = text.find_first_of("\r\n", pos);
     if (eol == std::string::npos) eol = text.size();
-    const std::string_view line(text.data() + pos, eol - pos);
-    pos = eol + 1;
+    std::string_view line(text.data() + pos, eol - pos);
+    pos = eol + (text.compare(eol, 2, "\r\n") == 0 ? 2 : 1);
     ++line_no;
-    const auto t = tokens(line);  // leading blanks are no reason to skip a line
-    if (t.empty() || t[0][0] == '#') continue;
-    // OBJ keywords are lower case; a "V" or "F" line skipped would shift every later index.
-    if (t[0] == "V" || t[0] == "F" || t[0] == "Vt" || t[0] == "VT" || t[0] == "Vn" || t[0] == "VN")
-      throw_input_error(path, line_no, "keyword '" + std::string(t[0]) + "': OBJ keywords are lower case");
+    line = line.substr(0, line.find('#'));  // a comment, the whole line or after the data
+    const auto t = tokens(line);            // leading blanks are no reason to skip a line
+    if (t.empty()) continue;
+    // OBJ's keywords that begin with v or f are v, vt, vn, vp and f (and fo, an old spelling of
+    // f, refused rather than skipped: its faces would be missing). Any other word that does
+    // ("V", "F", "VT", "v0.5") is a slip for one of them, and skipped it would shift every later
+    // vertex index or drop faces without a word.
+    const char first = t[0][0];
+    if ((first == 'v' || first == 'V' || first == 'f' || first == 'F') && t[0] != "v" && t[0] != "vt" &&
+        t[0] != "vn" && t[0] != "vp" && t[0] != "f")
+      throw_input_error(path, line_no, "keyword '" + std::string(t[0]) +
+                                           "' is none of OBJ's v, vt, vn, vp and f (keywords are lower case)");
     if (t[0] == "v") {
       Eigen::Vector3d p;
       if (t.size() < 4 || !parse_double(t[1], p.x()) || !parse_double(t[2], p.y()) || !parse_double(t[3], p.z()))
@@ -161,7 +198,7 @@ GownMesh read_obj(const std::filesystem::path& path, double scale) {
                                 " vertices defined so far)");
         idx.push_back(k);
       }
-      // Fan triangulation of a (convex, planar enough) polygon.
+      check_fan(mesh, idx, path, line_no);
       for (size_t i = 1; i + 1 < idx.size(); ++i) {
         const std::array<int, 3> tri{idx[0], idx[i], idx[i + 1]};
         if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])

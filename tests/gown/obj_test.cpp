@@ -35,6 +35,19 @@ std::string error_of(const std::string& name, const std::string& text) {
   return msg;
 }
 
+// A file read_obj must refuse, and what its error must say after the file's name.
+struct ErrorCase {
+  const char* name;
+  std::string text, want;
+};
+
+void expect_errors(const std::vector<ErrorCase>& cases) {
+  for (const auto& c : cases) {
+    const std::string e = error_of(c.name, c.text);
+    EXPECT_NE(e.find(c.name + c.want), std::string::npos) << "want '" << c.want << "', got '" << e << "'";
+  }
+}
+
 // An n x n grid of unit squares as an OBJ, each square one quad face.
 std::string grid_obj(int n, double h) {
   std::string s;
@@ -103,19 +116,14 @@ TEST(ReadObj, ErrorsNameFileAndLine) {
 // keyword; a vertex a unit slip put kilometres out, or a scale that overflows.
 TEST(ReadObj, RejectsWhatTheSimulatorCannotTake) {
   const std::string square = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 0.5 0 0\nf 1 2 3\nf 1 3 4\n";
-  struct Case { const char* name; std::string text, want; };
-  const Case cases[] = {
+  expect_errors({
       {"area.obj", square + "f 1 6 2\n", ":9: face of area 0"},
       {"twice.obj", square + "f 3 2 1\n", ":9: the same triangle as line 7"},
       {"folded.obj", square + "f 2 5 3 5\n", ":9: the same triangle as line 9"},
       {"fan.obj", square + "f 1 3 5\n", ":9: edge 1-3 is shared by three faces (lines 7, 8 and this one)"},
       {"upper.obj", "v 0 0 0\nV 1 0 0\nv 1 1 0\nf 1 2 3\n", ":2: keyword 'V'"},
       {"far.obj", "v 0 0 0\nv 1000 0 0\nv 0 1 0\nf 1 2 3\n", ":2: vertex 2 lies 1000"},
-  };
-  for (const auto& c : cases) {
-    const std::string e = error_of(c.name, c.text);
-    EXPECT_NE(e.find(c.name + std::string(c.want)), std::string::npos) << "want '" << c.want << "', got '" << e << "'";
-  }
+  });
   const fs::path p = write_obj("scale.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
   EXPECT_THROW(read_obj(p, 1e307), InputError);
   EXPECT_THROW(read_obj(p, std::numeric_limits<double>::infinity()), InputError);  // not a finite scale either
@@ -144,16 +152,11 @@ TEST(ReadObj, RejectsPinchedAndUnusedVertices) {
     return s;
   };
   const std::string square = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n";
-  struct Case { const char* name; std::string text, want; };
-  const Case cases[] = {
+  expect_errors({
       {"pinch.obj", holed(true), ":11: vertex 11 is pinched: its faces form 2 fans that meet only there"},
       {"bowtie.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv -1 0 0\nv -1 -1 0\nf 1 2 3\nf 1 4 5\n", ":1: vertex 1 is pinched"},
       {"unused.obj", square + "v 5 5 5\nf 1 2 3\nf 1 3 4\n", ":5: vertex 5 is used by no face"},
-  };
-  for (const auto& c : cases) {
-    const std::string e = error_of(c.name, c.text);
-    EXPECT_NE(e.find(c.name + std::string(c.want)), std::string::npos) << "want '" << c.want << "', got '" << e << "'";
-  }
+  });
   // A hole that touches nothing is a cloth: two loops, 12 and 4 vertices.
   const fs::path p = write_obj("annulus.obj", holed(false));
   const GownMesh m = read_obj(p, 1.0);
@@ -161,6 +164,61 @@ TEST(ReadObj, RejectsPinchedAndUnusedVertices) {
   ASSERT_EQ(m.boundary_loops.size(), 2u);
   EXPECT_EQ(m.boundary_loops[0].size(), 12u);
   EXPECT_EQ(m.boundary_loops[1].size(), 4u);
+}
+
+// The text (finding 6 of session 85's gown review): any isspace blank separates words (a 'v'
+// glued to a vertical tab or form feed was an unknown keyword, its line skipped and every later
+// index shifted), '#' starts a comment anywhere on a line (an inline one was read as a vertex
+// reference), a subnormal coordinate is a coordinate (strtod's ERANGE refused it), and a lone CR
+// ends a line (a classic Mac file read as one line: "no faces").
+TEST(ReadObj, BlanksCommentsSubnormalsAndLoneCarriageReturns) {
+  struct Case { const char* name; std::string text; };
+  const Case cases[] = {
+      {"blanks.obj", "v 0 0 0\nv 1 0 0\nv\v0 1 0\nv\f1 1 0\nf 1 2 3\nf 2 4 3\n"},
+      {"comments.obj", "v 0 0 0 # origin\nv 1 0 0\nv 0 1 0\nv 1 1 0#\nf 1 2 3 # the first face\nf 2 4 3\n"},
+      {"subnormal.obj", "v 0 0 1e-320\nv 1 0 1e-400\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n"},
+      {"cr.obj", "v 0 0 0\rv 1 0 0\rv 0 1 0\rv 1 1 0\rf 1 2 3\rf 2 4 3\r"},
+  };
+  for (const auto& c : cases) {
+    const fs::path p = write_obj(c.name, c.text);
+    GownMesh m;
+    EXPECT_NO_THROW(m = read_obj(p, 1.0)) << c.name;
+    fs::remove(p);
+    ASSERT_EQ(m.x.size(), 4u) << c.name;
+    EXPECT_EQ(m.triangles, (std::vector<std::array<int, 3>>{{0, 1, 2}, {1, 3, 2}})) << c.name;
+    EXPECT_EQ(m.x[2], Eigen::Vector3d(0, 1, 0)) << c.name;
+    EXPECT_NEAR(total_area(m), 1.0, 1e-12) << c.name;
+  }
+  const fs::path p = write_obj("subnormal.obj", cases[2].text);
+  EXPECT_EQ(read_obj(p, 1.0).x[0].z(), 1e-320);
+  fs::remove(p);
+  EXPECT_NE(error_of("cr2.obj", "v 0 0 0\rv 1 0\r").find("cr2.obj:2: malformed vertex line"), std::string::npos);
+  EXPECT_NE(error_of("huge.obj", "v 1e400 0 0\n").find("huge.obj:1: malformed vertex line"), std::string::npos);
+}
+
+// A word that begins with v or f but is no OBJ keyword is refused at its line, as upper case
+// always was: skipped, "v0.5 1 0" shifted every later index and "fo" (an old spelling of f) lost
+// its faces. A polygon whose fan from its first corner folds (a concave one whose first corner
+// does not see the others) is refused at its line: it gave overlapping triangles, one flipped.
+TEST(ReadObj, RejectsSlippedKeywordsAndFoldedFans) {
+  const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  // A square with a notch: corner 4 is reflex. Fanned from corner 1 triangle 1 3 4 is flipped;
+  // fanned from corner 4, which sees them all, it is the polygon's area, 4 - 1.8.
+  const std::string notched = "v 0 0 0\nv 2 0 0\nv 2 2 0\nv 1 0.2 0\nv 0 2 0\n";
+  expect_errors({
+      {"glued.obj", tri + "v0.5 1 0\nf 1 2 3\n", ":4: keyword 'v0.5' is none of OBJ's v, vt, vn, vp and f"},
+      {"fo.obj", tri + "fo 1 2 3\n", ":4: keyword 'fo'"},
+      {"mixed.obj", tri + "vT 0 0\nf 1 2 3\n", ":4: keyword 'vT'"},
+      {"upper.obj", tri + "F 1 2 3\n", ":4: keyword 'F'"},
+      {"concave.obj", notched + "f 1 2 3 4 5\n",
+       ":6: polygon of 5 corners is not convex: fanned from its first corner, triangles 1 2 3 and 1 3 4 face "
+       "opposite ways"},
+  });
+  const fs::path p = write_obj("seen.obj", notched + "f 4 5 1 2 3\n");
+  const GownMesh m = read_obj(p, 1.0);
+  fs::remove(p);
+  EXPECT_EQ(m.triangles.size(), 3u);
+  EXPECT_NEAR(total_area(m), 2.2, 1e-12);
 }
 
 TEST(BoundaryLoops, GridHasOneOrderedLoopOfItsPerimeter) {
