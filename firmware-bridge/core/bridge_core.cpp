@@ -17,11 +17,51 @@ void bridge_init(BridgeCore& c, const BridgeConfig& cfg, uint32_t now_ms) {
   c.last_trial_frame_ms = now_ms;
 }
 
+const char* stop_cause_name(StopCause c) {
+  switch (c) {
+    case StopCause::None: return "none";
+    case StopCause::StopFrame: return "stop_frame";
+    case StopCause::PredictorSilent: return "predictor_silent";
+    case StopCause::BridgeShutdown: return "bridge_shutdown";
+    case StopCause::TrialUnguarded: return "trial_unguarded";
+  }
+  return "unknown";
+}
+
 namespace {
 
 // Wrap-safe: more than protocol::kSporadicResyncMs since `then`.
 bool silent_since(uint32_t now_ms, uint32_t then) {
   return static_cast<uint32_t>(now_ms - then) > protocol::kSporadicResyncMs;
+}
+
+// Wrap-safe: more than `ms` since `then`.
+bool longer_than(uint32_t now_ms, uint32_t then, uint32_t ms) { return static_cast<uint32_t>(now_ms - then) > ms; }
+
+// TrialStart and TrialEnd come from the robot controller, sporadically: a controller that
+// restarted counts from 0 again, so after a silence both checkers start afresh. Counts a frame
+// that fails its check and says whether it was accepted.
+bool trial_frame_accepted(BridgeCore& c, protocol::E2EChecker& checker, const Frame& f, uint32_t now_ms) {
+  if (silent_since(now_ms, c.last_trial_frame_ms)) {
+    c.trial_checker.reset();
+    c.trial_end_checker.reset();
+  }
+  c.last_trial_frame_ms = now_ms;
+  uint32_t lost = 0;
+  if (protocol::accepted(checker.check(f, lost))) return true;
+  ++c.bad_frames;
+  return false;
+}
+
+// Whether the predictor's heartbeat guards the running trial: it names the trial, in trial or
+// stopped (a stop it decided is latched here already). Idle or fault, or another trial's id,
+// is a predictor that missed the TrialStart or restarted since.
+void note_guard(BridgeCore& c, const protocol::HeartbeatPredictor& hb, uint32_t now_ms) {
+  if (!c.trial_running) return;
+  const bool guards = hb.trial_id == c.trial_id && (hb.state == protocol::PredictorState::InTrial ||
+                                                    hb.state == protocol::PredictorState::Stopped);
+  if (!guards && c.trial_guarded) c.unguarded_since_ms = now_ms;
+  c.trial_guarded = guards;
 }
 
 }  // namespace
@@ -64,20 +104,28 @@ BridgeAction bridge_on_frame(BridgeCore& c, const Frame& f, uint32_t now_ms) {
       c.stop_written = false;
       return BridgeAction::StopRobot;
     }
-    case protocol::id_of(protocol::MsgId::TrialStart):
-      // A robot controller that restarted counts from 0 again.
-      if (silent_since(now_ms, c.last_trial_frame_ms)) c.trial_checker.reset();
-      c.last_trial_frame_ms = now_ms;
-      if (!protocol::accepted(c.trial_checker.check(f, lost))) {
-        ++c.bad_frames;
-        return BridgeAction::None;
-      }
+    case protocol::id_of(protocol::MsgId::TrialStart): {
+      if (!trial_frame_accepted(c, c.trial_checker, f, now_ms)) return BridgeAction::None;
+      protocol::TrialStart m;
+      protocol::decode(f, m);
+      c.trial_running = true;
+      c.trial_id = m.trial_id;
+      c.trial_guarded = false;
+      c.unguarded_since_ms = now_ms;
       // A new trial releases a latch whose stop reached the robot (the robot controller restarts
       // the motion itself); one still unwritten stands (bridge_core.h).
       if (c.stop_cause != StopCause::None && !c.stop_written) return BridgeAction::None;
       c.stop_cause = StopCause::None;
       c.last_stop_reason = protocol::StopReason::None;
       return BridgeAction::None;
+    }
+    case protocol::id_of(protocol::MsgId::TrialEnd): {
+      if (!trial_frame_accepted(c, c.trial_end_checker, f, now_ms)) return BridgeAction::None;
+      protocol::TrialEnd m;
+      protocol::decode(f, m);
+      if (m.trial_id == c.trial_id) c.trial_running = false;  // another's end: not this trial's
+      return BridgeAction::None;
+    }
     case protocol::id_of(protocol::MsgId::HeartbeatPredictor):
       // A restarted predictor counts from 0 again; it was silent for its restart.
       if (silent_since(now_ms, c.last_predictor_ms)) c.predictor_hb_checker.reset();
@@ -90,6 +138,7 @@ BridgeAction bridge_on_frame(BridgeCore& c, const Frame& f, uint32_t now_ms) {
       if (protocol::HeartbeatPredictor hb; protocol::decode(f, hb)) {
         c.predictor_state = hb.state;
         c.predictor_trial = hb.trial_id;
+        note_guard(c, hb, now_ms);
       }
       return BridgeAction::None;
     default: return BridgeAction::None;
@@ -106,11 +155,15 @@ BridgeAction bridge_on_shutdown(BridgeCore& c) {
 
 int bridge_on_tick(BridgeCore& c, uint32_t now_ms, Frame* out, BridgeAction* action) {
   *action = BridgeAction::None;
-  if (c.cfg.predictor_timeout_ms > 0 && c.stop_cause == StopCause::None &&
-      static_cast<uint32_t>(now_ms - c.last_predictor_ms) > c.cfg.predictor_timeout_ms) {
-    c.stop_cause = StopCause::PredictorSilent;
-    c.stop_written = false;
-    *action = BridgeAction::StopRobot;
+  const uint32_t timeout = c.cfg.predictor_timeout_ms;
+  if (timeout > 0 && c.stop_cause == StopCause::None) {
+    if (longer_than(now_ms, c.last_predictor_ms, timeout)) c.stop_cause = StopCause::PredictorSilent;
+    else if (c.trial_running && !c.trial_guarded && longer_than(now_ms, c.unguarded_since_ms, timeout))
+      c.stop_cause = StopCause::TrialUnguarded;
+    if (c.stop_cause != StopCause::None) {
+      c.stop_written = false;
+      *action = BridgeAction::StopRobot;
+    }
   }
   // Wrap-safe comparison of millisecond ticks.
   if (static_cast<int32_t>(now_ms - c.next_heartbeat_ms) < 0) return 0;

@@ -15,8 +15,17 @@
 //     says StopLatched until it is written;
 //   - trial starts and the predictor's heartbeat are sporadic streams whose sender may restart:
 //     their E2E checkers resynchronise after protocol::kSporadicResyncMs of silence;
-//   - optionally, a predictor whose heartbeat is silent for predictor_timeout_ms is itself a
-//     reason to stop (the robot must not run unguarded);
+//   - optionally (predictor_timeout_ms > 0), the predictor is watched, and the robot must not
+//     run unguarded:
+//       - a predictor whose heartbeat is silent for predictor_timeout_ms is a reason to stop;
+//       - so is a trial the predictor does not guard: from a TrialStart to its TrialEnd, the
+//         predictor's heartbeat must name that trial in state "in trial" or "stopped" within
+//         predictor_timeout_ms of the start, and again within predictor_timeout_ms whenever it
+//         stops naming it. A TrialStart the predictor lost (its socket's queue overflowed, it
+//         restarted just then, its E2E check refused the frame) left it idle while the robot
+//         pulled, and it stops nothing outside a trial; a predictor restarted within a trial
+//         comes back idle the same way. The bridge, which hears the same frames, is the one
+//         node that can tell (PROTOCOL.md, TrialStart);
 //   - a bridge that shuts down while the predictor's last heartbeat said "in trial" latches a
 //     stop itself: without the bridge no sample reaches the predictor and no stop reaches the
 //     robot, so the trial would run on unguarded.
@@ -46,7 +55,13 @@ enum class BridgeAction : uint8_t {
   StopRobot = 1,     // newly latched: write the stop to the robot controller now
 };
 
-enum class StopCause : uint8_t { None = 0, StopFrame = 1, PredictorSilent = 2, BridgeShutdown = 3 };
+enum class StopCause : uint8_t { None = 0, StopFrame = 1, PredictorSilent = 2, BridgeShutdown = 3, TrialUnguarded = 4 };
+const char* stop_cause_name(StopCause c);  // "stop_frame", "predictor_silent", ...
+
+// The identifiers a port receives and passes to bridge_on_frame (its receive filter).
+inline constexpr uint32_t kBridgeReceives[] = {
+    protocol::id_of(protocol::MsgId::Stop), protocol::id_of(protocol::MsgId::TrialStart),
+    protocol::id_of(protocol::MsgId::TrialEnd), protocol::id_of(protocol::MsgId::HeartbeatPredictor)};
 
 struct BridgeCore {
   BridgeConfig cfg;
@@ -54,6 +69,7 @@ struct BridgeCore {
   protocol::AliveCounter heartbeat_counter;
   protocol::E2EChecker stop_checker{protocol::MsgId::Stop, 255};
   protocol::E2EChecker trial_checker{protocol::MsgId::TrialStart, 255};
+  protocol::E2EChecker trial_end_checker{protocol::MsgId::TrialEnd, 255};
   protocol::E2EChecker predictor_hb_checker{protocol::MsgId::HeartbeatPredictor, 255};
   bool sensor_ok = false;        // the last read succeeded (false before the first reading)
   StopCause stop_cause = StopCause::None;
@@ -65,11 +81,18 @@ struct BridgeCore {
   uint32_t start_ms = 0;
   uint32_t next_heartbeat_ms = 0;
   uint32_t last_predictor_ms = 0;     // the last accepted predictor heartbeat (or the start)
-  uint32_t last_trial_frame_ms = 0;   // the last TrialStart frame, accepted or not (or the start)
+  uint32_t last_trial_frame_ms = 0;   // the last TrialStart or TrialEnd frame, accepted or not (or the start)
   bool predictor_seen = false;
   protocol::PredictorState predictor_state = protocol::PredictorState::Idle;  // its last heartbeat's
   uint16_t predictor_trial = 0;                                                // ... and trial id
   bool stop_written = false;          // the latched stop reached the robot (bridge_on_stop_written)
+  // The robot controller's trial, from its TrialStart to its TrialEnd, and whether the predictor
+  // guards it: its last heartbeat named the trial, in trial or stopped (watched only with
+  // predictor_timeout_ms > 0).
+  bool trial_running = false;
+  uint16_t trial_id = 0;
+  bool trial_guarded = false;
+  uint32_t unguarded_since_ms = 0;    // the trial's start, or the heartbeat that stopped guarding it
 };
 
 void bridge_init(BridgeCore& c, const BridgeConfig& cfg, uint32_t now_ms);
@@ -86,11 +109,12 @@ void bridge_on_reconnect(BridgeCore& c);
 // TrialStart may release the latch from now on.
 inline void bridge_on_stop_written(BridgeCore& c) { c.stop_written = true; }
 
-// A frame received from the bus (Stop, TrialStart, HeartbeatPredictor; others are ignored).
+// A frame received from the bus (kBridgeReceives; others are ignored).
 BridgeAction bridge_on_frame(BridgeCore& c, const Frame& f, uint32_t now_ms);
 
 // The periodic tick: writes a heartbeat frame to *out when one is due (returns 1, else 0);
-// *action becomes StopRobot when the predictor's heartbeat timed out.
+// *action becomes StopRobot when the predictor's heartbeat timed out or it has not guarded the
+// running trial for predictor_timeout_ms.
 int bridge_on_tick(BridgeCore& c, uint32_t now_ms, Frame* out, BridgeAction* action);
 
 // The port is shutting down: StopRobot when the predictor's last accepted heartbeat said a trial

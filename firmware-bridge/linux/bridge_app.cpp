@@ -88,6 +88,26 @@ void BridgeApp::send(const Frame& f) {
   else ++stats_.send_failures;
 }
 
+// The core latched a stop: say why, and write it to the robot in this wakeup (try_stop).
+void BridgeApp::stop_robot(uint32_t t) {
+  const BridgeCore& c = core_;
+  const unsigned timeout = c.cfg.predictor_timeout_ms;
+  switch (c.stop_cause) {
+    case StopCause::StopFrame: say("stop frame from the predictor: %s", protocol::stop_reason_name(c.last_stop_reason)); break;
+    case StopCause::PredictorSilent: say("no heartbeat from the predictor for more than %u ms: stopping the robot", timeout); break;
+    case StopCause::TrialUnguarded:
+      say("the predictor has not guarded trial %u for more than %u ms (its heartbeat says %s, trial %u): "
+          "stopping the robot",
+          static_cast<unsigned>(c.trial_id), timeout, protocol::predictor_state_name(c.predictor_state),
+          static_cast<unsigned>(c.predictor_trial));
+      break;
+    case StopCause::BridgeShutdown:  // begin_shutdown says it
+    case StopCause::None: break;
+  }
+  stop_pending_ = true;
+  next_stop_try_ms_ = t;
+}
+
 void BridgeApp::try_stop(uint32_t t) {
   if (!stop_pending_ || !due(t, next_stop_try_ms_)) return;
   if (!robot_) {
@@ -161,10 +181,7 @@ void BridgeApp::on_timer(uint32_t t) {
   Frame hb;
   BridgeAction a;
   if (bridge_on_tick(core_, t, &hb, &a)) send(hb);
-  if (a == BridgeAction::StopRobot) {
-    stop_pending_ = true;
-    next_stop_try_ms_ = t;
-  }
+  if (a == BridgeAction::StopRobot) stop_robot(t);
   try_stop(t);
 }
 
@@ -173,10 +190,7 @@ void BridgeApp::drain_can(uint32_t t) {
   can::RxInfo info;
   for (int n = 0; n < 64 && port_.receive(f, info) == 1; ++n) {
     if (info.error_frame || info.own_echo) continue;
-    if (bridge_on_frame(core_, f, t) == BridgeAction::StopRobot) {
-      stop_pending_ = true;
-      next_stop_try_ms_ = t;
-    }
+    if (bridge_on_frame(core_, f, t) == BridgeAction::StopRobot) stop_robot(t);
   }
   try_stop(t);  // in the same wakeup as the stop frame
 }
@@ -189,8 +203,7 @@ void BridgeApp::begin_shutdown(uint32_t t) {
   if (bridge_on_shutdown(core_) == BridgeAction::StopRobot) {
     say("shutting down during the predictor's trial %u: stopping the robot first",
         static_cast<unsigned>(core_.predictor_trial));
-    stop_pending_ = true;
-    next_stop_try_ms_ = t;
+    stop_robot(t);
     try_stop(t);
   }
 }

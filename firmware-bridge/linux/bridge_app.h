@@ -55,6 +55,7 @@ class BridgeApp {
   void drain_can(uint32_t now_ms);
   void send(const Frame& f);
   void try_stop(uint32_t now_ms);
+  void stop_robot(uint32_t now_ms);
   void begin_shutdown(uint32_t now_ms);
   void say(const char* fmt, ...) __attribute__((format(printf, 2, 3)));
   void sensor_failed(const char* what);

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <iterator>
 #include <string>
 
 #include "bridge_app.h"
@@ -42,7 +43,9 @@ const char* kUsage =
     "  --robot-slave N         its unit id (default 1)\n"
     "  --stop-coil ADDR        write the stop as coil ADDR = ON (default: coil 0)\n"
     "  --stop-register ADDR=V  write the stop as holding register ADDR = V instead\n"
-    "  --predictor-timeout-ms N  stop the robot when the predictor's heartbeat is silent this long (0: off)\n"
+    "  --predictor-timeout-ms N  stop the robot when the predictor's heartbeat is silent this long, or\n"
+    "                          does not name the robot's running trial (TrialStart to TrialEnd) for this\n"
+    "                          long (0: off)\n"
     "  --shutdown-grace-ms N   on SIGTERM/SIGINT, a stop not yet written (one on the bus, or the bridge's\n"
     "                          own when the predictor is in a trial) is retried this long (default 1000)\n"
     "  --help                  this text\n"
@@ -160,12 +163,11 @@ int main(int argc, char** argv) {
                  "controller (it must then act on CAN 0x080 itself)\n");
   if (cfg.core.predictor_timeout_ms == 0)
     std::fprintf(stderr,
-                 "dressguard-bridge: warning: --predictor-timeout-ms 0: a predictor that goes silent does not "
-                 "stop the robot (a deployment sets it, e.g. 300)\n");
+                 "dressguard-bridge: warning: --predictor-timeout-ms 0: a predictor that goes silent or misses a "
+                 "trial does not stop the robot (a deployment sets it, e.g. 300)\n");
   try {
     can::PortOptions opt;
-    opt.ids = {protocol::id_of(protocol::MsgId::Stop), protocol::id_of(protocol::MsgId::TrialStart),
-               protocol::id_of(protocol::MsgId::HeartbeatPredictor)};
+    opt.ids.assign(std::begin(kBridgeReceives), std::end(kBridgeReceives));
     auto port = can::open_socketcan(iface, opt);
     ModbusSensor sensor(sensor_ep, map);
     std::unique_ptr<RobotStopWriter> robot;

@@ -35,6 +35,16 @@ const char* stop_reason_name(StopReason r) {
   return "unknown";
 }
 
+const char* predictor_state_name(PredictorState s) {
+  switch (s) {
+    case PredictorState::Idle: return "idle";
+    case PredictorState::InTrial: return "in_trial";
+    case PredictorState::Stopped: return "stopped";
+    case PredictorState::Fault: return "fault";
+  }
+  return "unknown";
+}
+
 const char* status_counter_name(StatusCounter c) {
   switch (c) {
     case StatusCounter::Corrupted: return "corrupted";

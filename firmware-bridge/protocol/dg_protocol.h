@@ -153,6 +153,7 @@ const char* stop_reason_name(StopReason r);  // "caught", "hard_limit", ...
 struct Stop { uint8_t counter; StopReason reason; uint8_t p_caught; uint16_t trial_id; uint16_t sample; };
 
 enum class PredictorState : uint8_t { Idle = 0, InTrial = 1, Stopped = 2, Fault = 3 };
+const char* predictor_state_name(PredictorState s);  // "idle", "in_trial", "stopped", "fault"
 
 // 0x300: status, paged: page p carries counters 2p and 2p+1 of StatusCounter (saturating u16),
 // so one page per status period cycles the whole set.

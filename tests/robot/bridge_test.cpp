@@ -181,6 +181,83 @@ TEST(BridgeCore, SilentPredictorStopsWhenConfigured) {
   FAIL() << "no stop for a predictor silent 300 ms";
 }
 
+// With the watchdog on, a trial the predictor does not guard is a stop reason: from a TrialStart
+// to its TrialEnd the predictor's heartbeat must name the trial, in trial or stopped, within
+// predictor_timeout_ms (bridge_core.h). The predictor here beats every 100 ms, as the daemon
+// does; `say(t)` is its heartbeat at t, then the tick.
+TEST(BridgeCore, TrialThePredictorDoesNotGuardStopsWhenConfigured) {
+  using protocol::PredictorState;
+  struct Rig {
+    BridgeCore c;
+    uint8_t hb_counter = 0, trial_counter = 0;
+    explicit Rig(uint32_t timeout) { bridge_init(c, BridgeConfig{100, timeout}, 0); }
+    BridgeAction say(uint32_t t, PredictorState s, uint16_t trial) {
+      bridge_on_frame(c, protocol::encode(protocol::HeartbeatPredictor{hb_counter++, s, 1, trial, 0}), t);
+      Frame hb;
+      BridgeAction a;
+      bridge_on_tick(c, t, &hb, &a);
+      return a;
+    }
+    BridgeAction tick(uint32_t t) {
+      Frame hb;
+      BridgeAction a;
+      bridge_on_tick(c, t, &hb, &a);
+      return a;
+    }
+    void start(uint32_t t, uint16_t trial) {
+      bridge_on_frame(c, protocol::encode(protocol::TrialStart{trial_counter++, trial, 100, protocol::HeightClass::Middle}), t);
+    }
+    void end(uint32_t t, uint16_t trial) {
+      bridge_on_frame(c, protocol::encode(protocol::TrialEnd{trial_counter++, trial, 300, protocol::TrialEndReason::Completed}), t);
+    }
+  };
+  {  // the predictor lost trial 7's start: its heartbeat stays idle, naming the trial before
+    Rig r(300);
+    for (uint32_t t = 0; t <= 1000; t += 100) ASSERT_EQ(r.say(t, PredictorState::Idle, 6), BridgeAction::None) << t;
+    r.start(1005, 7);
+    uint32_t stopped_at = 0;
+    for (uint32_t t = 1010; t <= 2000 && !stopped_at; t += 10) {
+      const BridgeAction a = t % 100 == 0 ? r.say(t, PredictorState::Idle, 6) : r.tick(t);
+      if (a == BridgeAction::StopRobot) stopped_at = t;
+    }
+    EXPECT_GT(stopped_at, 1005u + 300u) << "stopped before the timeout";
+    EXPECT_LE(stopped_at, 1005u + 310u) << "no stop within a tick of the timeout";
+    EXPECT_EQ(r.c.stop_cause, StopCause::TrialUnguarded);
+  }
+  {  // guarded from its first heartbeat to its end, in trial and then stopped; the trial's end
+     // with the predictor idle again, and a TrialEnd of another trial, change nothing
+    Rig r(300);
+    r.say(0, PredictorState::Idle, 6);
+    r.start(5, 7);
+    for (uint32_t t = 100; t <= 3000; t += 100)
+      ASSERT_EQ(r.say(t, t < 2000 ? PredictorState::InTrial : PredictorState::Stopped, 7), BridgeAction::None) << t;
+    r.end(3005, 6);  // not this trial's end
+    EXPECT_TRUE(r.c.trial_running);
+    r.end(3010, 7);
+    EXPECT_FALSE(r.c.trial_running);
+    for (uint32_t t = 3100; t <= 6000; t += 100) ASSERT_EQ(r.say(t, PredictorState::Idle, 7), BridgeAction::None) << t;
+  }
+  {  // guarded, then not (a predictor restarted within the trial is idle, trial 0), then
+     // guarded again within the timeout: no stop; not again within it: a stop
+    Rig r(300);
+    r.start(0, 7);
+    for (uint32_t t = 100; t <= 1000; t += 100) ASSERT_EQ(r.say(t, PredictorState::InTrial, 7), BridgeAction::None);
+    ASSERT_EQ(r.say(1100, PredictorState::Idle, 0), BridgeAction::None);
+    ASSERT_EQ(r.say(1200, PredictorState::InTrial, 8), BridgeAction::None) << "another trial's id does not guard this one";
+    ASSERT_EQ(r.say(1300, PredictorState::InTrial, 7), BridgeAction::None);
+    ASSERT_EQ(r.say(1400, PredictorState::Fault, 7), BridgeAction::None);
+    EXPECT_EQ(r.say(1600, PredictorState::Fault, 7), BridgeAction::None);
+    EXPECT_EQ(r.say(1700, PredictorState::Fault, 7), BridgeAction::None) << "unguarded since 1400: exactly 300 ms";
+    EXPECT_EQ(r.tick(1701), BridgeAction::StopRobot);
+    EXPECT_EQ(r.c.stop_cause, StopCause::TrialUnguarded);
+  }
+  {  // watchdog off (a bridge that only records): an unguarded trial stops nothing
+    Rig r(0);
+    r.start(0, 7);
+    for (uint32_t t = 100; t <= 3000; t += 100) ASSERT_EQ(r.say(t, PredictorState::Idle, 0), BridgeAction::None) << t;
+  }
+}
+
 // Shutdown latches the bridge's own stop exactly when the predictor's last accepted heartbeat
 // said "in trial" and no stop is latched; a corrupted heartbeat changes nothing.
 TEST(BridgeCore, ShutdownStopsOnlyARunningTrial) {
@@ -320,10 +397,9 @@ struct BridgeRig {
   std::thread loop;
   std::atomic<int> rc{-1};          // what run() returned
   std::FILE* log = std::tmpfile();  // what the bridge says
-  explicit BridgeRig(int shutdown_grace_ms = 1000) {
+  explicit BridgeRig(int shutdown_grace_ms = 1000, uint32_t predictor_timeout_ms = 0) {
     // The identifiers dressguard-bridge's main subscribes to.
-    bridge_port = bus.open({{protocol::id_of(protocol::MsgId::Stop), protocol::id_of(protocol::MsgId::TrialStart),
-                             protocol::id_of(protocol::MsgId::HeartbeatPredictor)}, false, true});
+    bridge_port = bus.open({{std::begin(kBridgeReceives), std::end(kBridgeReceives)}, false, true});
     listener = bus.open({{protocol::id_of(protocol::MsgId::FtForce), protocol::id_of(protocol::MsgId::FtTorque),
                           protocol::id_of(protocol::MsgId::HeartbeatBridge)}, false, true});
     predictor = bus.open({{}, false, true});
@@ -334,6 +410,7 @@ struct BridgeRig {
     cfg.backoff_max_ms = 160;
     cfg.log = log;
     cfg.shutdown_grace_ms = shutdown_grace_ms;
+    cfg.core.predictor_timeout_ms = predictor_timeout_ms;
     app = std::make_unique<BridgeApp>(cfg, *sensor, robot.get(), *bridge_port);
     loop = std::thread([this] { rc = app->run(); });
   }
@@ -559,6 +636,35 @@ TEST(BridgeModbus, ShutdownDuringATrialStopsTheRobot) {
     }
     const std::string coil = "-p " + std::to_string(rig.robot_emu.port()) + " -a 1 -r 7 -c 1 -t 0 127.0.0.1";
     EXPECT_NE(mbpoll(coil).find(in_trial ? "[7]: \t1" : "[7]: \t0"), std::string::npos) << mbpoll(coil);
+  }
+}
+
+// The Linux port with the watchdog on: the robot controller starts trial 7, and the predictor
+// beats every 50 ms. Idle (it lost the TrialStart), the bridge writes the stop coil and says
+// why; naming trial 7 in trial, it writes nothing.
+TEST(BridgeModbus, TrialThePredictorDoesNotGuardStopsTheRobot) {
+  for (const auto state : {protocol::PredictorState::Idle, protocol::PredictorState::InTrial}) {
+    const bool guarded = state == protocol::PredictorState::InTrial;
+    BridgeRig rig(1000, 300);
+    ASSERT_GT(rig.robot_emu.port(), 0);
+    uint8_t counter = 0;
+    const auto beat_for = [&](std::chrono::milliseconds d) {
+      for (const auto end = std::chrono::steady_clock::now() + d; std::chrono::steady_clock::now() < end;) {
+        rig.predictor->send(protocol::encode(protocol::HeartbeatPredictor{counter++, state, 1, guarded ? uint16_t{7} : uint16_t{6}, 5}));
+        std::this_thread::sleep_for(50ms);
+      }
+    };
+    beat_for(200ms);
+    rig.predictor->send(protocol::encode(protocol::TrialStart{0, 7, 100, protocol::HeightClass::High}));
+    beat_for(800ms);
+    EXPECT_EQ(rig.app->stats().stops_written.load(), guarded ? 0u : 1u) << rig.logged();
+    const std::string coil = "-p " + std::to_string(rig.robot_emu.port()) + " -a 1 -r 7 -c 1 -t 0 127.0.0.1";
+    EXPECT_NE(mbpoll(coil).find(guarded ? "[7]: \t0" : "[7]: \t1"), std::string::npos) << mbpoll(coil);
+    if (!guarded) {
+      EXPECT_NE(rig.logged().find("the predictor has not guarded trial 7 for more than 300 ms (its heartbeat says idle, trial 6)"),
+                std::string::npos)
+          << rig.logged();
+    }
   }
 }
 

@@ -10,11 +10,16 @@
 //               was not latched; a corrupted or short one changes nothing;
 //   release     only a TrialStart that its E2E check accepts releases the latch, and only once
 //               the port has written the stop (bridge_on_stop_written);
-//   resync      a TrialStart after more than protocol::kSporadicResyncMs without one, and a
-//               predictor heartbeat that long after the last accepted one, start their E2E
-//               check afresh (a restarted sender counts from 0);
+//   resync      a TrialStart or TrialEnd after more than protocol::kSporadicResyncMs without
+//               either, and a predictor heartbeat that long after the last accepted one, start
+//               their E2E checks afresh (a restarted sender counts from 0);
 //   silence     with a predictor timeout, a tick latches the stop exactly when the predictor's
 //               heartbeat (E2E-accepted) is older than the timeout, wrap-safe;
+//   guard       else, with a predictor timeout, a tick latches the stop exactly when a trial runs
+//               (an accepted TrialStart, until an accepted TrialEnd of its id) and the
+//               predictor's accepted heartbeats have not named it, in trial or stopped, since
+//               the start or since the first one that stopped naming it, longer than the
+//               timeout;
 //   heartbeat   sent on the tick when due (period from the last one, wrap-safe), E2E-protected,
 //               carrying the state: StopLatched while latched, else SensorLost after a failed
 //               read until the next reading, else Ok; the failed reads (saturating at 255),
@@ -56,11 +61,17 @@ struct Shadow {
   bool sampled = false;
   uint32_t last_predictor = 0;
   protocol::PredictorState predictor_state = protocol::PredictorState::Idle;  // last accepted heartbeat's
-  uint32_t last_trial = 0;  // the last TrialStart frame, accepted or not
+  uint32_t last_trial = 0;  // the last TrialStart or TrialEnd frame, accepted or not
+  uint8_t c_end = 0;        // the robot's TrialEnd sender
+  bool trial_running = false;
+  uint16_t trial_id = 0;
+  bool guarded = false;
+  uint32_t unguarded_since = 0;
   uint32_t next_heartbeat = 0;
   uint32_t start = 0;
   uint32_t sensor_errors = 0, reconnects = 0;  // counted without bound
   protocol::E2EChecker trial_e2e{MsgId::TrialStart, 255};
+  protocol::E2EChecker end_e2e{MsgId::TrialEnd, 255};
   protocol::E2EChecker hb_e2e{MsgId::HeartbeatPredictor, 255};
 };
 
@@ -107,23 +118,43 @@ bool resyncs(const Shadow& sh, uint32_t then) {
   return static_cast<uint32_t>(sh.now - then) > protocol::kSporadicResyncMs;
 }
 
-// Any other frame: a TrialStart accepted by its E2E check releases a written latch; a predictor
-// heartbeat accepted by its check restarts the silence clock; nothing asks for a stop.
+// Any other frame: a TrialStart accepted by its E2E check releases a written latch and starts
+// a trial, an accepted TrialEnd of its id ends it; a predictor heartbeat accepted by its check
+// restarts the silence clock and says whether the trial is guarded; nothing asks for a stop.
 void other_frame(const Frame& f, BridgeCore& c, Shadow& sh, long op) {
   uint32_t lost = 0;
-  if (is(f, MsgId::TrialStart)) {
-    if (resyncs(sh, sh.last_trial)) sh.trial_e2e.reset();
+  if (is(f, MsgId::TrialStart) || is(f, MsgId::TrialEnd)) {
+    if (resyncs(sh, sh.last_trial)) {
+      sh.trial_e2e.reset();
+      sh.end_e2e.reset();
+    }
     sh.last_trial = sh.now;
   }
   if (is(f, MsgId::HeartbeatPredictor) && resyncs(sh, sh.last_predictor)) sh.hb_e2e.reset();
   const bool trial_ok = is(f, MsgId::TrialStart) && protocol::accepted(sh.trial_e2e.check(f, lost));
+  const bool end_ok = is(f, MsgId::TrialEnd) && protocol::accepted(sh.end_e2e.check(f, lost));
   const bool hb_ok = is(f, MsgId::HeartbeatPredictor) && protocol::accepted(sh.hb_e2e.check(f, lost));
   if (bridge::bridge_on_frame(c, f, sh.now) != BridgeAction::None) broken("a frame other than a stop stopped the robot", op);
   if (trial_ok && (!sh.latched || sh.written)) sh.latched = false;
+  if (protocol::TrialStart m; trial_ok && protocol::decode(f, m)) {
+    sh.trial_running = true;
+    sh.trial_id = m.trial_id;
+    sh.guarded = false;
+    sh.unguarded_since = sh.now;
+  }
+  if (protocol::TrialEnd m; end_ok && protocol::decode(f, m) && m.trial_id == sh.trial_id) sh.trial_running = false;
   if (hb_ok) {
     sh.last_predictor = sh.now;
-    if (protocol::HeartbeatPredictor m; protocol::decode(f, m)) sh.predictor_state = m.state;
+    if (protocol::HeartbeatPredictor m; protocol::decode(f, m)) {
+      sh.predictor_state = m.state;
+      const bool guards = m.trial_id == sh.trial_id && (m.state == protocol::PredictorState::InTrial ||
+                                                        m.state == protocol::PredictorState::Stopped);
+      if (sh.trial_running && !guards && sh.guarded) sh.unguarded_since = sh.now;
+      if (sh.trial_running) sh.guarded = guards;
+    }
   }
+  if (c.trial_running != sh.trial_running || (sh.trial_running && c.trial_guarded != sh.guarded))
+    broken("the running trial, or whether the predictor guards it, is not the frames'", op);
   if (bridge::bridge_stop_latched(c) != sh.latched)
     broken(!trial_ok ? "a frame other than a stop or a trial start changed the latch"
            : sh.latched ? "an accepted trial start released a stop not yet written"
@@ -131,20 +162,29 @@ void other_frame(const Frame& f, BridgeCore& c, Shadow& sh, long op) {
 
 }
 
-// A tick: the predictor's silence, then the heartbeat when due.
+// A tick: the predictor's silence or a trial it does not guard, then the heartbeat when due.
 void tick(BridgeCore& c, Shadow& sh, long op) {
-  const bool silent = c.cfg.predictor_timeout_ms > 0 && !sh.latched &&
-                      static_cast<uint32_t>(sh.now - sh.last_predictor) > c.cfg.predictor_timeout_ms;
+  const uint32_t timeout = c.cfg.predictor_timeout_ms;
+  const bool watched = timeout > 0 && !sh.latched;
+  const bool silent = watched && static_cast<uint32_t>(sh.now - sh.last_predictor) > timeout;
+  const bool unguarded = watched && !silent && sh.trial_running && !sh.guarded &&
+                         static_cast<uint32_t>(sh.now - sh.unguarded_since) > timeout;
   const bool due = static_cast<int32_t>(sh.now - sh.next_heartbeat) >= 0;
   Frame hb;
   BridgeAction a = BridgeAction::None;
   const int n = bridge::bridge_on_tick(c, sh.now, &hb, &a);
-  if ((a == BridgeAction::StopRobot) != silent) broken(silent ? "a silent predictor did not stop the robot" : "a tick stopped the robot with the predictor heard", op);
-  if (silent) {
+  if ((a == BridgeAction::StopRobot) != (silent || unguarded))
+    broken(silent      ? "a silent predictor did not stop the robot"
+           : unguarded ? "a trial the predictor did not guard did not stop the robot"
+                       : "a tick stopped the robot with the predictor heard and guarding", op);
+  if (silent || unguarded) {
     sh.latched = true;
     sh.written = false;
+    const auto want = silent ? bridge::StopCause::PredictorSilent : bridge::StopCause::TrialUnguarded;
+    if (c.stop_cause != want) broken("a tick's stop has the wrong cause", op);
   }
-  if (bridge::bridge_stop_latched(c) != sh.latched) broken("a tick changed the latch other than for the predictor's silence", op);
+  if (bridge::bridge_stop_latched(c) != sh.latched)
+    broken("a tick changed the latch other than for the predictor's silence or an unguarded trial", op);
   if ((n == 1) != due) broken(due ? "a heartbeat due was not sent" : "a heartbeat before it was due", op);
   if (n != 1) return;
   sh.next_heartbeat = sh.now + c.cfg.heartbeat_period_ms;
@@ -209,10 +249,18 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         break;
       }
       case BridgeOp::PredictorHeartbeat: {
-        if (!in.take(1)) return 0;
-        const uint8_t ctl = in.u8();
+        if (!in.take(2)) return 0;
+        const uint8_t ctl = in.u8(), trial = in.u8();
         const auto state = static_cast<protocol::PredictorState>((ctl >> 4 & 1) | (ctl >> 6 & 2));
-        Frame f = protocol::encode(protocol::HeartbeatPredictor{counter_for(ctl, sh.c_phb, ctl), state, 1, 0, 0});
+        Frame f = protocol::encode(protocol::HeartbeatPredictor{counter_for(ctl, sh.c_phb, ctl), state, 1, trial, 0});
+        damage(f, ctl);
+        other_frame(f, c, sh, op);
+        break;
+      }
+      case BridgeOp::TrialEnd: {
+        if (!in.take(2)) return 0;
+        const uint8_t ctl = in.u8(), trial = in.u8();
+        Frame f = protocol::encode(protocol::TrialEnd{counter_for(ctl, sh.c_end, trial), trial, 0, protocol::TrialEndReason::Completed});
         damage(f, ctl);
         other_frame(f, c, sh, op);
         break;

@@ -253,13 +253,13 @@ int bridge_seeds(const std::filesystem::path& dir) {
   {
     BridgeWriter w(guarded);  // the predictor's heartbeat every 40 ms, then silence, a tick every 4 ms
     for (int i = 0; i < 20; ++i) {
-      w.op(BridgeOp::PredictorHeartbeat, 10, {0});
+      w.op(BridgeOp::PredictorHeartbeat, 10, {0, 0});
       w.tick();
     }
     for (int i = 0; i < 45; ++i) w.tick(1);
     w.op(BridgeOp::StopWritten, 1);
     w.op(BridgeOp::TrialStart, 1, {0, 2});
-    w.op(BridgeOp::PredictorHeartbeat, 1, {0});
+    w.op(BridgeOp::PredictorHeartbeat, 1, {0, 0});
     w.tick(1);
     seeds.emplace_back("silent_predictor", w);
   }
@@ -281,12 +281,31 @@ int bridge_seeds(const std::filesystem::path& dir) {
   {
     BridgeWriter w(plain);  // the predictor in a trial (state bit 4), then the bridge shuts down
     readings(w, 10, -2.0);
-    w.op(BridgeOp::PredictorHeartbeat, 1, {0x10});
+    w.op(BridgeOp::PredictorHeartbeat, 1, {0x10, 0});
     readings(w, 10, -2.0);
     w.op(BridgeOp::Shutdown, 1);
     w.op(BridgeOp::StopWritten, 1);
     w.op(BridgeOp::Shutdown, 1);
     seeds.emplace_back("shutdown_in_trial", w);
+  }
+  {
+    BridgeWriter w(guarded);  // trial 5 guarded from its second heartbeat, then the predictor idle
+    for (int i = 0; i < 5; ++i) {  // (restarted), guarded again, ended; trial 6 never guarded
+      w.op(BridgeOp::PredictorHeartbeat, 10, {0, 4});
+      w.tick();
+    }
+    w.op(BridgeOp::TrialStart, 1, {0, 5});
+    for (int i = 0; i < 30; ++i) {
+      w.op(BridgeOp::PredictorHeartbeat, 10, {static_cast<uint8_t>(i > 0 && (i < 10 || i > 20) ? 0x10 : 0), 5});
+      w.tick();
+    }
+    w.op(BridgeOp::TrialEnd, 1, {0, 5});
+    w.op(BridgeOp::TrialStart, 1, {0, 6});
+    for (int i = 0; i < 30; ++i) {
+      w.op(BridgeOp::PredictorHeartbeat, 10, {0, 5});
+      w.tick();
+    }
+    seeds.emplace_back("unguarded_trial", w);
   }
   {
     BridgeWriter w(plain);  // a sensor that keeps failing: its error count saturates at 255

@@ -73,12 +73,13 @@ enum class BridgeOp : uint8_t {
   Reconnect = 2,    // the port reconnected to the sensor
   Stop = 3,         // ctl (counter and damage bits as TrafficOp::Force), reason, trial id
   TrialStart = 4,   // ctl, trial id
-  PredictorHeartbeat = 5,  // ctl; its bits 4 and 7 are the predictor's state (bit 4 low)
+  PredictorHeartbeat = 5,  // ctl (its bits 4 and 7 are the predictor's state, bit 4 low), trial id
   RawFrame = 6,     // as TrafficOp::RawFrame
   Tick = 7,         // the port's periodic tick
   Wait = 8,         // 4 x b ms pass, then a tick
   StopWritten = 9,  // the port wrote the latched stop to the robot
   Shutdown = 10,    // the port is shutting down (bridge_on_shutdown)
+  TrialEnd = 11,    // ctl, trial id
 };
 
 // ---- helpers of both harnesses ----
