@@ -30,8 +30,9 @@ std::string format_candump_line(int64_t time_us, std::string_view iface, const F
   char ts[48];
   const int nt = std::snprintf(ts, sizeof ts, "(%lld.%06lld) ", static_cast<long long>(time_us / 1000000),
                                static_cast<long long>(time_us % 1000000));
-  char fr[4 + 1 + 16 + 1];
-  int nf = std::snprintf(fr, sizeof fr, " %03X#", static_cast<unsigned>(f.id & 0x7FF));
+  char fr[1 + 8 + 1 + 16 + 1];
+  int nf = is_error_frame(f) ? std::snprintf(fr, sizeof fr, " %08X#", static_cast<unsigned>(f.id & (kCanErrFlag | kCanErrMask)))
+                             : std::snprintf(fr, sizeof fr, " %03X#", static_cast<unsigned>(f.id & 0x7FF));
   for (int i = 0; i < f.len && i < 8; ++i) nf += std::snprintf(fr + nf, sizeof fr - nf, "%02X", f.data[i]);
   std::string line(ts, nt);
   line.append(iface);
@@ -86,11 +87,23 @@ bool parse_candump_line(std::string_view line, LoggedFrame& out, std::string& wh
   }
   // 8 digits: can-utils' 29-bit identifier, or with CAN_ERR_FLAG (0x20000000) an error frame,
   // which candump logs when error frames are subscribed (-e, or an error mask in a filter).
-  if (hash == 8 && (id & 0x20000000u)) return why = "error frame (candump -e) not supported", false;
-  if (hash == 8) return why = "extended (29-bit) identifier not supported (only classic 11-bit frames)", false;
-  if (hash != 3) return why = "identifier is not 3 hex digits (only classic 11-bit frames)", false;
-  if (id > 0x7FF) return why = "identifier above 0x7FF", false;
-  const std::string_view hex = fr.substr(hash + 1);
+  const bool error_frame = hash == 8 && (id & kCanErrFlag);
+  if (error_frame && id > (kCanErrFlag | kCanErrMask))
+    return why = "error frame's identifier has bits above CAN_ERR_FLAG (candump never writes them)", false;
+  if (hash == 8 && !error_frame)
+    return why = "extended (29-bit) identifier not supported (only classic 11-bit frames)", false;
+  if (hash != 3 && !error_frame) return why = "identifier is not 3 hex digits (only classic 11-bit frames)", false;
+  if (!error_frame && id > 0x7FF) return why = "identifier above 0x7FF", false;
+  std::string_view hex = fr.substr(hash + 1);
+  // candump -8 (--len8-dlc) writes a classic frame of 8 bytes whose raw DLC is 9..15 as
+  // "data_D" (one hex digit, can-utils' lib.c): still 8 data bytes, can_frame.len 8 (the raw
+  // DLC is in len8_dlc, which the predictor does not read), so it is dropped, as the direction is.
+  if (const size_t u = hex.find('_'); u != std::string_view::npos) {
+    if (u != 16) return why = "raw DLC suffix (candump -8's _D) after other than 8 data bytes", false;
+    const int dlc = hex.size() == 18 ? hex_value(hex[17]) : -1;
+    if (dlc < 9) return why = "raw DLC suffix is not one hex digit 9..F (candump -8's _D)", false;
+    hex = hex.substr(0, 16);
+  }
   if (!hex.empty() && hex[0] == '#') return why = "CAN FD frame (##) not supported (only classic frames)", false;
   if (!hex.empty() && (hex[0] == 'R' || hex[0] == 'r'))
     return why = "remote frame (RTR) not supported: the protocol has none", false;

@@ -7,13 +7,16 @@
 // candump writes "(%010lu.%06lu) %*s %s%s": with several interfaces the names are padded to the
 // longest, so one or more spaces may come before a name; with -x the line ends in the
 // direction, " R" (received) or " T" (sent by the recording host). Both are read, and the
-// direction is dropped: either way the frame was on the bus.
+// direction is dropped: either way the frame was on the bus. With -8 an 8-byte frame whose raw
+// DLC is 9..15 ends in "_D" (D one hex digit 9..F); it is read as the 8 bytes it carries.
 //
-// Classic frames only (3 hex digits of identifier, 0..8 data bytes), timestamps of at most 10
-// digits of seconds, interface names of at most 15 characters. What candump writes beyond that
-// is refused with its name: error frames (8 digits with 0x20000000, candump -e), 29-bit
-// identifiers (8 digits), remote frames (id#R), CAN FD frames (id##flags+data). Host side:
-// allocates.
+// Classic frames (3 hex digits of identifier, 0..8 data bytes) and controller error frames
+// (candump -e, or an error mask in a filter: 8 digits with CAN_ERR_FLAG 0x20000000 and the
+// CAN_ERR_* class bits, as the socket's can_id carries them; read with that id, so that a
+// replay hands them to the predictor as the daemon does: is_error_frame), timestamps of at
+// most 10 digits of seconds, interface names of at most 15 characters. What candump writes
+// beyond that is refused with its name: 29-bit identifiers (8 digits), remote frames (id#R),
+// CAN FD frames (id##flags+data). Host side: allocates.
 #pragma once
 
 #include <cstddef>
@@ -35,6 +38,13 @@ inline constexpr size_t kMaxInterfaceName = 15;
 // reader checks each line's name with it, a writer its name before the first line.
 const char* interface_name_error(std::string_view name);
 
+// A controller error frame's identifier: CAN_ERR_FLAG with the CAN_ERR_* class bits below it
+// (linux/can/error.h; CAN_ERR_BUSOFF is 0x40).
+inline constexpr uint32_t kCanErrFlag = 0x20000000u;
+inline constexpr uint32_t kCanErrMask = 0x1FFFFFFFu;
+constexpr bool is_error_frame(const Frame& f) { return (f.id & kCanErrFlag) != 0; }
+constexpr uint32_t error_class_of(const Frame& f) { return f.id & kCanErrMask; }
+
 struct LoggedFrame {
   int64_t time_us = 0;  // timestamp in microseconds
   std::string iface;
@@ -42,7 +52,7 @@ struct LoggedFrame {
   long line = 0;        // 1-based line in the log (0 when built in memory)
 };
 
-// "(sec.usec) iface id#data" (no newline). Writes `iface` as given: a writer that takes the
+// "(sec.usec) iface id#data" (no newline; an error frame's id in 8 digits). Writes `iface` as given: a writer that takes the
 // name from its user checks it with interface_name_error first.
 std::string format_candump_line(int64_t time_us, std::string_view iface, const Frame& f);
 

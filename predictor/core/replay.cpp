@@ -76,7 +76,9 @@ ReplayResult replay_frames(const model::OutcomeModel* model, const PredictorConf
     const int64_t now = lf.time_us * 1000;
     tick_until(now);
     const uint32_t started_before = p.trials_started();
-    p.on_frame(lf.frame, now);
+    // A controller error frame goes where the daemon sends it (daemon.cpp: info.error_frame).
+    if (protocol::is_error_frame(lf.frame)) p.on_bus_error(protocol::error_class_of(lf.frame), now);
+    else p.on_frame(lf.frame, now);
     const Decision& d = p.decision();
     if (p.trials_started() != started_before) {
       out.trials.push_back(ReplayTrial{});

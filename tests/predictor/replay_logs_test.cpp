@@ -224,6 +224,39 @@ TEST(ReplayLogs, ALongSilenceIsNotTickedThroughMillisecondByMillisecond) {
   EXPECT_EQ(r.trials[1].trial, 2);
 }
 
+// A log recorded with candump -e holds the controller's error frames among the data: the replay
+// hands each to the predictor as the daemon does (on_bus_error: counted as a tx error, no
+// decision changes), and every stop is the one of the same log without them.
+TEST(ReplayLogs, ErrorFramesInALogAreBusErrorsAsInTheDaemon) {
+  const auto m = load_model();
+  const auto frames = load(kLogs / "syn2-caught-0-caught.log");
+  std::string text = slurp(kLogs / "syn2-caught-0-caught.log");
+  // One error frame (CAN_ERR_CRTL, rx warning) after every 50th line, as candump -e writes it.
+  std::string with_errors;
+  int lines = 0, errors = 0;
+  for (size_t pos = 0; pos < text.size();) {
+    const size_t nl = text.find('\n', pos);
+    const std::string line = text.substr(pos, nl == std::string::npos ? std::string::npos : nl - pos + 1);
+    pos = nl == std::string::npos ? text.size() : nl + 1;
+    with_errors += line;
+    if (++lines % 50 == 0 && line.size() > 20 && line[0] == '(') {
+      with_errors += line.substr(0, line.find(')') + 1) + " vcan0 20000004#0004000000000000\n";
+      ++errors;
+    }
+  }
+  ASSERT_GT(errors, 3);
+  const auto mixed = protocol::parse_candump_log(with_errors, "with-errors.log");
+  ASSERT_EQ(mixed.size(), frames.size() + static_cast<size_t>(errors));
+  const auto plain = replay_frames(&m, PredictorConfig{}, frames);
+  const auto r = replay_frames(&m, PredictorConfig{}, mixed);
+  ASSERT_EQ(r.trials.size(), 1u);
+  ASSERT_TRUE(plain.trials[0].stopped);
+  EXPECT_EQ(r.trials[0].reason, plain.trials[0].reason);
+  EXPECT_EQ(r.trials[0].stop_sample, plain.trials[0].stop_sample);
+  const int tx_errors = static_cast<int>(protocol::StatusCounter::TxErrors);
+  EXPECT_EQ(r.counters[tx_errors], plain.counters[tx_errors] + static_cast<uint32_t>(errors));
+}
+
 TEST(ReplayLogs, ModelThatDoesNotLoadStopsEveryTrial) {
   const auto frames = load(kLogs / "syn2-good-0-good.log");
   const auto r = replay_frames(nullptr, PredictorConfig{}, frames);

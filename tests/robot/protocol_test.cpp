@@ -269,24 +269,58 @@ TEST(CandumpLog, ReadsPaddedNamesAndDirection) {
   EXPECT_NE(e.find("x.log:1: unexpected text after the frame"), std::string::npos) << e;
 }
 
+// Why parse_candump_line refuses a line holding `frame` (it must refuse it).
+std::string why_of(const std::string& frame) {
+  LoggedFrame lf;
+  std::string why;
+  EXPECT_FALSE(parse_candump_line("(1700000000.012345) vcan0 " + frame, lf, why)) << frame;
+  return why;
+}
+
 // What candump writes but the protocol has no use for is refused, and the reason says what it
 // is: an error frame was "identifier is not 3 hex digits", a lower-case remote frame "data is not
 // 0..8 bytes of hex".
 TEST(CandumpLog, RefusedFramesAreNamed) {
-  auto why_of = [](const std::string& frame) {
-    LoggedFrame lf;
-    std::string why;
-    EXPECT_FALSE(parse_candump_line("(1700000000.012345) vcan0 " + frame, lf, why)) << frame;
-    return why;
-  };
-  EXPECT_EQ(why_of("20000040#0000000000000000"), "error frame (candump -e) not supported");
-  EXPECT_EQ(why_of("20000004#0004000000000000 R"), "error frame (candump -e) not supported");
+  EXPECT_NE(why_of("60000040#0000000000000000").find("bits above CAN_ERR_FLAG"), std::string::npos);
   EXPECT_NE(why_of("12345678#00").find("extended (29-bit) identifier"), std::string::npos);
   EXPECT_NE(why_of("100#r").find("remote frame"), std::string::npos);
   EXPECT_NE(why_of("100#R").find("remote frame"), std::string::npos);
   EXPECT_NE(why_of("100##1A5").find("CAN FD frame (##)"), std::string::npos);
   EXPECT_NE(why_of("123456789#00").find("not 3 hex digits"), std::string::npos);
   EXPECT_NE(why_of("10#00").find("not 3 hex digits"), std::string::npos);
+}
+
+// candump -e (or an error mask) logs controller error frames: 8 digits, CAN_ERR_FLAG and the
+// class, 8 data bytes. They were refused, so a log recorded while diagnosing a bus could not be
+// replayed at all; now they are read with that id (the socket's can_id) and written back the same.
+// candump -8 marks an 8-byte frame whose raw DLC is 9..15 with "_D": the 8 bytes are read, the
+// raw DLC dropped; it was "data is not 0..8 bytes of hex" (session 85's note).
+TEST(CandumpLog, ReadsErrorFramesAndRawDlcSuffixes) {
+  const auto frames = parse_candump_log(
+      "(1700000000.000100) can0 20000040#0000000000000000\n"
+      "(1700000000.000200) can0 20000004#0004000000000000 R\n"
+      "(1700000000.000300) can0 100#A5010A00F6FF3200_F\n"
+      "(1700000000.000400) can0 100#A5010A00F6FF3200_9 R\n",
+      "e.log");
+  ASSERT_EQ(frames.size(), 4u);
+  EXPECT_TRUE(is_error_frame(frames[0].frame));
+  EXPECT_EQ(error_class_of(frames[0].frame), 0x40u);  // CAN_ERR_BUSOFF
+  EXPECT_EQ(error_class_of(frames[1].frame), 0x04u);  // CAN_ERR_CRTL
+  EXPECT_EQ(frames[1].frame.len, 8);
+  EXPECT_EQ(frames[1].frame.data[1], 0x04);
+  EXPECT_EQ(format_candump_line(frames[0].time_us, "can0", frames[0].frame),
+            "(1700000000.000100) can0 20000040#0000000000000000");
+  for (int i : {2, 3}) {
+    EXPECT_FALSE(is_error_frame(frames[i].frame));
+    EXPECT_EQ(frames[i].frame.id, 0x100u);
+    EXPECT_EQ(frames[i].frame.len, 8);
+    EXPECT_EQ(frames[i].frame.data[7], 0x00);
+    EXPECT_EQ(frames[i].frame.data[6], 0x32);
+  }
+  EXPECT_NE(why_of("100#A5010A00F6FF32_9").find("after other than 8 data bytes"), std::string::npos);
+  EXPECT_NE(why_of("100#A5010A00F6FF3200_8").find("not one hex digit 9..F"), std::string::npos);
+  EXPECT_NE(why_of("100#A5010A00F6FF3200_").find("not one hex digit 9..F"), std::string::npos);
+  EXPECT_NE(why_of("100#A5010A00F6FF3200_AB").find("not one hex digit 9..F"), std::string::npos);
 }
 
 // canplayer skips every line that does not begin with '(' (its -h says so): comments, candump

@@ -347,6 +347,7 @@ int candump_seeds(const std::filesystem::path& dir) {
       {"crlf.log", crlf},
       {"two_ifaces.log", two_ifaces},
       {"error_frame.log", "(1700000000.000100) vcan0 20000040#0000000000000000\n"},
+      {"len8_dlc.log", "(1700000000.000100) vcan0 100#A5010A00F6FF3200_C\n"},
       {"extended.log", "(1700000000.000100) vcan0 12345678#00\n"},
       {"remote.log", "(1700000000.000100) vcan0 100#R\n"},
       {"fd.log", "(1700000000.000100) vcan0 100##1A5\n"}};
