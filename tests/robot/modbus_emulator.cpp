@@ -10,9 +10,12 @@
 //                          4  answer the next read of register 180 register 902 milliseconds
 //                             late, then go back to 0 (one late answer)
 //   holding register 910      number of reads of register 180 answered (mod 65536)
-// The registers 180-185 are set by clients (FC06/FC16), e.g. by the test.
+// The registers 180-185 are set by clients (FC06/FC16), e.g. by the test, or at start with
+// --hold ADDR=VALUE (repeatable; the SocketCAN VM test, which has no Modbus client, holds a
+// force with it).
 //
-//   dg_modbus_emulator [--port N]      prints "listening on PORT" (N = 0: any free port)
+//   dg_modbus_emulator [--port N] [--hold ADDR=VALUE]...
+//                                      prints "listening on PORT" (N = 0: any free port)
 //   dg_modbus_emulator --rtu DEVICE [--slave N]   Modbus RTU (115200 8N1) on a serial device
 //                                      (a pty in the tests); prints "serving DEVICE"
 #include <arpa/inet.h>
@@ -28,6 +31,8 @@
 #include <cstring>
 #include <chrono>
 #include <thread>
+#include <utility>
+#include <vector>
 
 namespace {
 
@@ -86,10 +91,22 @@ int serve_rtu(const char* device, int slave) {
 int main(int argc, char** argv) {
   int port = 0, slave = 9;
   const char* rtu = nullptr;
+  std::vector<std::pair<int, uint16_t>> holds;
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--port")) port = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--rtu")) rtu = argv[i + 1];
     if (!std::strcmp(argv[i], "--slave")) slave = std::atoi(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--hold")) {
+      int addr = -1;
+      long value = -1;
+      if (std::sscanf(argv[i + 1], "%d=%ld", &addr, &value) != 2 || addr < 0 || addr >= 1000 || value < -32768 ||
+          value > 65535) {
+        std::fprintf(stderr, "dg_modbus_emulator: --hold %s: expected ADDR=VALUE, ADDR 0..999, VALUE a 16-bit word\n",
+                     argv[i + 1]);
+        return 2;
+      }
+      holds.emplace_back(addr, static_cast<uint16_t>(value));
+    }
   }
   if (rtu) return serve_rtu(rtu, slave);
   modbus_t* ctx = modbus_new_tcp("127.0.0.1", port);
@@ -98,6 +115,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "dg_modbus_emulator: %s\n", modbus_strerror(errno));
     return 1;
   }
+  for (const auto& [addr, value] : holds) map->tab_registers[addr] = value;
   int server = listen_on(ctx, port);
   if (server < 0) {
     std::fprintf(stderr, "dg_modbus_emulator: listen: %s\n", modbus_strerror(errno));

@@ -13,6 +13,11 @@ recorded frames and asserts on them by their payloads' counters (logical time):
   unconfirmed  stop frames dropped on their way out (tc; vcan echo=1, so no echo): the stop is
             retried, never sent into the next trial, and that trial is refused
             (stop_unconfirmed) once the way out is clear;
+  bridge    the firmware bridge on vcan0 against Modbus TCP peers (dg_modbus_emulator as the
+            FT 300, a force past the limit, and as the robot controller): its readings reach the
+            bus E2E-protected at about 100 Hz, the predictor stops the trial the robot starts at
+            its first sample (hard limit), and the bridge takes that Stop frame from the bus and
+            writes the robot's stop coil;
   latency   end to end through the kernel (probe send -> stop frame received), a histogram.
 Every scenario ends with SIGTERM: the daemon must exit 0.
 
@@ -57,6 +62,16 @@ def e2e_ok(can_id, data):
         return False
     did = 0xD000 | can_id
     return crc8_h2f(bytes([did & 0xFF, did >> 8]) + data[1:]) == data[0]
+
+
+def protect(can_id, payload):
+    """A protocol frame as cansend takes it: CRC, then counter and payload (7 bytes)."""
+    did = 0xD000 | can_id
+    crc = crc8_h2f(bytes([did & 0xFF, did >> 8]) + payload)
+    return f"{can_id:03X}#" + (bytes([crc]) + payload).hex().upper()
+
+
+BRIDGE_TRIAL = 77  # the bridge scenario's trial id (TrialStart: counter 0, 100 mm/s, middle arm)
 
 
 def i16(d, o):
@@ -136,7 +151,9 @@ def main():
     cache = args.cache or os.path.join(args.source, "build", "vm")
     logs_dir = os.path.join(args.source, "tests", "data", "robot")
     bins = [os.path.join(args.build, "predictor", "daemon", "dressguard-predictor"),
-            os.path.join(args.build, "tools", "bench", "bench_predictor")]
+            os.path.join(args.build, "tools", "bench", "bench_predictor"),
+            os.path.join(args.build, "firmware-bridge", "dressguard-bridge"),
+            os.path.join(args.build, "tests", "robot", "dg_modbus_emulator")]
     for b in bins:
         if not os.path.exists(b):
             print(f"FAIL: {b} not built")
@@ -154,6 +171,9 @@ def main():
         for f in sorted(os.listdir(logs_dir)):
             shutil.copy(os.path.join(logs_dir, f), os.path.join(data, "logs", f))
         shutil.copy(args.model, os.path.join(data, "model.dgm"))
+        with open(os.path.join(data, "bridge-trial-start.txt"), "w") as f:
+            trial_start = bytes([0]) + BRIDGE_TRIAL.to_bytes(2, "little") + (100).to_bytes(2, "little") + bytes([1, 0])
+            f.write(protect(0x180, trial_start) + "\n")
         # Per run: the release and sanitize builds share the kernel cache, not their initramfs.
         initrd = os.path.join(tmp, "initramfs.gz")
         cmd = [os.path.join(args.source, "tools", "vm", "build_initramfs.sh"), "--cache", cache, "--out", initrd,
@@ -202,7 +222,7 @@ def main():
     check("scenario unconfirmed: tc" not in console, "unconfirmed: tc dropped 0x080 on its way out of vcan0")
     played = re.findall(r"PLAYFAIL (.*)", console)
     check(not played, "every log was played" + (f" (not: {'; '.join(p.strip() for p in played)})" if played else ""))
-    for name in ("clean", "hardlimit", "gap", "nomodel", "unconfirmed", "latency"):
+    for name in ("clean", "hardlimit", "gap", "nomodel", "unconfirmed", "bridge", "latency"):
         m = re.search(rf"DG-VM: \[[\d.]+\] scenario {name} daemon_exit (\d+)", console)
         check(m is not None and m.group(1) == "0", f"{name}: the daemon exited 0 on SIGTERM")
         check("shutting down" in sec.get(f"{name}.log", ""), f"{name}: clean shutdown logged")
@@ -308,6 +328,30 @@ def main():
     m = re.search(r"shutting down: (.*)", sec.get("unconfirmed.log", ""))
     uc = dict((k, int(v)) for k, v in re.findall(r"(\w+)=(\d+)", m.group(1))) if m else {}
     check(uc.get("tx_retries", 0) >= 10, f"unconfirmed: the unechoed stop was retried ({uc.get('tx_retries')} retries)")
+
+    # --- the firmware bridge on SocketCAN ---
+    rec = sec.get("bridge.rec", "")
+    blog = sec.get("bridge-app.log", "")
+    frames = [fr for fr in (parse_frame(l) for l in rec.splitlines()) if fr]
+    forces = [fr for fr in frames if fr[1] == 0x100]
+    check(len(forces) >= 100 and all(e2e_ok(0x100, fr[2]) for fr in forces),
+          f"bridge: its readings on vcan0, E2E-protected ({len(forces)} FtForce frames in about 3 s)")
+    check(all(i16(fr[2], 2) == 1200 for fr in forces), "bridge: each carries the sensor's Fx, 1200 counts (12.00 N)")
+    if len(forces) > 10:
+        gaps = sorted(b[0] - a[0] for a, b in zip(forces, forces[1:]))
+        print(f"  bridge: readings every {gaps[len(gaps) // 2] * 1e3:.1f} ms (median; the sensor is polled every 10 ms)")
+    hbs = [fr for fr in frames if fr[1] == 0x700 and e2e_ok(0x700, fr[2])]
+    check(len(hbs) >= 10, f"bridge: its heartbeat on vcan0 ({len(hbs)} frames)")
+    s = first_stop_per_trial(stops_in(rec)).get(BRIDGE_TRIAL)
+    check(s is not None and s["ok"] and s["reason"] == "hard_limit" and s["sample"] == 0,
+          f"bridge: the predictor stopped trial {BRIDGE_TRIAL} at its first sample (hard limit): "
+          f"{(s['reason'], s['sample']) if s else 'none'}")
+    check(hbs and hbs[-1][2][2] == 2, "bridge: its last heartbeat says stop latched")
+    check("stop frame from the predictor: hard_limit" in blog and "stop written to the robot controller" in blog,
+          "bridge: took the Stop frame from vcan0 and wrote the robot's stop coil")
+    check("has not guarded" not in blog and "no heartbeat from the predictor" not in blog,
+          "bridge: the predictor's heartbeat guarded the trial (no stop of the bridge's own)")
+    check(re.search(r"^bridge_exit 0", blog, re.M) is not None, "bridge: exited 0 on SIGTERM")
 
     # --- latency ---
     lat = sec.get("latency.out", "")

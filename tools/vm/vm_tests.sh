@@ -1,8 +1,9 @@
 #!/bin/sh
 # Runs inside the test VM (busybox sh, as root, from /init). Every scenario starts the predictor
-# daemon on vcan0, replays candump logs with canplayer, records the bus with candump -d, stops
-# the daemon with SIGTERM, and prints its recording and log between markers on the console
-# (ttyS0) for tools/vm/run_vm_tests.py, which decodes the frames and asserts on them.
+# daemon on vcan0, replays candump logs with canplayer (or runs the firmware bridge against
+# Modbus TCP peers on 127.0.0.1), records the bus with candump -d, stops the daemon with
+# SIGTERM, and prints its recording and log between markers on the console (ttyS0) for
+# tools/vm/run_vm_tests.py, which decodes the frames and asserts on them.
 D=/data
 MODEL=$D/model.dgm
 say() { echo "DG-VM: [$(cut -d" " -f1 /proc/uptime)] $*"; }
@@ -108,6 +109,40 @@ play_unconfirmed() {
 # A 5 s deadline: the second trial's samples end before the way out is cleared, and no timeout
 # stop may replace the pending one meanwhile (that would hide a stale stop resent).
 scenario unconfirmed "--model $MODEL --set stop_consecutive=100000 --set sensor_timeout_ms=5000" ",080:7FF"
+
+# G: the firmware bridge on SocketCAN, the whole chain: dg_modbus_emulator as the FT 300 (Modbus
+# TCP on 127.0.0.1, Fx held at 12.00 N, past the 10 N limit) and as the robot controller; the
+# bridge publishes its readings on vcan0, the robot's TrialStart follows (cansend), the predictor
+# stops the trial at its first sample (hard limit) with a Stop frame on vcan0, and the bridge
+# writes the robot's stop coil. With --predictor-timeout-ms the bridge also watches the
+# predictor, which guards the trial: no stop of the bridge's own.
+wait_port() {  # wait_port FILE: the port dg_modbus_emulator printed
+  i=0
+  while ! grep -q "listening on" "$1" 2>/dev/null && [ $i -lt 100 ]; do i=$((i + 1)); sleep 0.1; done
+  sed -n 's/^listening on //p' "$1"
+}
+play_bridge() {
+  ip link set lo up || ip2 link set lo up
+  dg_modbus_emulator --port 0 --hold 180=1200 > /tmp/sensor.out 2>&1 &
+  spid=$!
+  dg_modbus_emulator --port 0 > /tmp/robot.out 2>&1 &
+  rpid=$!
+  sport=$(wait_port /tmp/sensor.out)
+  rport=$(wait_port /tmp/robot.out)
+  [ -n "$sport" ] && [ -n "$rport" ] || say "scenario bridge: emulator not listening ($sport, $rport)"
+  dressguard-bridge --interface vcan0 --sensor tcp:127.0.0.1:$sport --robot tcp:127.0.0.1:$rport \
+    --predictor-timeout-ms 300 > /tmp/bridge.log 2>&1 &
+  bpid=$!
+  sleep 1.5   # readings and heartbeats flow
+  cansend vcan0 "$(cat $D/bridge-trial-start.txt)" || say "scenario bridge: cansend failed"
+  sleep 1.5
+  kill -TERM $bpid
+  wait $bpid
+  echo "bridge_exit $?" >> /tmp/bridge.log
+  kill $spid $rpid 2>/dev/null
+  section bridge-app.log /tmp/bridge.log
+}
+scenario bridge "--model $MODEL" ",080:7FF,100:7FF,180:7FF,700:7FF"
 
 # E: end-to-end latency through the kernel: frame in (the probe's send) to stop frame out (the
 # probe's receive), hard-limit trials back to back.
