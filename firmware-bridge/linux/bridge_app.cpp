@@ -22,14 +22,14 @@ uint32_t now_ms() {
   return static_cast<uint32_t>(static_cast<uint64_t>(ts.tv_sec) * 1000 + ts.tv_nsec / 1000000);
 }
 
-constexpr uint64_t kTimer = 1, kCan = 2, kShutdown = 3;
+constexpr uint64_t kTimer = 1, kCan = 2, kShutdown = 3, kSensor = 4;
 
 bool due(uint32_t now, uint32_t t) { return static_cast<int32_t>(now - t) >= 0; }
 bool power_of_two(uint64_t n) { return n != 0 && (n & (n - 1)) == 0; }
 
 }  // namespace
 
-BridgeApp::BridgeApp(const BridgeAppConfig& cfg, ModbusSensor& sensor, RobotStopWriter* robot, can::CanPort& port)
+BridgeApp::BridgeApp(const BridgeAppConfig& cfg, Sensor& sensor, RobotStopWriter* robot, can::CanPort& port)
     : cfg_(cfg), sensor_(sensor), robot_(robot), port_(port) {
   const uint32_t t0 = now_ms();
   bridge_init(core_, cfg.core, t0);
@@ -40,7 +40,9 @@ BridgeApp::BridgeApp(const BridgeAppConfig& cfg, ModbusSensor& sensor, RobotStop
   timer_fd_ = timerfd_create(CLOCK_MONOTONIC, TFD_NONBLOCK | TFD_CLOEXEC);
   shutdown_fd_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
   if (epoll_fd_ < 0 || timer_fd_ < 0 || shutdown_fd_ < 0) throw std::system_error(errno, std::generic_category(), "epoll/timerfd/eventfd");
-  for (auto [fd, tag] : {std::pair{timer_fd_, kTimer}, std::pair{port_.fd(), kCan}, std::pair{shutdown_fd_, kShutdown}}) {
+  for (auto [fd, tag] : {std::pair{timer_fd_, kTimer}, std::pair{port_.fd(), kCan}, std::pair{shutdown_fd_, kShutdown},
+                        std::pair{sensor_.events_fd(), kSensor}}) {
+    if (fd < 0) continue;  // a polled sensor has no events
     epoll_event ev{};
     ev.events = EPOLLIN;
     ev.data.u64 = tag;
@@ -63,7 +65,7 @@ void BridgeApp::request_shutdown() noexcept {
   [[maybe_unused]] ssize_t n = ::write(shutdown_fd_, &one, sizeof one);
 }
 
-std::string BridgeApp::last_error() const { return sensor_.link().last_error(); }
+std::string BridgeApp::last_error() const { return sensor_.last_error(); }
 
 void BridgeApp::say(const char* fmt, ...) {
   if (!cfg_.log) return;
@@ -78,7 +80,7 @@ void BridgeApp::say(const char* fmt, ...) {
 
 void BridgeApp::sensor_failed(const char* what) {
   if (power_of_two(++sensor_failures_))
-    say("sensor: %s: %s (%llu in a row; no frames until it answers)", what, sensor_.link().last_error().c_str(),
+    say("sensor: %s: %s (%llu in a row; no frames until it answers)", what, sensor_.last_error().c_str(),
         static_cast<unsigned long long>(sensor_failures_));
 }
 
@@ -131,50 +133,68 @@ void BridgeApp::try_stop(uint32_t t) {
   }
 }
 
+void BridgeApp::back_off(uint32_t t) {
+  next_connect_ms_ = t + static_cast<uint32_t>(backoff_ms_);
+  backoff_ms_ = backoff_ms_ == 0 ? cfg_.backoff_min_ms : std::min(2 * backoff_ms_, cfg_.backoff_max_ms);
+}
+
+// One read of the sensor: a reading is published, a failure reported. False when there is
+// nothing more to read now (Pending, or the sensor closed itself).
+bool BridgeApp::take_reading(uint32_t t) {
+  FtReading r;
+  const ReadResult rr = sensor_.read(r);
+  if (rr == ReadResult::Pending) return false;
+  if (rr == ReadResult::Ok) {
+    Frame frames[2];
+    const int n = bridge_on_reading(core_, r, t, frames);
+    for (int i = 0; i < n; ++i) send(frames[i]);
+    ++stats_.readings;
+    backoff_ms_ = 0;
+    if (sensor_failures_ > 0)
+      say("sensor answers again after %llu failures", static_cast<unsigned long long>(sensor_failures_));
+    sensor_failures_ = 0;
+    return true;
+  }
+  bridge_on_sensor_error(core_, t);
+  ++stats_.sensor_errors;
+  sensor_failed(read_result_name(rr));
+  if (sensor_.connected()) return true;  // e.g. one stream frame's CRC failed: the next may be good
+  // Closed after a timeout or a garbled answer (modbus_link.h): the first reconnect waits
+  // reopen_quiet_ms, so that a late answer lands before the link reopens.
+  back_off(t);
+  const uint32_t quiet = t + static_cast<uint32_t>(sensor_.reopen_quiet_ms());
+  if (!due(next_connect_ms_, quiet)) next_connect_ms_ = quiet;
+  return false;
+}
+
+// A streaming sensor: every reading its line holds now (bounded: a level-triggered epoll calls
+// again for the rest).
+void BridgeApp::drain_sensor(uint32_t t) {
+  for (int n = 0; n < 64 && sensor_.connected() && take_reading(t); ++n) {
+  }
+}
+
 void BridgeApp::on_timer(uint32_t t) {
   // The sensor: reconnect with exponential backoff, else read one sample. The backoff is reset
   // by a good reading, not by a connect: a device that accepts and then fails every request is
   // retried ever more slowly too.
-  const auto back_off = [&] {
-    next_connect_ms_ = t + static_cast<uint32_t>(backoff_ms_);
-    backoff_ms_ = backoff_ms_ == 0 ? cfg_.backoff_min_ms : std::min(2 * backoff_ms_, cfg_.backoff_max_ms);
-  };
-  if (!sensor_.link().connected()) {
+  if (!sensor_.connected()) {
     if (due(t, next_connect_ms_)) {
-      if (sensor_.link().connect()) {
+      if (sensor_.connect()) {
         bridge_on_reconnect(core_);
         ++stats_.reconnects;
       } else {
         ++stats_.connect_failures;
         sensor_failed("connect");
-        back_off();
+        back_off(t);
       }
     }
   }
-  if (sensor_.link().connected()) {
-    FtReading r;
-    const ReadResult rr = sensor_.read(r);
-    if (rr == ReadResult::Ok) {
-      Frame frames[2];
-      const int n = bridge_on_reading(core_, r, t, frames);
-      for (int i = 0; i < n; ++i) send(frames[i]);
-      ++stats_.readings;
-      backoff_ms_ = 0;
-      if (sensor_failures_ > 0)
-        say("sensor answers again after %llu failures", static_cast<unsigned long long>(sensor_failures_));
-      sensor_failures_ = 0;
-    } else {
-      bridge_on_sensor_error(core_, t);
-      ++stats_.sensor_errors;
-      sensor_failed(read_result_name(rr));
-      if (!sensor_.link().connected()) {
-        // Closed after a timeout or a garbled answer (modbus_link.h): the first reconnect waits
-        // one response timeout, so that a late answer lands before the link reopens.
-        back_off();
-        const uint32_t quiet = t + static_cast<uint32_t>(sensor_.link().endpoint().response_timeout_ms);
-        if (!due(next_connect_ms_, quiet)) next_connect_ms_ = quiet;
-      }
-    }
+  if (sensor_.connected()) {
+    // A polled sensor is read once per period. A streaming one is read whenever its line has
+    // bytes (kSensor), and here too: that finds its silence.
+    if (sensor_.events_fd() < 0) take_reading(t);
+    else drain_sensor(t);
   } else {
     bridge_on_sensor_error(core_, t);
   }
@@ -230,6 +250,11 @@ int BridgeApp::run() {
         }
       }
       if (evs[i].data.u64 == kCan) drain_can(t);
+      if (evs[i].data.u64 == kSensor) {
+        // No more readings once shutting down (as on the timer): the line is no longer watched.
+        if (shutting_down) epoll_ctl(epoll_fd_, EPOLL_CTL_DEL, sensor_.events_fd(), nullptr);
+        else drain_sensor(t);
+      }
       if (evs[i].data.u64 == kTimer) {
         uint64_t exp;
         [[maybe_unused]] ssize_t r = ::read(timer_fd_, &exp, sizeof exp);

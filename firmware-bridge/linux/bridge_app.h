@@ -1,5 +1,6 @@
 // The bridge's Linux host port: one event loop (epoll on a timerfd at the sensor rate, the CAN
-// port, a shutdown eventfd) around the portable core. Reads the sensor over Modbus each period,
+// port, a shutdown eventfd, and a streaming sensor's line) around the portable core. Reads a
+// polled sensor over Modbus each period, or a streaming one whenever its line has bytes,
 // publishes the frames, and on a stop writes the stop to the robot controller; reconnects to a
 // lost sensor with exponential backoff (no frames meanwhile: never stale data).
 #pragma once
@@ -40,7 +41,7 @@ struct BridgeStats {
 class BridgeApp {
  public:
   // `robot` may be null (no robot controller: stops are only logged).
-  BridgeApp(const BridgeAppConfig& cfg, ModbusSensor& sensor, RobotStopWriter* robot, can::CanPort& port);
+  BridgeApp(const BridgeAppConfig& cfg, Sensor& sensor, RobotStopWriter* robot, can::CanPort& port);
   ~BridgeApp();
   // Until request_shutdown(), then until no stop is left unwritten: 0, or 1 when the grace ran
   // out with a stop unwritten (said on the log) or epoll failed.
@@ -52,6 +53,9 @@ class BridgeApp {
 
  private:
   void on_timer(uint32_t now_ms);
+  bool take_reading(uint32_t now_ms);
+  void drain_sensor(uint32_t now_ms);
+  void back_off(uint32_t now_ms);
   void drain_can(uint32_t now_ms);
   void send(const Frame& f);
   void try_stop(uint32_t now_ms);
@@ -61,7 +65,7 @@ class BridgeApp {
   void sensor_failed(const char* what);
 
   BridgeAppConfig cfg_;
-  ModbusSensor& sensor_;
+  Sensor& sensor_;
   RobotStopWriter* robot_;
   can::CanPort& port_;
   BridgeCore core_;

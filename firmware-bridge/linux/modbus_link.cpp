@@ -19,6 +19,7 @@ const char* read_result_name(ReadResult r) {
     case ReadResult::Exception: return "modbus exception";
     case ReadResult::Disconnected: return "disconnected";
     case ReadResult::BadData: return "bad data";
+    case ReadResult::Pending: return "pending";
   }
   return "unknown";
 }

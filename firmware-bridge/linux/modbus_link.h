@@ -38,7 +38,8 @@ std::string parse_endpoint(const std::string& spec, EndpointParts* out = nullptr
 // baud it is 16.7 ms: 100 Hz polling needs 38400 baud or more.
 double rtu_reading_ms(const EndpointParts& p);
 
-enum class ReadResult : uint8_t { Ok = 0, Timeout = 1, Exception = 2, Disconnected = 3, BadData = 4 };
+// Pending: no reading yet, and nothing failed (a streaming sensor between two frames).
+enum class ReadResult : uint8_t { Ok = 0, Timeout = 1, Exception = 2, Disconnected = 3, BadData = 4, Pending = 5 };
 const char* read_result_name(ReadResult r);
 
 // A Modbus connection that knows how to (re)open itself.
@@ -78,12 +79,38 @@ struct SensorMap {
   double torque_scale = 1.0;
 };
 
-class ModbusSensor {
+// What the bridge's loop needs of a force-torque sensor: polled over Modbus each period
+// (ModbusSensor), or streaming on its own clock (Ft300Stream, ft300_stream.h).
+class Sensor {
+ public:
+  virtual ~Sensor() = default;
+  // Opens (or reopens) it; false with last_error() set when that fails.
+  virtual bool connect() = 0;
+  virtual bool connected() const = 0;
+  // The next reading; on failure nothing is written to `out`, and the sensor may have closed
+  // itself (connected() says).
+  virtual ReadResult read(FtReading& out) = 0;
+  virtual const std::string& last_error() const = 0;
+  // [ms] After a failure that closed it, the least wait before it is reopened.
+  virtual int reopen_quiet_ms() const = 0;
+  // -1: a polled sensor, read once per period (read() blocks up to its timeout). Else a
+  // descriptor that is readable when a streaming sensor has bytes: read() never blocks and
+  // says Pending when no reading is complete, and it is read on every period too (which finds
+  // a stream gone silent).
+  virtual int events_fd() const { return -1; }
+};
+
+class ModbusSensor : public Sensor {
  public:
   ModbusSensor(ModbusEndpoint ep, SensorMap map) : link_(std::move(ep)), map_(map) {}
   ModbusLink& link() { return link_; }
   // One reading (six registers in one request); on failure nothing is written to `out`.
-  ReadResult read(FtReading& out);
+  ReadResult read(FtReading& out) override;
+  bool connect() override { return link_.connect(); }
+  bool connected() const override { return link_.connected(); }
+  const std::string& last_error() const override { return link_.last_error(); }
+  // A late answer lands before the link reopens (ModbusLink::classify_failure).
+  int reopen_quiet_ms() const override { return link_.endpoint().response_timeout_ms; }
 
  private:
   ModbusLink link_;
