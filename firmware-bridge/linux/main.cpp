@@ -1,4 +1,5 @@
-// dressguard-bridge: Modbus force-torque sensor -> CAN, and CAN stop -> robot controller.
+// dressguard-bridge: force-torque sensor (Modbus, or an FT 300's data stream) -> CAN, and CAN
+// stop -> robot controller.
 #include <signal.h>
 
 #include <cerrno>
@@ -9,6 +10,7 @@
 #include <string>
 
 #include "bridge_app.h"
+#include "ft300_stream.h"
 
 using namespace dressguard;
 using namespace dressguard::bridge;
@@ -23,22 +25,26 @@ void on_signal(int) {
 const char* kUsage =
     "usage: dressguard-bridge [options]\n"
     "  Reads a force-torque sensor over Modbus (default: a Robotiq FT 300, holding registers\n"
-    "  180-185, int16, F x 100 and M x 1000, slave 9) at a fixed rate and publishes each reading as\n"
-    "  the protocol's FtForce + FtTorque frames on SocketCAN (firmware-bridge/PROTOCOL.md). On a\n"
-    "  Stop frame it writes a stop to the robot controller over Modbus. A lost sensor is reconnected\n"
-    "  with exponential backoff; meanwhile no sample frames are sent (the predictor's deadline stops\n"
-    "  the robot).\n"
+    "  180-185, int16, F x 100 and M x 1000, slave 9) at a fixed rate, or an FT 300's own 100 Hz\n"
+    "  data stream (rtu-stream:DEVICE), and publishes each reading as the protocol's FtForce +\n"
+    "  FtTorque frames on SocketCAN (firmware-bridge/PROTOCOL.md). On a Stop frame it writes a stop\n"
+    "  to the robot controller over Modbus. A lost sensor is reconnected with exponential backoff;\n"
+    "  meanwhile no sample frames are sent (the predictor's deadline stops the robot).\n"
     "  --interface IF          SocketCAN interface (default can0)\n"
     "  --sensor SPEC           tcp:HOST:PORT or rtu:DEVICE:BAUD[:PARITY] (default rtu:/dev/ttyUSB0:19200:N;\n"
-    "                          HOST a numeric IPv4 address)\n"
+    "                          HOST a numeric IPv4 address), read over Modbus every period; or\n"
+    "                          rtu-stream:DEVICE, an FT 300's data stream: its line is fixed at 19200 8N1,\n"
+    "                          where polling gives about 60 readings/s, the stream 100 frames/s (a stream\n"
+    "                          left running is stopped first; silent 100 ms: lost, restarted; stopped at exit)\n"
     "  --sensor-slave N        Modbus unit id (default 9)\n"
     "  --sensor-register N     first of the six registers (default 180)\n"
     "  --input-registers       read with FC04 instead of FC03\n"
     "  --force-scale S         sensor counts -> 0.01 N counts (default 1, the FT 300's)\n"
     "  --torque-scale S        sensor counts -> 0.001 Nm counts (default 1)\n"
     "  --timeout-ms N          Modbus response timeout, 1-1000 (default 20); a stop frame can wait about\n"
-    "                          this long behind a sensor read that gets no answer\n"
-    "  --period-ms N           sampling period (default 10: 100 Hz)\n"
+    "                          this long behind a sensor read that gets no answer (rtu-stream never waits)\n"
+    "  --period-ms N           sampling period (default 10: 100 Hz); with rtu-stream the sensor's frames\n"
+    "                          set the rate, and this is the period of the heartbeat and of the checks\n"
     "  --robot SPEC            robot controller, tcp:HOST:PORT or rtu:...; none: stops are only logged\n"
     "  --robot-slave N         its unit id (default 1)\n"
     "  --stop-coil ADDR        write the stop as coil ADDR = ON (default: coil 0)\n"
@@ -55,6 +61,18 @@ const char* kUsage =
 int bad(const std::string& why) {
   std::fprintf(stderr, "dressguard-bridge: %s (see --help)\n", why.c_str());
   return 2;
+}
+
+// An rtu-stream sensor: its device, and no register map (the stream's frames carry the FT 300's
+// six values in its own counts, which are the protocol's).
+std::string stream_spec_error(const std::string& spec, const SensorMap& map, std::string* device) {
+  if (const std::string why = parse_stream_spec(spec, device); !why.empty()) return why;
+  const SensorMap plain;
+  if (map.first_register != plain.first_register || map.input_registers || map.force_scale != plain.force_scale ||
+      map.torque_scale != plain.torque_scale)
+    return "'" + spec + "': the data stream has no register map: --sensor-register, --input-registers, "
+           "--force-scale and --torque-scale apply to polling only";
+  return {};
 }
 
 // Whole-number options and their ranges: Modbus addresses are 16 bits (the six sensor registers
@@ -144,14 +162,19 @@ int main(int argc, char** argv) {
   }
   // Both endpoints are checked now, not when the first stop must go out.
   EndpointParts sensor_parts;
-  if (const std::string why = parse_endpoint(sensor_ep.spec, &sensor_parts); !why.empty()) return bad("--sensor: " + why);
+  std::string stream_device;
+  const bool stream = is_stream_spec(sensor_ep.spec);
+  if (const std::string why = stream ? stream_spec_error(sensor_ep.spec, map, &stream_device)
+                                     : parse_endpoint(sensor_ep.spec, &sensor_parts);
+      !why.empty())
+    return bad("--sensor: " + why);
   // A serial line too slow for the period: readings come late, and the sample counter (the
   // predictor's logical time, one count per reading) runs slower than the model's 100 Hz.
   if (const double line_ms = rtu_reading_ms(sensor_parts); line_ms > cfg.sample_period_ms)
     std::fprintf(stderr,
                  "dressguard-bridge: warning: at %d baud one reading takes at least %.1f ms on the line, more "
                  "than --period-ms %d: readings will come late and the predictor's logical time will run slow "
-                 "(set the sensor to a faster baud rate)\n",
+                 "(an FT 300's line is fixed at 19200 baud: --sensor rtu-stream:DEVICE reads its 100 Hz stream)\n",
                  sensor_parts.number, line_ms, cfg.sample_period_ms);
   if (!robot_spec.empty())
     if (const std::string why = parse_endpoint(robot_spec); !why.empty()) return bad("--robot: " + why);
@@ -169,22 +192,38 @@ int main(int argc, char** argv) {
     can::PortOptions opt;
     opt.ids.assign(std::begin(kBridgeReceives), std::end(kBridgeReceives));
     auto port = can::open_socketcan(iface, opt);
-    ModbusSensor sensor(sensor_ep, map);
+    std::unique_ptr<Sensor> sensor;
+    Ft300Stream* ft300 = nullptr;  // to stop its stream at the end
+    if (stream) {
+      auto s = std::make_unique<Ft300Stream>(Ft300StreamConfig{stream_device, sensor_ep.slave});
+      ft300 = s.get();
+      sensor = std::move(s);
+    } else {
+      sensor = std::make_unique<ModbusSensor>(sensor_ep, map);
+    }
     std::unique_ptr<RobotStopWriter> robot;
     if (!robot_spec.empty()) {
       robot_ep.spec = robot_spec;
       robot = std::make_unique<RobotStopWriter>(robot_ep, target);
     }
-    BridgeApp app(cfg, sensor, robot.get(), *port);
+    BridgeApp app(cfg, *sensor, robot.get(), *port);
     g_app = &app;
     struct sigaction sa{};
     sa.sa_handler = on_signal;
     sigemptyset(&sa.sa_mask);
     sigaction(SIGTERM, &sa, nullptr);
     sigaction(SIGINT, &sa, nullptr);
-    std::fprintf(stderr, "dressguard-bridge: %s -> %s every %d ms\n", sensor_ep.spec.c_str(), iface.c_str(), cfg.sample_period_ms);
+    if (stream)
+      std::fprintf(stderr, "dressguard-bridge: %s -> %s, every frame\n", sensor_ep.spec.c_str(), iface.c_str());
+    else
+      std::fprintf(stderr, "dressguard-bridge: %s -> %s every %d ms\n", sensor_ep.spec.c_str(), iface.c_str(),
+                   cfg.sample_period_ms);
     const int rc = app.run();
     g_app = nullptr;
+    // After the robot's stop (run() wrote it): the sensor is left answering Modbus.
+    if (ft300 && !ft300->stop_stream(1000))
+      std::fprintf(stderr, "dressguard-bridge: warning: the FT 300's stream may still run: %s\n",
+                   ft300->last_error().c_str());
     const auto& s = app.stats();
     std::fprintf(stderr,
                  "dressguard-bridge: readings=%llu frames=%llu send_failures=%llu sensor_errors=%llu reconnects=%llu "
@@ -193,6 +232,12 @@ int main(int argc, char** argv) {
                  (unsigned long long)s.send_failures.load(), (unsigned long long)s.sensor_errors.load(),
                  (unsigned long long)s.reconnects.load(), (unsigned long long)s.stops_written.load(),
                  (unsigned long long)s.stop_write_failures.load());
+    if (ft300)
+      std::fprintf(stderr, "dressguard-bridge: stream frames=%llu crc_failures=%llu resyncs=%llu skipped_bytes=%llu\n",
+                   (unsigned long long)ft300->stats().frames.load(),
+                   (unsigned long long)ft300->stats().crc_failures.load(),
+                   (unsigned long long)ft300->stats().resyncs.load(),
+                   (unsigned long long)ft300->stats().skipped_bytes.load());
     return rc;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "dressguard-bridge: %s\n", e.what());

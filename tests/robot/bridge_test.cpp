@@ -14,18 +14,22 @@
 #include <stdlib.h>
 #include <termios.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <time.h>
+#include <vector>
 
 #include "bridge_app.h"
+#include "ft300_stream.h"
 #include "bridge_core.h"
 #include "can_port.h"
 
@@ -397,7 +401,9 @@ struct BridgeRig {
   std::thread loop;
   std::atomic<int> rc{-1};          // what run() returned
   std::FILE* log = std::tmpfile();  // what the bridge says
-  explicit BridgeRig(int shutdown_grace_ms = 1000, uint32_t predictor_timeout_ms = 0) {
+  // `own_sensor`, when given, is read instead of a ModbusSensor on sensor_emu.
+  explicit BridgeRig(int shutdown_grace_ms = 1000, Sensor* own_sensor = nullptr, int period_ms = 10,
+                     uint32_t predictor_timeout_ms = 0) {
     // The identifiers dressguard-bridge's main subscribes to.
     bridge_port = bus.open({{std::begin(kBridgeReceives), std::end(kBridgeReceives)}, false, true});
     listener = bus.open({{protocol::id_of(protocol::MsgId::FtForce), protocol::id_of(protocol::MsgId::FtTorque),
@@ -410,8 +416,9 @@ struct BridgeRig {
     cfg.backoff_max_ms = 160;
     cfg.log = log;
     cfg.shutdown_grace_ms = shutdown_grace_ms;
+    cfg.sample_period_ms = period_ms;
     cfg.core.predictor_timeout_ms = predictor_timeout_ms;
-    app = std::make_unique<BridgeApp>(cfg, *sensor, robot.get(), *bridge_port);
+    app = std::make_unique<BridgeApp>(cfg, own_sensor ? *own_sensor : *sensor, robot.get(), *bridge_port);
     loop = std::thread([this] { rc = app->run(); });
   }
   ~BridgeRig() {
@@ -433,14 +440,16 @@ struct BridgeRig {
     s << in.rdbuf();
     return s.str();
   }
-  // Force frames received within `d`, the last one in *last.
-  int collect(std::chrono::milliseconds d, protocol::FtForce* last = nullptr, protocol::HeartbeatBridge* hb = nullptr) {
+  // Force frames received within `d`, the last one in *last; every frame in *all.
+  int collect(std::chrono::milliseconds d, protocol::FtForce* last = nullptr, protocol::HeartbeatBridge* hb = nullptr,
+              std::vector<Frame>* all = nullptr) {
     const auto end = std::chrono::steady_clock::now() + d;
     int n = 0;
     Frame f;
     can::RxInfo info;
     while (std::chrono::steady_clock::now() < end) {
       while (listener->receive(f, info) == 1) {
+        if (all) all->push_back(f);
         protocol::FtForce m;
         protocol::HeartbeatBridge h;
         if (protocol::decode(f, m)) {
@@ -645,7 +654,7 @@ TEST(BridgeModbus, ShutdownDuringATrialStopsTheRobot) {
 TEST(BridgeModbus, TrialThePredictorDoesNotGuardStopsTheRobot) {
   for (const auto state : {protocol::PredictorState::Idle, protocol::PredictorState::InTrial}) {
     const bool guarded = state == protocol::PredictorState::InTrial;
-    BridgeRig rig(1000, 300);
+    BridgeRig rig(1000, nullptr, 10, 300);
     ASSERT_GT(rig.robot_emu.port(), 0);
     uint8_t counter = 0;
     const auto beat_for = [&](std::chrono::milliseconds d) {
@@ -768,6 +777,299 @@ TEST(BridgeModbus, RtuSensorOnASerialLine) {
   sensor.link().close();
   kill(pid, SIGTERM);
   waitpid(pid, nullptr, 0);
+}
+
+// ---- the FT 300's data stream (ft300_stream.h) -----------------------------------------------
+
+// A stream frame as the FT 300 manual draws it: 0x20 0x4E, six int16 low byte first, the CRC.
+std::vector<uint8_t> ft300_frame(std::array<int16_t, 6> v) {
+  std::vector<uint8_t> f = {0x20, 0x4E};
+  for (const int16_t x : v) {
+    f.push_back(static_cast<uint8_t>(static_cast<uint16_t>(x) & 0xFF));
+    f.push_back(static_cast<uint8_t>(static_cast<uint16_t>(x) >> 8));
+  }
+  const uint16_t crc = crc16_modbus(f.data(), f.size());
+  f.push_back(static_cast<uint8_t>(crc & 0xFF));
+  f.push_back(static_cast<uint8_t>(crc >> 8));
+  return f;
+}
+
+void feed(Ft300FrameParser& p, const std::vector<uint8_t>& bytes) {
+  ASSERT_GE(p.space(), bytes.size());
+  std::memcpy(p.tail(), bytes.data(), bytes.size());
+  p.added(bytes.size());
+}
+
+// The CRC against the catalogue's check value, the start request against the bytes that
+// scripts written apart from Robotiq's driver send to FT 300s (its CRC, CD CA, included).
+TEST(Ft300Stream, CrcAndStartRequestAsPublished) {
+  const uint8_t digits[] = {'1', '2', '3', '4', '5', '6', '7', '8', '9'};
+  EXPECT_EQ(crc16_modbus(digits, sizeof digits), 0x4B37);
+  uint8_t request[ft300::kStartRequestBytes];
+  ft300_start_request(9, request);
+  const std::vector<uint8_t> want = {0x09, 0x10, 0x01, 0x9A, 0x00, 0x01, 0x02, 0x02, 0x00, 0xCD, 0xCA};
+  EXPECT_EQ(std::vector<uint8_t>(request, request + sizeof request), want);
+  std::string device;
+  EXPECT_EQ(parse_stream_spec("rtu-stream:/dev/ttyUSB0", &device), "");
+  EXPECT_EQ(device, "/dev/ttyUSB0");
+  EXPECT_NE(parse_stream_spec("rtu-stream:", &device).find("no device"), std::string::npos);
+  EXPECT_FALSE(is_stream_spec("rtu:/dev/ttyUSB0:19200:N"));
+}
+
+// Frames among junk, a damaged frame, a false header (also one inside the data: 20000 is
+// 0x4E20, sent 20 4E), a frame split across two reads: every good frame exactly, no damaged
+// one, each loss of step counted once.
+TEST(Ft300Stream, ParserResynchronisesAndPublishesOnlyGoodFrames) {
+  Ft300StreamStats stats;
+  Ft300FrameParser p(stats);
+  FtReading r{};
+  const auto expect_frame = [&](std::array<int16_t, 6> v) {
+    ASSERT_EQ(p.next(r), ReadResult::Ok);
+    EXPECT_EQ(r.force[0], v[0]);
+    EXPECT_EQ(r.force[2], v[2]);
+    EXPECT_EQ(r.torque[0], v[3]);
+    EXPECT_EQ(r.torque[2], v[5]);
+  };
+  feed(p, {0x00, 0x20, 0x11});  // junk before the first frame: skipped, not a resync
+  feed(p, ft300_frame({-420, 17, 20000, -1, 2, -3}));
+  expect_frame({-420, 17, 20000, -1, 2, -3});
+  EXPECT_EQ(stats.resyncs.load(), 0u);
+  EXPECT_EQ(stats.skipped_bytes.load(), 3u);
+  std::vector<uint8_t> damaged = ft300_frame({-420, 17, 20000, -1, 2, -3});
+  damaged[2] ^= 0x01;
+  feed(p, damaged);
+  feed(p, ft300_frame({100, -200, 300, -400, 500, -600}));
+  EXPECT_EQ(p.next(r), ReadResult::BadData) << "the damaged frame";
+  // The false header inside the damaged frame's data (its 20000) fails too, counted but not
+  // returned: one frame was lost.
+  expect_frame({100, -200, 300, -400, 500, -600});
+  EXPECT_EQ(stats.resyncs.load(), 1u);
+  EXPECT_EQ(stats.crc_failures.load(), 2u);
+  const uint64_t failures = stats.crc_failures.load();
+  feed(p, {0x20, 0x4E, 0x01});  // a false header before a frame
+  feed(p, ft300_frame({1, 2, 3, 4, 5, 6}));
+  EXPECT_EQ(p.next(r), ReadResult::BadData);
+  expect_frame({1, 2, 3, 4, 5, 6});
+  EXPECT_EQ(stats.crc_failures.load(), failures + 1);
+  EXPECT_EQ(stats.resyncs.load(), 2u);
+  const std::vector<uint8_t> split = ft300_frame({-32768, 32767, 0, 0, 0, 0});
+  feed(p, std::vector<uint8_t>(split.begin(), split.begin() + 9));
+  EXPECT_EQ(p.next(r), ReadResult::Pending);
+  feed(p, std::vector<uint8_t>(split.begin() + 9, split.end()));
+  expect_frame({-32768, 32767, 0, 0, 0, 0});
+  EXPECT_EQ(p.next(r), ReadResult::Pending);
+  EXPECT_EQ(stats.frames.load(), 4u);
+}
+
+// dg_modbus_emulator as an FT 300 on one end of a null-modem cable, commanded through its stdin
+// (--control: what Modbus cannot reach while the line streams); the bridge's end is device().
+class Ft300OnALine {
+ public:
+  Ft300OnALine(bool streaming, const std::vector<std::string>& commands) {
+    int in[2], out[2];
+    if (pipe(in) != 0 || pipe(out) != 0) return;
+    pid_ = fork();
+    if (pid_ == 0) {
+      dup2(in[0], 0);
+      dup2(out[1], 1);
+      close(in[1]);
+      close(out[0]);
+      execl(DG_EMULATOR, DG_EMULATOR, "--rtu", cable_.end(0).c_str(), "--stream", streaming ? "1" : "0", "--control",
+            "1", static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    close(in[0]);
+    close(out[1]);
+    control_ = in[1];
+    FILE* f = fdopen(out[0], "r");
+    char line[256];
+    ready_ = std::fgets(line, sizeof line, f) && std::strncmp(line, "serving", 7) == 0;
+    std::fclose(f);
+    for (const std::string& c : commands) command(c);
+  }
+  ~Ft300OnALine() {
+    if (control_ >= 0) close(control_);
+    if (pid_ > 0) {
+      kill(pid_, SIGTERM);
+      waitpid(pid_, nullptr, 0);
+    }
+  }
+  bool ready() const { return ready_; }
+  void command(const std::string& c) {
+    const std::string line = c + "\n";
+    ASSERT_EQ(::write(control_, line.data(), line.size()), static_cast<ssize_t>(line.size()));
+  }
+  const std::string& device() const { return cable_.end(1); }
+  // Over Modbus on the bridge's end (the stream stopped): holding register `addr`, or -1.
+  int read_register(int addr) {
+    ModbusLink link(ModbusEndpoint{"rtu:" + device() + ":19200:N", 9, 500});
+    uint16_t v = 0;
+    if (!link.connect() || modbus_read_registers(link.ctx(), addr, 1, &v) != 1) return -1;
+    return v;
+  }
+
+ private:
+  NullModem cable_;
+  pid_t pid_ = -1;
+  int control_ = -1;
+  bool ready_ = false;
+};
+
+// The bridge reading the stream of an emulated FT 300 (its values set first), the CAN side on
+// the in-process bus. Declared in this order, the bridge stops before its sensor goes.
+struct StreamRig {
+  Ft300OnALine ft300;
+  Ft300Stream stream;
+  BridgeRig rig;
+  explicit StreamRig(bool streaming, int period_ms = 10)
+      : ft300(streaming, {"set 180 -420 17 20000 -1 2 -3"}), stream(Ft300StreamConfig{ft300.device()}),
+        rig(1000, &stream, period_ms) {}
+  const Ft300StreamStats& stats() const { return stream.stats(); }
+};
+
+// Force and torque frames of `frames` in pairs: each pair's counter, and whether all were
+// exactly `want` (the emulated sensor's values).
+struct Samples {
+  std::vector<uint8_t> counters;
+  int wrong = 0, unpaired = 0;
+};
+Samples samples_of(const std::vector<Frame>& frames, std::array<int16_t, 6> want) {
+  Samples s;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    protocol::FtForce force;
+    protocol::FtTorque torque;
+    if (!protocol::decode(frames[i], force)) continue;
+    if (i + 1 >= frames.size() || !protocol::decode(frames[i + 1], torque) || torque.counter != force.counter) {
+      ++s.unpaired;
+      continue;
+    }
+    s.counters.push_back(force.counter);
+    const std::array<int16_t, 6> got = {force.fx, force.fy, force.fz, torque.mx, torque.my, torque.mz};
+    s.wrong += got != want;
+  }
+  return s;
+}
+
+// The stream started by the bridge: 100 frames a second on CAN (the sensor's clock, not the
+// bridge's timer), each a force and a torque frame with one counter, the counters in step,
+// the values and their signs as the sensor holds them (-1 is sent FF FF, 20000 as 20 4E: a
+// false header inside every frame).
+TEST(BridgeStream, FramesFlowAt100HzWithTheirSigns) {
+  StreamRig s(/*streaming=*/false);
+  ASSERT_TRUE(s.ft300.ready());
+  ASSERT_GE(s.rig.collect(600ms), 10) << s.rig.logged();  // started (listen 80 ms, switch, start)
+  const uint64_t n0 = s.rig.app->stats().readings.load();
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<Frame> frames;
+  s.rig.collect(1500ms, nullptr, nullptr, &frames);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double hz = static_cast<double>(s.rig.app->stats().readings.load() - n0) / seconds;
+  EXPECT_NEAR(hz, 100.0, 12.0) << "readings per second";
+  const Samples got = samples_of(frames, {-420, 17, 20000, -1, 2, -3});
+  ASSERT_GE(got.counters.size(), 100u);
+  EXPECT_EQ(got.wrong, 0);
+  EXPECT_LE(got.unpaired, 1);  // the last force frame's torque may come after the window
+  for (size_t i = 1; i < got.counters.size(); ++i)
+    ASSERT_EQ(static_cast<uint8_t>(got.counters[i] - got.counters[i - 1]), 1) << "a sample lost or repeated at " << i;
+  EXPECT_EQ(s.stats().crc_failures.load(), 0u);
+  EXPECT_EQ(s.stats().streams_found.load(), 0u) << "it was not streaming";
+  EXPECT_EQ(s.stats().starts.load(), 1u);
+  EXPECT_EQ(s.rig.app->stats().sensor_errors.load(), 0u) << s.rig.logged();
+}
+
+// Each frame is published when its bytes come (epoll on the line), not on the bridge's next
+// tick: with a 100 ms period, the frames still come every 10 ms, one at a time. (Read only on
+// the timer they came ten at once; and the loop never waits on the line, so a stop frame does
+// not wait either.)
+TEST(BridgeStream, FramesArePublishedAsTheyComeNotOnTheTimer) {
+  StreamRig s(/*streaming=*/false, /*period_ms=*/100);
+  ASSERT_TRUE(s.ft300.ready());
+  ASSERT_GE(s.rig.collect(800ms), 10) << s.rig.logged();
+  std::vector<double> gaps_ms;
+  auto last = std::chrono::steady_clock::now();
+  const auto end = last + 1000ms;
+  Frame f;
+  can::RxInfo info;
+  while (std::chrono::steady_clock::now() < end) {
+    protocol::FtForce m;
+    while (s.rig.listener->receive(f, info) == 1) {
+      if (!protocol::decode(f, m)) continue;
+      const auto now = std::chrono::steady_clock::now();
+      gaps_ms.push_back(std::chrono::duration<double, std::milli>(now - last).count());
+      last = now;
+    }
+    std::this_thread::sleep_for(1ms);
+  }
+  ASSERT_GE(gaps_ms.size(), 80u);
+  std::sort(gaps_ms.begin(), gaps_ms.end());
+  EXPECT_GT(gaps_ms[gaps_ms.size() / 2], 5.0) << "frames came in bursts (the median gap)";
+  EXPECT_LT(gaps_ms[gaps_ms.size() * 9 / 10], 30.0) << "frames waited for the timer (the 90th percentile gap)";
+}
+
+// A frame with one flipped bit (its CRC as sent) and a false header before a frame: neither is
+// published, the reader finds the next frame, and the bridge says so (a sensor error, the line
+// kept: no restart).
+TEST(BridgeStream, ACorruptedByteIsNeverPublished) {
+  StreamRig s(/*streaming=*/false);
+  ASSERT_TRUE(s.ft300.ready());
+  ASSERT_GE(s.rig.collect(600ms), 10) << s.rig.logged();
+  std::vector<Frame> frames;
+  for (const char* fault : {"corrupt", "junk", "corrupt"}) {
+    s.ft300.command(fault);
+    s.rig.collect(150ms, nullptr, nullptr, &frames);
+  }
+  s.rig.collect(200ms, nullptr, nullptr, &frames);
+  const Samples got = samples_of(frames, {-420, 17, 20000, -1, 2, -3});
+  EXPECT_EQ(got.wrong, 0) << "a damaged frame was published (fx -420 flipped is -419)";
+  EXPECT_GE(got.counters.size(), 45u) << "frames stopped after the faults";
+  EXPECT_GE(s.stats().crc_failures.load(), 3u);
+  EXPECT_EQ(s.stats().resyncs.load(), 3u);
+  EXPECT_EQ(s.stats().starts.load(), 1u) << "the line was restarted for a bad frame";
+  EXPECT_EQ(s.rig.app->stats().sensor_errors.load(), 3u) << "one sensor error per lost frame";
+  EXPECT_NE(s.rig.logged().find("a stream frame failed its CRC: not published"), std::string::npos) << s.rig.logged();
+  EXPECT_NE(s.rig.logged().find("sensor answers again"), std::string::npos) << s.rig.logged();
+}
+
+// A sensor left streaming (by Robotiq's software, or just booted): the bridge hears it, jams it
+// until the line is quiet, starts it again and reads it. At the end the stream is stopped, and
+// the sensor answers Modbus on the line: it counted the jam and the start.
+TEST(BridgeStream, AStreamLeftRunningIsJammedAndRestarted) {
+  StreamRig s(/*streaming=*/true);
+  ASSERT_TRUE(s.ft300.ready());
+  protocol::FtForce last{};
+  ASSERT_GE(s.rig.collect(800ms), 10) << s.rig.logged();
+  EXPECT_GE(s.rig.collect(300ms, &last), 20);
+  EXPECT_EQ(last.fx, -420);
+  EXPECT_EQ(s.stats().streams_found.load(), 1u);
+  EXPECT_EQ(s.stats().starts.load(), 1u);
+  EXPECT_EQ(s.rig.shut_down(), 0);
+  EXPECT_TRUE(s.stream.stop_stream(1000)) << s.stream.last_error();
+  EXPECT_EQ(s.ft300.read_register(911), 2) << "streams stopped: the one found, the one at the end";
+  EXPECT_EQ(s.ft300.read_register(912), 1) << "streams started";
+}
+
+// A sensor that goes dark for 300 ms (a power cut; it boots streaming): the silence is a sensor
+// error within the stream's 100 ms, the heartbeat says so, no frame is sent meanwhile; the
+// bridge restarts the stream once the sensor is back (jamming the one it booted into, or taking
+// it for its start's when it comes while a start waits for its first frame, as [R] does).
+TEST(BridgeStream, ASilentStreamIsASensorErrorAndRecovers) {
+  StreamRig s(/*streaming=*/false);
+  ASSERT_TRUE(s.ft300.ready());
+  ASSERT_GE(s.rig.collect(600ms), 10) << s.rig.logged();
+  s.ft300.command("dark 300");
+  s.rig.collect(30ms);
+  protocol::HeartbeatBridge hb{};
+  EXPECT_EQ(s.rig.collect(250ms, nullptr, &hb), 0) << "frames while the sensor was dark";
+  EXPECT_EQ(hb.state, protocol::BridgeState::SensorLost);
+  EXPECT_GE(s.rig.app->stats().sensor_errors.load(), 1u);
+  EXPECT_NE(s.rig.logged().find("sensor: timeout: " + s.ft300.device() + ": no good stream frame for "),
+            std::string::npos) << s.rig.logged();
+  protocol::FtForce last{};
+  EXPECT_GE(s.rig.collect(1500ms, &last, &hb), 50) << "the stream did not come back: " << s.rig.logged();
+  EXPECT_EQ(last.fx, -420);
+  EXPECT_EQ(hb.state, protocol::BridgeState::Ok);
+  EXPECT_GE(s.stats().starts.load(), 2u);
+  EXPECT_NE(s.rig.logged().find("sensor answers again"), std::string::npos) << s.rig.logged();
 }
 
 }  // namespace
