@@ -106,15 +106,25 @@ bool ModbusLink::connect() {
   return true;
 }
 
+namespace {
+
+// The device answered with one of the exception codes Modbus defines (libmodbus: EMBXILFUN to
+// EMBXGTAR). An exception reply whose code is none of them is EMBBADEXC: garbled, not answered.
+bool modbus_exception(int e) { return e >= EMBXILFUN && e <= EMBXGTAR; }
+
+// libmodbus's own codes past the exceptions: a bad CRC, unit id, length or exception code.
+bool garbled_answer(int e) { return e > EMBXGTAR && e < MODBUS_ENOBASE + 20; }
+
+}  // namespace
+
 ReadResult ModbusLink::classify_failure() {
   const int e = errno;
   error_ = ep_.spec + ": " + modbus_strerror(e);
   // Modbus exceptions keep the link (the device answered); anything else may have lost it.
-  if (e > MODBUS_ENOBASE && e < MODBUS_ENOBASE + 20 && e != EMBBADDATA && e != EMBBADCRC && e != EMBBADSLAVE)
-    return ReadResult::Exception;
+  if (modbus_exception(e)) return ReadResult::Exception;
   close();  // see the header: a late or garbled answer must not be read as the next one's
   if (e == ETIMEDOUT) return ReadResult::Timeout;
-  if (e == EMBBADDATA || e == EMBBADCRC || e == EMBBADSLAVE || e == EMBBADEXC || e == EMBUNKEXC) return ReadResult::BadData;
+  if (garbled_answer(e)) return ReadResult::BadData;
   return ReadResult::Disconnected;
 }
 

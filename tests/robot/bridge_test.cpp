@@ -22,9 +22,12 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <thread>
+#include <utility>
+#include <vector>
 #include <time.h>
 #include <vector>
 
@@ -1070,6 +1073,85 @@ TEST(BridgeStream, ASilentStreamIsASensorErrorAndRecovers) {
   EXPECT_EQ(hb.state, protocol::BridgeState::Ok);
   EXPECT_GE(s.stats().starts.load(), 2u);
   EXPECT_NE(s.rig.logged().find("sensor answers again"), std::string::npos) << s.rig.logged();
+// The Modbus RTU CRC-16 (reflected polynomial 0xA001, initial 0xFFFF) appended to `frame`, low
+// byte first, as on the line.
+std::vector<uint8_t> with_crc(std::vector<uint8_t> frame) {
+  const uint16_t crc = crc16_modbus(frame.data(), frame.size());
+  frame.push_back(static_cast<uint8_t>(crc & 0xFF));
+  frame.push_back(static_cast<uint8_t>(crc >> 8));
+  return frame;
+}
+
+// A Modbus RTU device on a pseudo-terminal whose answers the test writes byte by byte:
+// `answer(k)` returns what goes back to the k-th request (0-based; nothing: no answer). It may
+// wait or act first (an answer that comes late or stops part-way, a frame sent meanwhile).
+class PtyDevice {
+ public:
+  using Answer = std::function<std::vector<uint8_t>(int request)>;
+  explicit PtyDevice(Answer answer) : answer_(std::move(answer)) {
+    master_ = posix_openpt(O_RDWR | O_NOCTTY);
+    grantpt(master_);
+    unlockpt(master_);
+    path_ = ptsname(master_);
+    // Keep the slave open so that the master never sees a hang-up between the link's opens.
+    hold_ = ::open(path_.c_str(), O_RDWR | O_NOCTTY);
+    termios t;
+    tcgetattr(hold_, &t);
+    cfmakeraw(&t);
+    tcsetattr(hold_, TCSANOW, &t);
+    serving_ = std::thread([this] { serve(); });
+  }
+  ~PtyDevice() {
+    stop_.store(true);
+    serving_.join();
+    ::close(hold_);
+    ::close(master_);
+  }
+  std::string spec() const { return "rtu:" + path_ + ":115200:N"; }
+  int requests() const { return requests_.load(); }
+
+ private:
+  void serve() {
+    uint8_t request[256];
+    while (!stop_.load()) {
+      pollfd p{master_, POLLIN, 0};
+      if (poll(&p, 1, 20) <= 0 || ::read(master_, request, sizeof request) <= 0) continue;
+      const std::vector<uint8_t> bytes = answer_(requests_.load());
+      ++requests_;
+      if (!bytes.empty()) [[maybe_unused]] ssize_t w = ::write(master_, bytes.data(), bytes.size());
+    }
+  }
+  Answer answer_;
+  int master_ = -1, hold_ = -1;
+  std::string path_;
+  std::atomic<int> requests_{0};
+  std::atomic<bool> stop_{false};
+  std::thread serving_;
+};
+
+// A garbled exception reply (function 0x83 with code 0x20, which Modbus does not define; its CRC
+// right) is a line fault like any garbled answer: the link is closed, so that what is left of it
+// on the line is never read as the next answer. It was classed as a Modbus exception and the
+// link kept. Every libmodbus code past the standard's exceptions (EMBXILFUN..EMBXGTAR) is one.
+TEST(BridgeModbus, AGarbledExceptionClosesTheLink) {
+  PtyDevice device([](int) { return with_crc({0x09, 0x83, 0x20}); });
+  ModbusSensor sensor(ModbusEndpoint{device.spec(), 9, 200}, SensorMap{});
+  ASSERT_TRUE(sensor.link().connect()) << sensor.link().last_error();
+  FtReading r{};
+  EXPECT_STREQ(read_result_name(sensor.read(r)), "bad data") << sensor.link().last_error();
+  EXPECT_FALSE(sensor.link().connected()) << "the link was kept after a garbled answer";
+  using Outcome = std::pair<std::string, bool>;  // what it was classed as, the link kept
+  const auto classified = [&sensor](int e) {
+    EXPECT_TRUE(sensor.link().connect()) << sensor.link().last_error();
+    errno = e;
+    const ReadResult rr = sensor.link().classify_failure();
+    return Outcome{read_result_name(rr), sensor.link().connected()};
+  };
+  for (int e : {EMBBADCRC, EMBBADDATA, EMBBADEXC, EMBUNKEXC, EMBMDATA, EMBBADSLAVE})
+    EXPECT_EQ(classified(e), (Outcome{"bad data", false})) << modbus_strerror(e);
+  for (int e = EMBXILFUN; e <= EMBXGTAR; ++e)
+    EXPECT_EQ(classified(e), (Outcome{"modbus exception", true})) << modbus_strerror(e);
+  sensor.link().close();
 }
 
 }  // namespace
