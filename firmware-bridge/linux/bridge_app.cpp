@@ -22,7 +22,7 @@ uint32_t now_ms() {
   return static_cast<uint32_t>(static_cast<uint64_t>(ts.tv_sec) * 1000 + ts.tv_nsec / 1000000);
 }
 
-constexpr uint64_t kTimer = 1, kCan = 2, kShutdown = 3, kSensor = 4;
+constexpr uint64_t kTimer = 1, kCan = 2, kShutdown = 3, kSensor = 4, kTags = 5;
 
 bool due(uint32_t now, uint32_t t) { return static_cast<int32_t>(now - t) >= 0; }
 bool power_of_two(uint64_t n) { return n != 0 && (n & (n - 1)) == 0; }
@@ -239,28 +239,30 @@ int BridgeApp::run() {
       return 1;
     }
     const uint32_t t = now_ms();
-    for (int i = 0; i < n; ++i) {
-      if (evs[i].data.u64 == kShutdown) {
-        uint64_t v;
-        [[maybe_unused]] ssize_t r = ::read(shutdown_fd_, &v, sizeof v);
-        if (!shutting_down) {
-          shutting_down = true;
-          give_up_ms = t + static_cast<uint32_t>(cfg_.shutdown_grace_ms);
-          begin_shutdown(t);
-        }
+    bool woke[kTags] = {};
+    for (int i = 0; i < n; ++i) woke[evs[i].data.u64] = true;
+    if (woke[kShutdown]) {
+      uint64_t v;
+      [[maybe_unused]] ssize_t r = ::read(shutdown_fd_, &v, sizeof v);
+      if (!shutting_down) {
+        shutting_down = true;
+        give_up_ms = t + static_cast<uint32_t>(cfg_.shutdown_grace_ms);
+        begin_shutdown(t);
       }
-      if (evs[i].data.u64 == kCan) drain_can(t);
-      if (evs[i].data.u64 == kSensor) {
-        // No more readings once shutting down (as on the timer): the line is no longer watched.
-        if (shutting_down) epoll_ctl(epoll_fd_, EPOLL_CTL_DEL, sensor_.events_fd(), nullptr);
-        else drain_sensor(t);
-      }
-      if (evs[i].data.u64 == kTimer) {
-        uint64_t exp;
-        [[maybe_unused]] ssize_t r = ::read(timer_fd_, &exp, sizeof exp);
-        if (shutting_down) try_stop(t);  // no more readings: only the stop's retries
-        else on_timer(t);
-      }
+    }
+    // The bus before the sensor: a stop waiting there is written before a read that may take a
+    // whole response timeout (epoll lists the timer first when it expired first).
+    if (woke[kCan]) drain_can(t);
+    if (woke[kSensor]) {
+      // No more readings once shutting down (as on the timer): the line is no longer watched.
+      if (shutting_down) epoll_ctl(epoll_fd_, EPOLL_CTL_DEL, sensor_.events_fd(), nullptr);
+      else drain_sensor(t);
+    }
+    if (woke[kTimer]) {
+      uint64_t exp;
+      [[maybe_unused]] ssize_t r = ::read(timer_fd_, &exp, sizeof exp);
+      if (shutting_down) try_stop(t);  // no more readings: only the stop's retries
+      else on_timer(t);
     }
     if (shutting_down) {
       if (!stop_pending_) return 0;

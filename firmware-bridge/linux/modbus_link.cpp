@@ -100,6 +100,10 @@ bool ModbusLink::connect() {
   if (modbus_set_response_timeout(ctx_, static_cast<uint32_t>(ep_.response_timeout_ms / 1000),
                                   static_cast<uint32_t>((ep_.response_timeout_ms % 1000) * 1000)) != 0)
     return fail("response timeout");
+  // No time between the bytes of an answer: the response timeout then bounds the whole answer.
+  // (libmodbus's default, 500 ms after each chunk, held a read whose answer stopped part-way for
+  // half a second, and every stop frame with it.)
+  if (modbus_set_byte_timeout(ctx_, 0, 0) != 0) return fail("byte timeout");
   if (modbus_connect(ctx_) != 0) return fail("connect");
   modbus_flush(ctx_);  // whatever a device sent before this connection is not an answer to it
   error_.clear();

@@ -17,7 +17,7 @@ namespace dressguard::bridge {
 struct ModbusEndpoint {
   std::string spec = "rtu:/dev/ttyUSB0:19200:N";
   int slave = 9;
-  int response_timeout_ms = 20;
+  int response_timeout_ms = 20;  // bounds the whole answer (libmodbus's byte timeout is off)
 };
 
 // A spec taken apart: "tcp:HOST:PORT" (HOST a numeric IPv4 address: libmodbus 3.1 resolves no

@@ -394,6 +394,17 @@ std::string mbpoll(const std::string& args) {
   return out;
 }
 
+// What a test changes of the rig: the sensor (the emulator over TCP unless a spec is given, e.g.
+// a PtyDevice's) and its response timeout, the shutdown grace.
+struct RigOptions {
+  int shutdown_grace_ms = 1000;
+  std::string sensor_spec;  // empty: the sensor emulator
+  int sensor_timeout_ms = 20;
+  Sensor* own_sensor = nullptr;  // when given, read instead of a ModbusSensor
+  int period_ms = 10;
+  uint32_t predictor_timeout_ms = 0;
+};
+
 struct BridgeRig {
   Emulator sensor_emu, robot_emu;
   can::InProcBus bus;
@@ -404,24 +415,23 @@ struct BridgeRig {
   std::thread loop;
   std::atomic<int> rc{-1};          // what run() returned
   std::FILE* log = std::tmpfile();  // what the bridge says
-  // `own_sensor`, when given, is read instead of a ModbusSensor on sensor_emu.
-  explicit BridgeRig(int shutdown_grace_ms = 1000, Sensor* own_sensor = nullptr, int period_ms = 10,
-                     uint32_t predictor_timeout_ms = 0) {
+  explicit BridgeRig(const RigOptions& o = {}) {
     // The identifiers dressguard-bridge's main subscribes to.
     bridge_port = bus.open({{std::begin(kBridgeReceives), std::end(kBridgeReceives)}, false, true});
     listener = bus.open({{protocol::id_of(protocol::MsgId::FtForce), protocol::id_of(protocol::MsgId::FtTorque),
                           protocol::id_of(protocol::MsgId::HeartbeatBridge)}, false, true});
     predictor = bus.open({{}, false, true});
-    sensor = std::make_unique<ModbusSensor>(ModbusEndpoint{sensor_emu.spec(), 9, 20}, SensorMap{});
+    const std::string sensor_spec = o.sensor_spec.empty() ? sensor_emu.spec() : o.sensor_spec;
+    sensor = std::make_unique<ModbusSensor>(ModbusEndpoint{sensor_spec, 9, o.sensor_timeout_ms}, SensorMap{});
     robot = std::make_unique<RobotStopWriter>(ModbusEndpoint{robot_emu.spec(), 1, 200}, StopTarget{true, 7, 1});
     BridgeAppConfig cfg;
     cfg.backoff_min_ms = 20;
     cfg.backoff_max_ms = 160;
     cfg.log = log;
-    cfg.shutdown_grace_ms = shutdown_grace_ms;
-    cfg.sample_period_ms = period_ms;
-    cfg.core.predictor_timeout_ms = predictor_timeout_ms;
-    app = std::make_unique<BridgeApp>(cfg, own_sensor ? *own_sensor : *sensor, robot.get(), *bridge_port);
+    cfg.shutdown_grace_ms = o.shutdown_grace_ms;
+    cfg.sample_period_ms = o.period_ms;
+    cfg.core.predictor_timeout_ms = o.predictor_timeout_ms;
+    app = std::make_unique<BridgeApp>(cfg, o.own_sensor ? *o.own_sensor : *sensor, robot.get(), *bridge_port);
     loop = std::thread([this] { rc = app->run(); });
   }
   ~BridgeRig() {
@@ -617,7 +627,9 @@ TEST(BridgeModbus, ShutdownWritesAStopTheRobotHasNotReceived) {
 // A stop that cannot be written within the grace: the bridge exits 1 and says the robot may not
 // be stopped (a clean 0 would hide it from the service manager).
 TEST(BridgeModbus, ShutdownSaysWhenAStopStaysUnwritten) {
-  BridgeRig rig(/*shutdown_grace_ms=*/150);
+  RigOptions short_grace;
+  short_grace.shutdown_grace_ms = 150;
+  BridgeRig rig(short_grace);
   ASSERT_GT(rig.robot_emu.port(), 0);
   ASSERT_TRUE(rig.robot_emu.write(901, {3000}));
   ASSERT_TRUE(rig.robot_emu.write(900, {3}));
@@ -657,7 +669,7 @@ TEST(BridgeModbus, ShutdownDuringATrialStopsTheRobot) {
 TEST(BridgeModbus, TrialThePredictorDoesNotGuardStopsTheRobot) {
   for (const auto state : {protocol::PredictorState::Idle, protocol::PredictorState::InTrial}) {
     const bool guarded = state == protocol::PredictorState::InTrial;
-    BridgeRig rig(1000, nullptr, 10, 300);
+    BridgeRig rig(RigOptions{.predictor_timeout_ms = 300});
     ASSERT_GT(rig.robot_emu.port(), 0);
     uint8_t counter = 0;
     const auto beat_for = [&](std::chrono::milliseconds d) {
@@ -926,7 +938,7 @@ struct StreamRig {
   BridgeRig rig;
   explicit StreamRig(bool streaming, int period_ms = 10)
       : ft300(streaming, {"set 180 -420 17 20000 -1 2 -3"}), stream(Ft300StreamConfig{ft300.device()}),
-        rig(1000, &stream, period_ms) {}
+        rig(RigOptions{.own_sensor = &stream, .period_ms = period_ms}) {}
   const Ft300StreamStats& stats() const { return stream.stats(); }
 };
 
@@ -1102,10 +1114,14 @@ class PtyDevice {
     serving_ = std::thread([this] { serve(); });
   }
   ~PtyDevice() {
-    stop_.store(true);
-    serving_.join();
+    stop();
     ::close(hold_);
     ::close(master_);
+  }
+  // No more answers (before what `answer` uses goes away).
+  void stop() {
+    stop_.store(true);
+    if (serving_.joinable()) serving_.join();
   }
   std::string spec() const { return "rtu:" + path_ + ":115200:N"; }
   int requests() const { return requests_.load(); }
@@ -1152,6 +1168,75 @@ TEST(BridgeModbus, AGarbledExceptionClosesTheLink) {
   for (int e = EMBXILFUN; e <= EMBXGTAR; ++e)
     EXPECT_EQ(classified(e), (Outcome{"modbus exception", true})) << modbus_strerror(e);
   sensor.link().close();
+}
+
+// The answer of a sensor (FC03, six registers) whose registers all read `value`.
+std::vector<uint8_t> ft_answer(uint8_t value = 0) {
+  std::vector<uint8_t> a = {0x09, 0x03, 0x0C};
+  for (int k = 0; k < 6; ++k) a.insert(a.end(), {0, value});
+  return with_crc(a);
+}
+
+// An answer that stops part-way (RS-485 noise, a device reset mid-frame) ends at the response
+// timeout, on the sensor's link and on the robot's. libmodbus's default byte timeout (500 ms
+// after each chunk) held such a read for 0.5 s, and every stop frame behind it. The bound is the
+// timeout plus 100 ms: a busy 2-core machine's scheduling delay (the device thread, the reader),
+// and still a fifth of the half second the byte timeout added.
+TEST(BridgeModbus, ACutShortAnswerEndsAtTheResponseTimeout) {
+  constexpr int kTimeoutMs = 20;
+  constexpr auto kMargin = 100ms;
+  const auto elapsed_since = [](std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - t0);
+  };
+  PtyDevice sensor_device([](int) { return std::vector<uint8_t>{0x09, 0x03, 0x0C}; });
+  ModbusSensor sensor(ModbusEndpoint{sensor_device.spec(), 9, kTimeoutMs}, SensorMap{});
+  for (int k = 0; k < 3; ++k) {
+    ASSERT_TRUE(sensor.link().connect()) << sensor.link().last_error();
+    FtReading r{};
+    const auto t0 = std::chrono::steady_clock::now();
+    EXPECT_STREQ(read_result_name(sensor.read(r)), "timeout") << sensor.link().last_error();
+    EXPECT_LE(elapsed_since(t0), std::chrono::milliseconds(kTimeoutMs) + kMargin) << "read " << k;
+  }
+  // The robot's link: write_stop tries twice (a reconnect between), each bounded the same way.
+  PtyDevice robot_device([](int) { return std::vector<uint8_t>{0x01, 0x05, 0x00}; });
+  RobotStopWriter robot(ModbusEndpoint{robot_device.spec(), 1, kTimeoutMs}, StopTarget{true, 7, 1});
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_FALSE(robot.write_stop());
+  EXPECT_EQ(robot_device.requests(), 2);
+  EXPECT_LE(elapsed_since(t0), std::chrono::milliseconds(2 * kTimeoutMs) + kMargin) << robot.link().last_error();
+}
+
+// A wakeup that finds both the timer and a stop frame ready takes the stop first: the stop is
+// written before the next sensor read, which may take a whole response timeout. Here one answer
+// comes 35 ms late (timeout 100 ms) with a stop sent 25 ms into it: the timer expired first, and
+// epoll listed it first, so the next read went out with the stop still unwritten.
+TEST(BridgeModbus, AStopOnTheBusGoesBeforeTheNextSensorRead) {
+  std::atomic<BridgeRig*> rig_seen{nullptr};
+  std::atomic<int> slow_read{-1}, written_at_next_read{-1};
+  PtyDevice device([&](int k) {
+    BridgeRig* rig = rig_seen.load();
+    if (rig && slow_read.load() < 0) {
+      slow_read = k;
+      std::this_thread::sleep_for(25ms);
+      rig->predictor->send(protocol::encode(protocol::Stop{0, protocol::StopReason::Caught, 240, 3, 250}));
+      std::this_thread::sleep_for(10ms);
+    } else if (rig && k == slow_read.load() + 1) {
+      written_at_next_read = static_cast<int>(rig->app->stats().stops_written.load());
+    }
+    return ft_answer();
+  });
+  RigOptions pty_sensor;
+  pty_sensor.sensor_spec = device.spec();
+  pty_sensor.sensor_timeout_ms = 100;
+  BridgeRig rig(pty_sensor);
+  struct DeviceFirst {  // the device stops answering before the rig it sends on goes away
+    PtyDevice& d;
+    ~DeviceFirst() { d.stop(); }
+  } device_first{device};
+  ASSERT_GT(rig.robot_emu.port(), 0);
+  rig_seen = &rig;
+  for (int i = 0; i < 2000 && written_at_next_read.load() < 0; ++i) std::this_thread::sleep_for(1ms);
+  EXPECT_EQ(written_at_next_read.load(), 1) << "the sensor was read again before the stop was written\n" << rig.logged();
 }
 
 }  // namespace
