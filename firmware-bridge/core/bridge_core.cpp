@@ -66,7 +66,15 @@ void note_guard(BridgeCore& c, const protocol::HeartbeatPredictor& hb, uint32_t 
 
 }  // namespace
 
+void bridge_on_periods_missed(BridgeCore& c, uint32_t periods) {
+  const uint32_t room = kMaxPeriodsMissed - c.periods_missed;
+  c.periods_missed += periods < room ? periods : room;
+}
+
 int bridge_on_reading(BridgeCore& c, const FtReading& r, uint32_t, Frame out[2]) {
+  // The periods since the last reading that had none are lost samples to the receiver.
+  c.sample_counter.value = static_cast<uint8_t>(c.sample_counter.value + c.periods_missed);
+  c.periods_missed = 0;
   const uint8_t n = c.sample_counter.next();
   out[0] = protocol::encode(protocol::FtForce{n, r.force[0], r.force[1], r.force[2]});
   out[1] = protocol::encode(protocol::FtTorque{n, r.torque[0], r.torque[1], r.torque[2]});
@@ -78,6 +86,7 @@ int bridge_on_reading(BridgeCore& c, const FtReading& r, uint32_t, Frame out[2])
 void bridge_on_sensor_error(BridgeCore& c, uint32_t) {
   if (c.sensor_errors < 255) ++c.sensor_errors;
   c.sensor_ok = false;
+  bridge_on_periods_missed(c, 1);
 }
 
 void bridge_on_reconnect(BridgeCore& c) {

@@ -8,6 +8,10 @@
 //   - a reading becomes exactly one FtForce and one FtTorque frame with the same alive counter;
 //     a failed read produces no frame at all (never stale data: the predictor's deadline then
 //     stops the robot), and the heartbeat says "sensor lost";
+//   - the sample counter counts sample periods, not readings: a failed read and each period the
+//     port's timer overran (bridge_on_periods_missed) advance it, so that the receiver's E2E
+//     check counts the missing samples as lost and its logical time (the counter) keeps pace
+//     with the robot's; one gap advances it by at most kMaxPeriodsMissed + 1;
 //   - a valid Stop frame (E2E-checked) latches a stop: the port must stop the robot and keeps
 //     the latch until the next TrialStart frame on the bus, once the port has written the stop
 //     (bridge_on_stop_written); a stop the robot never received is not released by a trial
@@ -45,6 +49,11 @@ struct FtReading {
   int16_t torque[3];  // 0.001 Nm
 };
 
+// The most missing samples one gap in the readings puts on the sample counter: a step of 128 or
+// more reads as a late frame (protocol::E2EChecker discards it), so a longer gap is sent as 126
+// lost samples (the predictor's sensor deadline, 5 periods, has stopped any trial long before).
+inline constexpr uint32_t kMaxPeriodsMissed = 126;
+
 struct BridgeConfig {
   uint32_t heartbeat_period_ms = 100;
   uint32_t predictor_timeout_ms = 0;  // 0: a silent predictor is not a stop reason
@@ -65,7 +74,8 @@ inline constexpr uint32_t kBridgeReceives[] = {
 
 struct BridgeCore {
   BridgeConfig cfg;
-  protocol::AliveCounter sample_counter;
+  protocol::AliveCounter sample_counter;  // counts sample periods (the rules above)
+  uint32_t periods_missed = 0;           // since the last reading, at most kMaxPeriodsMissed
   protocol::AliveCounter heartbeat_counter;
   protocol::E2EChecker stop_checker{protocol::MsgId::Stop, 255};
   protocol::E2EChecker trial_checker{protocol::MsgId::TrialStart, 255};
@@ -100,8 +110,12 @@ void bridge_init(BridgeCore& c, const BridgeConfig& cfg, uint32_t now_ms);
 // A reading arrived: writes the two sample frames to out[0..1] and returns 2.
 int bridge_on_reading(BridgeCore& c, const FtReading& r, uint32_t now_ms, Frame out[2]);
 
-// The sensor could not be read (timeout, exception, connection lost): no frames.
+// The sensor could not be read (timeout, exception, connection lost): no frames; the period's
+// sample is missing.
 void bridge_on_sensor_error(BridgeCore& c, uint32_t now_ms);
+// `periods` sample periods passed with no read at all (the port's timer overran: its expiration
+// count less the one it handles): their samples are missing.
+void bridge_on_periods_missed(BridgeCore& c, uint32_t periods);
 // The port reconnected to the sensor.
 void bridge_on_reconnect(BridgeCore& c);
 

@@ -205,6 +205,21 @@ void BridgeApp::on_timer(uint32_t t) {
   try_stop(t);
 }
 
+// The loop came back to the timer more than a period late (a read longer than a period, a busy
+// machine): the periods it slept through have no sample, and the sample counter says so.
+void BridgeApp::timer_overran(uint64_t periods) {
+  // A polled sensor is read once per period: the periods the loop missed carry no sample. A
+  // streaming one sends on its own clock, and its frames wait in the line for the late loop.
+  const bool polled = sensor_.events_fd() < 0;
+  if (polled) bridge_on_periods_missed(core_, static_cast<uint32_t>(std::min<uint64_t>(periods, kMaxPeriodsMissed)));
+  stats_.periods_overrun += periods;
+  const uint64_t overruns = ++stats_.overruns;
+  if (power_of_two(overruns))
+    say("timer overran: %llu period(s) of %d ms late (overrun %llu; %s)", static_cast<unsigned long long>(periods),
+        cfg_.sample_period_ms, static_cast<unsigned long long>(overruns),
+        polled ? "no reading in them: the sample counter skips them" : "the stream's frames wait in the line");
+}
+
 void BridgeApp::drain_can(uint32_t t) {
   Frame f;
   can::RxInfo info;
@@ -259,10 +274,14 @@ int BridgeApp::run() {
       else drain_sensor(t);
     }
     if (woke[kTimer]) {
-      uint64_t exp;
-      [[maybe_unused]] ssize_t r = ::read(timer_fd_, &exp, sizeof exp);
-      if (shutting_down) try_stop(t);  // no more readings: only the stop's retries
-      else on_timer(t);
+      uint64_t expirations = 0;
+      [[maybe_unused]] ssize_t r = ::read(timer_fd_, &expirations, sizeof expirations);
+      if (shutting_down) {
+        try_stop(t);  // no more readings: only the stop's retries
+      } else {
+        if (expirations > 1) timer_overran(expirations - 1);
+        on_timer(t);
+      }
     }
     if (shutting_down) {
       if (!stop_pending_) return 0;

@@ -29,13 +29,15 @@ struct BridgeAppConfig {
   int shutdown_grace_ms = 1000;
   // Where the bridge says what went wrong (null: nowhere). A failing sensor or stop write is
   // reported at its 1st, 2nd, 4th, 8th, ... consecutive failure with libmodbus's reason, and
-  // once when it recovers; every stop is reported.
+  // once when it recovers; every stop is reported; a timer overrun at the 1st, 2nd, 4th, ...
   std::FILE* log = stderr;
 };
 
 struct BridgeStats {
   std::atomic<uint64_t> readings{0}, frames_sent{0}, send_failures{0}, sensor_errors{0}, reconnects{0},
       connect_failures{0}, stops_written{0}, stop_write_failures{0};
+  // Wakeups that found the timer expired more than once, and the periods they skipped.
+  std::atomic<uint64_t> overruns{0}, periods_overrun{0};
 };
 
 class BridgeApp {
@@ -56,6 +58,7 @@ class BridgeApp {
   bool take_reading(uint32_t now_ms);
   void drain_sensor(uint32_t now_ms);
   void back_off(uint32_t now_ms);
+  void timer_overran(uint64_t periods);
   void drain_can(uint32_t now_ms);
   void send(const Frame& f);
   void try_stop(uint32_t now_ms);

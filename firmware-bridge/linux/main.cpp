@@ -169,13 +169,14 @@ int main(int argc, char** argv) {
                                      : parse_endpoint(sensor_ep.spec, &sensor_parts);
       !why.empty())
     return bad("--sensor: " + why);
-  // A serial line too slow for the period: readings come late, and the sample counter (the
-  // predictor's logical time, one count per reading) runs slower than the model's 100 Hz.
+  // A serial line too slow for the period: every reading overruns the timer, and the sample
+  // counter (it counts periods) tells the predictor of a lost sample after each.
   if (const double line_ms = rtu_reading_ms(sensor_parts); line_ms > cfg.sample_period_ms)
     std::fprintf(stderr,
                  "dressguard-bridge: warning: at %d baud one reading takes at least %.1f ms on the line, more "
-                 "than --period-ms %d: readings will come late and the predictor's logical time will run slow "
-                 "(an FT 300's line is fixed at 19200 baud: --sensor rtu-stream:DEVICE reads its 100 Hz stream)\n",
+                 "than --period-ms %d: the periods between readings carry no sample, and the predictor counts "
+                 "them as lost (its bad-frame budget stops a trial; an FT 300's line is fixed at 19200 baud: "
+                 "--sensor rtu-stream:DEVICE reads its 100 Hz stream)\n",
                  sensor_parts.number, line_ms, cfg.sample_period_ms);
   if (!robot_spec.empty())
     if (const std::string why = parse_endpoint(robot_spec); !why.empty()) return bad("--robot: " + why);
@@ -228,11 +229,12 @@ int main(int argc, char** argv) {
     const auto& s = app.stats();
     std::fprintf(stderr,
                  "dressguard-bridge: readings=%llu frames=%llu send_failures=%llu sensor_errors=%llu reconnects=%llu "
-                 "stops_written=%llu stop_write_failures=%llu\n",
+                 "stops_written=%llu stop_write_failures=%llu overruns=%llu (%llu periods)\n",
                  (unsigned long long)s.readings.load(), (unsigned long long)s.frames_sent.load(),
                  (unsigned long long)s.send_failures.load(), (unsigned long long)s.sensor_errors.load(),
                  (unsigned long long)s.reconnects.load(), (unsigned long long)s.stops_written.load(),
-                 (unsigned long long)s.stop_write_failures.load());
+                 (unsigned long long)s.stop_write_failures.load(), (unsigned long long)s.overruns.load(),
+                 (unsigned long long)s.periods_overrun.load());
     if (ft300)
       std::fprintf(stderr, "dressguard-bridge: stream frames=%llu crc_failures=%llu resyncs=%llu skipped_bytes=%llu\n",
                    (unsigned long long)ft300->stats().frames.load(),

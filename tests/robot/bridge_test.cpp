@@ -23,6 +23,7 @@
 #include <cstring>
 #include <fstream>
 #include <functional>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -87,6 +88,38 @@ TEST(BridgeCore, ReadingBecomesTwoFramesWithOneCounter) {
     EXPECT_EQ(torque.my, -2);
   }
   EXPECT_EQ(bridge_state(c), protocol::BridgeState::Ok);
+}
+
+// The sample counter counts sample periods, not readings: a failed read and the periods the
+// port's timer overran advance it, so the receiver's E2E check counts their samples as lost (it
+// counted one sample for any gap: the predictor's logical time fell behind the robot's). A gap
+// of more than 127 periods advances it by 127, the most that does not read as a late frame.
+TEST(BridgeCore, FailedReadsAndOverrunsAdvanceTheSampleCounter) {
+  BridgeCore c;
+  bridge_init(c, {}, 0);
+  protocol::E2EChecker receiver(protocol::MsgId::FtForce);
+  uint32_t t = 0;
+  const auto lost_before_next_reading = [&] {
+    Frame f[2];
+    bridge_on_reading(c, FtReading{{1, 2, 3}, {4, 5, 6}}, t += 10, f);
+    uint32_t lost = 0;
+    EXPECT_TRUE(protocol::accepted(receiver.check(f[0], lost))) << "sample at " << t;
+    EXPECT_EQ(f[0].data[1], f[1].data[1]) << "force and torque counters";
+    return lost;
+  };
+  EXPECT_EQ(lost_before_next_reading(), 0u);
+  bridge_on_sensor_error(c, t += 10);
+  EXPECT_EQ(lost_before_next_reading(), 1u) << "a failed read";
+  bridge_on_periods_missed(c, 3);
+  bridge_on_sensor_error(c, t += 40);
+  EXPECT_EQ(lost_before_next_reading(), 4u) << "an overrun of 3 periods, then a failed read";
+  EXPECT_EQ(lost_before_next_reading(), 0u);
+  for (int k = 0; k < 300; ++k) bridge_on_sensor_error(c, t += 10);
+  EXPECT_EQ(lost_before_next_reading(), kMaxPeriodsMissed) << "300 failed reads: capped, not late";
+  bridge_on_periods_missed(c, 0xFFFFFFFFu);
+  bridge_on_periods_missed(c, 0xFFFFFFFFu);
+  EXPECT_EQ(lost_before_next_reading(), kMaxPeriodsMissed) << "overruns without end: capped";
+  EXPECT_EQ(lost_before_next_reading(), 0u);
 }
 
 TEST(BridgeCore, StopLatchesUntilTheNextTrialAndIgnoresCorruptStops) {
@@ -475,6 +508,36 @@ struct BridgeRig {
       std::this_thread::sleep_for(1ms);
     }
     return n;
+  }
+  // Over `d`, the time from the first force frame received to the last, and how far the
+  // counter advanced between them (each step mod 256, summed); `disturb` runs after the first.
+  struct Span {
+    double ms = 0;
+    int periods = 0;
+  };
+  Span counted_periods(std::chrono::milliseconds d, const std::function<void()>& disturb) {
+    const auto end = std::chrono::steady_clock::now() + d;
+    Span span;
+    std::optional<std::chrono::steady_clock::time_point> first;
+    std::optional<uint8_t> last_counter;
+    Frame f;
+    can::RxInfo info;
+    while (std::chrono::steady_clock::now() < end) {
+      protocol::FtForce m;
+      while (listener->receive(f, info) == 1) {
+        if (!protocol::decode(f, m)) continue;
+        const auto now = std::chrono::steady_clock::now();
+        if (!first) {
+          first = now;
+          disturb();
+        }
+        span.ms = std::chrono::duration<double, std::milli>(now - *first).count();
+        if (last_counter) span.periods += static_cast<uint8_t>(m.counter - *last_counter);
+        last_counter = m.counter;
+      }
+      std::this_thread::sleep_for(1ms);
+    }
+    return span;
   }
 };
 
@@ -1237,6 +1300,45 @@ TEST(BridgeModbus, AStopOnTheBusGoesBeforeTheNextSensorRead) {
   rig_seen = &rig;
   for (int i = 0; i < 2000 && written_at_next_read.load() < 0; ++i) std::this_thread::sleep_for(1ms);
   EXPECT_EQ(written_at_next_read.load(), 1) << "the sensor was read again before the stop was written\n" << rig.logged();
+}
+
+// A gap in the readings shows on the sample counter as that many periods: across a late
+// answer the counter advances by the time between the first and the last force frame in 10 ms
+// periods (+-1: the two frames' jitter). It advanced by one per reading, and the predictor's
+// logical time fell behind by the gap (4-5 periods here). First an answer 60 ms late against
+// the 20 ms timeout (failed reads, timer overruns, reconnects), then on a pty sensor one answer
+// 55 ms late within a 100 ms timeout (no failed read: only the overrun, counted and logged).
+TEST(BridgeModbus, ALateAnswerShowsAsLostSamples) {
+  const auto expect_periods_are_the_time = [](const BridgeRig::Span& span) {
+    EXPECT_GE(span.ms, 250.0) << "too few readings";
+    EXPECT_NEAR(span.periods, std::round(span.ms / 10.0), 1.0) << "over " << span.ms << " ms";
+  };
+  {
+    SCOPED_TRACE("an answer after the timeout");
+    BridgeRig rig;
+    ASSERT_GT(rig.sensor_emu.port(), 0);
+    EXPECT_GE(rig.collect(100ms), 3);
+    expect_periods_are_the_time(rig.counted_periods(400ms, [&rig] {
+      EXPECT_TRUE(rig.sensor_emu.write(902, {60}));
+      EXPECT_TRUE(rig.sensor_emu.write(900, {4}));
+    }));
+    EXPECT_GE(rig.app->stats().sensor_errors.load(), 1u);
+  }
+  SCOPED_TRACE("an answer before the timeout");
+  std::atomic<bool> slow_next{false};
+  PtyDevice device([&](int) {
+    if (slow_next.exchange(false)) std::this_thread::sleep_for(55ms);
+    return ft_answer();
+  });
+  RigOptions pty_sensor;
+  pty_sensor.sensor_spec = device.spec();
+  pty_sensor.sensor_timeout_ms = 100;
+  BridgeRig rig(pty_sensor);
+  EXPECT_GE(rig.collect(100ms), 3);
+  expect_periods_are_the_time(rig.counted_periods(400ms, [&slow_next] { slow_next = true; }));
+  EXPECT_EQ(rig.app->stats().sensor_errors.load(), 0u) << rig.logged();
+  EXPECT_GE(rig.app->stats().overruns.load(), 1u);
+  EXPECT_NE(rig.logged().find("timer overran: "), std::string::npos) << rig.logged();
 }
 
 }  // namespace

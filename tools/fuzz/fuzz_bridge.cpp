@@ -4,7 +4,9 @@
 // checks the rules of bridge_core.h against a shadow of them written from that header:
 //
 //   samples     a reading becomes one FtForce and one FtTorque frame, E2E-protected, with the
-//               reading's counts and one alive counter that advances by one per reading;
+//               reading's counts and one alive counter that counts sample periods: it advances
+//               by one per reading plus one per failed read and per period missed (the port's
+//               timer overran) since the last reading, those at most kMaxPeriodsMissed;
 //   stop        a Stop frame with a valid CRC latches the stop (a repeated one too: a stop is
 //               never dropped for its counter), and asks the robot to stop exactly when it
 //               was not latched; a corrupted or short one changes nothing;
@@ -57,8 +59,8 @@ struct Shadow {
   bool latched = false;
   bool written = false;     // the latched stop was written (StopWritten)
   bool sensor_lost = true;  // until the first reading
-  uint8_t sample_counter = 0;
-  bool sampled = false;
+  uint8_t next_sample = 0;      // the next reading's counter with no period missed before it
+  uint32_t periods_missed = 0;  // failed reads and missed periods since the last reading, unbounded
   uint32_t last_predictor = 0;
   protocol::PredictorState predictor_state = protocol::PredictorState::Idle;  // last accepted heartbeat's
   uint32_t last_trial = 0;  // the last TrialStart or TrialEnd frame, accepted or not
@@ -79,7 +81,8 @@ BridgeState expected_state(const Shadow& sh) {
   return sh.latched ? BridgeState::StopLatched : sh.sensor_lost ? BridgeState::SensorLost : BridgeState::Ok;
 }
 
-// A reading: two frames with the reading's counts and one counter, advancing by one.
+// A reading: two frames with the reading's counts and one counter, advanced by one and by the
+// periods missed since the last reading (at most kMaxPeriodsMissed).
 void reading(Reader& in, BridgeCore& c, Shadow& sh, long op) {
   bridge::FtReading r;
   for (auto& v : r.force) v = in.i16();
@@ -95,9 +98,11 @@ void reading(Reader& in, BridgeCore& c, Shadow& sh, long op) {
       t.mz != r.torque[2])
     broken("a sample frame does not carry the reading's counts", op);
   if (f.counter != t.counter) broken("the force and torque frames of one reading carry different counters", op);
-  if (sh.sampled && f.counter != static_cast<uint8_t>(sh.sample_counter + 1)) broken("the sample counter did not advance by one", op);
-  sh.sample_counter = f.counter;
-  sh.sampled = true;
+  const uint32_t skipped = std::min(sh.periods_missed, bridge::kMaxPeriodsMissed);
+  if (f.counter != static_cast<uint8_t>(sh.next_sample + skipped))
+    broken("the sample counter did not advance by one and the periods missed since the last reading", op);
+  sh.next_sample = static_cast<uint8_t>(f.counter + 1);
+  sh.periods_missed = 0;
   sh.sensor_lost = false;
 }
 
@@ -226,7 +231,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         bridge::bridge_on_sensor_error(c, sh.now);
         sh.sensor_lost = true;
         ++sh.sensor_errors;
+        ++sh.periods_missed;
         break;
+      case BridgeOp::PeriodsMissed: {
+        if (!in.take(1)) return 0;
+        const uint8_t periods = in.u8();
+        bridge::bridge_on_periods_missed(c, periods);
+        sh.periods_missed += periods;
+        if (bridge::bridge_state(c) != expected_state(sh)) broken("missed periods changed the bridge's state", op);
+        break;
+      }
       case BridgeOp::Reconnect:
         bridge::bridge_on_reconnect(c);
         ++sh.reconnects;

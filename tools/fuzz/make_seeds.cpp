@@ -7,7 +7,7 @@
 //              stop must be resent, a burst of corrupted frames, no model, SIGTERM in a trial;
 //   bridge     fuzz_bridge: readings and heartbeats across the millisecond clock's wrap, a stop
 //              latched and released by a trial start, a predictor that falls silent, failed
-//              reads around a stop;
+//              reads around a stop, timer overruns between readings (one past the counter's cap);
 //   candump    fuzz_candump: `candump -l` logs of each message of the protocol, with blank
 //              lines, CRLF endings and a short frame; one as candump -l -x -d writes it on two
 //              interfaces (padded names, R/T, a comment and a DROPCOUNT line), and one line each
@@ -314,6 +314,18 @@ int bridge_seeds(const std::filesystem::path& dir) {
     w.op(BridgeOp::Reconnect, 1);
     readings(w, 3, -1.0);
     seeds.emplace_back("sensor_errors", w);
+  }
+  {
+    BridgeWriter w(plain);  // the port's timer overran: 1 and 3 periods, a failed read, 200 periods
+    readings(w, 5, -1.0);
+    w.op(BridgeOp::PeriodsMissed, 1, {1});
+    readings(w, 2, -1.0);
+    w.op(BridgeOp::PeriodsMissed, 3, {3});
+    w.op(BridgeOp::SensorError, 1);
+    readings(w, 2, -1.0);
+    w.op(BridgeOp::PeriodsMissed, 15, {200});
+    readings(w, 3, -1.0);
+    seeds.emplace_back("overruns", w);
   }
   return write_seeds(dir, seeds);
 }

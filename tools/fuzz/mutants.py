@@ -183,6 +183,18 @@ BRIDGE_FAULTS = [
     ("a corrupted predictor heartbeat heard",
      "if (!protocol::accepted(c.predictor_hb_checker.check(f, lost))) {",
      "if (false) {"),
+    ("a failed read does not advance the sample counter",
+     "  bridge_on_periods_missed(c, 1);\n",
+     ""),
+    ("missed periods not put on the sample counter",
+     "c.sample_counter.value = static_cast<uint8_t>(c.sample_counter.value + c.periods_missed);",
+     ""),
+    ("missed periods kept after a reading",
+     "  c.periods_missed = 0;\n",
+     ""),
+    ("missed periods past the cap (read as a late frame)",
+     "c.periods_missed += periods < room ? periods : room;",
+     "c.periods_missed += periods;"),
 ]
 
 # target: (the core the faults go into, the other sources, include folders, the faults)

@@ -80,6 +80,7 @@ enum class BridgeOp : uint8_t {
   StopWritten = 9,  // the port wrote the latched stop to the robot
   Shutdown = 10,    // the port is shutting down (bridge_on_shutdown)
   TrialEnd = 11,    // ctl, trial id
+  PeriodsMissed = 12,  // b periods passed without a read (the port's timer overran)
 };
 
 // ---- helpers of both harnesses ----
