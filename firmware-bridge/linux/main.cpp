@@ -1,6 +1,7 @@
 // dressguard-bridge: force-torque sensor (Modbus, or an FT 300's data stream) -> CAN, and CAN
 // stop -> robot controller.
 #include <signal.h>
+#include <sys/stat.h>
 
 #include <cerrno>
 #include <cstdio>
@@ -10,6 +11,7 @@
 #include <string>
 
 #include "bridge_app.h"
+#include "candump_log.h"
 #include "ft300_stream.h"
 
 using namespace dressguard;
@@ -30,29 +32,31 @@ const char* kUsage =
     "  FtTorque frames on SocketCAN (firmware-bridge/PROTOCOL.md). On a Stop frame it writes a stop\n"
     "  to the robot controller over Modbus. A lost sensor is reconnected with exponential backoff;\n"
     "  meanwhile no sample frames are sent (the predictor's deadline stops the robot).\n"
-    "  --interface IF          SocketCAN interface (default can0)\n"
+    "  --interface IF          SocketCAN interface, 1-15 characters (default can0)\n"
     "  --sensor SPEC           tcp:HOST:PORT or rtu:DEVICE:BAUD[:PARITY] (default rtu:/dev/ttyUSB0:19200:N;\n"
-    "                          HOST a numeric IPv4 address), read over Modbus every period; or\n"
-    "                          rtu-stream:DEVICE, an FT 300's data stream: its line is fixed at 19200 8N1,\n"
-    "                          where polling gives about 60 readings/s, the stream 100 frames/s (a stream\n"
-    "                          left running is stopped first; silent 100 ms: lost, restarted; stopped at exit)\n"
-    "  --sensor-slave N        Modbus unit id (default 9)\n"
+    "                          HOST a numeric IPv4 address, BAUD a standard rate: 9600, 19200, 38400, ...),\n"
+    "                          read over Modbus every period; or rtu-stream:DEVICE, an FT 300's data\n"
+    "                          stream: its line is fixed at 19200 8N1, where polling gives about 60\n"
+    "                          readings/s, the stream 100 frames/s (a stream left running is stopped\n"
+    "                          first; silent 100 ms: lost, restarted; stopped at exit)\n"
+    "  --sensor-slave N        Modbus unit id, 1-247 (1-255 on TCP; default 9)\n"
     "  --sensor-register N     first of the six registers (default 180)\n"
     "  --input-registers       read with FC04 instead of FC03\n"
-    "  --force-scale S         sensor counts -> 0.01 N counts (default 1, the FT 300's)\n"
-    "  --torque-scale S        sensor counts -> 0.001 Nm counts (default 1)\n"
+    "  --force-scale S         sensor counts -> 0.01 N counts, 0.0001-10000 (default 1, the FT 300's)\n"
+    "  --torque-scale S        sensor counts -> 0.001 Nm counts, 0.0001-10000 (default 1)\n"
     "  --timeout-ms N          Modbus response timeout, 1-1000 (default 20), for the whole answer; a stop\n"
     "                          frame can wait about this long behind a sensor read that gets no answer\n"
     "                          or one cut short (rtu-stream never waits)\n"
     "  --period-ms N           sampling period (default 10: 100 Hz); with rtu-stream the sensor's frames\n"
     "                          set the rate, and this is the period of the heartbeat and of the checks\n"
-    "  --robot SPEC            robot controller, tcp:HOST:PORT or rtu:...; none: stops are only logged\n"
-    "  --robot-slave N         its unit id (default 1)\n"
+    "  --robot SPEC            robot controller, tcp:HOST:PORT or rtu:... (not the sensor's device; its\n"
+    "                          response timeout is 100 ms); none: stops are only logged\n"
+    "  --robot-slave N         its unit id, as --sensor-slave (default 1)\n"
     "  --stop-coil ADDR        write the stop as coil ADDR = ON (default: coil 0)\n"
     "  --stop-register ADDR=V  write the stop as holding register ADDR = V instead\n"
     "  --predictor-timeout-ms N  stop the robot when the predictor's heartbeat is silent this long, or\n"
     "                          does not name the robot's running trial (TrialStart to TrialEnd) for this\n"
-    "                          long (0: off)\n"
+    "                          long: 0 (off, the default) or 200-60000\n"
     "  --shutdown-grace-ms N   on SIGTERM/SIGINT, a stop not yet written (one on the bus, or the bridge's\n"
     "                          own when the predictor is in a trial) is retried this long (default 1000)\n"
     "  --help                  this text\n"
@@ -77,7 +81,7 @@ std::string stream_spec_error(const std::string& spec, const SensorMap& map, std
 }
 
 // Whole-number options and their ranges: Modbus addresses are 16 bits (the six sensor registers
-// must fit), unit ids 0-255 (libmodbus refuses above 247 on a serial line), and a response
+// must fit), unit ids a byte (unit_id_error then holds them to their line), and a response
 // timeout or a period beyond a second is no sampling of a 100 Hz sensor.
 struct Range { const char* name; long lo, hi; };
 constexpr Range kRanges[] = {
@@ -107,6 +111,35 @@ bool to_int(const std::string& s, long& v) {
   return !s.empty() && end && *end == '\0' && errno == 0;
 }
 
+// A sensor-count scale: finite, in [1e-4, 1e4] (inf made a zero count NaN; 1e-300 made every
+// force 0, and the predictor's hard limit could never fire). NaN fails the comparisons.
+bool sane_scale(double s) { return s >= 1e-4 && s <= 1e4; }
+
+// The least --predictor-timeout-ms besides 0 (off): two of the predictor's 100 ms heartbeats.
+// A shorter one stops the robot whenever a heartbeat comes a little late.
+constexpr long kLeastPredictorTimeoutMs = 200;
+
+// Why `option`'s unit id cannot address a device on `line` (null: no such link), or "". 0 is
+// Modbus's broadcast: no device answers it, so a read never gets an answer and a stop is never
+// confirmed (its latch would never release); a serial line's ids end at 247 (libmodbus refuses
+// the rest at every connect, forever).
+std::string unit_id_error(const char* option, int id, const EndpointParts* line) {
+  if (id == 0)
+    return std::string(option) + ": 0 is the broadcast address: no device answers it (give the device's unit id)";
+  if (line && !line->tcp && id > 247) return std::string(option) + ": " + std::to_string(id) + " is not in 1-247, "
+                                             "the unit ids of a serial line";
+  return {};
+}
+
+// Two endpoints on one serial device (also under another name, e.g. a /dev/serial/by-id link).
+bool same_serial_device(const EndpointParts& a, const EndpointParts& b) {
+  if (a.tcp || b.tcp) return false;
+  if (a.where == b.where) return true;
+  struct stat sa {}, sb {};
+  return stat(a.where.c_str(), &sa) == 0 && stat(b.where.c_str(), &sb) == 0 && sa.st_dev == sb.st_dev &&
+         sa.st_ino == sb.st_ino;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -132,13 +165,15 @@ int main(int argc, char** argv) {
     const std::string v = argv[++i];
     long n = 0;
     const bool is_int = to_int(v, n);
-    if (a == "--interface") iface = v;
-    else if (a == "--sensor") sensor_ep.spec = v;
+    if (a == "--interface") {
+      if (const char* why = protocol::interface_name_error(v)) return bad("--interface: '" + v + "': " + why);
+      iface = v;
+    } else if (a == "--sensor") sensor_ep.spec = v;
     else if (a == "--robot") robot_spec = v;
     else if (a == "--force-scale" || a == "--torque-scale") {
       char* end = nullptr;
       const double d = std::strtod(v.c_str(), &end);
-      if (!end || *end || !(d > 0)) return bad(a + ": '" + v + "' is not a positive number");
+      if (!end || *end || !sane_scale(d)) return bad(a + ": '" + v + "' is not a number in 0.0001-10000");
       (a == "--force-scale" ? map.force_scale : map.torque_scale) = d;
     } else if (a == "--stop-register") {
       const auto eq = v.find('=');
@@ -158,6 +193,8 @@ int main(int argc, char** argv) {
       else if (a == "--robot-slave") robot_ep.slave = static_cast<int>(n);
       else if (a == "--stop-coil") target = {true, static_cast<int>(n), 1};
       else if (a == "--shutdown-grace-ms") cfg.shutdown_grace_ms = static_cast<int>(n);
+      else if (n != 0 && n < kLeastPredictorTimeoutMs)
+        return bad(a + ": '" + v + "' is neither 0 (off) nor at least 200 (two of the predictor's 100 ms heartbeats)");
       else cfg.core.predictor_timeout_ms = static_cast<uint32_t>(n);
     }
   }
@@ -169,17 +206,26 @@ int main(int argc, char** argv) {
                                      : parse_endpoint(sensor_ep.spec, &sensor_parts);
       !why.empty())
     return bad("--sensor: " + why);
+  // The stream's line, for the checks below (its unit id, a --robot on the same device).
+  if (stream) sensor_parts = EndpointParts{false, stream_device, ft300::kBaud, 'N'};
   // A serial line too slow for the period: every reading overruns the timer, and the sample
   // counter (it counts periods) tells the predictor of a lost sample after each.
-  if (const double line_ms = rtu_reading_ms(sensor_parts); line_ms > cfg.sample_period_ms)
+  if (const double line_ms = stream ? 0.0 : rtu_reading_ms(sensor_parts); line_ms > cfg.sample_period_ms)
     std::fprintf(stderr,
                  "dressguard-bridge: warning: at %d baud one reading takes at least %.1f ms on the line, more "
                  "than --period-ms %d: the periods between readings carry no sample, and the predictor counts "
                  "them as lost (its bad-frame budget stops a trial; an FT 300's line is fixed at 19200 baud: "
                  "--sensor rtu-stream:DEVICE reads its 100 Hz stream)\n",
                  sensor_parts.number, line_ms, cfg.sample_period_ms);
+  EndpointParts robot_parts;
   if (!robot_spec.empty())
-    if (const std::string why = parse_endpoint(robot_spec); !why.empty()) return bad("--robot: " + why);
+    if (const std::string why = parse_endpoint(robot_spec, &robot_parts); !why.empty()) return bad("--robot: " + why);
+  if (!robot_spec.empty() && same_serial_device(sensor_parts, robot_parts))
+    return bad("--robot: '" + robot_parts.where + "' is the --sensor's serial device too (one line, two links)");
+  for (const std::string& why :
+       {unit_id_error("--sensor-slave", sensor_ep.slave, &sensor_parts),
+        unit_id_error("--robot-slave", robot_ep.slave, robot_spec.empty() ? nullptr : &robot_parts)})
+    if (!why.empty()) return bad(why);
   // Both are right for a bridge that only records; on a robot each leaves a way unguarded, so the
   // bridge says so once at start rather than only at the first stop.
   if (robot_spec.empty())

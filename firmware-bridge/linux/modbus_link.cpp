@@ -31,6 +31,21 @@ double rtu_reading_ms(const EndpointParts& p) {
   return 1000.0 * characters * bits / p.number;
 }
 
+namespace {
+
+// The rates libmodbus 3.1 turns into a termios speed; it opens a line at any other at 9600
+// without a word (a typo such as 11520 then looks like a sensor that never answers).
+bool libmodbus_sets_baud(long baud) {
+  static constexpr long kRates[] = {110,     300,     600,     1200,    2400,    4800,    9600,    19200,
+                                    38400,   57600,   115200,  230400,  460800,  500000,  576000,  921600,
+                                    1000000, 1152000, 1500000, 2500000, 3000000, 3500000, 4000000};
+  for (long r : kRates)
+    if (r == baud) return true;
+  return false;
+}
+
+}  // namespace
+
 std::string parse_endpoint(const std::string& spec, EndpointParts* out) {
   std::vector<std::string> parts;
   std::stringstream in(spec);
@@ -53,7 +68,9 @@ std::string parse_endpoint(const std::string& spec, EndpointParts* out) {
     if (!whole(parts[2], 1, 65535, p.number)) return "'" + spec + "': port '" + parts[2] + "' is not in 1-65535";
   } else if ((parts.size() == 3 || parts.size() == 4) && parts[0] == "rtu") {
     if (parts[1].empty()) return "'" + spec + "': no device";
-    if (!whole(parts[2], 1, 4000000, p.number)) return "'" + spec + "': baud rate '" + parts[2] + "' is not a positive number";
+    if (!whole(parts[2], 1, 4000000, p.number) || !libmodbus_sets_baud(p.number))
+      return "'" + spec + "': baud rate '" + parts[2] + "' is not one libmodbus sets (a standard rate: ..., 9600, "
+             "19200, 38400, 57600, 115200, 230400, ... 4000000; any other runs the line at 9600)";
     if (parts.size() == 4) {
       if (parts[3] != "N" && parts[3] != "E" && parts[3] != "O") return "'" + spec + "': parity is not N, E or O";
       p.parity = parts[3][0];

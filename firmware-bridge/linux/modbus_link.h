@@ -25,7 +25,7 @@ struct ModbusEndpoint {
 struct EndpointParts {
   bool tcp = false;
   std::string where;   // host or device
-  int number = 0;      // port (1-65535) or baud (> 0)
+  int number = 0;      // port (1-65535) or baud (one libmodbus sets: termios' rates)
   char parity = 'N';   // N, E or O
 };
 // Empty when `spec` is a valid endpoint (written to *out), else what is wrong with it.
