@@ -11,6 +11,7 @@
 #include <cerrno>
 #include <cstdarg>
 #include <cstdio>
+#include <cstring>
 #include <system_error>
 
 namespace dressguard::bridge {
@@ -52,7 +53,9 @@ BridgeApp::BridgeApp(const BridgeAppConfig& cfg, Sensor& sensor, RobotStopWriter
   its.it_interval.tv_sec = cfg_.sample_period_ms / 1000;
   its.it_interval.tv_nsec = (cfg_.sample_period_ms % 1000) * 1000000L;
   its.it_value = its.it_interval;
-  timerfd_settime(timer_fd_, 0, &its, nullptr);
+  // A period of 0 would disarm the timer: no reading, no heartbeat, without a word.
+  if (cfg_.sample_period_ms <= 0 || timerfd_settime(timer_fd_, 0, &its, nullptr) < 0)
+    throw std::system_error(cfg_.sample_period_ms <= 0 ? EINVAL : errno, std::generic_category(), "timerfd_settime");
 }
 
 BridgeApp::~BridgeApp() {
@@ -85,9 +88,22 @@ void BridgeApp::sensor_failed(const char* what) {
 }
 
 void BridgeApp::send(const Frame& f) {
-  // A full transmit queue drops this frame (the next sample supersedes it); counted, never blocked on.
-  if (port_.send(f) == can::SendResult::Ok) ++stats_.frames_sent;
-  else ++stats_.send_failures;
+  // A full transmit queue or a bus-off drops this frame (the next sample supersedes it): counted,
+  // never blocked on, and said, since nothing the bridge publishes gets out meanwhile.
+  const can::SendResult r = port_.send(f);
+  if (r == can::SendResult::Ok) {
+    ++stats_.frames_sent;
+    if (send_failures_ > 0)
+      say("CAN sends go out again after %llu failures", static_cast<unsigned long long>(send_failures_));
+    send_failures_ = 0;
+    return;
+  }
+  const int err = errno;
+  ++stats_.send_failures;
+  if (power_of_two(++send_failures_))
+    say("CAN send failed: %s%s%s (%llu in a row; frames are dropped meanwhile)", can::send_result_name(r),
+        r == can::SendResult::Error ? ": " : "", r == can::SendResult::Error ? std::strerror(err) : "",
+        static_cast<unsigned long long>(send_failures_));
 }
 
 // The core latched a stop: say why, and write it to the robot in this wakeup (try_stop).
@@ -220,10 +236,43 @@ void BridgeApp::timer_overran(uint64_t periods) {
         polled ? "no reading in them: the sample counter skips them" : "the stream's frames wait in the line");
 }
 
+// A receive's outcome said when it fails (1st, 2nd, 4th, ... in a row) and once when it works
+// again: true when a frame was read.
+bool BridgeApp::received(int got, const can::RxInfo& info) {
+  if (got < 0) {
+    const int err = errno;
+    ++stats_.receive_failures;
+    if (power_of_two(++receive_failures_))
+      say("CAN receive failed: %s (%llu in a row; no stop frame can reach the bridge meanwhile)", std::strerror(err),
+          static_cast<unsigned long long>(receive_failures_));
+    return false;
+  }
+  if (got == 0) return false;
+  if (receive_failures_ > 0)
+    say("CAN receives work again after %llu failures", static_cast<unsigned long long>(receive_failures_));
+  receive_failures_ = 0;
+  if (info.error_frame) error_frame(info.error_class);
+  return true;
+}
+
+// A controller error frame: a restart (the recovery from bus-off) is said each time, the others
+// at the 1st, 2nd, 4th, ... since the last restart (a babbling fault must not flood the log).
+void BridgeApp::error_frame(uint32_t error_class) {
+  ++stats_.error_frames;
+  if (error_class & can::kErrorRestarted) {
+    say("CAN controller restarted (after %llu error frames)", static_cast<unsigned long long>(error_frames_));
+    error_frames_ = 0;
+  } else if (power_of_two(++error_frames_)) {
+    say("CAN error frame: %s (class 0x%X; %llu since the controller's last restart)",
+        can::error_class_name(error_class), static_cast<unsigned>(error_class),
+        static_cast<unsigned long long>(error_frames_));
+  }
+}
+
 void BridgeApp::drain_can(uint32_t t) {
   Frame f;
   can::RxInfo info;
-  for (int n = 0; n < 64 && port_.receive(f, info) == 1; ++n) {
+  for (int n = 0; n < 64 && received(port_.receive(f, info), info); ++n) {
     if (info.error_frame || info.own_echo) continue;
     if (bridge_on_frame(core_, f, t) == BridgeAction::StopRobot) stop_robot(t);
   }
@@ -243,6 +292,28 @@ void BridgeApp::begin_shutdown(uint32_t t) {
   }
 }
 
+void BridgeApp::say_stop_unwritten() {
+  say("shutting down with a stop not written to the robot controller after %d ms (%llu failed writes): "
+      "the robot may not be stopped", cfg_.shutdown_grace_ms, static_cast<unsigned long long>(stop_failures_));
+}
+
+// epoll failed: the loop cannot wait for anything any more. It is said, and the shutdown's stop
+// still runs (the bridge is the only way to the robot), its retries paced by sleeping.
+int BridgeApp::loop_failed(int err) {
+  say("epoll_wait failed: %s; shutting down", std::strerror(err));
+  uint32_t t = now_ms();
+  const uint32_t give_up_ms = t + static_cast<uint32_t>(cfg_.shutdown_grace_ms);
+  begin_shutdown(t);
+  while (stop_pending_ && !due(t, give_up_ms)) {
+    const timespec pause{cfg_.stop_retry_ms / 1000, (cfg_.stop_retry_ms % 1000) * 1000000L};
+    nanosleep(&pause, nullptr);
+    t = now_ms();
+    try_stop(t);
+  }
+  if (stop_pending_) say_stop_unwritten();
+  return 1;
+}
+
 int BridgeApp::run() {
   epoll_event evs[4];
   bool shutting_down = false;
@@ -251,7 +322,7 @@ int BridgeApp::run() {
     const int n = epoll_wait(epoll_fd_, evs, 4, -1);
     if (n < 0) {
       if (errno == EINTR) continue;
-      return 1;
+      return loop_failed(errno);
     }
     const uint32_t t = now_ms();
     bool woke[kTags] = {};
@@ -286,8 +357,7 @@ int BridgeApp::run() {
     if (shutting_down) {
       if (!stop_pending_) return 0;
       if (due(t, give_up_ms)) {
-        say("shutting down with a stop not written to the robot controller after %d ms (%llu failed writes): "
-            "the robot may not be stopped", cfg_.shutdown_grace_ms, static_cast<unsigned long long>(stop_failures_));
+        say_stop_unwritten();
         return 1;
       }
     }

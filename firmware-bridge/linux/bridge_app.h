@@ -29,7 +29,9 @@ struct BridgeAppConfig {
   int shutdown_grace_ms = 1000;
   // Where the bridge says what went wrong (null: nowhere). A failing sensor or stop write is
   // reported at its 1st, 2nd, 4th, 8th, ... consecutive failure with libmodbus's reason, and
-  // once when it recovers; every stop is reported; a timer overrun at the 1st, 2nd, 4th, ...
+  // once when it recovers; every stop is reported; a timer overrun at the 1st, 2nd, 4th, ...;
+  // CAN send and receive failures at the 1st, 2nd, 4th, ... in a row and once when they stop,
+  // controller error frames at the 1st, 2nd, 4th, ... since the last restart, and the restart.
   std::FILE* log = stderr;
 };
 
@@ -38,6 +40,7 @@ struct BridgeStats {
       connect_failures{0}, stops_written{0}, stop_write_failures{0};
   // Wakeups that found the timer expired more than once, and the periods they skipped.
   std::atomic<uint64_t> overruns{0}, periods_overrun{0};
+  std::atomic<uint64_t> receive_failures{0}, error_frames{0};
 };
 
 class BridgeApp {
@@ -46,7 +49,8 @@ class BridgeApp {
   BridgeApp(const BridgeAppConfig& cfg, Sensor& sensor, RobotStopWriter* robot, can::CanPort& port);
   ~BridgeApp();
   // Until request_shutdown(), then until no stop is left unwritten: 0, or 1 when the grace ran
-  // out with a stop unwritten (said on the log) or epoll failed.
+  // out with a stop unwritten (said on the log) or epoll failed (said, and the shutdown's stop
+  // still written within the grace).
   int run();
   void request_shutdown() noexcept; // async-signal-safe
   const BridgeStats& stats() const { return stats_; }
@@ -60,10 +64,14 @@ class BridgeApp {
   void back_off(uint32_t now_ms);
   void timer_overran(uint64_t periods);
   void drain_can(uint32_t now_ms);
+  bool received(int got, const can::RxInfo& info);
+  void error_frame(uint32_t error_class);
   void send(const Frame& f);
   void try_stop(uint32_t now_ms);
   void stop_robot(uint32_t now_ms);
   void begin_shutdown(uint32_t now_ms);
+  int loop_failed(int err);
+  void say_stop_unwritten();
   void say(const char* fmt, ...) __attribute__((format(printf, 2, 3)));
   void sensor_failed(const char* what);
 
@@ -80,6 +88,9 @@ class BridgeApp {
   uint32_t next_stop_try_ms_ = 0;
   uint64_t sensor_failures_ = 0;  // in a row, since the last good reading
   uint64_t stop_failures_ = 0;    // in a row, for the pending stop
+  uint64_t send_failures_ = 0;    // CAN sends, in a row
+  uint64_t receive_failures_ = 0; // CAN receives, in a row
+  uint64_t error_frames_ = 0;     // since the controller's last restart
 };
 
 }  // namespace dressguard::bridge

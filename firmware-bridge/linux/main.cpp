@@ -275,12 +275,14 @@ int main(int argc, char** argv) {
     const auto& s = app.stats();
     std::fprintf(stderr,
                  "dressguard-bridge: readings=%llu frames=%llu send_failures=%llu sensor_errors=%llu reconnects=%llu "
-                 "stops_written=%llu stop_write_failures=%llu overruns=%llu (%llu periods)\n",
+                 "stops_written=%llu stop_write_failures=%llu overruns=%llu (%llu periods) receive_failures=%llu "
+                 "error_frames=%llu\n",
                  (unsigned long long)s.readings.load(), (unsigned long long)s.frames_sent.load(),
                  (unsigned long long)s.send_failures.load(), (unsigned long long)s.sensor_errors.load(),
                  (unsigned long long)s.reconnects.load(), (unsigned long long)s.stops_written.load(),
                  (unsigned long long)s.stop_write_failures.load(), (unsigned long long)s.overruns.load(),
-                 (unsigned long long)s.periods_overrun.load());
+                 (unsigned long long)s.periods_overrun.load(), (unsigned long long)s.receive_failures.load(),
+                 (unsigned long long)s.error_frames.load());
     if (ft300)
       std::fprintf(stderr, "dressguard-bridge: stream frames=%llu crc_failures=%llu resyncs=%llu skipped_bytes=%llu\n",
                    (unsigned long long)ft300->stats().frames.load(),

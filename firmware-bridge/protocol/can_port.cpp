@@ -137,6 +137,17 @@ struct Wire {
 
 }  // namespace
 
+static_assert(kErrorTxTimeout == CAN_ERR_TX_TIMEOUT && kErrorController == CAN_ERR_CRTL &&
+              kErrorBusOff == CAN_ERR_BUSOFF && kErrorRestarted == CAN_ERR_RESTARTED);
+
+const char* error_class_name(uint32_t error_class) {
+  if (error_class & kErrorBusOff) return "bus-off";
+  if (error_class & kErrorRestarted) return "restarted";
+  if (error_class & kErrorController) return "controller problem";
+  if (error_class & kErrorTxTimeout) return "tx timeout";
+  return "other";
+}
+
 const char* send_result_name(SendResult r) {
   switch (r) {
     case SendResult::Ok: return "ok";

@@ -29,6 +29,14 @@ enum class SendResult : uint8_t {
 };
 const char* send_result_name(SendResult r);
 
+// The error classes of RxInfo::error_class that the ports subscribe to (linux/can/error.h's
+// CAN_ERR_TX_TIMEOUT, _CRTL, _BUSOFF, _RESTARTED), for code that includes no SocketCAN header.
+inline constexpr uint32_t kErrorTxTimeout = 0x001, kErrorController = 0x004, kErrorBusOff = 0x040,
+                          kErrorRestarted = 0x100;
+// The gravest class set in `error_class`: "bus-off", "restarted", "controller problem",
+// "tx timeout", else "other".
+const char* error_class_name(uint32_t error_class);
+
 struct RxInfo {
   bool own_echo = false;        // our own transmitted frame, echoed back: it reached the bus
   bool error_frame = false;     // a controller error frame (CAN_ERR_FLAG); see error_class

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <modbus.h>
 #include <signal.h>
+#include <sys/epoll.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -56,6 +57,18 @@ extern "C" int clock_gettime(clockid_t id, timespec* ts) noexcept {
     ts->tv_nsec = ns % 1000000000;
   }
   return r;
+}
+
+// While set, epoll_wait fails with EBADF, for the bridge's loop (linked in statically, as above).
+static std::atomic<bool> g_fail_epoll{false};
+extern "C" int epoll_wait(int epfd, epoll_event* events, int maxevents, int timeout) {
+  using Real = int (*)(int, epoll_event*, int, int);
+  static const Real real = reinterpret_cast<Real>(dlsym(RTLD_NEXT, "epoll_wait"));
+  if (g_fail_epoll.load()) {
+    errno = EBADF;
+    return -1;
+  }
+  return real(epfd, events, maxevents, timeout);
 }
 
 namespace {
@@ -427,6 +440,56 @@ std::string mbpoll(const std::string& args) {
   return out;
 }
 
+// The bridge's CAN port with faults a test arms: receive errors (errno `err`) and controller
+// error frames of one class, each returned by the next receives before any frame waiting (send
+// a frame to wake the loop for them).
+class FaultyPort final : public can::CanPort {
+ public:
+  explicit FaultyPort(std::unique_ptr<can::CanPort> port) : port_(std::move(port)) {}
+  void fail_receives(int n, int err) {
+    err_ = err;
+    receive_errors_ = n;
+  }
+  void error_frames(int n, uint32_t error_class) {
+    error_class_ = error_class;
+    error_frames_ = n;
+  }
+  int fd() const override { return port_->fd(); }
+  int receive(protocol::Frame& f, can::RxInfo& info) noexcept override {
+    if (take(receive_errors_)) {
+      errno = err_.load();
+      return -1;
+    }
+    if (take(error_frames_)) {
+      f = protocol::Frame{};
+      info = can::RxInfo{};
+      info.error_frame = true;
+      info.error_class = error_class_.load();
+      return 1;
+    }
+    return port_->receive(f, info);
+  }
+  can::SendResult send(const protocol::Frame& f) noexcept override { return port_->send(f); }
+
+ private:
+  static bool take(std::atomic<int>& n) {
+    for (int left = n.load(); left > 0;)
+      if (n.compare_exchange_weak(left, left - 1)) return true;
+    return false;
+  }
+  std::unique_ptr<can::CanPort> port_;
+  std::atomic<int> receive_errors_{0}, error_frames_{0}, err_{0};
+  std::atomic<uint32_t> error_class_{0};
+};
+
+// The lines of `text` that contain `needle`.
+int lines_with(const std::string& text, const std::string& needle) {
+  std::istringstream lines(text);
+  int n = 0;
+  for (std::string l; std::getline(lines, l);) n += l.find(needle) != std::string::npos;
+  return n;
+}
+
 // What a test changes of the rig: the sensor (the emulator over TCP unless a spec is given, e.g.
 // a PtyDevice's) and its response timeout, the shutdown grace.
 struct RigOptions {
@@ -442,6 +505,7 @@ struct BridgeRig {
   Emulator sensor_emu, robot_emu;
   can::InProcBus bus;
   std::unique_ptr<can::CanPort> bridge_port, listener, predictor;
+  FaultyPort* faults = nullptr;  // the bridge's port
   std::unique_ptr<ModbusSensor> sensor;
   std::unique_ptr<RobotStopWriter> robot;
   std::unique_ptr<BridgeApp> app;
@@ -450,7 +514,9 @@ struct BridgeRig {
   std::FILE* log = std::tmpfile();  // what the bridge says
   explicit BridgeRig(const RigOptions& o = {}) {
     // The identifiers dressguard-bridge's main subscribes to.
-    bridge_port = bus.open({{std::begin(kBridgeReceives), std::end(kBridgeReceives)}, false, true});
+    auto port = std::make_unique<FaultyPort>(bus.open({{std::begin(kBridgeReceives), std::end(kBridgeReceives)}, false, true}));
+    faults = port.get();
+    bridge_port = std::move(port);
     listener = bus.open({{protocol::id_of(protocol::MsgId::FtForce), protocol::id_of(protocol::MsgId::FtTorque),
                           protocol::id_of(protocol::MsgId::HeartbeatBridge)}, false, true});
     predictor = bus.open({{}, false, true});
@@ -485,6 +551,15 @@ struct BridgeRig {
     std::ostringstream s;
     s << in.rdbuf();
     return s.str();
+  }
+  // Waits up to `d` for the bridge to log `needle`: whether it did.
+  bool logs(const std::string& needle, std::chrono::milliseconds d = 3000ms) const {
+    const auto end = std::chrono::steady_clock::now() + d;
+    while (logged().find(needle) == std::string::npos) {
+      if (std::chrono::steady_clock::now() > end) return false;
+      std::this_thread::sleep_for(5ms);
+    }
+    return true;
   }
   // Force frames received within `d`, the last one in *last; every frame in *all.
   int collect(std::chrono::milliseconds d, protocol::FtForce* last = nullptr, protocol::HeartbeatBridge* hb = nullptr,
@@ -644,9 +719,7 @@ TEST(BridgeModbus, FailuresAndStopsAreLoggedAtEachDoubling) {
   for (int i = 0; i < 200 && rig.app->stats().stops_written.load() == 0; ++i) std::this_thread::sleep_for(1ms);
   std::this_thread::sleep_for(5ms);
   const std::string text = rig.logged();
-  std::istringstream lines(text);
-  int failures = 0;
-  for (std::string l; std::getline(lines, l);) failures += l.find("sensor: timeout: ") != std::string::npos;
+  const int failures = lines_with(text, "sensor: timeout: ");
   const uint64_t errors = rig.app->stats().sensor_errors.load();
   ASSERT_GE(errors, 2u);
   // One line per power of two up to the run's length: floor(log2(errors)) + 1 at most.
@@ -1339,6 +1412,56 @@ TEST(BridgeModbus, ALateAnswerShowsAsLostSamples) {
   EXPECT_EQ(rig.app->stats().sensor_errors.load(), 0u) << rig.logged();
   EXPECT_GE(rig.app->stats().overruns.load(), 1u);
   EXPECT_NE(rig.logged().find("timer overran: "), std::string::npos) << rig.logged();
+}
+
+// The CAN side says what fails, as the sensor side does: a send failing at its 1st, 2nd, 4th,
+// ... failure in a row by its kind, once when sends go out again; the same for receives (by
+// errno); controller error frames by class at the 1st, 2nd, 4th, ... since the last restart, and
+// the restart. 300 sends failed with "down" (a bus-off controller) and the log stayed empty.
+TEST(BridgeModbus, CanFailuresAreLoggedAtEachDoublingAndAtRecovery) {
+  BridgeRig rig;
+  ASSERT_GT(rig.sensor_emu.port(), 0);
+  EXPECT_GE(rig.collect(100ms), 3);
+  rig.bus.fail_next_sends(300, can::SendResult::Down);
+  ASSERT_TRUE(rig.logs("CAN sends go out again after 300 failures")) << rig.logged();
+  EXPECT_EQ(lines_with(rig.logged(), "CAN send failed: down ("), 9) << "1, 2, 4, ..., 256\n" << rig.logged();
+  uint8_t counter = 0;
+  const auto wake_the_loop = [&] {
+    rig.predictor->send(protocol::encode(
+        protocol::HeartbeatPredictor{counter++, protocol::PredictorState::Idle, 1, 0, 0}));
+  };
+  rig.faults->fail_receives(20, ENETDOWN);
+  wake_the_loop();
+  ASSERT_TRUE(rig.logs("CAN receives work again after 20 failures")) << rig.logged();
+  EXPECT_EQ(lines_with(rig.logged(), "CAN receive failed: Network is down ("), 5) << rig.logged();
+  rig.faults->error_frames(40, can::kErrorBusOff);
+  wake_the_loop();
+  ASSERT_TRUE(rig.logs("(class 0x40; 32 since the controller's last restart)")) << rig.logged();
+  EXPECT_EQ(lines_with(rig.logged(), "CAN error frame: bus-off (class 0x40; "), 6) << rig.logged();
+  rig.faults->error_frames(1, can::kErrorRestarted);
+  wake_the_loop();
+  EXPECT_TRUE(rig.logs("CAN controller restarted (after 40 error frames)")) << rig.logged();
+  EXPECT_EQ(rig.app->stats().error_frames.load(), 41u);
+  EXPECT_EQ(rig.app->stats().receive_failures.load(), 20u);
+}
+
+// epoll failing ends the loop (exit 1), but not silently and not without the shutdown's stop:
+// with the predictor in a trial the bridge stops the robot first, as at SIGTERM. It returned 1
+// at once, saying nothing and leaving the trial unguarded.
+TEST(BridgeModbus, AnEpollFailureIsSaidAndStillStopsARunningTrial) {
+  BridgeRig rig;
+  ASSERT_GT(rig.robot_emu.port(), 0);
+  rig.predictor->send(protocol::encode(protocol::HeartbeatPredictor{0, protocol::PredictorState::InTrial, 1, 12, 5}));
+  std::this_thread::sleep_for(30ms);  // the bridge's loop takes it
+  g_fail_epoll = true;
+  for (int i = 0; i < 3000 && rig.rc.load() == -1; ++i) std::this_thread::sleep_for(1ms);
+  g_fail_epoll = false;
+  EXPECT_EQ(rig.rc.load(), 1);
+  EXPECT_NE(rig.logged().find("epoll_wait failed: Bad file descriptor; shutting down"), std::string::npos)
+      << rig.logged();
+  EXPECT_EQ(rig.app->stats().stops_written.load(), 1u) << rig.logged();
+  const std::string coil = "-p " + std::to_string(rig.robot_emu.port()) + " -a 1 -r 7 -c 1 -t 0 127.0.0.1";
+  EXPECT_NE(mbpoll(coil).find("[7]: \t1"), std::string::npos) << mbpoll(coil);
 }
 
 }  // namespace
