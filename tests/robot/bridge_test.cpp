@@ -805,7 +805,9 @@ TEST(BridgeModbus, ShutdownDuringATrialStopsTheRobot) {
 TEST(BridgeModbus, TrialThePredictorDoesNotGuardStopsTheRobot) {
   for (const auto state : {protocol::PredictorState::Idle, protocol::PredictorState::InTrial}) {
     const bool guarded = state == protocol::PredictorState::InTrial;
-    BridgeRig rig(RigOptions{.predictor_timeout_ms = 300});
+    RigOptions watched;
+    watched.predictor_timeout_ms = 300;
+    BridgeRig rig(watched);
     ASSERT_GT(rig.robot_emu.port(), 0);
     uint8_t counter = 0;
     const auto beat_for = [&](std::chrono::milliseconds d) {
@@ -1074,7 +1076,13 @@ struct StreamRig {
   BridgeRig rig;
   explicit StreamRig(bool streaming, int period_ms = 10)
       : ft300(streaming, {"set 180 -420 17 20000 -1 2 -3"}), stream(Ft300StreamConfig{ft300.device()}),
-        rig(RigOptions{.own_sensor = &stream, .period_ms = period_ms}) {}
+        rig(options(&stream, period_ms)) {}
+  static RigOptions options(Sensor* sensor, int period_ms) {
+    RigOptions o;
+    o.own_sensor = sensor;
+    o.period_ms = period_ms;
+    return o;
+  }
   const Ft300StreamStats& stats() const { return stream.stats(); }
 };
 
@@ -1221,6 +1229,8 @@ TEST(BridgeStream, ASilentStreamIsASensorErrorAndRecovers) {
   EXPECT_EQ(hb.state, protocol::BridgeState::Ok);
   EXPECT_GE(s.stats().starts.load(), 2u);
   EXPECT_NE(s.rig.logged().find("sensor answers again"), std::string::npos) << s.rig.logged();
+}
+
 // The Modbus RTU CRC-16 (reflected polynomial 0xA001, initial 0xFFFF) appended to `frame`, low
 // byte first, as on the line.
 std::vector<uint8_t> with_crc(std::vector<uint8_t> frame) {
