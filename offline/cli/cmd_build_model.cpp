@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <iterator>
 #include <optional>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -171,6 +172,7 @@ int run_build_model(int argc, char** argv) {
 #else
   std::string data;  // the training sets' names, for the model's metadata and the summary
   for (const auto& d : sets) data += (data.empty() ? "" : ",") + d.string();
+  const std::string set_names = data;  // `data` gains notes below; an error names the sets alone
   Dataset ds;
   int left_out = 0;
   for (std::size_t i = 0; i < sets.size(); ++i) {
@@ -220,7 +222,14 @@ int run_build_model(int argc, char** argv) {
   so.source = data + "; forces: " + axes.reason + (priors == "training" ? "; priors: the training shares" : "");
   so.second_axis = axes.second_axis;
   so.uniform_priors = priors == "uniform";
-  model::OutcomeModel m = build_outcome_model(trials, so);
+  // Training refuses what the trials cannot teach (a class whose trials are all shorter than
+  // --states, no labelled trial): the input's fault, exit 2 as train's, not a runtime failure.
+  model::OutcomeModel m;
+  try {
+    m = build_outcome_model(trials, so);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(set_names + ": " + e.what());
+  }
   m.tool_version = "dressguard 0.1.0 build-model";
   m.created = args.get("created").value_or(utc_now());
   model::write_model(out, m);

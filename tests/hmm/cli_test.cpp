@@ -394,17 +394,29 @@ TEST_F(CliTest, BadInputExitsTwoNamingTheProblem) {
 
 // One class's trials all shorter than the states (three caught trials of 6 samples, beside good
 // and missed ones of 300): the refusal names the class, its trials and --states. It read "no
-// training sequence has at least as many samples as states (10)", as if no trial had.
+// training sequence has at least as many samples as states (10)", as if no trial had. train and
+// build-model --data alike exit 2 (bad input), also for a dataset with no labelled trial:
+// build-model exited 1, as for a runtime failure.
 TEST_F(CliTest, AClassTooShortForTheStatesIsNamed) {
   Dataset d = fx::synthetic_dataset(3, 300, 300, 54, 5);
   for (auto& t : d.trials)
     if (t.label == Outcome::Caught) t.samples.resize(6);
   save_dataset(d, dir / "d");
-  const auto r = run("train --data " + (dir / "d").string() + " --out " + (dir / "m.dgm").string() + " --states 10");
-  EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("class 'caught' (3 trials, the longest 6 samples): "), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("the 10 states (--states)"), std::string::npos) << r.err;
-  EXPECT_FALSE(fs::exists(dir / "m.dgm"));
+  for (auto& t : d.trials) t.label.reset();
+  save_dataset(d, dir / "unlabelled");
+  for (const std::string command : {"train", "build-model"}) {
+    const auto r = run(command + " --data " + (dir / "d").string() + " --out " + (dir / "m.dgm").string() +
+                       " --states 10");
+    EXPECT_EQ(r.code, 2) << command;
+    EXPECT_NE(r.err.find("class 'caught' (3 trials, the longest 6 samples): "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("the 10 states (--states)"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("error:"), std::string::npos) << r.err;  // main's prefix of a runtime failure
+    EXPECT_FALSE(fs::exists(dir / "m.dgm"));
+    const auto none = run(command + " --data " + (dir / "unlabelled").string() + " --out " +
+                          (dir / "m.dgm").string());
+    EXPECT_EQ(none.code, 2) << command;
+    EXPECT_NE(none.err.find("unlabelled: no labelled trials to train on"), std::string::npos) << none.err;
+  }
 }
 
 // --cov-floor below 1e-9 is refused, naming it: with 1e-300, the states fitted to a pull's
