@@ -1,5 +1,7 @@
 #include "args.h"
 
+#include "files.h"
+
 #include <cstdlib>
 
 #include <charconv>
@@ -24,18 +26,17 @@ std::set<std::string> split_list(const std::string& s) {
   return {items.begin(), items.end()};
 }
 
-std::vector<std::filesystem::path> dataset_list(const std::string& option, const std::string& list) {
-  namespace fs = std::filesystem;
-  std::vector<fs::path> dirs;
-  std::map<fs::path, std::string> given;  // canonical path -> as given
+std::vector<std::filesystem::path> dataset_list(const std::string& option, const std::string& list,
+                                                const std::string& why_once) {
+  std::vector<std::filesystem::path> dirs;
+  std::vector<std::string> given;
   for (const std::string& d : split_in_order(list)) {
-    std::error_code ec;
-    fs::path key = fs::weakly_canonical(fs::absolute(d), ec);
-    if (ec) key = fs::absolute(d).lexically_normal();
-    if (const auto [it, fresh] = given.emplace(key, d); !fresh)
-      throw UsageError("--" + option + " names the dataset " + d + " twice" +
-                       (it->second == d ? "" : " (as " + it->second + " and " + d + ")") +
-                       ": its trials would count twice");
+    // same_file: one folder under two spellings (study, ./study) or through a symlink.
+    for (const std::string& before : given)
+      if (same_file(before, d))
+        throw UsageError("--" + option + " names the dataset " + d + " twice" +
+                         (before == d ? "" : " (as " + before + " and " + d + ")") + ": " + why_once);
+    given.push_back(d);
     dirs.emplace_back(d);
   }
   if (dirs.empty()) throw UsageError("--" + option + " names no dataset");

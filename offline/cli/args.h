@@ -30,10 +30,12 @@ std::set<std::string> split_list(const std::string& s);
 std::vector<std::string> split_in_order(const std::string& s);
 
 // The datasets that option --`option` pools ("A,B,...", split_in_order), in the order given.
-// UsageError when it names none, or one folder twice, by its canonical path (study and ./study
-// are one): pooled twice, a folder's trials would count twice in training, their weight doubled
-// and the model's trial counts wrong, without a word (train --data study,study once did).
-std::vector<std::filesystem::path> dataset_list(const std::string& option, const std::string& list);
+// UsageError when it names none, or one folder twice (same_file: study and ./study are one),
+// saying `why_once`. By default why a pooled folder counts once: pooled twice, its trials would
+// count twice in training, their weight doubled and the model's trial counts wrong, without a word
+// (train --data study,study once did).
+std::vector<std::filesystem::path> dataset_list(const std::string& option, const std::string& list,
+                                                const std::string& why_once = "its trials would count twice");
 
 // UsageError naming every name of `given` (option --`option`'s list) that is no participant of
 // `ds` (the dataset `data`), and the participants it has: a name that matches nobody would

@@ -142,9 +142,10 @@ int run_classify(int argc, char** argv) {
         "                          set that model was trained on; each member's vote then counts by\n"
         "                          its log-odds of being right on the other members' sets at the same\n"
         "                          cut and --among (hmm.h, simulation_weights: learnt from simulation\n"
-        "                          alone; give one model per person). Printed, and in the JSON. For a\n"
-        "                          model built with --discrepancy give its build-model --training-out\n"
-        "                          set: the synthesized set on disk lacks the correction it learnt\n"
+        "                          alone; give one model per person, each set once). Printed, and in\n"
+        "                          the JSON. For a model built with --discrepancy give its\n"
+        "                          build-model --training-out set: the synthesized set on disk lacks\n"
+        "                          the correction it learnt\n"
         "  --json                  print a machine-readable result");
     return 0;
   }
@@ -194,8 +195,16 @@ int run_classify(int argc, char** argv) {
   // One model classifies as it always did (its log-likelihoods in the JSON); several vote.
   const model::OutcomeModel* single = models.size() == 1 ? &models[0] : nullptr;
   // --weigh-on: each member's training set, for the weights at each cut (rule S).
-  const std::vector<std::string> weigh_paths = split_in_order(args.get("weigh-on").value_or(""));
   if (args.get("weigh-on") && single) throw UsageError("--weigh-on weighs the members of a committee: give several --model");
+  // One folder twice would weigh each of its two members on its own training set, which says how
+  // well it learnt itself, not how it fares on a person it was not fitted to (hmm.h,
+  // simulation_weights): a slip, as in train --data.
+  std::vector<std::string> weigh_paths;
+  if (const auto list = args.get("weigh-on"))
+    for (const auto& path : dataset_list("weigh-on", *list,
+                                         "each member must be weighed on the other members' training sets, "
+                                         "not on its own"))
+      weigh_paths.push_back(path.string());
   if (args.get("weigh-on") && weigh_paths.size() != models.size())
     throw UsageError("--weigh-on names " + std::to_string(weigh_paths.size()) + " sets for " +
                      std::to_string(models.size()) + " models: one set per model, in --model's order");

@@ -215,26 +215,34 @@ TEST_F(CliTest, CommitteeOfModelsVotes) {
 }
 
 // --weigh-on (rule S, hmm::simulation_weights): each member counts by its log-odds on the other
-// members' sets. Weighed on their own training sets, the two liars agree with each other's set
-// and m with neither: m gets 0 (right on the 24 caught of 72 trials: chance for three classes),
-// each liar ln 4 (48 of 72: ln(2/3 / 1/3) + ln 2), and the committee is the liars' (6/18). Weighed
-// on three sets that tell the truth, m is right on all 72 of the others' (a held at 1 - 1/144:
-// ln 143 + ln 2) and the liars on 24 (0): the committee is m's (18/18), where the plain vote
-// goes the liars' way.
+// members' sets. Weighed on their own training sets, the two liars (trained on two draws with the
+// labels swapped) agree with each other's set and m with neither: m gets 0 (right on the 24
+// caught of 72 trials: chance for three classes), each liar ln 4 (48 of 72: ln(2/3 / 1/3) + ln 2),
+// and the committee is the liars' (6/18). Weighed on three sets that tell the truth, m is right
+// on all 72 of the others' (a held at 1 - 1/144: ln 143 + ln 2) and the liars on 24 (0): the
+// committee is m's (18/18), where the plain vote goes the liars' way.
 TEST_F(CliTest, CommitteeWeighedOnTheMembersSets) {
   ASSERT_TRUE(train_right_and_liar());
   save_dataset(fx::synthetic_dataset(12, 300, 500, 58, 5, "c"), dir / "train2");
   save_dataset(fx::synthetic_dataset(12, 300, 500, 59, 5, "d"), dir / "train3");
-  const std::string committee = "classify --model " + m + "," + liar + "," + liar + " --data " + test;
+  Dataset swapped2 = fx::synthetic_dataset(12, 300, 500, 60, 5, "t");
+  for (auto& t : swapped2.trials)
+    if (t.label == Outcome::Good || t.label == Outcome::Missed)
+      t.label = t.label == Outcome::Good ? Outcome::Missed : Outcome::Good;
+  save_dataset(swapped2, dir / "swapped2");
+  const std::string liar2 = (dir / "liar2.dgm").string();
+  ASSERT_EQ(run("train --data " + (dir / "swapped2").string() + " --out " + liar2 + " --states 5").code, 0);
+  const std::string committee = "classify --model " + m + "," + liar + "," + liar2 + " --data " + test;
   const std::string train = (dir / "train").string(), sw = (dir / "swapped").string();
+  const std::string sw2 = (dir / "swapped2").string();
 
-  const auto own = run(committee + " --weigh-on " + train + "," + sw + "," + sw + " --json");
+  const auto own = run(committee + " --weigh-on " + train + "," + sw + "," + sw2 + " --json");
   ASSERT_EQ(own.code, 0) << own.err;
   const size_t w = own.out.find("\"weights\": [");
   ASSERT_NE(w, std::string::npos) << own.out;
   EXPECT_EQ(std::strtod(own.out.c_str() + w + 12, nullptr), 0.0) << own.out;
   EXPECT_NEAR(json_field(own.out, "accuracy"), 6.0 / 18, 1e-12) << own.out;
-  const auto own_text = run(committee + " --weigh-on " + train + "," + sw + "," + sw);
+  const auto own_text = run(committee + " --weigh-on " + train + "," + sw + "," + sw2);
   ASSERT_EQ(own_text.code, 0) << own_text.err;
   char line[128];
   std::snprintf(line, sizeof line, "%s %.3f %s %.3f", m.c_str(), 0.0, liar.c_str(), std::log(4.0));
@@ -275,6 +283,18 @@ TEST_F(CliTest, CommitteeWeighedOnTheMembersSets) {
   const auto missing = run(committee + " --weigh-on " + train + "," + sw + "," + (dir / "none").string());
   EXPECT_EQ(missing.code, 2);
   EXPECT_NE(missing.err.find("none"), std::string::npos) << missing.err;
+  // One set twice, under one spelling or two, would weigh each of its members on its own training
+  // set: refused naming both, as train --data refuses a folder pooled twice. It was accepted.
+  const std::string sw_again = (dir / "." / "swapped").string();
+  for (const std::string& again : {sw, sw_again}) {
+    const auto twice = run(committee + " --weigh-on " + train + "," + sw + "," + again);
+    EXPECT_EQ(twice.code, 2) << again;
+    EXPECT_NE(twice.err.find("--weigh-on names the dataset " + again + " twice" +
+                             (again == sw ? "" : " (as " + sw + " and " + again + ")") +
+                             ": each member must be weighed on the other members' training sets"),
+              std::string::npos)
+        << twice.err;
+  }
 }
 
 // The sweep writes accuracy against travel as CSV (one row per distance) and a PNG.
