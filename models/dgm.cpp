@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -77,6 +78,13 @@ namespace {
   throw ModelError(source + ": " + what);
 }
 
+// A number for a message, to 6 significant digits at any magnitude (1e-320 too).
+std::string short_number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", v);
+  return text;
+}
+
 // Longest string field the loader accepts (metadata, class names): keeps a corrupt length from
 // asking for gigabytes.
 constexpr uint32_t kMaxString = 65536;
@@ -107,7 +115,8 @@ void check_stochastic(const double* p, int n, const std::string& source, const s
 
 // Covariance [[a b][c d]]: symmetric (|b - c| <= 1e-12 max(|a|,|d|)) and positive definite,
 // i.e. a > 0 and det = a d - b^2 > 0 (Sylvester's criterion for 2x2), with det relative to a d
-// above 1e-12 so the inverse the filter precomputes is meaningful.
+// above 1e-12 so the inverse the filter precomputes is meaningful; and det a normal double and
+// that inverse (emission_terms) finite, so that it can be computed at all.
 void check_covariance(const GaussianEmission& e, const std::string& source, const std::string& what) {
   for (int r = 0; r < kFeatures; ++r) {
     check_finite(e.mean[r], source, what + " mean[" + std::to_string(r) + "]");
@@ -118,8 +127,20 @@ void check_covariance(const GaussianEmission& e, const std::string& source, cons
   if (std::fabs(b - c) > 1e-12 * std::max(std::fabs(a), std::fabs(d)))
     fail(source, what + " covariance is not symmetric");
   const double det = a * d - b * b;
-  if (!(a > 0.0) || !(d > 0.0) || !(det > 1e-12 * a * d))
-    fail(source, what + " covariance is not positive definite (det " + std::to_string(det) + ")");
+  const std::string text = short_number(det);  // to_string's %f said "det 0.000000" of 1e-20
+  if (!(a > 0.0) || !(d > 0.0) || !(det > 0.0))
+    fail(source, what + " covariance is not positive definite (det " + text + ")");
+  // Positive, but a d can overflow or sink below the normal doubles (so can det): the inverse and
+  // log-determinant that the filter and the trainer compute (emission_terms) are then inf, 0 or
+  // rounding's, every likelihood -inf or NaN, and the relative test below cannot see it.
+  if (!(det >= std::numeric_limits<double>::min() && det <= std::numeric_limits<double>::max()))
+    fail(source, what + " covariance is degenerate: its determinant " + text +
+                     " is outside the normal doubles, so its inverse and log-determinant are lost to rounding");
+  if (!(det > 1e-12 * a * d)) fail(source, what + " covariance is not positive definite (det " + text + ")");
+  const EmissionTerms t = emission_terms(e);
+  if (!std::isfinite(t.ip) || !std::isfinite(t.iq) || !std::isfinite(t.ir) || !std::isfinite(t.lconst))
+    fail(source, what + " covariance is degenerate: its inverse is not finite (det " + text + ", cov[0][0] " +
+                     short_number(a) + ", cov[1][1] " + short_number(d) + ")");
 }
 
 void check_features(const FeatureConvention& f, const std::string& source) {

@@ -57,10 +57,9 @@ void fix_crc(std::vector<uint8_t>& b) {
   for (int i = 0; i < 4; ++i) b[b.size() - 4 + i] = static_cast<uint8_t>(c >> (8 * i));
 }
 
-// Replaces the (unique) little-endian double `from` by `to` and repairs the CRC, so the check
-// under test is the semantic one, not the CRC.
-std::vector<uint8_t> patched(double from, double to) {
-  auto b = encode_model(sample_model());
+// Replaces the (unique) little-endian double `from` by `to` in `b`; patched() does so in the
+// sample model's bytes and repairs the CRC, so the check under test is the semantic one.
+void replace_double(std::vector<uint8_t>& b, double from, double to) {
   uint8_t f[8], t[8];
   std::memcpy(f, &from, 8);
   std::memcpy(t, &to, 8);
@@ -68,6 +67,10 @@ std::vector<uint8_t> patched(double from, double to) {
   for (size_t i = 0; i + 8 <= b.size(); ++i)
     if (std::memcmp(&b[i], f, 8) == 0) std::memcpy(&b[i], t, 8), ++hits;
   EXPECT_EQ(hits, 1) << "marker not unique";
+}
+std::vector<uint8_t> patched(double from, double to) {
+  auto b = encode_model(sample_model());
+  replace_double(b, from, to);
   fix_crc(b);
   return b;
 }
@@ -246,6 +249,44 @@ TEST(ModelFileRejects, TransitionRowNotSummingToOne) {
 TEST(ModelFileRejects, CovarianceNotPositiveDefinite) {
   expect_rejected(patched(0.6543210987, -0.5), "not positive definite");
   expect_rejected(patched(0.6543210987, 0.125 * 0.125 / 0.5), "not positive definite");  // det = 0
+}
+
+// A covariance positive definite by the relative test (det > 1e-12 a d) whose determinant or
+// inverse a double cannot hold: with a d overflowing, det is inf and the filter's log density is
+// -inf at every sample; with a d subnormal, det passes and its inverse is rounding's; with a at the
+// bottom of the subnormals, the inverse overflows and the density at the mean is NaN. Each was
+// accepted, in a file and on encode; each is named by class and state.
+TEST(ModelFileRejects, CovarianceADoubleCannotInvert) {
+  struct Case { double a, d; const char* want; };
+  const Case cases[] = {
+      {1e155, 1e155, "class 'good' state 5 covariance is degenerate: its determinant inf is outside the normal"},
+      {1e-160, 1e-160, "class 'good' state 5 covariance is degenerate: its determinant 9.99989e-321 is outside"},
+      {5e-324, 1e300, "class 'good' state 5 covariance is degenerate: its inverse is not finite (det 4.94066e-24"},
+  };
+  for (const Case& c : cases) {
+    // In a file: a valid model whose state 5 of 'good' holds two markers, patched to the case.
+    OutcomeModel m = sample_model();
+    GaussianEmission& e = m.classes[0].emission[5];
+    e.cov[0][1] = e.cov[1][0] = 0.0;
+    e.cov[0][0] = 0.4321098765;
+    auto b = encode_model(m);
+    replace_double(b, 0.4321098765, c.a);
+    replace_double(b, 0.6543210987, c.d);
+    fix_crc(b);
+    expect_rejected(b, c.want);
+    // On encode: never written.
+    e.cov[0][0] = c.a, e.cov[1][1] = c.d;
+    try {
+      encode_model(m);
+      ADD_FAILURE() << "encoded a model that should fail with: " << c.want;
+    } catch (const ModelError& err) {
+      EXPECT_NE(std::string(err.what()).find(c.want), std::string::npos) << err.what();
+    }
+  }
+  // The determinant in the message at any magnitude: one ulp of d from singular, det is 2^-58
+  // (it read "det 0.000000").
+  expect_rejected(patched(0.6543210987, std::nextafter(0.125 * 0.125 / 0.5, 1.0)),
+                  "not positive definite (det 3.46945e-18)");
 }
 
 TEST(ModelFileRejects, SemanticChecksOnEncode) {
