@@ -113,11 +113,23 @@ bool is_trial_file_name(const fs::path& p) {
   return e == ".txt";
 }
 
+// A trial is a pull's force sequence. One sample is none: it has no sampling period (the late
+// start's sample count would be guessed at 100 Hz) and classify would score one force as a whole
+// pull. `first_row` is the line of the first sample.
+void require_a_sequence(const std::vector<HapticSample>& samples, const fs::path& file, long first_row) {
+  if (samples.empty()) throw_input_error(file, 0, "no samples");
+  if (samples.size() == 1)
+    throw_input_error(file, first_row,
+                      "the only sample: a trial is a pull's force sequence, at least 2 samples (one has no "
+                      "sampling period, and classify would score one force as a whole pull)");
+}
+
 }  // namespace
 
 std::vector<HapticSample> read_trial_csv(const fs::path& path) {
   const std::string text = read_file(path);
   std::vector<HapticSample> out;
+  long first_row = 0;
   for_each_line(text, [&](std::string_view line, long n) {
     if (n == 1) {
       if (line != kTrialHeader) throw_input_error(path, 1, std::string("expected header '") + kTrialHeader + "'");
@@ -128,8 +140,9 @@ std::vector<HapticSample> read_trial_csv(const fs::path& path) {
     if (f.size() != 5) throw_input_error(path, n, "expected 5 columns, found " + std::to_string(f.size()));
     static constexpr const char* names[] = {"t", "travel", "f_motion", "f_lateral", "f_vertical"};
     append_sample(f, names, path, n, out);
+    if (out.size() == 1) first_row = n;
   });
-  if (out.empty()) throw_input_error(path, 0, "no samples");
+  require_a_sequence(out, path, first_row);
   return out;
 }
 
@@ -304,14 +317,16 @@ void save_dataset(const Dataset& ds, const fs::path& dir) {
 std::vector<HapticSample> read_study_trial(const fs::path& path) {
   const std::string text = read_file(path);
   std::vector<HapticSample> out;
+  long first_row = 0;
   for_each_line(text, [&](std::string_view line, long n) {
     const auto f = split_ws(line);
     if (f.empty()) return;
     if (f.size() != 5) throw_input_error(path, n, "expected 5 space-separated columns, found " + std::to_string(f.size()));
     static constexpr const char* names[] = {"t", "position", "F_motion", "F_lateral", "F_vertical"};
     append_sample(f, names, path, n, out);
+    if (out.size() == 1) first_row = n;
   });
-  if (out.empty()) throw_input_error(path, 0, "no samples");
+  require_a_sequence(out, path, first_row);
   return out;
 }
 

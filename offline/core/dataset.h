@@ -7,13 +7,14 @@
 //
 // Simulated and measured trials share the format, so every command reads both alike.
 //
-// What a reader accepts (else InputError naming file and line): every number finite; t
-// increasing; travel in [kMinTravel, kMaxTravel] metres, never going back by more than
-// kTravelJitter; each force within +-kMaxForce; speed in [kMinSpeed, kMaxSpeed] m/s; a trial
-// that starts late (haptic.h, unrecorded_samples) at most kMaxUnrecordedSamples into its pull;
-// a trial id and a file named once per manifest. The bounds are far outside any dressing pull;
-// what they catch is a unit slip (travel in mm, speed in mm/s) or a glitch, which would
-// otherwise train a model without a word or ask the HMMs for 10^300 unrecorded samples.
+// What a reader accepts (else InputError naming file and line): at least two samples per trial
+// (one is no force sequence); every number finite; t increasing; travel in [kMinTravel,
+// kMaxTravel] metres, never going back by more than kTravelJitter; each force within
+// +-kMaxForce; speed in [kMinSpeed, kMaxSpeed] m/s; a trial that starts late (haptic.h,
+// unrecorded_samples) at most kMaxUnrecordedSamples into its pull; a trial id and a file named
+// once per manifest. The bounds are far outside any dressing pull; what they catch is a unit
+// slip (travel in mm, speed in mm/s) or a glitch, which would otherwise train a model without a
+// word or ask the HMMs for 10^300 unrecorded samples.
 // A UTF-8 byte-order mark at the start of a file is skipped; CRLF line ends are accepted.
 #pragma once
 

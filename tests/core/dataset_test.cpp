@@ -156,12 +156,27 @@ TEST(DatasetRejects, ImplausibleValuesNameFileLineAndColumn) {
   EXPECT_EQ(load_error(dir, "0,0,0,0,0\n0.01,0.0105,0,0,0\n0.02,0.0100,0,0,0\n"), "");
 }
 
+// A trial of one sample is no force sequence: it has no sampling period and classify scored its
+// one force as a whole pull (and counted it in the accuracy). Refused at its only row, in a
+// dataset's trial and in a study trial (after a blank line: the row's own number); two load.
+TEST(DatasetRejects, ATrialOfOneSample) {
+  const TempDir tmp("one_sample");
+  const fs::path& dir = tmp.path;
+  EXPECT_TRUE(names(load_error(dir, "\n0,0.02,-0.1,0,0.05\n"),
+                    "a.csv:3: the only sample: a trial is a pull's force sequence, at least 2 samples"));
+  EXPECT_EQ(load_error(dir, "0,0.02,-0.1,0,0.05\n0.01,0.021,-0.1,0,0.05\n"), "");
+  write_text(dir / "1.txt", "0 0 0 0 0\n");
+  EXPECT_TRUE(names(input_error_of([&] { read_study_trial(dir / "1.txt"); }), "1.txt:1: the only sample"));
+  write_text(dir / "1.txt", "0 0 0 0 0\n0.01 0.001 -0.1 0 0\n");
+  EXPECT_EQ(read_study_trial(dir / "1.txt").size(), 2u);
+}
+
 TEST(DatasetRejects, EmptyManifestRepeatedFileAndFolders) {
   const TempDir tmp("manifest");
   const fs::path& dir = tmp.path;
   write_text(dir / "manifest.csv", "");
   EXPECT_TRUE(names(input_error_of([&] { load_dataset(dir); }), "manifest.csv: empty file"));
-  write_text(dir / "a.csv", std::string(kTrialHead) + "0,0,0,0,0\n");
+  write_text(dir / "a.csv", std::string(kTrialHead) + "0,0,0,0,0\n0.01,0.001,0,0,0\n");
   write_text(dir / "manifest.csv", std::string(kManifestHead) + "a,1,high,0.1,good,a.csv\nb,1,high,0.1,good,a.csv\n");
   EXPECT_TRUE(names(input_error_of([&] { load_dataset(dir); }), "manifest.csv:3: file 'a.csv' repeats line 2"));
   fs::create_directories(dir / "sub");
