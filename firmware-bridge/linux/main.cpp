@@ -50,7 +50,8 @@ const char* kUsage =
     "  --period-ms N           sampling period (default 10: 100 Hz); with rtu-stream the sensor's frames\n"
     "                          set the rate, and this is the period of the heartbeat and of the checks\n"
     "  --robot SPEC            robot controller, tcp:HOST:PORT or rtu:... (not the sensor's device; its\n"
-    "                          response timeout is 100 ms); none: stops are only logged\n"
+    "                          response timeout is 100 ms); none: stops are only logged. Its stop target is\n"
+    "                          read once at start: one it lacks exits 2, no answer is a warning\n"
     "  --robot-slave N         its unit id, as --sensor-slave (default 1)\n"
     "  --stop-coil ADDR        write the stop as coil ADDR = ON (default: coil 0)\n"
     "  --stop-register ADDR=V  write the stop as holding register ADDR = V instead\n"
@@ -138,6 +139,33 @@ bool same_serial_device(const EndpointParts& a, const EndpointParts& b) {
   struct stat sa {}, sb {};
   return stat(a.where.c_str(), &sa) == 0 && stat(b.where.c_str(), &sb) == 0 && sa.st_dev == sb.st_dev &&
          sa.st_ino == sb.st_ino;
+}
+
+// The robot's link, tried once at start, before the CAN socket is opened and the loop runs: a
+// target the controller does not have is refused (every stop would fail on it, found when an arm
+// is caught); a controller that does not answer is said, not refused (it may not be powered
+// yet); a stop already set is said too. 0, or 2 when refused.
+int probe_robot(RobotStopWriter& robot, const StopTarget& target) {
+  const std::string what = stop_target_name(target);
+  const char* option = target.coil ? "--stop-coil" : "--stop-register";
+  const ProbeResult said = robot.probe();
+  const std::string& why = robot.link().last_error();
+  switch (said) {
+    case ProbeResult::NoSuchTarget:
+      return bad(std::string(option) + ": the robot controller has no " + what + " (" + why + ")");
+    case ProbeResult::Failed:
+      std::fprintf(stderr,
+                   "dressguard-bridge: warning: the robot controller did not answer a read of its %s (%s): it may "
+                   "not be powered yet; until it answers, a stop cannot reach it\n",
+                   what.c_str(), why.c_str());
+      break;
+    case ProbeResult::StopSet:
+      std::fprintf(stderr, "dressguard-bridge: warning: the robot controller's %s (%s) says stop already, left from "
+                   "an earlier run\n", what.c_str(), robot.link().endpoint().spec.c_str());
+      break;
+    case ProbeResult::Clear: break;
+  }
+  return 0;
 }
 
 }  // namespace
@@ -239,6 +267,12 @@ int main(int argc, char** argv) {
     std::fprintf(stderr,
                  "dressguard-bridge: warning: --predictor-timeout-ms 0: a predictor that goes silent or misses a "
                  "trial does not stop the robot (a deployment sets it, e.g. 300)\n");
+  std::unique_ptr<RobotStopWriter> robot;
+  if (!robot_spec.empty()) {
+    robot_ep.spec = robot_spec;
+    robot = std::make_unique<RobotStopWriter>(robot_ep, target);
+    if (const int rc = probe_robot(*robot, target); rc != 0) return rc;
+  }
   try {
     can::PortOptions opt;
     opt.ids.assign(std::begin(kBridgeReceives), std::end(kBridgeReceives));
@@ -251,11 +285,6 @@ int main(int argc, char** argv) {
       sensor = std::move(s);
     } else {
       sensor = std::make_unique<ModbusSensor>(sensor_ep, map);
-    }
-    std::unique_ptr<RobotStopWriter> robot;
-    if (!robot_spec.empty()) {
-      robot_ep.spec = robot_spec;
-      robot = std::make_unique<RobotStopWriter>(robot_ep, target);
     }
     BridgeApp app(cfg, *sensor, robot.get(), *port);
     g_app = &app;

@@ -174,6 +174,22 @@ ReadResult ModbusSensor::read(FtReading& out) {
   return ReadResult::Ok;
 }
 
+std::string stop_target_name(const StopTarget& t) {
+  return (t.coil ? "coil " : "holding register ") + std::to_string(t.address);
+}
+
+ProbeResult RobotStopWriter::probe() {
+  if (!link_.connected() && !link_.connect()) return ProbeResult::Failed;
+  uint8_t bit = 0;
+  uint16_t reg = 0;
+  const int rc = target_.coil ? modbus_read_bits(link_.ctx(), target_.address, 1, &bit)
+                              : modbus_read_registers(link_.ctx(), target_.address, 1, &reg);
+  if (rc == 1) return (target_.coil ? bit != 0 : reg == target_.value) ? ProbeResult::StopSet : ProbeResult::Clear;
+  const int e = errno;
+  link_.classify_failure();
+  return e == EMBXILADD ? ProbeResult::NoSuchTarget : ProbeResult::Failed;
+}
+
 bool RobotStopWriter::write_stop() {
   for (int attempt = 0; attempt < 2; ++attempt) {
     if (!link_.connected() && !link_.connect()) continue;

@@ -123,6 +123,17 @@ struct StopTarget {
   int address = 0;
   int value = 1;  // register value (a coil is written ON)
 };
+// "coil 7", "holding register 7": the target as the log and the errors name it.
+std::string stop_target_name(const StopTarget& t);
+
+// What the robot controller said when the bridge read its stop target at start
+// (RobotStopWriter::probe).
+enum class ProbeResult : uint8_t {
+  Clear = 0,         // it answered: no stop set
+  StopSet = 1,       // it answered: the stop is set already (left from an earlier run)
+  NoSuchTarget = 2,  // it has no such coil or register (Modbus exception 02, illegal data address)
+  Failed = 3,        // no connection or no answer (it may not be powered yet), or another exception
+};
 
 class RobotStopWriter {
  public:
@@ -130,6 +141,11 @@ class RobotStopWriter {
   ModbusLink& link() { return link_; }
   // Writes the stop; reconnects once if needed. False with link().last_error() on failure.
   bool write_stop();
+  // Once at start, before the loop: connects and reads the target (FC01 for a coil, FC03 for a
+  // register), so that a wrong endpoint, unit id or address is found then, not when an arm is
+  // caught. link().last_error() says why for NoSuchTarget and Failed; the link stays open when
+  // the controller answered (the first stop then needs no connect).
+  ProbeResult probe();
 
  private:
   ModbusLink link_;

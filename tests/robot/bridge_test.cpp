@@ -742,6 +742,34 @@ TEST(BridgeModbus, StopFrameWritesTheRobotsStopCoil) {
   EXPECT_NE(mbpoll(coil).find("[7]: \t1"), std::string::npos) << mbpoll(coil);
 }
 
+// The robot's stop target is read once at start (dressguard-bridge's main, before the loop): the
+// link used to be first used at the first stop, so a wrong address or a controller that was off
+// was found when an arm was caught. An address the controller lacks is told apart (main refuses
+// it) from a controller that does not answer (main warns: it may not be powered yet), and a stop
+// left set is seen.
+TEST(BridgeModbus, TheRobotsStopTargetIsProbedAtStart) {
+  Emulator robot_emu;
+  ASSERT_GT(robot_emu.port(), 0);
+  const ModbusEndpoint ep{robot_emu.spec(), 1, 200};
+  RobotStopWriter coil(ep, StopTarget{true, 7, 1});
+  EXPECT_EQ(coil.probe(), ProbeResult::Clear) << coil.link().last_error();
+  EXPECT_TRUE(coil.link().connected()) << "the first stop would have to connect";
+  ASSERT_TRUE(coil.write_stop());
+  EXPECT_EQ(RobotStopWriter(ep, StopTarget{true, 7, 1}).probe(), ProbeResult::StopSet);
+  ASSERT_TRUE(robot_emu.write(20, {5}));
+  EXPECT_EQ(RobotStopWriter(ep, StopTarget{false, 20, 5}).probe(), ProbeResult::StopSet);
+  EXPECT_EQ(RobotStopWriter(ep, StopTarget{false, 20, 6}).probe(), ProbeResult::Clear);
+  // The emulator has 1000 coils and registers.
+  RobotStopWriter absent(ep, StopTarget{true, 5000, 1});
+  EXPECT_EQ(absent.probe(), ProbeResult::NoSuchTarget);
+  EXPECT_NE(absent.link().last_error().find("Illegal data address"), std::string::npos) << absent.link().last_error();
+  EXPECT_EQ(RobotStopWriter(ep, StopTarget{false, 5000, 1}).probe(), ProbeResult::NoSuchTarget);
+  RobotStopWriter nobody(ModbusEndpoint{"tcp:127.0.0.1:1", 1, 200}, StopTarget{true, 7, 1});
+  EXPECT_EQ(nobody.probe(), ProbeResult::Failed);
+  EXPECT_NE(nobody.link().last_error().find("Connection refused"), std::string::npos) << nobody.link().last_error();
+  EXPECT_EQ(stop_target_name(StopTarget{false, 20, 5}), "holding register 20");
+}
+
 // Shutdown with a stop that the robot controller has not received: the bridge is the only way
 // to the robot, so it keeps retrying the write through its grace instead of returning at once.
 // The robot controller is dark for 300 ms (emulator mode 3) when the stop comes and SIGTERM
