@@ -122,11 +122,12 @@ BridgeAction bridge_on_frame(BridgeCore& c, const Frame& f, uint32_t now_ms) {
       c.trial_guarded = false;
       c.unguarded_since_ms = now_ms;
       // A new trial releases a latch whose stop reached the robot (the robot controller restarts
-      // the motion itself); one still unwritten stands (bridge_core.h).
+      // the motion itself), and the robot's stop target is cleared with it (also one left set
+      // from before the bridge started); one still unwritten stands (bridge_core.h).
       if (c.stop_cause != StopCause::None && !c.stop_written) return BridgeAction::None;
       c.stop_cause = StopCause::None;
       c.last_stop_reason = protocol::StopReason::None;
-      return BridgeAction::None;
+      return BridgeAction::ReleaseRobot;
     }
     case protocol::id_of(protocol::MsgId::TrialEnd): {
       if (!trial_frame_accepted(c, c.trial_end_checker, f, now_ms)) return BridgeAction::None;

@@ -16,7 +16,9 @@
 //     the latch until the next TrialStart frame on the bus, once the port has written the stop
 //     (bridge_on_stop_written); a stop the robot never received is not released by a trial
 //     start, so it is neither lost nor written into the next trial unannounced: the heartbeat
-//     says StopLatched until it is written;
+//     says StopLatched until it is written; a TrialStart that leaves no stop latched tells the
+//     port to clear the robot's stop (ReleaseRobot: the robot's stop target mirrors the latch,
+//     so a robot program that acts on the rising edge sees every stop);
 //   - trial starts and the predictor's heartbeat are sporadic streams whose sender may restart:
 //     their E2E checkers resynchronise after protocol::kSporadicResyncMs of silence;
 //   - optionally (predictor_timeout_ms > 0), the predictor is watched, and the robot must not
@@ -62,6 +64,9 @@ struct BridgeConfig {
 enum class BridgeAction : uint8_t {
   None = 0,
   StopRobot = 1,     // newly latched: write the stop to the robot controller now
+  // A TrialStart left no stop latched (it released one, or none was): clear the robot's stop
+  // target. It mirrors the latch, and only the robot controller's own TrialStart clears it.
+  ReleaseRobot = 2,
 };
 
 enum class StopCause : uint8_t { None = 0, StopFrame = 1, PredictorSilent = 2, BridgeShutdown = 3, TrialUnguarded = 4 };

@@ -122,8 +122,36 @@ void BridgeApp::stop_robot(uint32_t t) {
     case StopCause::BridgeShutdown:  // begin_shutdown says it
     case StopCause::None: break;
   }
+  // A clear not yet written is superseded: written after this stop, it would take it back.
+  release_pending_ = false;
   stop_pending_ = true;
   next_stop_try_ms_ = t;
+}
+
+// The robot controller's TrialStart left no stop latched: its stop target is cleared, so that it
+// mirrors the latch (and the next stop is a rising edge), retried as a stop is.
+void BridgeApp::release_robot(uint32_t t) {
+  if (!robot_) return;
+  release_pending_ = true;
+  next_stop_try_ms_ = t;
+}
+
+void BridgeApp::try_release(uint32_t t) {
+  if (!release_pending_ || !due(t, next_stop_try_ms_)) return;
+  if (robot_->write_release()) {
+    release_pending_ = false;
+    ++stats_.releases_written;
+    if (release_failures_)
+      say("stop cleared on the robot controller after %llu failed writes",
+          static_cast<unsigned long long>(release_failures_));
+    release_failures_ = 0;
+    return;
+  }
+  ++stats_.release_write_failures;
+  if (power_of_two(++release_failures_))
+    say("clearing the stop failed: %s (%llu in a row; retried every %d ms; the robot still reads a stop)",
+        robot_->link().last_error().c_str(), static_cast<unsigned long long>(release_failures_), cfg_.stop_retry_ms);
+  next_stop_try_ms_ = t + static_cast<uint32_t>(cfg_.stop_retry_ms);
 }
 
 void BridgeApp::try_stop(uint32_t t) {
@@ -219,6 +247,7 @@ void BridgeApp::on_timer(uint32_t t) {
   if (bridge_on_tick(core_, t, &hb, &a)) send(hb);
   if (a == BridgeAction::StopRobot) stop_robot(t);
   try_stop(t);
+  try_release(t);
 }
 
 // The loop came back to the timer more than a period late (a read longer than a period, a busy
@@ -274,9 +303,12 @@ void BridgeApp::drain_can(uint32_t t) {
   can::RxInfo info;
   for (int n = 0; n < 64 && received(port_.receive(f, info), info); ++n) {
     if (info.error_frame || info.own_echo) continue;
-    if (bridge_on_frame(core_, f, t) == BridgeAction::StopRobot) stop_robot(t);
+    const BridgeAction a = bridge_on_frame(core_, f, t);
+    if (a == BridgeAction::StopRobot) stop_robot(t);
+    else if (a == BridgeAction::ReleaseRobot) release_robot(t);
   }
   try_stop(t);  // in the same wakeup as the stop frame
+  try_release(t);
 }
 
 void BridgeApp::begin_shutdown(uint32_t t) {

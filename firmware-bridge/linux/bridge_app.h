@@ -38,6 +38,8 @@ struct BridgeAppConfig {
 struct BridgeStats {
   std::atomic<uint64_t> readings{0}, frames_sent{0}, send_failures{0}, sensor_errors{0}, reconnects{0},
       connect_failures{0}, stops_written{0}, stop_write_failures{0};
+  // The robot's stop target cleared at a TrialStart that left no stop latched, and failed tries.
+  std::atomic<uint64_t> releases_written{0}, release_write_failures{0};
   // Wakeups that found the timer expired more than once, and the periods they skipped.
   std::atomic<uint64_t> overruns{0}, periods_overrun{0};
   std::atomic<uint64_t> receive_failures{0}, error_frames{0};
@@ -69,6 +71,8 @@ class BridgeApp {
   void send(const Frame& f);
   void try_stop(uint32_t now_ms);
   void stop_robot(uint32_t now_ms);
+  void release_robot(uint32_t now_ms);
+  void try_release(uint32_t now_ms);
   void begin_shutdown(uint32_t now_ms);
   int loop_failed(int err);
   void say_stop_unwritten();
@@ -88,6 +92,8 @@ class BridgeApp {
   uint32_t next_stop_try_ms_ = 0;
   uint64_t sensor_failures_ = 0;  // in a row, since the last good reading
   uint64_t stop_failures_ = 0;    // in a row, for the pending stop
+  bool release_pending_ = false;  // the robot's stop target is to be cleared (never with a stop pending)
+  uint64_t release_failures_ = 0; // in a row, for the pending release
   uint64_t send_failures_ = 0;    // CAN sends, in a row
   uint64_t receive_failures_ = 0; // CAN receives, in a row
   uint64_t error_frames_ = 0;     // since the controller's last restart

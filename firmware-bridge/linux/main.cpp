@@ -53,8 +53,9 @@ const char* kUsage =
     "                          response timeout is 100 ms); none: stops are only logged. Its stop target is\n"
     "                          read once at start: one it lacks exits 2, no answer is a warning\n"
     "  --robot-slave N         its unit id, as --sensor-slave (default 1)\n"
-    "  --stop-coil ADDR        write the stop as coil ADDR = ON (default: coil 0)\n"
-    "  --stop-register ADDR=V  write the stop as holding register ADDR = V instead\n"
+    "  --stop-coil ADDR        write the stop as coil ADDR = ON (default: coil 0); it mirrors the stop\n"
+    "                          latch: OFF when the robot's next TrialStart releases it (PROTOCOL.md, Stop)\n"
+    "  --stop-register ADDR=V  write the stop as holding register ADDR = V (1-65535) instead, 0 to clear it\n"
     "  --predictor-timeout-ms N  stop the robot when the predictor's heartbeat is silent this long, or\n"
     "                          does not name the robot's running trial (TrialStart to TrialEnd) for this\n"
     "                          long: 0 (off, the default) or 200-60000\n"
@@ -161,7 +162,8 @@ int probe_robot(RobotStopWriter& robot, const StopTarget& target) {
       break;
     case ProbeResult::StopSet:
       std::fprintf(stderr, "dressguard-bridge: warning: the robot controller's %s (%s) says stop already, left from "
-                   "an earlier run\n", what.c_str(), robot.link().endpoint().spec.c_str());
+                   "an earlier run: the robot's next TrialStart clears it\n", what.c_str(),
+                   robot.link().endpoint().spec.c_str());
       break;
     case ProbeResult::Clear: break;
   }
@@ -212,6 +214,8 @@ int main(int argc, char** argv) {
       if (eq == std::string::npos || !to_int(v.substr(0, eq), addr) || !to_int(v.substr(eq + 1), val) || addr < 0 ||
           addr > 65535 || val < 0 || val > 65535)
         return bad("--stop-register: '" + v + "' is not ADDR=VALUE");
+      // 0 is what the bridge writes when a TrialStart releases the stop: a stop of 0 would never show.
+      if (val == 0) return bad("--stop-register: '" + v + "': the value 0 clears the stop (give 1-65535)");
       target = {false, static_cast<int>(addr), static_cast<int>(val)};
     } else {
       const Range* r = range_of(a);
@@ -307,12 +311,13 @@ int main(int argc, char** argv) {
     const auto& s = app.stats();
     std::fprintf(stderr,
                  "dressguard-bridge: readings=%llu frames=%llu send_failures=%llu sensor_errors=%llu reconnects=%llu "
-                 "stops_written=%llu stop_write_failures=%llu overruns=%llu (%llu periods) receive_failures=%llu "
-                 "error_frames=%llu\n",
+                 "stops_written=%llu stop_write_failures=%llu releases_written=%llu release_write_failures=%llu "
+                 "overruns=%llu (%llu periods) receive_failures=%llu error_frames=%llu\n",
                  (unsigned long long)s.readings.load(), (unsigned long long)s.frames_sent.load(),
                  (unsigned long long)s.send_failures.load(), (unsigned long long)s.sensor_errors.load(),
                  (unsigned long long)s.reconnects.load(), (unsigned long long)s.stops_written.load(),
-                 (unsigned long long)s.stop_write_failures.load(), (unsigned long long)s.overruns.load(),
+                 (unsigned long long)s.stop_write_failures.load(), (unsigned long long)s.releases_written.load(),
+                 (unsigned long long)s.release_write_failures.load(), (unsigned long long)s.overruns.load(),
                  (unsigned long long)s.periods_overrun.load(), (unsigned long long)s.receive_failures.load(),
                  (unsigned long long)s.error_frames.load());
     if (ft300)

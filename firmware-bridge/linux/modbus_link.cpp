@@ -190,11 +190,12 @@ ProbeResult RobotStopWriter::probe() {
   return e == EMBXILADD ? ProbeResult::NoSuchTarget : ProbeResult::Failed;
 }
 
-bool RobotStopWriter::write_stop() {
+bool RobotStopWriter::write_target(bool stop) {
+  const uint16_t value = stop ? static_cast<uint16_t>(target_.value) : 0;
   for (int attempt = 0; attempt < 2; ++attempt) {
     if (!link_.connected() && !link_.connect()) continue;
-    const int rc = target_.coil ? modbus_write_bit(link_.ctx(), target_.address, 1)
-                                : modbus_write_register(link_.ctx(), target_.address, static_cast<uint16_t>(target_.value));
+    const int rc = target_.coil ? modbus_write_bit(link_.ctx(), target_.address, stop ? 1 : 0)
+                                : modbus_write_register(link_.ctx(), target_.address, value);
     if (rc == 1) return true;
     link_.classify_failure();
   }

@@ -117,11 +117,13 @@ class ModbusSensor : public Sensor {
   SensorMap map_;
 };
 
-// How the stop reaches the robot controller: a coil (FC05) or a holding register (FC06).
+// How the stop reaches the robot controller: a coil (FC05) or a holding register (FC06). It
+// mirrors the bridge's latch: set (coil ON, register = value) when a stop is latched, clear
+// (coil OFF, register 0) when the robot controller's TrialStart leaves none (PROTOCOL.md, Stop).
 struct StopTarget {
   bool coil = true;
   int address = 0;
-  int value = 1;  // register value (a coil is written ON)
+  int value = 1;  // register value, not 0 (a coil is written ON)
 };
 // "coil 7", "holding register 7": the target as the log and the errors name it.
 std::string stop_target_name(const StopTarget& t);
@@ -140,7 +142,9 @@ class RobotStopWriter {
   RobotStopWriter(ModbusEndpoint ep, StopTarget t) : link_(std::move(ep)), target_(t) {}
   ModbusLink& link() { return link_; }
   // Writes the stop; reconnects once if needed. False with link().last_error() on failure.
-  bool write_stop();
+  bool write_stop() { return write_target(true); }
+  // Clears it (coil OFF, register 0), as write_stop writes it.
+  bool write_release() { return write_target(false); }
   // Once at start, before the loop: connects and reads the target (FC01 for a coil, FC03 for a
   // register), so that a wrong endpoint, unit id or address is found then, not when an arm is
   // caught. link().last_error() says why for NoSuchTarget and Failed; the link stays open when
@@ -148,6 +152,8 @@ class RobotStopWriter {
   ProbeResult probe();
 
  private:
+  bool write_target(bool stop);
+
   ModbusLink link_;
   StopTarget target_;
 };

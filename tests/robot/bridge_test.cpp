@@ -179,6 +179,26 @@ TEST(BridgeCore, TrialStartKeepsAStopNotYetWritten) {
   EXPECT_TRUE(bridge_stop_latched(c));
 }
 
+// The robot's stop target mirrors the latch: a TrialStart that releases it, or finds none (a
+// target left set from before the bridge started), tells the port to clear it; one that keeps a
+// stop not yet written does not, and nor does any other frame.
+TEST(BridgeCore, ATrialStartThatLeavesNoStopClearsTheRobotsStop) {
+  BridgeCore c;
+  bridge_init(c, {}, 0);
+  const auto trial = [](uint8_t counter) {
+    return protocol::encode(protocol::TrialStart{counter, counter, 100, protocol::HeightClass::High});
+  };
+  EXPECT_EQ(bridge_on_frame(c, trial(0), 1), BridgeAction::ReleaseRobot) << "nothing latched";
+  EXPECT_EQ(bridge_on_frame(c, trial(0), 2), BridgeAction::None) << "a repeated frame is not accepted";
+  ASSERT_EQ(bridge_on_frame(c, protocol::encode(protocol::Stop{0, protocol::StopReason::Caught, 250, 1, 9}), 3),
+            BridgeAction::StopRobot);
+  EXPECT_EQ(bridge_on_frame(c, trial(1), 4), BridgeAction::None) << "the stop is not written yet";
+  bridge_on_stop_written(c);
+  EXPECT_EQ(bridge_on_frame(c, trial(2), 5), BridgeAction::ReleaseRobot);
+  EXPECT_EQ(bridge_on_frame(c, protocol::encode(protocol::TrialEnd{0, 2, 10, protocol::TrialEndReason::Completed}), 6),
+            BridgeAction::None);
+}
+
 // A robot controller or predictor that restarts counts from 0 again. After a silence of
 // protocol::kSporadicResyncMs its frames are heard at once; before, the E2E check discarded them
 // as late until the counter passed the old one (up to 128 trial starts: a latch that never
@@ -499,6 +519,7 @@ struct RigOptions {
   Sensor* own_sensor = nullptr;  // when given, read instead of a ModbusSensor
   int period_ms = 10;
   uint32_t predictor_timeout_ms = 0;
+  StopTarget stop_target{true, 7, 1};
 };
 
 struct BridgeRig {
@@ -522,7 +543,7 @@ struct BridgeRig {
     predictor = bus.open({{}, false, true});
     const std::string sensor_spec = o.sensor_spec.empty() ? sensor_emu.spec() : o.sensor_spec;
     sensor = std::make_unique<ModbusSensor>(ModbusEndpoint{sensor_spec, 9, o.sensor_timeout_ms}, SensorMap{});
-    robot = std::make_unique<RobotStopWriter>(ModbusEndpoint{robot_emu.spec(), 1, 200}, StopTarget{true, 7, 1});
+    robot = std::make_unique<RobotStopWriter>(ModbusEndpoint{robot_emu.spec(), 1, 200}, o.stop_target);
     BridgeAppConfig cfg;
     cfg.backoff_min_ms = 20;
     cfg.backoff_max_ms = 160;
@@ -768,6 +789,87 @@ TEST(BridgeModbus, TheRobotsStopTargetIsProbedAtStart) {
   EXPECT_EQ(nobody.probe(), ProbeResult::Failed);
   EXPECT_NE(nobody.link().last_error().find("Connection refused"), std::string::npos) << nobody.link().last_error();
   EXPECT_EQ(stop_target_name(StopTarget{false, 20, 5}), "holding register 20");
+}
+
+// What mbpoll, an independent Modbus client, reads at the robot's stop target: 1 set, 0 clear
+// (a register holding the target's value is 1), -1 nothing read.
+int robot_reads(const Emulator& robot, const StopTarget& t) {
+  const std::string out = mbpoll("-p " + std::to_string(robot.port()) + " -a 1 -r " + std::to_string(t.address) +
+                                 " -c 1 -t " + (t.coil ? "0" : "4") + " 127.0.0.1");
+  const std::string at = "[" + std::to_string(t.address) + "]: \t";
+  const size_t k = out.find(at);
+  if (k == std::string::npos) return -1;
+  return std::atoi(out.c_str() + k + at.size()) == (t.coil ? 1 : t.value) ? 1 : 0;
+}
+
+// Waits up to 1 s for the robot's stop target to read `want`: whether it did.
+bool robot_comes_to(const Emulator& robot, const StopTarget& t, int want) {
+  for (int i = 0; i < 50; ++i) {
+    if (robot_reads(robot, t) == want) return true;
+    std::this_thread::sleep_for(20ms);
+  }
+  return false;
+}
+
+// The robot's stop target mirrors the bridge's latch: set at a stop, cleared when the robot
+// controller's next TrialStart releases the latch, so a robot program that acts on the rising
+// edge sees every stop (the bridge used to write it ON and never OFF: the second stop was 1 -> 1,
+// no edge). One left set from an earlier run is cleared by the first TrialStart, not at start.
+// A coil, and a holding register (cleared to 0).
+TEST(BridgeModbus, SecondStopIsSeenByTheRobot) {
+  for (const StopTarget target : {StopTarget{true, 7, 1}, StopTarget{false, 20, 5}}) {
+    SCOPED_TRACE(stop_target_name(target));
+    RigOptions o;
+    o.stop_target = target;
+    BridgeRig rig(o);
+    ASSERT_GT(rig.robot_emu.port(), 0);
+    // Left set from an earlier run: the bridge does not clear it at start ...
+    ASSERT_TRUE(rig.robot_emu.write(20, {5}));
+    ASSERT_NE(mbpoll("-p " + std::to_string(rig.robot_emu.port()) + " -a 1 -r 7 -t 0 127.0.0.1 1").find("Written"),
+              std::string::npos);
+    std::this_thread::sleep_for(50ms);
+    EXPECT_EQ(robot_reads(rig.robot_emu, target), 1);
+    uint8_t trial = 0, stop = 0;
+    const auto start_trial = [&] {
+      rig.predictor->send(protocol::encode(protocol::TrialStart{trial, trial, 100, protocol::HeightClass::High}));
+      ++trial;
+    };
+    const auto stop_robot = [&] {
+      rig.predictor->send(protocol::encode(protocol::Stop{stop++, protocol::StopReason::Caught, 240, trial, 50}));
+    };
+    // ... the robot controller's first TrialStart does.
+    start_trial();
+    EXPECT_TRUE(robot_comes_to(rig.robot_emu, target, 0)) << rig.logged();
+    for (int k = 0; k < 2; ++k) {
+      stop_robot();
+      EXPECT_TRUE(robot_comes_to(rig.robot_emu, target, 1)) << "stop " << k << "\n" << rig.logged();
+      start_trial();
+      EXPECT_TRUE(robot_comes_to(rig.robot_emu, target, 0)) << "release " << k << "\n" << rig.logged();
+    }
+    stop_robot();
+    EXPECT_TRUE(robot_comes_to(rig.robot_emu, target, 1)) << rig.logged();
+    EXPECT_EQ(rig.app->stats().stops_written.load(), 3u);
+    EXPECT_EQ(rig.app->stats().releases_written.load(), 3u);
+  }
+}
+
+// A clear that could not be written yet (the robot controller dark when its TrialStart came) is
+// superseded by the next stop: written after the stop, it would take the stop back.
+TEST(BridgeModbus, AStopSupersedesAClearNotYetWritten) {
+  BridgeRig rig;
+  ASSERT_GT(rig.robot_emu.port(), 0);
+  const StopTarget target{true, 7, 1};
+  rig.predictor->send(protocol::encode(protocol::Stop{0, protocol::StopReason::Caught, 240, 1, 50}));
+  ASSERT_TRUE(robot_comes_to(rig.robot_emu, target, 1)) << rig.logged();
+  ASSERT_TRUE(rig.robot_emu.write(901, {300}));
+  ASSERT_TRUE(rig.robot_emu.write(900, {3}));
+  rig.predictor->send(protocol::encode(protocol::TrialStart{0, 2, 100, protocol::HeightClass::High}));
+  ASSERT_TRUE(rig.logs("clearing the stop failed")) << rig.logged();
+  rig.predictor->send(protocol::encode(protocol::Stop{1, protocol::StopReason::Caught, 240, 2, 50}));
+  ASSERT_TRUE(rig.logs("stop written to the robot controller (after failed writes)", 2000ms)) << rig.logged();
+  std::this_thread::sleep_for(100ms);  // a clear still pending would be written by now
+  EXPECT_EQ(robot_reads(rig.robot_emu, target), 1) << rig.logged();
+  EXPECT_EQ(rig.app->stats().releases_written.load(), 0u) << rig.logged();
 }
 
 // Shutdown with a stop that the robot controller has not received: the bridge is the only way

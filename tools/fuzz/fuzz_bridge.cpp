@@ -123,8 +123,8 @@ bool resyncs(const Shadow& sh, uint32_t then) {
   return static_cast<uint32_t>(sh.now - then) > protocol::kSporadicResyncMs;
 }
 
-// Any other frame: a TrialStart accepted by its E2E check releases a written latch and starts
-// a trial, an accepted TrialEnd of its id ends it; a predictor heartbeat accepted by its check
+// Any other frame: a TrialStart accepted by its E2E check releases a written latch (and then
+// clears the robot's stop) and starts a trial, an accepted TrialEnd of its id ends it; a predictor heartbeat accepted by its check
 // restarts the silence clock and says whether the trial is guarded; nothing asks for a stop.
 void other_frame(const Frame& f, BridgeCore& c, Shadow& sh, long op) {
   uint32_t lost = 0;
@@ -139,8 +139,15 @@ void other_frame(const Frame& f, BridgeCore& c, Shadow& sh, long op) {
   const bool trial_ok = is(f, MsgId::TrialStart) && protocol::accepted(sh.trial_e2e.check(f, lost));
   const bool end_ok = is(f, MsgId::TrialEnd) && protocol::accepted(sh.end_e2e.check(f, lost));
   const bool hb_ok = is(f, MsgId::HeartbeatPredictor) && protocol::accepted(sh.hb_e2e.check(f, lost));
-  if (bridge::bridge_on_frame(c, f, sh.now) != BridgeAction::None) broken("a frame other than a stop stopped the robot", op);
+  const BridgeAction a = bridge::bridge_on_frame(c, f, sh.now);
+  if (a == BridgeAction::StopRobot) broken("a frame other than a stop stopped the robot", op);
   if (trial_ok && (!sh.latched || sh.written)) sh.latched = false;
+  // The robot's stop target mirrors the latch: cleared by an accepted TrialStart that leaves
+  // none, and by nothing else.
+  const bool clears = trial_ok && !sh.latched;
+  if ((a == BridgeAction::ReleaseRobot) != clears)
+    broken(clears ? "a trial start that left no stop latched did not clear the robot's stop"
+                  : "the robot's stop was cleared with a stop latched or without an accepted trial start", op);
   if (protocol::TrialStart m; trial_ok && protocol::decode(f, m)) {
     sh.trial_running = true;
     sh.trial_id = m.trial_id;

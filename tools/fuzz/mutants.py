@@ -195,6 +195,12 @@ BRIDGE_FAULTS = [
     ("missed periods past the cap (read as a late frame)",
      "c.periods_missed += periods < room ? periods : room;",
      "c.periods_missed += periods;"),
+    ("a trial start does not clear the robot's stop",
+     "return BridgeAction::ReleaseRobot;",
+     "return BridgeAction::None;"),
+    ("the robot's stop cleared while a stop not yet written stands",
+     "if (c.stop_cause != StopCause::None && !c.stop_written) return BridgeAction::None;",
+     "if (c.stop_cause != StopCause::None && !c.stop_written) return BridgeAction::ReleaseRobot;"),
 ]
 
 # target: (the core the faults go into, the other sources, include folders, the faults)
