@@ -83,8 +83,9 @@ int run_gown(int argc, char** argv) {
         "  with the paper's gripper and arm, and prints its statistics.\n"
         "  --obj FILE      mesh to load (default: shared/data/gown/fullgown.obj when present,\n"
         "                  else the project's parametric gown)\n"
-        "  --scale S       file units -> metres (default 1.679, the paper's)\n"
-        "  --in-world      the OBJ is already placed in W (as --out writes it; use --scale 1)\n"
+        "  --scale S       file units -> metres (default 1.679, the paper's; 1 for a file --out wrote,\n"
+        "                  whose first line says it is in metres, and refused there unless 1)\n"
+        "  --in-world      the OBJ is already placed in W (as --out writes it)\n"
         "  --placement P   opening (default: the jaws hold the sleeve's top from 4 cm behind its rim,\n"
         "                  the opening facing the fist) or paper (the paper's code's transform, as\n"
         "                  read); a placement whose jaws hold no vertex is refused (exit 2)\n"
@@ -110,8 +111,11 @@ int run_gown(int argc, char** argv) {
     if (args.has("parametric") && args.has(o))
       throw UsageError(std::string("--parametric and --") + o + " exclude each other");
   gown::GownOptions opt;
-  opt.scale = args.number("scale", 1.679);
-  if (!(opt.scale > 0)) throw UsageError("--scale must be positive");
+  // Unset, the file's own (gown.h, read_obj): a file --out wrote is in metres.
+  if (args.has("scale")) {
+    opt.scale = args.number("scale", 0);
+    if (!(*opt.scale > 0)) throw UsageError("--scale must be positive");
+  }
   const long reduced = args.integer("reduced", 0);
   if (reduced < 0 || (reduced > 0 && reduced < 100)) throw UsageError("--reduced wants 0 (full) or at least 100 triangles");
   opt.target_triangles = static_cast<int>(reduced);

@@ -11,7 +11,7 @@
 // GownPlacement::Opening); the paper's code's own transform is GownPlacement::Paper.
 //
 // How the simulator uses it:
-//   GownOptions opt;                       // defaults: measured gown if present, scale 1.679
+//   GownOptions opt;                       // defaults: measured gown if present, its scale 1.679
 //   opt.target_triangles = 5000;           // or 0 for the full 20k-triangle mesh
 //   GownMesh g = load_gown(opt);           // placed in W, loops found, sleeve labelled
 //   auto m = vertex_masses(g);             // lumped (the paper's simulator gives every particle
@@ -27,6 +27,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
@@ -50,12 +51,15 @@ struct GownMesh {
 struct GownOptions {
   std::filesystem::path obj;  // empty: the measured gown shared/data/gown/fullgown.obj if present,
                               // else the parametric gown
-  double scale = 1.679;       // file units -> metres (the paper's simulator)
+  // File units -> metres. Unset: the file's own, 1 for one to_obj wrote (its first line says it
+  // is in metres, kObjMetresHeader), else kMeasuredGownScale. read_obj refuses any other than 1
+  // for a file in metres.
+  std::optional<double> scale;
   int target_triangles = 0;   // 0: full resolution; e.g. 5000 for the reduced gown
   double areal_density = 0.145;
   bool parametric = false;    // use the parametric gown even when the measured one is present
   bool already_in_W = false;  // the file is already placed in W (as `dressguard gown --out` writes
-                              // it, scale 1): skip the paper's transform
+                              // it, in metres): skip the paper's transform
   PaperScene scene{};         // placement of a file's mesh and the grasp box that picks the sleeve
   GownPlacement placement = GownPlacement::Opening;  // how a file's mesh is placed (placement.h)
   // How the jaws hold the sleeve (placement.h): unset, each gown's own (kOpeningGripDepth and
@@ -86,7 +90,10 @@ GownMesh load_gown(const GownOptions& options);
 // Reads v/f lines of an OBJ (1-based and negative indices; "f a/b/c", "a//c" and "a/b" forms;
 // polygons fan-triangulated from their first corner, and refused when that fan folds them, as
 // for a concave polygon whose first corner does not see the others; other lines ignored).
-// Positions are multiplied by `scale` and stay in the file's frame (no placement). Boundary loops
+// Positions are multiplied by `scale` and stay in the file's frame (no placement); unset, the
+// scale is 1 for a file whose first line is kObjMetresHeader (to_obj wrote it, in metres) and
+// kMeasuredGownScale for any other, and a file in metres with a scale other than 1 is refused at
+// line 1 (it was scaled a second time without a word: a 4.55 m^2 gown). Boundary loops
 // are found; the sleeve is not labelled. InputError names file:line on a malformed line or an
 // index out of range. Words are split at any isspace blank, '#' starts a comment anywhere on a
 // line, a line ends at LF, CRLF or a lone CR, and a coordinate may be subnormal.
@@ -99,7 +106,12 @@ GownMesh load_gown(const GownOptions& options);
 // skipped line that would shift every later index or drop faces.
 inline constexpr double kMaxObjCoordinate = 100.0;  // [m]
 inline constexpr double kMinObjFaceArea = 1e-12;    // [m^2]; the measured gown's smallest: 1e-5
-GownMesh read_obj(const std::filesystem::path& path, double scale);
+// File units -> metres of the measured gown (fullgown.obj), as the paper's simulator scales it.
+inline constexpr double kMeasuredGownScale = 1.679;
+// The first line to_obj writes: the file is in metres, placed in W.
+inline constexpr std::string_view kObjMetresHeader =
+    "# dressguard gown mesh, world frame W (z up, gripper moves along +x), metres";
+GownMesh read_obj(const std::filesystem::path& path, std::optional<double> scale = std::nullopt);
 
 // The project's own gown (no shared data needed): a body panel with a sleeve tube, the measured
 // gown's dimensions (area ~1.6 m^2, sleeve opening perimeter 0.47 m, ~1.4 cm mean edge), already
@@ -148,7 +160,8 @@ double max_distance_to_surface(const GownMesh& from, const GownMesh& to, double 
 // The smallest interior angle of any triangle [rad] (slivers have small ones).
 double min_triangle_angle(const GownMesh& mesh);
 
-// The whole mesh as OBJ text (v and f lines, 1-based), for `dressguard gown --out` and frames.
+// The whole mesh as OBJ text (v and f lines, 1-based), for `dressguard gown --out`: the first
+// line is kObjMetresHeader, so read_obj takes it at scale 1.
 std::string to_obj(const GownMesh& mesh);
 
 }  // namespace dressguard::gown

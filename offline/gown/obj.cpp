@@ -145,16 +145,37 @@ void check_fan(const GownMesh& mesh, const std::vector<int>& idx, const std::fil
                                              " face opposite ways; split it into triangles");
 }
 
+// Whether the text's first line (after a byte-order mark, up to trailing blanks) is the one
+// to_obj writes: the file is in metres.
+bool says_metres(std::string_view text, size_t start) {
+  std::string_view first = text.substr(start, text.find_first_of("\r\n", start) - start);
+  while (!first.empty() && is_space(first.back())) first.remove_suffix(1);
+  return first == kObjMetresHeader;
+}
+
+// The scale of a file whose first line says whether it is in metres: 1 for one that does, when
+// unset or asked for; a file in metres scaled by anything else was `gown --out`'s placed gown
+// read back with the measured gown's default 1.679, a 4.55 m^2 gown and no word said.
+double file_scale(const std::filesystem::path& path, bool in_metres, std::optional<double> scale) {
+  if (!in_metres) return scale.value_or(kMeasuredGownScale);
+  if (scale && *scale != 1.0)
+    throw_input_error(path, 1, "the file says it is in metres (as `dressguard gown --out` writes it): its scale is 1, "
+                               "not " + format_number(*scale) + " (delete this line to scale it)");
+  return 1.0;
+}
+
 }  // namespace
 
-GownMesh read_obj(const std::filesystem::path& path, double scale) {
-  if (!(scale > 0)) throw_input_error(path, 0, "scale must be positive, got " + format_number(scale));
+GownMesh read_obj(const std::filesystem::path& path, std::optional<double> asked_scale) {
+  if (asked_scale && !(*asked_scale > 0))
+    throw_input_error(path, 0, "scale must be positive, got " + format_number(*asked_scale));
   const std::string text = read_file(path);
   GownMesh mesh;
   std::vector<long> face_line;    // the line of each triangle, for the topology's messages
   std::vector<long> vertex_line;  // the line of each vertex
   long line_no = 0;
   size_t pos = text.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;  // a UTF-8 byte-order mark
+  const double scale = file_scale(path, says_metres(text, pos), asked_scale);
   while (pos < text.size()) {
     // A line ends at "\n", "\r\n" or a lone "\r" (old Mac files: read as one line, "no faces").
     size_t eol = text.find_first_of("\r\n", pos);
@@ -215,7 +236,7 @@ GownMesh read_obj(const std::filesystem::path& path, double scale) {
 }
 
 std::string to_obj(const GownMesh& mesh) {
-  std::string out = "# dressguard gown mesh, world frame W (z up, gripper moves along +x), metres\n";
+  std::string out = std::string(kObjMetresHeader) + "\n";  // read_obj then takes it at scale 1
   out.reserve(mesh.x.size() * 40 + mesh.triangles.size() * 24);
   char buf[96];
   for (const auto& p : mesh.x) {

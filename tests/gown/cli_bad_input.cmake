@@ -140,3 +140,27 @@ foreach(how "--out;${mine}" "--out;${CMAKE_CURRENT_BINARY_DIR}/./dg_gown_mine.ob
   endif()
 endforeach()
 file(REMOVE ${mine})
+# --out writes the placed gown in metres and says so on its first line: read back without --scale
+# it is the same gown (area and mass), not scaled by the measured gown's 1.679 a second time (a
+# 4.55 m^2 gown without a word), and a --scale other than 1 is refused naming the file's line 1.
+set(placed ${CMAKE_CURRENT_BINARY_DIR}/dg_gown_placed.obj)
+execute_process(COMMAND ${DG} gown --parametric --reduced 1500 --json --out ${placed} RESULT_VARIABLE rc1
+                OUTPUT_VARIABLE a)
+execute_process(COMMAND ${DG} gown --obj ${placed} --json RESULT_VARIABLE rc2 OUTPUT_VARIABLE b ERROR_VARIABLE err2)
+execute_process(COMMAND ${DG} gown --obj ${placed} --in-world --json RESULT_VARIABLE rc3 OUTPUT_VARIABLE c
+                ERROR_VARIABLE err3)
+execute_process(COMMAND ${DG} gown --obj ${placed} --scale 1.679 RESULT_VARIABLE rc4 ERROR_VARIABLE err4 OUTPUT_QUIET)
+file(REMOVE ${placed})
+foreach(key area_m2 mass_kg)
+  string(JSON want ERROR_VARIABLE e1 GET "${a}" ${key})
+  string(JSON back ERROR_VARIABLE e2 GET "${b}" ${key})
+  string(JSON world ERROR_VARIABLE e3 GET "${c}" ${key})
+  if(NOT rc1 EQUAL 0 OR NOT rc2 EQUAL 0 OR NOT rc3 EQUAL 0 OR NOT want STREQUAL back OR NOT want STREQUAL world)
+    message(FATAL_ERROR "gown --out read back without --scale: ${key} ${want} written, ${back} placed again, ${world} "
+                        "in W (rc ${rc1} ${rc2} ${rc3}): ${err2} ${err3}")
+  endif()
+endforeach()
+if(NOT rc4 EQUAL 2 OR NOT err4 MATCHES "dg_gown_placed.obj:1: the file says it is in metres.*not 1.679")
+  message(FATAL_ERROR "gown --obj OUT --scale 1.679: expected exit 2 naming the file's first line, got rc=${rc4}: "
+                      "${err4}")
+endif()

@@ -289,3 +289,47 @@ TEST(ToObj, RoundTripsThroughReadObj) {
   ASSERT_EQ(n.triangles, m.triangles);
   for (size_t i = 0; i < m.x.size(); ++i) EXPECT_NEAR((n.x[i] - m.x[i]).norm(), 0, 1e-6);  // 6 printed digits
 }
+
+// A file to_obj wrote says on its first line that it is in metres: read_obj takes it at scale 1
+// unless told, and refuses any other scale at that line. `gown --obj OUT` read the placed gown
+// back with the measured gown's 1.679 and went on with a 4.55 m^2 gown (session 85's gown review).
+// Any other file keeps the measured gown's default scale, and so does one whose first line is not
+// the header, word for word.
+TEST(ToObj, AFileInMetresIsReadAtScaleOneAndRefusesAnother) {
+  const fs::path p = write_obj("grid.obj", grid_obj(3, 0.2));
+  const GownMesh m = read_obj(p, 1.0);
+  const std::string text = to_obj(m);
+  ASSERT_EQ(text.rfind(std::string(kObjMetresHeader) + "\n", 0), 0u);
+  const std::string body = text.substr(kObjMetresHeader.size() + 1);
+  const std::string crlf_header = std::string(kObjMetresHeader) + " \r\n";
+  for (const std::string& in_metres : {text, "\xEF\xBB\xBF" + text, crlf_header + body}) {
+    const fs::path q = write_obj("metres.obj", in_metres);
+    const GownMesh n = read_obj(q);
+    ASSERT_EQ(n.x.size(), m.x.size());
+    for (size_t i = 0; i < m.x.size(); ++i) EXPECT_NEAR((n.x[i] - m.x[i]).norm(), 0, 1e-6);
+    EXPECT_EQ(read_obj(q, 1.0).x, n.x);
+    for (const double scale : {kMeasuredGownScale, 2.0, 0.999}) {
+      try {
+        read_obj(q, scale);
+        ADD_FAILURE() << "a file in metres read at scale " << scale;
+      } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(q.string() + ":1: the file says it is in metres"), std::string::npos)
+            << e.what();
+        EXPECT_NE(std::string(e.what()).find("not " + format_number(scale)), std::string::npos) << e.what();
+      }
+    }
+    fs::remove(q);
+  }
+  // Not the header: the measured gown's scale by default, and any scale asked for.
+  const std::string first_line_off = std::string(kObjMetresHeader).substr(0, kObjMetresHeader.size() - 1) + "\n";
+  for (const std::string& other : {body, "# a comment\n" + text, first_line_off + body}) {
+    const fs::path q = write_obj("units.obj", other);
+    const GownMesh n = read_obj(q);
+    ASSERT_EQ(n.x.size(), m.x.size());
+    EXPECT_EQ(n.x, read_obj(q, kMeasuredGownScale).x);
+    EXPECT_NEAR(n.x[1].x(), kMeasuredGownScale * m.x[1].x(), 1e-6);
+    EXPECT_NEAR(read_obj(q, 2.0).x[1].x(), 2 * m.x[1].x(), 1e-6);
+    fs::remove(q);
+  }
+  fs::remove(p);
+}

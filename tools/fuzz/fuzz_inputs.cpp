@@ -12,7 +12,8 @@
 //            joined by their edges).
 //
 // Readers: 0 a dataset trial CSV (read_trial_csv), 1 a trial of the study's layout
-// (read_study_trial), 2 an OBJ mesh (read_obj, scale 1.679 as the measured gown's).
+// (read_study_trial), 2 an OBJ mesh (read_obj at the file's own scale: 1 when its first line says
+// it is in metres, as `gown --out` writes it, else 1.679 as the measured gown's).
 #include <unistd.h>
 
 #include <algorithm>
@@ -127,7 +128,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         if (!plausible_samples(read_study_trial(path))) broken("a study trial read with a value out of bounds", 0);
         break;
       default:
-        check_mesh(gown::read_obj(path, 1.679));
+        check_mesh(gown::read_obj(path));
         break;
     }
   } catch (const InputError& e) {

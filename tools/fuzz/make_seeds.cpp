@@ -373,6 +373,9 @@ int input_seeds(const std::filesystem::path& dir) {
       {"study.txt", "\x01" "0.00 0.000 -0.10 0.01 0.02\n0.01 0.001 -0.2 0.0 0.05\n0.02 0.002 -0.3 0.0 0.07\n"},
       {"gown.obj", "\x02" "# a square and its fan\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nvn 0 0 1\n"
                    "f 1 2 3\nf 2/1 4/1 3/1\nf 1//1 2//1 4//1\nf -1 -2 -3\nf 1 2 4 3\n"},
+      // In metres: the first line as gown.h's kObjMetresHeader (to_obj) writes it.
+      {"metres.obj", "\x02# dressguard gown mesh, world frame W (z up, gripper moves along +x), metres\n"
+                     "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n"},
       // Values the readers must refuse, as strtod and from_chars would otherwise take them.
       {"nan.csv", std::string(1, '\0') + "t,travel,f_motion,f_lateral,f_vertical\n0.00,0.000,nan,0.01,0.02\n"},
       {"inf.txt", "\x01" "0.00 0.000 -0.10 inf 0.02\n"},
