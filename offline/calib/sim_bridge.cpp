@@ -200,6 +200,7 @@ ClothSimulator make_cloth_simulator(const std::string& gown) {
     for (sim::TrialResult& r : res) out.push_back(simulated(std::move(r), scene));
     return out;
   };
+  cs.build_grasp = [scenes](double rim_shift) { scenes->get(rim_shift); };
   // The bending length is the mesh's: a grasp moves the gown, it does not change its triangles.
   const double factor = sim::bend_mesh_factor(scenes->own()->data());
   cs.bending_length = [factor](double bend, double areal_density) {

@@ -26,6 +26,10 @@ struct ClothSimulator {
   // Peirce's bending length [m] that a bend value gives on this simulator's gown mesh
   // (sim::bending_length in offline/sim/model.h): what the calibrated `bend` means as a fabric.
   std::function<double(double bend, double areal_density)> bending_length;
+  // Builds (and keeps, as `trial` would) the scene of a rim_shift's grasp, throwing
+  // UnbuildableCandidate as `trial` does: calibrate refuses a held rim_shift with it before the
+  // search, whose every candidate would otherwise be unbuildable.
+  std::function<void(double rim_shift)> build_grasp;
 };
 
 // "full" (the measured 20k-triangle gown), "reduced" (the default for calibration and synthesis)

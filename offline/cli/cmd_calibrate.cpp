@@ -284,6 +284,17 @@ int run_calibrate(int argc, char** argv) {
 #else
   const Comm& comm = Comm::world();
   const ClothSimulator sim = make_cloth_simulator(gown);
+  // A held rim_shift whose jaws hold none of the gown (the measured gown's from +0.0431 m) makes
+  // every candidate unbuildable: the whole budget was spent to end with "no candidate could be
+  // simulated" (exit 1). Unlike a fitted box's, which the search may leave, it is refused here.
+  if (const ParameterSpace::Person& rim = space.person[kRimShift]; !rim.fit) {
+    try {
+      sim.build_grasp(rim.value);
+    } catch (const UnbuildableCandidate& e) {
+      throw UsageError("--rim-shift " + args.get("rim-shift").value_or("") + " holds none of the gown: no candidate "
+                       "could be simulated (" + e.what() + ")");
+    }
+  }
   // Now, not after the first generation (20 minutes on the full gown), and on every rank.
   try {
     probe_checkpoint(o.checkpoint, comm);

@@ -15,7 +15,7 @@ inline constexpr const char* kGripHelp =
     "                    OpeningGrip)\n"
     "  --rim-ahead M     [m] the opening's rim ahead of the jaws (default 0.04; parametric 0.01).\n"
     "                    The measured sleeve's top falls away behind its rim: the further ahead,\n"
-    "                    the less the jaws hold (14 vertices at 0.04, 2 at 0.08, none from 0.085,\n"
+    "                    the less the jaws hold (14 vertices at 0.04, 2 at 0.08, none from 0.0831,\n"
     "                    which is refused)\n";
 
 // The grip the options ask for, starting from `base` (a calibration's grasp) or else the gown's

@@ -37,7 +37,7 @@ GownMesh load_gown(const GownOptions& options) {
   }
   // The jaws must hold some of the cloth. A file already in W that puts its sleeve elsewhere, or a
   // grip that misses the measured sleeve's top, which falls away behind its rim (placement.h,
-  // OpeningGrip: nothing from 8.5 cm ahead at the default depth), grasped nothing: `gown` said
+  // OpeningGrip: nothing from 8.31 cm ahead at the default depth), grasped nothing: `gown` said
   // "grasped vertices: 0" and exited 0, and the simulator failed later or a calibration ended.
   // Before the reduction, which keeps the grasped vertices as they are.
   if (grasp_vertices(mesh, options.scene).empty()) {

@@ -84,7 +84,7 @@ class NothingGrasped : public InputError {
 // sleeve opening labelled. Throws InputError for a malformed file or a mesh with fewer than two
 // boundary loops, and NothingGrasped, naming the mesh and the grip, when the jaws hold none of
 // its vertices: a file already in W that puts its sleeve elsewhere, or a grip that misses the
-// measured sleeve's top (placement.h, OpeningGrip: from 8.5 cm ahead at the default depth).
+// measured sleeve's top (placement.h, OpeningGrip: from 8.31 cm ahead at the default depth).
 GownMesh load_gown(const GownOptions& options);
 
 // Reads v/f lines of an OBJ (1-based and negative indices; "f a/b/c", "a//c" and "a/b" forms;

@@ -145,8 +145,8 @@ inline constexpr double kOpeningRimAhead = 0.04;
 // resolution holds the same vertices, load_gown freezes them):
 //   rim_ahead 0     29 vertices, the cloth reaching 1.5 cm above the lower jaw at its front
 //   rim_ahead 0.04  14 vertices, 0.97 cm, over the jaws' front 4.3 cm only (the default)
-//   rim_ahead 0.08   2 vertices, 0.45 cm
-//   from 0.085 m    none (at depth 0.005, none from the default 0.04 on)
+//   rim_ahead 0.08   2 vertices, 0.45 cm (1 vertex from 0.081)
+//   from 0.0831 m   none (at depth 0.005, none from the default 0.04 on)
 // So on that gown `rim_ahead` changes both when the fist meets the rim and how much of the sleeve
 // is held (offline/calib's rim_shift does both). This is the placement every calibration in
 // models/ was fitted with, kept as it is; load_gown refuses a grip that holds no vertex. What is

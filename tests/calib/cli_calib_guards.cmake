@@ -56,6 +56,22 @@ if(EXISTS ${WORK}/c.json)
   message(FATAL_ERROR "calibrate wrote ${WORK}/c.json for a command it refused")
 endif()
 
+# A rim_shift held where the jaws hold none of the measured gown (from +0.0431 m: placement.h,
+# OpeningGrip) made every candidate unbuildable: the whole budget was spent and the run ended with
+# "no candidate could be simulated" (exit 1). Now refused before the search, naming the value and
+# the gown, with no checkpoint written.
+if(EXISTS ${STUDY}/../gown/fullgown.obj)
+  expect_fail("calibrate with the rim held where the jaws hold none of the measured gown"
+              "--rim-shift 0.05 holds none of the gown: no candidate could be simulated (rim_shift 0.05 m: "
+              ${quick} --rim-shift 0.05 --checkpoint ${WORK}/held.ckpt)
+  expect_fail("the same, naming the gown and the grip"
+              "fullgown.obj: the gripper's jaws (x -0.21..-0.13, y -0.06..0.06, z 0.055..0.205 m) hold no vertex "
+              ${quick} --rim-shift 0.0431 --checkpoint ${WORK}/held.ckpt)
+  if(EXISTS ${WORK}/held.ckpt OR EXISTS ${WORK}/c.json)
+    message(FATAL_ERROR "calibrate wrote a checkpoint or a calibration for a rim_shift it refused")
+  endif()
+endif()
+
 # The parametric gown (no shared/data: the measured gown is absent): its sleeve opening is held
 # 1 cm ahead of the jaws, so a rim_shift below -0.01 m cannot be built.
 set(ENV{DRESSGUARD_SHARED_DIR} ${WORK}/no-shared)

@@ -167,7 +167,7 @@ TEST(SimCalibration, RimShiftIsTheScenesGrasp) {
 }
 
 // A rim_shift whose grasp holds none of the measured gown (its sleeve's top lies below the lower
-// jaw from the rim 8.5 cm ahead of the jaws on: placement.h, OpeningGrip) is an
+// jaw from the rim 8.31 cm ahead of the jaws on: placement.h, OpeningGrip) is an
 // UnbuildableCandidate naming it, which calibrate ranks last; it was make_scene's
 // std::invalid_argument, which ended the whole calibration. 0.04 ahead of the gown's own still
 // holds some (2 vertices, the rim 8 cm ahead).
@@ -188,8 +188,11 @@ TEST(SimCalibration, AGraspThatHoldsNothingIsAnUnbuildableCandidate) {
               std::string::npos) << e.what();
   }
   EXPECT_THROW(cs.trial(c, r), UnbuildableCandidate);
+  EXPECT_THROW(cs.build_grasp(0.05), UnbuildableCandidate);  // what calibrate asks of a held rim_shift
   c.rim_shift = 0.04;
   EXPECT_FALSE(cs.trial(c, r).samples.empty());
+  EXPECT_NO_THROW(cs.build_grasp(0.04));
+  EXPECT_NO_THROW(cs.build_grasp(0.0));
 }
 
 // A calibration's friction scheme reaches the simulator: each named scheme gives, bit for bit,
