@@ -18,6 +18,30 @@ std::filesystem::path measured_gown_path() {
   return std::filesystem::exists(p) ? p : std::filesystem::path{};
 }
 
+namespace {
+
+// A gown read already in W is where the file puts it, and the jaws holding some of it does not
+// make it a scene: the parametric gown moved 1 m along x has its other sleeve's rim in the jaws
+// (the two openings are 1.06 m apart), that opening faces away from the fist and the sleeves' tube
+// runs through the arm. A placement starts the cloth clear of the arm at every height (placement.h,
+// vertices_in_arm); a file that does not is refused, naming the height and a vertex inside.
+void check_clear_of_arm(const GownMesh& mesh, const PaperScene& scene, const std::filesystem::path& path) {
+  const std::pair<const char*, double> heights[] = {
+      {"high", 0.0}, {"middle", scene.arm_offset_middle}, {"low", scene.arm_offset_low}};
+  for (const auto& [name, offset] : heights) {
+    const std::vector<int> inside = vertices_in_arm(mesh, scene, offset);
+    if (inside.empty()) continue;
+    const Eigen::Vector3d& p = mesh.x[inside.front()];
+    throw_input_error(path, 0, format_string("the gown where the file puts it (already in W) starts inside the arm: at "
+                                             "the %s arm height %zu of its vertices lie within it (vertex %d at %.3f, "
+                                             "%.3f, %.3f m); the jaws hold it elsewhere than at a sleeve opening ahead "
+                                             "of the arm (place it without --in-world, or move it)",
+                                             name, inside.size(), inside.front() + 1, p.x(), p.y(), p.z()));
+  }
+}
+
+}  // namespace
+
 GownMesh load_gown(const GownOptions& options) {
   const std::filesystem::path path =
       options.parametric ? std::filesystem::path{} : (options.obj.empty() ? measured_gown_path() : options.obj);
@@ -57,6 +81,7 @@ GownMesh load_gown(const GownOptions& options) {
                                        (path.empty() ? std::string("parametric gown") : path.string()).c_str(),
                                        lo.x(), hi.x(), lo.y(), hi.y(), lo.z(), hi.z(), where.c_str()));
   }
+  if (!path.empty() && options.already_in_W) check_clear_of_arm(mesh, options.scene, path);
   mesh.areal_density = options.areal_density;
   if (options.target_triangles > 0) {
     std::vector<bool> frozen(mesh.x.size(), false);

@@ -85,6 +85,9 @@ class NothingGrasped : public InputError {
 // boundary loops, and NothingGrasped, naming the mesh and the grip, when the jaws hold none of
 // its vertices: a file already in W that puts its sleeve elsewhere, or a grip that misses the
 // measured sleeve's top (placement.h, OpeningGrip: from 8.31 cm ahead at the default depth).
+// A file already in W is also refused (InputError) when its cloth starts inside the arm at any
+// of the three heights (placement.h, vertices_in_arm): the jaws may then hold another part of the
+// gown, as the parametric gown moved 1 m along x has its other sleeve's rim in them.
 GownMesh load_gown(const GownOptions& options);
 
 // Reads v/f lines of an OBJ (1-based and negative indices; "f a/b/c", "a//c" and "a/b" forms;

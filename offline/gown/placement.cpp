@@ -112,6 +112,32 @@ std::vector<int> grasp_vertices(const GownMesh& mesh, const PaperScene& scene) {
   return vertices_in_box(mesh, scene.grasp_box_center_W(), scene.grasp_box_half_extent_W());
 }
 
+namespace {
+
+// Whether p lies within the tapered capsule from sphere (a, ra) to sphere (b, rb), its radius
+// taken at the closest point of the axis.
+bool in_tapered_capsule(const Eigen::Vector3d& p, const Eigen::Vector3d& a, double ra, const Eigen::Vector3d& b,
+                        double rb) {
+  const Eigen::Vector3d ab = b - a;
+  const double t = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+  return (p - (a + t * ab)).norm() < ra + t * (rb - ra);
+}
+
+}  // namespace
+
+std::vector<int> vertices_in_arm(const GownMesh& mesh, const PaperScene& scene, double offset) {
+  const Eigen::Vector3d fist = scene.fist_W(offset), wrist = scene.wrist_W(offset);
+  const Eigen::Vector3d elbow = scene.elbow_W(offset), shoulder = scene.shoulder_W(offset);
+  std::vector<int> out;
+  for (int v = 0; v < static_cast<int>(mesh.x.size()); ++v) {
+    const Eigen::Vector3d& p = mesh.x[v];
+    if ((p - fist).norm() < scene.r_fist || in_tapered_capsule(p, wrist, scene.r_wrist, elbow, scene.r_elbow) ||
+        in_tapered_capsule(p, elbow, scene.r_elbow, shoulder, scene.r_shoulder))
+      out.push_back(v);
+  }
+  return out;
+}
+
 std::vector<Eigen::Vector3d> crude_hang(const GownMesh& m, const PaperScene& s, double seconds) {
   std::vector<std::array<int, 2>> edges;
   for (const auto& t : m.triangles)

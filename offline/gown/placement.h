@@ -196,6 +196,13 @@ void set_sleeve_loop(GownMesh& mesh, int loop);
 // The vertices the gripper holds: vertices_in_box(grasp box).
 std::vector<int> grasp_vertices(const GownMesh& mesh, const PaperScene& scene = {});
 
+// The vertices inside the arm at the high setting moved by `offset` [m] along z (arm_offset_middle,
+// arm_offset_low): within the fist's sphere, or within the tapered capsules wrist-elbow and
+// elbow-shoulder (the radius linear along each; the simulator's round cones are a little fuller).
+// A placement starts the cloth outside it: on the measured gown 9.5 cm or more away, placed at
+// the opening or like the paper.
+std::vector<int> vertices_in_arm(const GownMesh& mesh, const PaperScene& scene = {}, double offset = 0);
+
 // A crude hang to check a placement, NOT the simulator: position-based dynamics with the mesh
 // edges as inextensible distance constraints, the grasped vertices moved to the closed jaws
 // (z = pinch_z_W) and fixed, gravity, 1% velocity damping per step, 300 Hz, 20 Gauss-Seidel

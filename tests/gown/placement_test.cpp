@@ -317,3 +317,50 @@ TEST(Placement, AGownInWAwayFromTheJawsIsRefused) {
   EXPECT_GE(grasp_vertices(load_gown(o)).size(), 10u);
   fs::remove(path);
 }
+
+// A file already in W whose jaws hold some of the gown is not yet a scene: the parametric gown
+// moved 1 m along x has its other sleeve's rim in the jaws (its openings are 1.06 m apart; 2
+// vertices held), that opening faces away from the fist and the sleeves' tube runs through the
+// arm. It was taken, that far sleeve labelled as the one the arm enters (session 85's gown
+// review); now it is refused naming the file and the arm. The gowns the placements write (the
+// parametric and, with shared/data, the measured gown at the opening and like the paper) start
+// clear of the arm at every height and are taken back.
+TEST(Placement, AGownInWThroughTheArmIsRefused) {
+  GownOptions parametric;
+  parametric.parametric = true;
+  parametric.target_triangles = 1500;
+  std::vector<GownMesh> placed{load_gown(parametric)};
+  if (!measured_gown_path().empty()) {
+    GownOptions measured;
+    measured.target_triangles = 1500;
+    placed.push_back(load_gown(measured));
+    measured.placement = GownPlacement::Paper;
+    placed.push_back(load_gown(measured));
+  }
+  const fs::path path = fs::temp_directory_path() / ("dg_gown_arm_" + std::to_string(::getpid()) + ".obj");
+  GownOptions o;
+  o.obj = path;
+  o.already_in_W = true;
+  const PaperScene s;
+  for (const GownMesh& g : placed) {
+    for (const double offset : {0.0, s.arm_offset_middle, s.arm_offset_low})
+      EXPECT_TRUE(vertices_in_arm(g, s, offset).empty()) << "arm offset " << offset;
+    write_file_atomic(path, to_obj(g));
+    EXPECT_EQ(grasp_vertices(load_gown(o)), grasp_vertices(g));
+  }
+  GownMesh off = placed.front();
+  for (auto& p : off.x) p.x() += 1.0;
+  EXPECT_EQ(grasp_vertices(off).size(), 2u);  // the other sleeve's rim
+  EXPECT_FALSE(vertices_in_arm(off, s).empty());
+  write_file_atomic(path, to_obj(off));
+  try {
+    load_gown(o);
+    ADD_FAILURE() << "a gown through the arm was taken";
+  } catch (const NothingGrasped& e) {
+    ADD_FAILURE() << "refused as holding nothing: " << e.what();
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(path.string() + ": the gown where the file puts it (already in W) starts "
+                                          "inside the arm: at the high arm height ", 0), 0u) << e.what();
+  }
+  fs::remove(path);
+}
