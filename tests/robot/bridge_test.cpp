@@ -582,6 +582,14 @@ struct BridgeRig {
     }
     return true;
   }
+  // Force frames received until `n` have come or `most` has passed: how many. On a loaded
+  // machine (ctest -j with the VM test beside) a reconnect after a fault can take several
+  // backoff steps, so a test that waits for readings to resume waits for them, not a fixed time.
+  int collect_at_least(int n, std::chrono::milliseconds most, protocol::FtForce* last = nullptr) {
+    int got = 0;
+    for (auto waited = 0ms; got < n && waited < most; waited += 50ms) got += collect(50ms, last);
+    return got;
+  }
   // Force frames received within `d`, the last one in *last; every frame in *all.
   int collect(std::chrono::milliseconds d, protocol::FtForce* last = nullptr, protocol::HeartbeatBridge* hb = nullptr,
               std::vector<Frame>* all = nullptr) {
@@ -720,7 +728,7 @@ TEST(BridgeModbus, ALateAnswerIsDroppedWithItsConnection) {
   rig.collect(100ms);
   ASSERT_TRUE(rig.sensor_emu.write(180, {300, 0, 0, 0, 0, 0}));
   protocol::FtForce last{};
-  EXPECT_GE(rig.collect(400ms, &last), 10) << "readings did not resume after one late answer";
+  EXPECT_GE(rig.collect_at_least(10, 3000ms, &last), 10) << "readings did not resume after one late answer";
   EXPECT_EQ(last.fx, 300);
   EXPECT_GT(rig.app->stats().reconnects.load(), reconnects) << "the late answer's connection was kept";
   EXPECT_LE(rig.app->stats().sensor_errors.load(), 3u) << "more than the one late answer failed";
@@ -735,9 +743,9 @@ TEST(BridgeModbus, FailuresAndStopsAreLoggedAtEachDoubling) {
   ASSERT_TRUE(rig.sensor_emu.write(900, {2}));
   rig.collect(400ms);
   ASSERT_TRUE(rig.sensor_emu.write(900, {0}));
-  EXPECT_GE(rig.collect(400ms), 5);
+  EXPECT_GE(rig.collect_at_least(5, 3000ms), 5) << "readings did not resume";
   rig.predictor->send(protocol::encode(protocol::Stop{0, protocol::StopReason::Caught, 240, 3, 250}));
-  for (int i = 0; i < 200 && rig.app->stats().stops_written.load() == 0; ++i) std::this_thread::sleep_for(1ms);
+  for (int i = 0; i < 2000 && rig.app->stats().stops_written.load() == 0; ++i) std::this_thread::sleep_for(1ms);
   std::this_thread::sleep_for(5ms);
   const std::string text = rig.logged();
   const int failures = lines_with(text, "sensor: timeout: ");
