@@ -106,8 +106,14 @@ void BridgeApp::send(const Frame& f) {
         static_cast<unsigned long long>(send_failures_));
 }
 
-// The core latched a stop: say why, and write it to the robot in this wakeup (try_stop).
+// The core latched a stop: write it to the robot at once, then say why (the log is a pipe
+// that can be slow; the robot's stop comes first).
 void BridgeApp::stop_robot(uint32_t t) {
+  // A clear not yet written is superseded: written after this stop, it would take it back.
+  release_pending_ = false;
+  stop_pending_ = true;
+  next_stop_try_ms_ = t;
+  try_stop(t);
   const BridgeCore& c = core_;
   const unsigned timeout = c.cfg.predictor_timeout_ms;
   switch (c.stop_cause) {
@@ -122,10 +128,6 @@ void BridgeApp::stop_robot(uint32_t t) {
     case StopCause::BridgeShutdown:  // begin_shutdown says it
     case StopCause::None: break;
   }
-  // A clear not yet written is superseded: written after this stop, it would take it back.
-  release_pending_ = false;
-  stop_pending_ = true;
-  next_stop_try_ms_ = t;
 }
 
 // The robot controller's TrialStart left no stop latched: its stop target is cleared, so that it
@@ -317,10 +319,9 @@ void BridgeApp::begin_shutdown(uint32_t t) {
   drain_can(t);
   // ... and a trial still running gets the bridge's own: it is the only way to the robot.
   if (bridge_on_shutdown(core_) == BridgeAction::StopRobot) {
+    stop_robot(t);
     say("shutting down during the predictor's trial %u: stopping the robot first",
         static_cast<unsigned>(core_.predictor_trial));
-    stop_robot(t);
-    try_stop(t);
   }
 }
 
