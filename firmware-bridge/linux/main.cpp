@@ -1,5 +1,6 @@
 // dressguard-bridge: force-torque sensor (Modbus, or an FT 300's data stream) -> CAN, and CAN
 // stop -> robot controller.
+#include <sched.h>
 #include <signal.h>
 #include <sys/stat.h>
 
@@ -13,6 +14,7 @@
 #include "bridge_app.h"
 #include "candump_log.h"
 #include "ft300_stream.h"
+#include "rt_setup.h"
 
 using namespace dressguard;
 using namespace dressguard::bridge;
@@ -61,9 +63,15 @@ const char* kUsage =
     "                          long: 0 (off, the default) or 200-60000\n"
     "  --shutdown-grace-ms N   on SIGTERM/SIGINT, a stop not yet written (one on the bus, or the bridge's\n"
     "                          own when the predictor is in a trial) is retried this long (default 1000)\n"
+    "  --rt-priority N         SCHED_FIFO priority of the loop, 1-99 (default 70: above the kernel's\n"
+    "                          interrupt threads, below the predictor's 80); given, the bridge does not\n"
+    "                          start without it (exit 1); the default not had is a warning\n"
+    "  --cpu N                 pin the loop to CPU N, 0-1023 (default: any CPU); not had: a warning\n"
+    "  --no-rt                 skip the real-time setup (mlockall, SCHED_FIFO, --cpu); by default\n"
+    "                          memory is locked (not had: a warning) and the loop runs SCHED_FIFO\n"
     "  --help                  this text\n"
-    "Exit codes: 0 clean shutdown (SIGTERM/SIGINT), 1 runtime error or a stop still unwritten at the\n"
-    "end of the shutdown grace, 2 bad arguments.";
+    "Exit codes: 0 clean shutdown (SIGTERM/SIGINT), 1 runtime error, an --rt-priority not had, or a stop\n"
+    "still unwritten at the end of the shutdown grace, 2 bad arguments.";
 
 int bad(const std::string& why) {
   std::fprintf(stderr, "dressguard-bridge: %s (see --help)\n", why.c_str());
@@ -90,6 +98,7 @@ constexpr Range kRanges[] = {
     {"--sensor-slave", 0, 255},   {"--sensor-register", 0, 65530}, {"--timeout-ms", 1, 1000},
     {"--period-ms", 1, 1000},     {"--robot-slave", 0, 255},       {"--stop-coil", 0, 65535},
     {"--predictor-timeout-ms", 0, 60000}, {"--shutdown-grace-ms", 0, 60000},
+    {"--rt-priority", 1, 99},     {"--cpu", 0, CPU_SETSIZE - 1},
 };
 constexpr const char* kTextOptions[] = {"--interface", "--sensor", "--robot", "--force-scale", "--torque-scale",
                                         "--stop-register"};
@@ -170,6 +179,19 @@ int probe_robot(RobotStopWriter& robot, const StopTarget& target) {
   return 0;
 }
 
+// The loop's real-time setup, before the CAN socket is opened and the loop runs: what is not had
+// is said (the bridge still carries samples and stops, only with less margin), except a priority
+// the command line asked for: 0, or 1 when that priority is not had.
+int setup_loop_realtime(const RtRequest& request) {
+  const RtOutcome had = setup_realtime(request);
+  for (const std::string& why : had.warnings)
+    std::fprintf(stderr, "dressguard-bridge: warning: real-time setup: %s\n", why.c_str());
+  if (had.refusal.empty()) return 0;
+  std::fprintf(stderr, "dressguard-bridge: --rt-priority %d: %s: not starting without it (--no-rt runs without "
+               "real-time setup)\n", request.fifo_priority, had.refusal.c_str());
+  return 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -183,6 +205,8 @@ int main(int argc, char** argv) {
   SensorMap map;
   StopTarget target;
   BridgeAppConfig cfg;
+  RtRequest rt;
+  bool no_rt = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--help" || a == "-h") {
@@ -191,6 +215,10 @@ int main(int argc, char** argv) {
     }
     if (a == "--input-registers") {
       map.input_registers = true;
+      continue;
+    }
+    if (a == "--no-rt") {
+      no_rt = true;
       continue;
     }
     if (!takes_value(a)) return bad("unknown option '" + a + "'");
@@ -228,11 +256,19 @@ int main(int argc, char** argv) {
       else if (a == "--robot-slave") robot_ep.slave = static_cast<int>(n);
       else if (a == "--stop-coil") target = {true, static_cast<int>(n), 1};
       else if (a == "--shutdown-grace-ms") cfg.shutdown_grace_ms = static_cast<int>(n);
+      else if (a == "--rt-priority") {
+        rt.fifo_priority = static_cast<int>(n);
+        rt.priority_required = true;
+      } else if (a == "--cpu") rt.cpu = static_cast<int>(n);
       else if (n != 0 && n < kLeastPredictorTimeoutMs)
         return bad(a + ": '" + v + "' is neither 0 (off) nor at least 200 (two of the predictor's 100 ms heartbeats)");
       else cfg.core.predictor_timeout_ms = static_cast<uint32_t>(n);
     }
   }
+  // --no-rt beside a priority or a CPU asks for both: which one was meant is not for the bridge to guess.
+  if (no_rt && (rt.priority_required || rt.cpu >= 0))
+    return bad(std::string("--no-rt skips the real-time setup: ") + (rt.priority_required ? "--rt-priority" : "--cpu") +
+               " cannot be given with it");
   // Both endpoints are checked now, not when the first stop must go out.
   EndpointParts sensor_parts;
   std::string stream_device;
@@ -277,6 +313,8 @@ int main(int argc, char** argv) {
     robot = std::make_unique<RobotStopWriter>(robot_ep, target);
     if (const int rc = probe_robot(*robot, target); rc != 0) return rc;
   }
+  if (!no_rt)
+    if (const int rc = setup_loop_realtime(rt); rc != 0) return rc;
   try {
     can::PortOptions opt;
     opt.ids.assign(std::begin(kBridgeReceives), std::end(kBridgeReceives));
