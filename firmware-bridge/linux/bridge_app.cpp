@@ -227,8 +227,13 @@ void BridgeApp::on_timer(uint32_t t) {
   if (!sensor_.connected()) {
     if (due(t, next_connect_ms_)) {
       if (sensor_.connect()) {
-        bridge_on_reconnect(core_);
-        ++stats_.reconnects;
+        // The first connect is none: the count says how often the sensor was lost and found again
+        // (a healthy bridge's heartbeat said 1).
+        if (sensor_was_connected_) {
+          bridge_on_reconnect(core_);
+          ++stats_.reconnects;
+        }
+        sensor_was_connected_ = true;
       } else {
         ++stats_.connect_failures;
         sensor_failed("connect");

@@ -88,6 +88,7 @@ class BridgeApp {
   int epoll_fd_ = -1, timer_fd_ = -1, shutdown_fd_ = -1;
   int backoff_ms_ = 0;
   uint32_t next_connect_ms_ = 0;
+  bool sensor_was_connected_ = false;  // a connect after the first is a reconnect
   bool stop_pending_ = false;
   uint32_t next_stop_try_ms_ = 0;
   uint64_t sensor_failures_ = 0;  // in a row, since the last good reading

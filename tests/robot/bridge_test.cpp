@@ -696,6 +696,20 @@ TEST(BridgeModbus, ReadingsFlowToCanAndSurviveFaults) {
   EXPECT_GE(rig.app->stats().connect_failures.load(), 1u) << "the backoff never tried while it was gone";
 }
 
+// The heartbeat's and the stats' reconnects count the sensor's connections after the first: a
+// bridge that never lost its sensor said 1.
+TEST(BridgeModbus, TheFirstConnectIsNoReconnect) {
+  BridgeRig rig;
+  ASSERT_GT(rig.sensor_emu.port(), 0);
+  protocol::HeartbeatBridge hb{};
+  hb.reconnects = 0xFFFF;
+  EXPECT_GE(rig.collect_at_least(5, 3000ms), 5) << "no readings";
+  rig.collect(250ms, nullptr, &hb);  // a heartbeat (every 100 ms) sent after the first reading
+  EXPECT_EQ(hb.state, protocol::BridgeState::Ok);
+  EXPECT_EQ(hb.reconnects, 0);
+  EXPECT_EQ(rig.app->stats().reconnects.load(), 0u);
+}
+
 // The bridge's millisecond clock is CLOCK_MONOTONIC mod 2^32 (49.7 days), compared wrap-safely.
 // Its first connect used to be due at 0, which such a comparison finds due only while the clock
 // is below 2^31: on a machine up 24.9 to 49.7 days (mod 49.7) it never connected, sent no frame
