@@ -49,8 +49,9 @@ const char* kUsage =
     "  --timeout-ms N          Modbus response timeout, 1-1000 (default 20), for the whole answer; a stop\n"
     "                          frame can wait about this long behind a sensor read that gets no answer\n"
     "                          or one cut short (rtu-stream never waits)\n"
-    "  --period-ms N           sampling period (default 10: 100 Hz); with rtu-stream the sensor's frames\n"
-    "                          set the rate, and this is the period of the heartbeat and of the checks\n"
+    "  --period-ms N           sampling period, 1-100 (default 10: 100 Hz); with rtu-stream the sensor's\n"
+    "                          frames set the rate; either way the tick of the heartbeat (every 100 ms),\n"
+    "                          the predictor watchdog and a stop's retries\n"
     "  --robot SPEC            robot controller, tcp:HOST:PORT or rtu:... (not the sensor's device; its\n"
     "                          response timeout is 100 ms); none: stops are only logged. Its stop target is\n"
     "                          read once at start: one it lacks exits 2, no answer is a warning\n"
@@ -92,11 +93,13 @@ std::string stream_spec_error(const std::string& spec, const SensorMap& map, std
 
 // Whole-number options and their ranges: Modbus addresses are 16 bits (the six sensor registers
 // must fit), unit ids a byte (unit_id_error then holds them to their line), and a response
-// timeout or a period beyond a second is no sampling of a 100 Hz sensor.
+// timeout beyond a second is no sampling of a 100 Hz sensor. The period is also the loop's tick,
+// which sends the heartbeat (PROTOCOL.md: 10 Hz), judges the predictor's silence and retries a
+// stop's write: beyond 100 ms the heartbeat comes late and a stop waits a period per retry.
 struct Range { const char* name; long lo, hi; };
 constexpr Range kRanges[] = {
     {"--sensor-slave", 0, 255},   {"--sensor-register", 0, 65530}, {"--timeout-ms", 1, 1000},
-    {"--period-ms", 1, 1000},     {"--robot-slave", 0, 255},       {"--stop-coil", 0, 65535},
+    {"--period-ms", 1, 100},      {"--robot-slave", 0, 255},       {"--stop-coil", 0, 65535},
     {"--predictor-timeout-ms", 0, 60000}, {"--shutdown-grace-ms", 0, 60000},
     {"--rt-priority", 1, 99},     {"--cpu", 0, CPU_SETSIZE - 1},
 };
