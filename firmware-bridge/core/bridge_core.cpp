@@ -30,13 +30,11 @@ const char* stop_cause_name(StopCause c) {
 
 namespace {
 
-// Wrap-safe: more than protocol::kSporadicResyncMs since `then`.
-bool silent_since(uint32_t now_ms, uint32_t then) {
-  return static_cast<uint32_t>(now_ms - then) > protocol::kSporadicResyncMs;
-}
-
 // Wrap-safe: more than `ms` since `then`.
 bool longer_than(uint32_t now_ms, uint32_t then, uint32_t ms) { return static_cast<uint32_t>(now_ms - then) > ms; }
+
+// Wrap-safe: more than protocol::kSporadicResyncMs since `then`.
+bool silent_since(uint32_t now_ms, uint32_t then) { return longer_than(now_ms, then, protocol::kSporadicResyncMs); }
 
 // TrialStart and TrialEnd come from the robot controller, sporadically: a controller that
 // restarted counts from 0 again, so after a silence both checkers start afresh. Counts a frame
