@@ -3,10 +3,13 @@
 
 #include <sched.h>
 #include <sys/mman.h>
+#include <sys/resource.h>
 
 #include <cerrno>
 #include <cstddef>
+#include <cstdlib>
 #include <cstring>
+#include <fstream>
 
 namespace dressguard::bridge {
 namespace {
@@ -35,7 +38,30 @@ std::string fifo_failure(int priority, int err) {
   for (std::size_t i = 0; i < kReserve; i += kPage) reserve[i] = 0;
 }
 
+// Whether the process's effective capabilities hold CAP_IPC_LOCK (bit 14 of /proc's CapEff),
+// which lifts RLIMIT_MEMLOCK.
+bool can_lock_past_the_limit() {
+  constexpr unsigned kCapIpcLock = 14;
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("CapEff:", 0) == 0) return (std::strtoull(line.c_str() + 7, nullptr, 16) >> kCapIpcLock) & 1;
+  return false;
+}
+
+// Why locking is not even tried, or "": under a finite RLIMIT_MEMLOCK without CAP_IPC_LOCK,
+// MCL_FUTURE counts every later mapping against the limit, and an allocation past it fails in
+// the loop (an error, perhaps while a stop is written) where a page fault was only a delay.
+std::string memory_lock_limit() {
+  rlimit limit{};
+  if (getrlimit(RLIMIT_MEMLOCK, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY || can_lock_past_the_limit())
+    return {};
+  return "mlockall not tried: RLIMIT_MEMLOCK is " + std::to_string(limit.rlim_cur / 1024) +
+         " KiB without CAP_IPC_LOCK, and locking all later memory under it makes an allocation past it fail in the "
+         "loop; grant CAP_IPC_LOCK or LimitMEMLOCK=infinity";
+}
+
 std::string lock_memory() {
+  if (std::string why = memory_lock_limit(); !why.empty()) return why;
   if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) return memory_lock_failure(errno);
   prefault_stack();
   return {};
