@@ -2,6 +2,7 @@
 #include "daemon.h"
 
 #include <sched.h>
+#include <signal.h>
 #include <sys/epoll.h>
 #include <sys/eventfd.h>
 #include <sys/mman.h>
@@ -291,6 +292,35 @@ int PredictorDaemon::run() {
     if (shutdown_at >= 0 && !predictor_.stop_pending()) return 0;
     if (shutdown_at >= 0 && now - shutdown_at > opt_.shutdown_grace_ns) return 1;
   }
+}
+
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+// Read by the signal handler: atomic, and lock-free, so async-signal-safe.
+std::atomic<PredictorDaemon*> g_signalled_daemon{nullptr};
+static_assert(std::atomic<PredictorDaemon*>::is_always_lock_free);
+
+void on_shutdown_signal(int) {
+  if (PredictorDaemon* d = g_signalled_daemon.load()) d->request_shutdown();
+}
+
+void set_handler(int sig, void (*handler)(int)) {
+  struct sigaction sa{};
+  sa.sa_handler = handler;
+  sigemptyset(&sa.sa_mask);
+  sigaction(sig, &sa, nullptr);
+}
+
+}  // namespace
+
+void handle_signals(PredictorDaemon* daemon) {
+  g_signalled_daemon.store(daemon);
+  set_handler(SIGTERM, on_shutdown_signal);
+  set_handler(SIGINT, on_shutdown_signal);
+  set_handler(SIGHUP, SIG_IGN);
+  set_handler(SIGPIPE, SIG_IGN);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -122,6 +122,13 @@ class PredictorDaemon final : private PredictorSink {
   bool interface_gone_ = false;
 };
 
+// The process's signals, routed to `daemon` (nullptr: to none). SIGTERM and SIGINT ask it to shut
+// down (a running trial is stopped first). SIGHUP and SIGPIPE are ignored: their default action
+// ends the process at once, with no stop for the running trial, and systemd takes such an end
+// for a clean exit and does not restart the unit. SIGHUP is what an operator sends to "reload"
+// and what a closed terminal sends; the daemon reads its config and model at start only.
+void handle_signals(PredictorDaemon* daemon);
+
 // Real-time setup, each step optional: a step that is not permitted yields a warning string
 // (mlockall without CAP_IPC_LOCK, SCHED_FIFO without CAP_SYS_NICE, a CPU that does not exist).
 struct RtOptions {

@@ -1,6 +1,4 @@
 // dressguard-predictor: the real-time predictor daemon. See predictor/README.md.
-#include <signal.h>
-
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
@@ -18,11 +16,6 @@ using namespace dressguard::predictor;
 
 namespace {
 
-PredictorDaemon* g_daemon = nullptr;
-void on_signal(int) {
-  if (g_daemon) g_daemon->request_shutdown();
-}
-
 const char* kUsage =
     "usage: dressguard-predictor [--config FILE] [--interface IF] [--model MODEL.dgm] [options]\n"
     "  Runs the outcome HMMs' forward filter on the F/T samples of a CAN bus and sends a stop\n"
@@ -39,6 +32,8 @@ const char* kUsage =
     "sensor_timeout_ms, bad_frame_budget, bad_frame_weight, max_delta_counter, status_period_ms,\n"
     "heartbeat_period_ms, posteriors_period_ms, stop_retry_ms, sample_period_ms, acceleration_m_s2,\n"
     "mount_axes, mount_bias.\n"
+    "Signals: SIGTERM and SIGINT shut down (a running trial is stopped first); SIGHUP is ignored:\n"
+    "the config and model are read at start only, a change takes a restart.\n"
     "Exit codes: 0 clean shutdown (SIGTERM/SIGINT), 1 runtime error (the interface gone, or a stop\n"
     "not confirmed on the bus when the daemon exited), 2 bad arguments or config.";
 
@@ -171,12 +166,7 @@ int main(int argc, char** argv) {
     static EventQueue events;  // 4096 events: static storage, not on the stack
     EventLogger logger(events, log, names);  // before the RT setup: it must not inherit SCHED_FIFO
     PredictorDaemon daemon(model.get(), cfg, *rx, *stop_port, events, dopt);
-    g_daemon = &daemon;
-    struct sigaction sa{};
-    sa.sa_handler = on_signal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGTERM, &sa, nullptr);
-    sigaction(SIGINT, &sa, nullptr);
+    handle_signals(&daemon);
     if (!no_rt) {
       for (const auto& w : setup_realtime(rt)) log->warn("real-time setup: {}", w);
     }
@@ -184,7 +174,7 @@ int main(int argc, char** argv) {
               daemon.predictor().threshold(), daemon.predictor().consecutive(), cfg.hard_limit_n,
               cfg.sensor_timeout_ns / 1000000);
     int rc = daemon.run();
-    g_daemon = nullptr;
+    handle_signals(nullptr);
     logger.stop();
     if (daemon.predictor().stop_pending()) {
       const auto& d = daemon.predictor().decision();

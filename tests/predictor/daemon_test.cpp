@@ -3,6 +3,7 @@
 // sensor is stopped by the deadline, SIGTERM's path shuts down cleanly, the logger thread writes
 // what happened through spdlog, and the loop thread allocates nothing after start-up.
 #include <gtest/gtest.h>
+#include <signal.h>
 
 #include <atomic>
 #include <cerrno>
@@ -267,6 +268,27 @@ TEST(Daemon, ReceiveErrorsAreLoggedAndAVanishedInterfaceEndsTheLoop) {
   EXPECT_NE(text.str().find("receive on the frame socket failed: " + std::string(std::strerror(ENETDOWN)) +
                             " (1 failures so far)"), std::string::npos) << text.str();
   EXPECT_NE(text.str().find(std::strerror(ENODEV)), std::string::npos) << text.str();
+}
+
+// SIGHUP (an operator's "reload", a closed terminal) and SIGPIPE (a log pipe whose reader died)
+// ended the process at once, mid-trial, with no stop, and systemd took that for a clean exit and
+// did not restart the unit. Both are now ignored: the daemon goes on guarding the trial, and
+// SIGTERM still shuts it down cleanly.
+TEST(Daemon, HangupAndBrokenPipeDoNotEndTheDaemon) {
+  Rig rig;
+  handle_signals(rig.daemon.get());
+  rig.sensor->send(rig.src.trial_start(4));
+  ASSERT_EQ(raise(SIGHUP), 0);
+  ASSERT_EQ(raise(SIGPIPE), 0);
+  protocol::Stop s{};
+  for (int i = 0; i < 30 && !rig.wait_stop(s, 5ms); ++i) rig.send_sample(-6.0, -1.0);
+  EXPECT_EQ(s.reason, protocol::StopReason::Caught) << "the trial after SIGHUP and SIGPIPE was guarded";
+  EXPECT_EQ(s.trial_id, 4);
+  ASSERT_EQ(raise(SIGTERM), 0);
+  rig.loop.join();
+  rig.logger->stop();
+  handle_signals(nullptr);
+  EXPECT_EQ(rig.rc, 0) << "SIGTERM: a clean shutdown";
 }
 
 TEST(Daemon, WithoutAModelEveryTrialIsRefused) {
