@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <limits>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
@@ -85,12 +87,24 @@ std::string trim(const std::string& s) {
   return s.substr(a, b - a + 1);
 }
 
-PredictorConfig parse_config_text(const std::string& text, const LineName& name, std::vector<ConfigEntry>* others) {
+// A key the file gives twice: the last would win in silence (a line appended at the end by
+// someone who did not see the first), so it is an error naming both lines. Lines past
+// `file_lines` are --set overrides, which may repeat a key: overriding is what they are for.
+void check_given_once(std::map<std::string, long>& first_line, const std::string& key, long line, long file_lines,
+                      const LineName& name) {
+  if (line > file_lines) return;
+  const auto [first, fresh] = first_line.emplace(key, line);
+  if (!fresh) config_error(name, line, "key '" + key + "' given twice (first on " + name(first->second) + ")");
+}
+
+PredictorConfig parse_config_text(const std::string& text, const LineName& name, std::vector<ConfigEntry>* others,
+                                  long file_lines) {
   PredictorConfig c;
   std::istringstream in(text);
   std::string raw;
   long line = 0;
   long limit_line = 0, bias_line = 0;  // where hard_limit_n and mount_bias were given
+  std::map<std::string, long> first_line;  // each key's line in the file
   while (std::getline(in, raw)) {
     ++line;
     const size_t hash = raw.find('#');
@@ -99,6 +113,7 @@ PredictorConfig parse_config_text(const std::string& text, const LineName& name,
     const size_t eq = s.find('=');
     if (eq == std::string::npos) config_error(name, line, "expected 'key = value'");
     const std::string key = trim(s.substr(0, eq)), v = trim(s.substr(eq + 1));
+    check_given_once(first_line, key, line, file_lines, name);
     auto num = [&] { return config_number(name, line, key, v); };
     // Every value has a range: beyond it a typo would overflow the integer it is stored in (in
     // practice a negative count or a deadline already past, silently) or make no physical sense.
@@ -194,7 +209,8 @@ PredictorConfig parse_config_text(const std::string& text, const LineName& name,
 }  // namespace
 
 PredictorConfig parse_predictor_config(const std::string& text, const std::string& name, std::vector<ConfigEntry>* others) {
-  return parse_config_text(text, [&](long line) { return name + ":" + std::to_string(line); }, others);
+  return parse_config_text(text, [&](long line) { return name + ":" + std::to_string(line); }, others,
+                           std::numeric_limits<long>::max());
 }
 
 PredictorConfig parse_config_with_sets(const std::string& file_text, const std::string& file_name,
@@ -207,6 +223,7 @@ PredictorConfig parse_config_with_sets(const std::string& file_text, const std::
   std::vector<std::string> names;  // names[i]: line i + 1
   for (char ch : text)
     if (ch == '\n') names.push_back(file_name + ":" + std::to_string(names.size() + 1));
+  const long file_lines = static_cast<long>(names.size());
   for (size_t k = 0; k < sets.size(); ++k) {
     text += sets[k] + "\n";
     const std::string set = "--set " + std::to_string(k + 1);
@@ -216,7 +233,7 @@ PredictorConfig parse_config_with_sets(const std::string& file_text, const std::
   auto name = [&](long line) {
     return line >= 1 && line <= static_cast<long>(names.size()) ? names[line - 1] : file_name;
   };
-  return parse_config_text(text, name, others);
+  return parse_config_text(text, name, others, file_lines);
 }
 
 long config_whole_number(const ConfigEntry& e, long lo, long hi) {

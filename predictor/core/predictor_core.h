@@ -77,8 +77,8 @@ struct PredictorConfig {
 // stop_retry_ms (each in (0, 600000]). Counts are whole numbers in a range (stop_consecutive
 // 1..1e6, bad_frame_budget 0..1e6, bad_frame_weight 1..1e6, max_delta_counter 1..127);
 // hard_limit_n is in [0.01, 1000] N, and with the mount bias's motion and vertical components
-// below the 327.67 N where the protocol's forces saturate. Unknown keys and bad or out-of-range values throw
-// std::runtime_error naming `name`, the line and the key. Keys it does not own
+// below the 327.67 N where the protocol's forces saturate. Unknown keys, a key given twice and bad or
+// out-of-range values throw std::runtime_error naming `name`, the line and the key. Keys it does not own
 // (the daemon's: interface, model, rt_priority, ...) are returned in `others` when given.
 struct ConfigEntry {
   std::string key, value;
@@ -89,8 +89,9 @@ PredictorConfig parse_predictor_config(const std::string& text, const std::strin
                                        std::vector<ConfigEntry>* others = nullptr);
 // The daemon's configuration as dressguard-predictor and `dressguard replay` both take it: the
 // file's text (empty without --config), then each --set KEY=VALUE on a line of its own, a later
-// entry winning. As parse_predictor_config, but an error, and each entry's `where`, names the
-// file's line or "--set N" (the Nth --set), never a line past the file's end.
+// entry winning (the file itself gives each key once). As parse_predictor_config, but an error,
+// and each entry's `where`, names the file's line or "--set N" (the Nth --set), never a line past
+// the file's end.
 PredictorConfig parse_config_with_sets(const std::string& file_text, const std::string& file_name,
                                        const std::vector<std::string>& sets, std::vector<ConfigEntry>* others);
 // The keys of the daemon's config file that are not the predictor's (predictor/daemon/main.cpp

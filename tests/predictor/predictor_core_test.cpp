@@ -553,6 +553,35 @@ TEST(Config, AHardLimitASaturatedReadingCannotPassIsAnError) {
   EXPECT_EQ(error_of("hard_limit_n = 327.66\n"), "");
 }
 
+// A key the file gave twice ran with the last value in silence (hard_limit_n = 10, then 50
+// appended at the end by someone who did not see the first): now an error naming the key and
+// both lines, for the daemon's keys too. A --set still overrides the file and an earlier --set.
+TEST(Config, AKeyGivenTwiceInTheFileIsAnError) {
+  const auto error_of = [](const std::string& text) -> std::string {
+    std::vector<ConfigEntry> others;
+    try {
+      parse_config_with_sets(text, "p.conf", {}, &others);
+    } catch (const std::runtime_error& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_EQ(error_of("hard_limit_n = 10\nsensor_timeout_ms = 50\nhard_limit_n = 50\n"),
+            "p.conf:3: key 'hard_limit_n' given twice (first on p.conf:1)");
+  EXPECT_EQ(error_of("model = a.dgm\n# the other one\nmodel=b.dgm\n"),
+            "p.conf:3: key 'model' given twice (first on p.conf:1)");
+  try {
+    parse_predictor_config("stop_consecutive = 5\nstop_consecutive = 5\n", "q.conf");
+    ADD_FAILURE() << "a key given twice was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "q.conf:2: key 'stop_consecutive' given twice (first on q.conf:1)");
+  }
+  std::vector<ConfigEntry> others;
+  const auto c =
+      parse_config_with_sets("hard_limit_n = 10\n", "p.conf", {"hard_limit_n=20", "hard_limit_n=30"}, &others);
+  EXPECT_DOUBLE_EQ(c.hard_limit_n, 30.0) << "--set overrides the file, a later --set an earlier one";
+}
+
 // The configuration file installed with the daemon says "the values below are the defaults":
 // it parses, every key it sets equals PredictorConfig's default, and the daemon's own keys come
 // back to the daemon.
