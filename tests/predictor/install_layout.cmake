@@ -1,6 +1,7 @@
 # The predictor's deployment fits together: `cmake --install` of BUILD into a staging DESTDIR
 # puts the binary, the unit, the config and the model where the unit and the config say, and
-# the installed config parses (the daemon checks it before it opens any CAN socket).
+# the installed config parses (the daemon checks it before it opens any CAN socket); the unit
+# is not restarted on exit 2 (bad config) and passes `systemd-analyze verify` where that exists.
 #   cmake -DBUILD=... -DSTAGE=... -P install_layout.cmake
 file(REMOVE_RECURSE "${STAGE}")
 execute_process(COMMAND ${CMAKE_COMMAND} -E env DESTDIR=${STAGE} ${CMAKE_COMMAND} --install ${BUILD}
@@ -26,6 +27,12 @@ file(STRINGS "${units}" dynamic REGEX "^DynamicUser=yes$")
 if(user AND NOT dynamic)
   message(FATAL_ERROR "${units}: ${user} but no DynamicUser=yes: the install creates no such user")
 endif()
+# Exit 2 is bad arguments or config (--help): a restart cannot mend it, so the unit restarts on
+# any other failure but not on that one (restarted, it hit the start limit and hid the reason).
+file(STRINGS "${units}" restart REGEX "^Restart")
+if(NOT restart MATCHES "(^|;)Restart=on-failure(;|$)" OR NOT restart MATCHES "RestartPreventExitStatus=([^;]* )?2( |;|$)")
+  message(FATAL_ERROR "${units}: not Restart=on-failure with RestartPreventExitStatus=2: ${restart}")
+endif()
 foreach(f "${bin}" "${conf}")
   if(NOT EXISTS "${STAGE}${f}")
     message(FATAL_ERROR "${units} names ${f}, which the install did not put there")
@@ -35,8 +42,9 @@ file(STRINGS "${STAGE}${conf}" model REGEX "^model *=")
 if(NOT model MATCHES "^model *= *([^ #]+)")
   message(FATAL_ERROR "${conf}: no model line")
 endif()
-if(NOT EXISTS "${STAGE}${CMAKE_MATCH_1}")
-  message(FATAL_ERROR "${conf} names the model ${CMAKE_MATCH_1}, which the install did not put there")
+set(model_path "${CMAKE_MATCH_1}")
+if(NOT EXISTS "${STAGE}${model_path}")
+  message(FATAL_ERROR "${conf} names the model ${model_path}, which the install did not put there")
 endif()
 # The installed config parses: the daemon reads it, then fails only on the missing interface
 # (exit 1), not on the file (exit 2).
@@ -45,4 +53,22 @@ execute_process(COMMAND "${STAGE}${bin}" --config "${STAGE}${conf}" --interface 
 if(NOT rc EQUAL 1 OR NOT err MATCHES "dg_none")
   message(FATAL_ERROR "the installed config was not accepted (exit ${rc}): ${err}")
 endif()
-message(STATUS "installed: ${bin}, ${conf}, ${CMAKE_MATCH_1}, ${units}")
+# systemd's own check of the unit, where systemd-analyze is (it needs no running systemd): an
+# instance of the template with its binary at the staged path. Any message is a failure: verify
+# exits 0 on unknown keys and unparsable values, which systemd then ignores.
+find_program(SYSTEMD_ANALYZE systemd-analyze)
+if(SYSTEMD_ANALYZE)
+  set(verify_dir "${STAGE}/verify")
+  file(MAKE_DIRECTORY "${verify_dir}")
+  file(READ "${units}" unit_text)
+  string(REPLACE "${bin}" "${STAGE}${bin}" unit_text "${unit_text}")
+  file(WRITE "${verify_dir}/dressguard-predictor@.service" "${unit_text}")
+  file(CREATE_LINK dressguard-predictor@.service "${verify_dir}/dressguard-predictor@can0.service" SYMBOLIC)
+  execute_process(COMMAND ${SYSTEMD_ANALYZE} verify --man=no "${verify_dir}/dressguard-predictor@can0.service"
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR NOT "${out}${err}" STREQUAL "")
+    message(FATAL_ERROR "systemd-analyze verify of ${units} (exit ${rc}): ${out}${err}")
+  endif()
+  message(STATUS "systemd-analyze verify: the unit passes")
+endif()
+message(STATUS "installed: ${bin}, ${conf}, ${model_path}, ${units}")
