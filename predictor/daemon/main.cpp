@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <memory>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
@@ -49,6 +50,16 @@ std::string read_text(const std::string& path) {
   std::fclose(f);
   if (failed) throw std::runtime_error(path + ": cannot read (" + std::strerror(err) + ")");  // a folder, say
   return s;
+}
+
+// The model named by a config entry. A relative path in the file is the file's neighbour: under
+// systemd the working directory is /, so read against it the same file named another model by
+// hand than under the unit (none: every trial refused). One on --set is the shell's, as --model's.
+std::string model_path_of(const ConfigEntry& e, const std::string& config_path) {
+  const std::filesystem::path model(e.value);
+  const bool in_file = !config_path.empty() && e.where.rfind(config_path + ":", 0) == 0;
+  if (!in_file || e.value.empty() || model.is_absolute()) return e.value;
+  return (std::filesystem::path(config_path).parent_path() / model).string();
 }
 
 }  // namespace
@@ -103,7 +114,7 @@ int main(int argc, char** argv) {
       const std::string& where = e.where;
       auto integer = [&](long lo, long hi) { return config_whole_number(e, lo, hi); };
       if (e.key == "interface") iface = e.value;
-      else if (e.key == "model") model_path = e.value;
+      else if (e.key == "model") model_path = model_path_of(e, config_path);
       else if (e.key == "rt_priority") rt.fifo_priority = static_cast<int>(integer(0, 99));
       else if (e.key == "cpu") rt.cpu = static_cast<int>(integer(-1, 4095));
       else if (e.key == "mlock") rt.lock_memory = integer(0, 1) != 0;
