@@ -96,8 +96,8 @@ PredictorConfig parse_config_with_sets(const std::string& file_text, const std::
                                        const std::vector<std::string>& sets, std::vector<ConfigEntry>* others);
 // The keys of the daemon's config file that are not the predictor's (predictor/daemon/main.cpp
 // reads them). A replay of the same file accepts and ignores them; any other key is an error.
-inline constexpr const char* kDaemonConfigKeys[] = {"interface", "model", "rt_priority", "cpu",
-                                                    "mlock",     "tick_ms", "log_level"};
+inline constexpr const char* kDaemonConfigKeys[] = {"interface", "model",   "rt_priority", "cpu",
+                                                    "mlock",     "tick_ms", "log_level",   "rt_required"};
 // A daemon key's value as a whole number in lo..hi; else std::runtime_error
 // "WHERE: KEY: 'VALUE' is not a whole number in LO-HI".
 long config_whole_number(const ConfigEntry& e, long lo, long hi);

@@ -28,15 +28,16 @@ const char* kUsage =
     "  --no-rt              skip mlockall, SCHED_FIFO and CPU affinity\n"
     "  --latency-report     print the processing-latency histogram summary at exit\n"
     "  --help               this text\n"
-    "Config keys: interface, model, rt_priority (80; 0 = none), cpu (-1), mlock (1), tick_ms (1),\n"
-    "log_level (info), and the predictor's: stop_threshold, stop_consecutive, hard_limit_n,\n"
-    "sensor_timeout_ms, bad_frame_budget, bad_frame_weight, max_delta_counter, status_period_ms,\n"
-    "heartbeat_period_ms, posteriors_period_ms, stop_retry_ms, sample_period_ms, acceleration_m_s2,\n"
-    "mount_axes, mount_bias.\n"
+    "Config keys: interface, model, rt_priority (80; 0 = none), cpu (-1), mlock (1), rt_required (0;\n"
+    "1: a real-time step that fails ends the daemon, exit 1), tick_ms (1), log_level (info), and the\n"
+    "predictor's: stop_threshold, stop_consecutive, hard_limit_n, sensor_timeout_ms, bad_frame_budget,\n"
+    "bad_frame_weight, max_delta_counter, status_period_ms, heartbeat_period_ms, posteriors_period_ms,\n"
+    "stop_retry_ms, sample_period_ms, acceleration_m_s2, mount_axes, mount_bias.\n"
     "Signals: SIGTERM and SIGINT shut down (a running trial is stopped first); SIGHUP is ignored:\n"
     "the config and model are read at start only, a change takes a restart.\n"
-    "Exit codes: 0 clean shutdown (SIGTERM/SIGINT), 1 runtime error (the interface gone, or a stop\n"
-    "not confirmed on the bus when the daemon exited), 2 bad arguments or config.";
+    "Exit codes: 0 clean shutdown (SIGTERM/SIGINT), 1 runtime error (the interface gone, a stop not\n"
+    "confirmed on the bus when the daemon exited, a real-time step failed with rt_required = 1),\n"
+    "2 bad arguments or config.";
 
 std::string read_text(const std::string& path) {
   FILE* f = std::fopen(path.c_str(), "rb");
@@ -62,12 +63,24 @@ std::string model_path_of(const ConfigEntry& e, const std::string& config_path) 
   return (std::filesystem::path(config_path).parent_path() / model).string();
 }
 
+// The real-time setup, each failed step logged. False when one failed and `required` (the
+// config's rt_required): a predictor that would run without the real time it was deployed with
+// (a unit that lost its capabilities) ends before it listens, rather than with a warning.
+bool realtime_ready(const RtOptions& rt, bool required, spdlog::logger& log) {
+  const auto failures = setup_realtime(rt);
+  const auto level = required ? spdlog::level::critical : spdlog::level::warn;
+  for (const auto& f : failures) log.log(level, "real-time setup: {}", f);
+  if (!required || failures.empty()) return true;
+  log.critical("rt_required = 1: not starting without real time (--no-rt skips the setup)");
+  return false;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::string config_path, iface_arg, model_arg;
   std::vector<std::string> sets;
-  bool no_rt = false, latency_report = false;
+  bool no_rt = false, latency_report = false, rt_required = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&]() -> std::string {
@@ -118,6 +131,7 @@ int main(int argc, char** argv) {
       else if (e.key == "rt_priority") rt.fifo_priority = static_cast<int>(integer(0, 99));
       else if (e.key == "cpu") rt.cpu = static_cast<int>(integer(-1, 4095));
       else if (e.key == "mlock") rt.lock_memory = integer(0, 1) != 0;
+      else if (e.key == "rt_required") rt_required = integer(0, 1) != 0;
       else if (e.key == "tick_ms") dopt.tick_ns = integer(1, max_tick_ms(cfg)) * 1000000;
       else if (e.key == "log_level") {
         // spdlog turns a name it does not know into "off": a typo would silence every error.
@@ -159,6 +173,10 @@ int main(int argc, char** argv) {
   }
 
   try {
+    static EventQueue events;  // 4096 events: static storage, not on the stack
+    EventLogger logger(events, log, names);  // before the RT setup: it must not inherit SCHED_FIFO
+    // Before the sockets: with rt_required, a step that fails ends the daemon before it listens.
+    if (!no_rt && !realtime_ready(rt, rt_required, *log)) return 1;
     can::PortOptions rx_opt;
     rx_opt.ids = PredictorDaemon::receive_ids();
     rx_opt.receive_buffer = 1 << 20;  // ~1.5 s of a saturated 1 Mbit/s bus: a late thread loses nothing
@@ -174,13 +192,8 @@ int main(int argc, char** argv) {
       log->warn("receive buffer {} bytes, not the {} asked: a late loop thread loses frames sooner; grant "
                 "CAP_NET_ADMIN (SO_RCVBUFFORCE) or raise net.core.rmem_max",
                 rx->receive_buffer(), rx_opt.receive_buffer);
-    static EventQueue events;  // 4096 events: static storage, not on the stack
-    EventLogger logger(events, log, names);  // before the RT setup: it must not inherit SCHED_FIFO
     PredictorDaemon daemon(model.get(), cfg, *rx, *stop_port, events, dopt);
     handle_signals(&daemon);
-    if (!no_rt) {
-      for (const auto& w : setup_realtime(rt)) log->warn("real-time setup: {}", w);
-    }
     log->info("listening on {} (threshold {}, k {}, hard limit {} N, sensor timeout {} ms)", iface,
               daemon.predictor().threshold(), daemon.predictor().consecutive(), cfg.hard_limit_n,
               cfg.sensor_timeout_ns / 1000000);

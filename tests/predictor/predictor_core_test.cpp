@@ -614,7 +614,8 @@ TEST(Config, TheShippedFileParsesToTheDefaults) {
   }
   std::vector<std::string> keys;
   for (const auto& e : others) keys.push_back(e.key);
-  EXPECT_EQ(keys, (std::vector<std::string>{"interface", "model", "tick_ms", "rt_priority", "cpu", "mlock", "log_level"}));
+  EXPECT_EQ(keys, (std::vector<std::string>{"interface", "model", "tick_ms", "rt_priority", "cpu", "mlock",
+                                            "rt_required", "log_level"}));
 }
 
 TEST(CommandedTravel, TrapezoidProfile) {
