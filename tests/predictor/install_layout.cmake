@@ -23,8 +23,9 @@ function(check_install root tree)
     message(FATAL_ERROR "expected one dressguard-predictor@.service under ${tree}, found ${n}")
   endif()
   file(STRINGS "${units}" exec REGEX "^ExecStart=")
-  if(NOT exec MATCHES "^ExecStart=([^ ]+) --config ([^ ]+) --interface %i$")
-    message(FATAL_ERROR "${units}: ExecStart is not 'BINARY --config FILE --interface %i': ${exec}")
+  # %I: the instance unescaped is the interface's name (%i, escaped, names the device unit).
+  if(NOT exec MATCHES "^ExecStart=([^ ]+) --config ([^ ]+) --interface %I$")
+    message(FATAL_ERROR "${units}: ExecStart is not 'BINARY --config FILE --interface %I': ${exec}")
   endif()
   set(bin "${CMAKE_MATCH_1}")
   set(conf "${CMAKE_MATCH_2}")
@@ -58,20 +59,38 @@ function(check_install root tree)
     message(FATAL_ERROR "the installed config was not accepted (exit ${rc}): ${err}")
   endif()
   # systemd's own check of the unit, where systemd-analyze is (it needs no running systemd): an
-  # instance of the template with its binary at the staged path. Any message is a failure: verify
-  # exits 0 on unknown keys and unparsable values, which systemd then ignores.
+  # instance of the template with its binary at the staged path, for an interface whose name has
+  # a '-' (the instance `systemd-escape can-arm` gives). Any message is a failure: verify exits 0
+  # on unknown keys and unparsable values, which systemd then ignores.
   find_program(SYSTEMD_ANALYZE systemd-analyze)
   if(SYSTEMD_ANALYZE)
     set(verify_dir "${tree}/verify")
+    set(instance "${verify_dir}/dressguard-predictor@can\\x2darm.service")
     file(MAKE_DIRECTORY "${verify_dir}")
     file(READ "${units}" unit_text)
     string(REPLACE "${bin}" "${root}${bin}" unit_text "${unit_text}")
     file(WRITE "${verify_dir}/dressguard-predictor@.service" "${unit_text}")
-    file(CREATE_LINK dressguard-predictor@.service "${verify_dir}/dressguard-predictor@can0.service" SYMBOLIC)
-    execute_process(COMMAND ${SYSTEMD_ANALYZE} verify --man=no "${verify_dir}/dressguard-predictor@can0.service"
+    file(CREATE_LINK dressguard-predictor@.service "${instance}" SYMBOLIC)
+    execute_process(COMMAND ${SYSTEMD_ANALYZE} verify --man=no "${instance}"
                     RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
     if(NOT rc EQUAL 0 OR NOT "${out}${err}" STREQUAL "")
       message(FATAL_ERROR "systemd-analyze verify of ${units} (exit ${rc}): ${out}${err}")
+    endif()
+    # Its debug log shows the unit as loaded: the daemon must be given the interface's own name
+    # and the unit bound to that interface's device (where this systemd prints them).
+    execute_process(COMMAND ${CMAKE_COMMAND} -E env SYSTEMD_LOG_LEVEL=debug ${SYSTEMD_ANALYZE} verify --man=no
+                            "${instance}" OUTPUT_VARIABLE out ERROR_VARIABLE err)
+    if("${out}${err}" MATCHES "Command Line: [^\n]*--interface ([^\n]*)")
+      set(given "${CMAKE_MATCH_1}")
+      if(NOT given MATCHES "^\"?can-arm\"?$")
+        message(FATAL_ERROR "${units}: instance can\\x2darm runs the daemon with --interface ${given}, not can-arm")
+      endif()
+      message(STATUS "instance can\\x2darm: --interface ${given}")
+    endif()
+    if("${out}${err}" MATCHES "BindsTo: ([^ \n]*)")
+      if(NOT CMAKE_MATCH_1 STREQUAL "sys-subsystem-net-devices-can\\x2darm.device")
+        message(FATAL_ERROR "${units}: instance can\\x2darm is bound to ${CMAKE_MATCH_1}, not can-arm's device")
+      endif()
     endif()
     message(STATUS "systemd-analyze verify: the unit passes")
   endif()
