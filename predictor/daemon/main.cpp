@@ -1,4 +1,6 @@
 // dressguard-predictor: the real-time predictor daemon. See predictor/README.md.
+#include <net/if.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
@@ -63,6 +65,15 @@ std::string model_path_of(const ConfigEntry& e, const std::string& config_path) 
   return (std::filesystem::path(config_path).parent_path() / model).string();
 }
 
+// A SocketCAN interface name as the kernel takes it, 1 to IFNAMSIZ - 1 characters; else an
+// error naming `what`. An empty one failed only at the socket (exit 1, a runtime error the unit
+// restarts), and a longer one was cut short and could name another interface.
+std::string interface_name(const std::string& what, const std::string& name) {
+  if (!name.empty() && name.size() < IFNAMSIZ) return name;
+  throw std::runtime_error(what + ": '" + name + "' is not an interface name (1 to " + std::to_string(IFNAMSIZ - 1) +
+                           " characters)");
+}
+
 // The real-time setup, each failed step logged. False when one failed and `required` (the
 // config's rt_required): a predictor that would run without the real time it was deployed with
 // (a unit that lost its capabilities) ends before it listens, rather than with a warning.
@@ -79,6 +90,7 @@ bool realtime_ready(const RtOptions& rt, bool required, spdlog::logger& log) {
 
 int main(int argc, char** argv) {
   std::string config_path, iface_arg, model_arg;
+  bool iface_given = false;
   std::vector<std::string> sets;
   bool no_rt = false, latency_report = false, rt_required = false;
   for (int i = 1; i < argc; ++i) {
@@ -97,6 +109,7 @@ int main(int argc, char** argv) {
       config_path = value();
     } else if (a == "--interface") {
       iface_arg = value();
+      iface_given = true;
     } else if (a == "--model") {
       model_arg = value();
     } else if (a == "--set") {
@@ -126,7 +139,7 @@ int main(int argc, char** argv) {
     for (const auto& e : others) {
       const std::string& where = e.where;
       auto integer = [&](long lo, long hi) { return config_whole_number(e, lo, hi); };
-      if (e.key == "interface") iface = e.value;
+      if (e.key == "interface") iface = interface_name(where + ": interface", e.value);
       else if (e.key == "model") model_path = model_path_of(e, config_path);
       else if (e.key == "rt_priority") rt.fifo_priority = static_cast<int>(integer(0, 99));
       else if (e.key == "cpu") rt.cpu = static_cast<int>(integer(-1, 4095));
@@ -142,11 +155,11 @@ int main(int argc, char** argv) {
         log->set_level(level);
       } else throw std::runtime_error(where + ": unknown key '" + e.key + "'");
     }
+    if (iface_given) iface = interface_name("--interface", iface_arg);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "dressguard-predictor: %s\n", e.what());
     return 2;
   }
-  if (!iface_arg.empty()) iface = iface_arg;
   if (!model_arg.empty()) model_path = model_arg;
   if (dopt.tick_ns <= 0) {
     std::fprintf(stderr, "dressguard-predictor: tick_ms must be >= 1\n");
