@@ -1,7 +1,8 @@
 // The daemon's event loop on the in-process CAN bus (SocketCAN semantics, this host has no
 // AF_CAN): the robot side hears the stop frames, the stop is confirmed by its own echo, a silent
 // sensor is stopped by the deadline, SIGTERM's path shuts down cleanly, the logger thread writes
-// what happened through spdlog, and the loop thread allocates nothing after start-up.
+// what happened through spdlog, and the loop thread allocates nothing after start-up (in every
+// test that runs it on a Rig).
 #include <gtest/gtest.h>
 #include <signal.h>
 
@@ -52,7 +53,12 @@ struct Rig {
       loop_allocations = count.count();
     });
   }
-  ~Rig() { shutdown(); }
+  // Every test's loop, not only the caught trial's: the timeout, the retries, the shutdown with
+  // and without its echo, the refusal without a model and the ignored signals run on it too.
+  ~Rig() {
+    shutdown();
+    EXPECT_EQ(loop_allocations, 0u) << "the event loop allocated after start-up";
+  }
   void shutdown() {
     if (loop.joinable()) {
       daemon->request_shutdown();
