@@ -50,8 +50,8 @@ inline Eigen::Matrix3d rotation_WP() {
 }
 
 struct PaperScene {
-  // --- gown transform (file -> P): p_P = R_PF * (scale * p_file) + t_P -----------------------
-  double scale = 1.679;           // file units -> metres
+  // --- gown transform (file -> P): p_P = R_PF * p_file + t_P, p_file already in metres --------
+  // (read_obj's scale, gown.h's kMeasuredGownScale for the measured gown's file units)
   double rot_y = 1.57;            // [rad] R_PF = Ry(rot_y) * Rx(rot_x) * Rz(rot_z), applied right to left
   double rot_x = -1.2;            // [rad]
   double rot_z = -3.14;           // [rad]
