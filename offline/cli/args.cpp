@@ -26,21 +26,25 @@ std::set<std::string> split_list(const std::string& s) {
   return {items.begin(), items.end()};
 }
 
-std::vector<std::filesystem::path> dataset_list(const std::string& option, const std::string& list,
-                                                const std::string& why_once) {
-  std::vector<std::filesystem::path> dirs;
+std::vector<std::string> distinct_files(const std::string& option, const std::string& list, const std::string& noun,
+                                        const std::string& why_once) {
   std::vector<std::string> given;
   for (const std::string& d : split_in_order(list)) {
-    // same_file: one folder under two spellings (study, ./study) or through a symlink.
+    // same_file: one file under two spellings (study, ./study) or through a symlink.
     for (const std::string& before : given)
       if (same_file(before, d))
-        throw UsageError("--" + option + " names the dataset " + d + " twice" +
+        throw UsageError("--" + option + " names the " + noun + " " + d + " twice" +
                          (before == d ? "" : " (as " + before + " and " + d + ")") + ": " + why_once);
     given.push_back(d);
-    dirs.emplace_back(d);
   }
-  if (dirs.empty()) throw UsageError("--" + option + " names no dataset");
-  return dirs;
+  return given;
+}
+
+std::vector<std::filesystem::path> dataset_list(const std::string& option, const std::string& list,
+                                                const std::string& why_once) {
+  const std::vector<std::string> given = distinct_files(option, list, "dataset", why_once);
+  if (given.empty()) throw UsageError("--" + option + " names no dataset");
+  return {given.begin(), given.end()};
 }
 
 std::filesystem::path plot_script(const std::string& name) {

@@ -36,6 +36,11 @@ std::vector<std::string> split_in_order(const std::string& s);
 // (train --data study,study once did).
 std::vector<std::filesystem::path> dataset_list(const std::string& option, const std::string& list,
                                                 const std::string& why_once = "its trials would count twice");
+// The files that option --`option` lists ("A,B,...", split_in_order), in the order given, each
+// once: UsageError when one file is named twice (same_file, as dataset_list), naming both
+// arguments, calling it a `noun` and saying `why_once`. An empty list is the caller's to refuse.
+std::vector<std::string> distinct_files(const std::string& option, const std::string& list, const std::string& noun,
+                                        const std::string& why_once);
 
 // UsageError naming every name of `given` (option --`option`'s list) that is no participant of
 // `ds` (the dataset `data`), and the participants it has: a name that matches nobody would

@@ -126,7 +126,8 @@ int run_classify(int argc, char** argv) {
         "  sample are skipped.\n"
         "  With several models, they vote (a committee, e.g. the STCs of several people's simulators):\n"
         "  each model classifies the trial, the class most of them pick wins, a tie goes to the larger\n"
-        "  sum of their posteriors; classes are matched by name.\n"
+        "  sum of their posteriors; classes are matched by name. Each model file once (in --against\n"
+        "  too): a file named twice would vote twice.\n"
         "  --truncate-at DIST      cut each trial after the last sample with travel <= DIST metres\n"
         "  --sweep A:B:STEP        accuracy at every truncation distance A, A+STEP, ..., B (metres)\n"
         "  --sweep-out PREFIX      with --sweep: write PREFIX.csv and PREFIX.png (tools/plot/hmm_sweep.py;\n"
@@ -182,11 +183,15 @@ int run_classify(int argc, char** argv) {
     if (ms.empty()) throw UsageError("--" + option + " needs at least one model file");
     return ms;
   };
-  const std::vector<std::string> model_paths = split_in_order(model_list);
+  // One model file twice in a committee (A.dgm,A.dgm or A.dgm,./A.dgm) would cast its vote twice
+  // and outvote a member it disagrees with, without a word; as --weigh-on refuses a set twice.
+  const std::string why_once = "its vote would count twice";
+  const std::vector<std::string> model_paths = distinct_files("model", model_list, "model", why_once);
   const std::vector<model::OutcomeModel> models = read_models("model", model_paths);
   std::vector<const model::OutcomeModel*> committee;
   for (const auto& m : models) committee.push_back(&m);
-  const std::vector<std::string> against_paths = split_in_order(args.get("against").value_or(""));
+  const std::vector<std::string> against_paths =
+      distinct_files("against", args.get("against").value_or(""), "model", why_once);
   if (args.get("against") && !sweep.empty()) throw UsageError("--against pairs the models at one cut, not with --sweep");
   const std::vector<model::OutcomeModel> against_models =
       args.get("against") ? read_models("against", against_paths) : std::vector<model::OutcomeModel>{};

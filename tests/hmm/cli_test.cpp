@@ -145,27 +145,35 @@ TEST_F(CliTest, ClassifyCountsALabelTheModelLacksAsWrong) {
   ASSERT_EQ(js.code, 0) << js.err;
   EXPECT_EQ(json_field(js.out, "total", js.out.find("\"evaluation\"")), 18.0) << js.out;
   EXPECT_NE(js.out.find("\"truth\": \"good\", \"predicted\": \"missed\""), std::string::npos) << js.out;
-  const auto vote = run("classify --model " + m1 + "," + m1 + " --data " + test);
+  const std::string m1_copy = (dir / "m1-copy.dgm").string();  // one file twice is refused
+  fs::copy_file(m1, m1_copy);
+  const auto vote = run("classify --model " + m1 + "," + m1_copy + " --data " + test);
   ASSERT_EQ(vote.code, 0) << vote.err;
   EXPECT_NE(vote.out.find("accuracy 0.3333 (6/18), a vote of 2 models;"), std::string::npos) << vote.out;
 }
 
 // A committee (--model A,B,C) votes: with two right models and one trained on swapped good and
-// missed labels, the majority is right on every trial; with the liar twice, the good and missed
-// trials go the liar's way and only the caught ones stay right. A bad file in the list is named.
+// missed labels, the majority is right on every trial; with two liars, the good and missed
+// trials go the liars' way and only the caught ones stay right. A bad file in the list is named,
+// and one file named twice is refused.
 TEST_F(CliTest, CommitteeOfModelsVotes) {
   ASSERT_TRUE(train_right_and_liar());
+  // Two members that agree: copies of m and of the liar under other names (one file twice is
+  // refused, below).
+  const std::string m2 = (dir / "m2.dgm").string(), liar2 = (dir / "liar2.dgm").string();
+  fs::copy_file(m, m2);
+  fs::copy_file(liar, liar2);
 
-  const auto two_right = run("classify --model " + m + "," + m + "," + liar + " --data " + test + " --json");
+  const auto two_right = run("classify --model " + m + "," + m2 + "," + liar + " --data " + test + " --json");
   ASSERT_EQ(two_right.code, 0) << two_right.err;
   EXPECT_EQ(json_field(two_right.out, "accuracy"), 1.0) << two_right.out;
   EXPECT_NE(two_right.out.find("\"votes\": ["), std::string::npos) << two_right.out;
-  const auto two_liars = run("classify --model " + m + "," + liar + "," + liar + " --data " + test);
+  const auto two_liars = run("classify --model " + m + "," + liar + "," + liar2 + " --data " + test);
   ASSERT_EQ(two_liars.code, 0) << two_liars.err;
   EXPECT_NE(two_liars.out.find("accuracy 0.3333 (6/18), a vote of 3 models"), std::string::npos) << two_liars.out;
   EXPECT_NE(two_liars.out.find("2/3"), std::string::npos) << two_liars.out;
   // The sweep of a committee: the majority's accuracy at every distance (the liars' again).
-  const auto sw = run("classify --model " + m + "," + liar + "," + liar + " --data " + test + " --sweep 0.05:0.15:0.05 --sweep-out " +
+  const auto sw = run("classify --model " + m + "," + liar + "," + liar2 + " --data " + test + " --sweep 0.05:0.15:0.05 --sweep-out " +
                       (dir / "sw").string() + " --no-plot");
   ASSERT_EQ(sw.code, 0) << sw.err;
   std::ifstream csv(dir / "sw.csv");
@@ -188,7 +196,7 @@ TEST_F(CliTest, CommitteeOfModelsVotes) {
   EXPECT_EQ(json_field(vs.out, "only_this_right", at), 12.0) << vs.out;
   EXPECT_EQ(json_field(vs.out, "only_against_right", at), 0.0) << vs.out;
   EXPECT_NEAR(json_field(vs.out, "mcnemar_exact_p", at), 2.0 / 4096, 1e-15) << vs.out;
-  const auto same = run("classify --model " + m + "," + m + "," + liar + " --against " + m + " --data " + test);
+  const auto same = run("classify --model " + m + "," + m2 + "," + liar + " --against " + m + " --data " + test);
   ASSERT_EQ(same.code, 0) << same.err;
   EXPECT_NE(same.out.find("18/18 right; only this one right on 0, only the other on 0: McNemar's exact p 1"),
             std::string::npos) << same.out;
@@ -197,13 +205,29 @@ TEST_F(CliTest, CommitteeOfModelsVotes) {
   EXPECT_EQ(sweep_vs.code, 2);
   EXPECT_NE(sweep_vs.err.find("--against"), std::string::npos) << sweep_vs.err;
 
+  // One model file twice, under one spelling or two, would cast its vote twice: the liar named
+  // twice outvoted m without a word. Refused naming both arguments, as --weigh-on refuses a set
+  // twice, and in --against too.
+  const std::string liar_again = (dir / "." / "liar.dgm").string();
+  for (const std::string& again : {liar, liar_again}) {
+    const std::string named = "--model names the model " + again + " twice" +
+                              (again == liar ? "" : " (as " + liar + " and " + again + ")") +
+                              ": its vote would count twice";
+    const auto twice = run("classify --model " + m + "," + liar + "," + again + " --data " + test);
+    EXPECT_EQ(twice.code, 2) << again;
+    EXPECT_NE(twice.err.find(named), std::string::npos) << twice.err;
+    const auto against_twice = run("classify --model " + m + " --against " + liar + "," + again + " --data " + test);
+    EXPECT_EQ(against_twice.code, 2) << again;
+    EXPECT_NE(against_twice.err.find("--against" + named.substr(7)), std::string::npos) << against_twice.err;
+  }
+
   const auto missing = run("classify --model " + m + "," + (dir / "none.dgm").string() + " --data " + test);
   EXPECT_EQ(missing.code, 2);
   EXPECT_NE(missing.err.find("none.dgm"), std::string::npos) << missing.err;
 
   // Asked "good or missed?" (--among), the right committee still gets those 12 trials right and
   // can no longer name the 6 caught ones; a class no model has is a usage error naming the file.
-  const auto among = run("classify --model " + m + "," + m + "," + liar + " --data " + test + " --among good,missed");
+  const auto among = run("classify --model " + m + "," + m2 + "," + liar + " --data " + test + " --among good,missed");
   ASSERT_EQ(among.code, 0) << among.err;
   EXPECT_NE(among.out.find("accuracy 0.6667 (12/18), a vote of 3 models"), std::string::npos) << among.out;
   const auto single = run("classify --model " + m + " --data " + test + " --among good,missed --json");
