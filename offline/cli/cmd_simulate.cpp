@@ -126,7 +126,8 @@ int run_simulate(int argc, char** argv) {
         "                    --max-travel and --rim-ahead\n"
         "  --seed S          seed of the noise models (default 0)\n"
         "  --max-travel M    [m] where the rig stops if the force limit does not stop it first\n"
-        "                    (default 0.85; a measured trial's own end: rig_end_of_travel)\n"
+        "                    (default 0.85; a measured trial's own end: rig_end_of_travel); more than\n"
+        "                    the travel of the pull's first sample (0.05 mm), so that it has two\n"
         "  --noise           the paper's gown perturbation (random force up to 6 N for 0.5 s)\n"
         "  --arm-noise       the paper's arm-height noise (+-1.5 cm high/low, -6..0 cm middle)\n"
         "  --gown G          full | reduced | coarse (default reduced): the measured gown at ~20k, 5k,\n"
@@ -171,6 +172,12 @@ int run_simulate(int argc, char** argv) {
   spec.max_travel = args.number("max-travel", cal ? cal->rig_travel : 0.85);
   if (!(spec.max_travel > 0.0 && spec.max_travel <= 0.85))
     throw UsageError("--max-travel must be in (0, 0.85] m (the rig's travel)");
+  // A pull stopped at its first sample writes a trial file of one sample, which every reader of
+  // a dataset refuses (core/dataset.h): refused here, before the run, with the least that gives two.
+  if (const double least = sim::least_max_travel_of(spec); !(spec.max_travel > least))
+    throw UsageError(format_string("--max-travel %g m ends the pull at its first sample, %g m into the rig's ramp: "
+                                   "a trial needs at least 2 samples (a dataset's reader refuses one), so more than that",
+                                   spec.max_travel, least - sim::kTravelEndTolerance));
   spec.gown_noise = args.has("noise");
   spec.arm_noise = args.has("arm-noise");
   spec.self_collision = !args.has("no-self-collision");

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <random>
 
@@ -364,7 +365,7 @@ void pull_sample(const GownModel& m, Pulling& p, const TrialSpec& spec, const Se
   if (std::abs(f.x) >= spec.force_limit || std::abs(f.z) >= spec.force_limit) {
     r.stopped_by_force = true;
     p.ended = true;
-  } else if (travel >= spec.max_travel - 1e-12) {
+  } else if (travel >= spec.max_travel - kTravelEndTolerance) {
     p.full = true;
     p.ended = true;
   } else if (!r.finite || p.t >= max_time_of(spec)) {
@@ -468,6 +469,12 @@ bool same_settling(const TrialSpec& a, const TrialDraws& da, const TrialSpec& b,
 }
 
 }  // namespace
+
+double least_max_travel_of(const TrialSpec& spec, const SceneOptions& opt) {
+  const double first_sample_t = 3 / opt.step_hz;  // pull_sample: one sample per 3 output steps
+  const Profile unbounded{spec.acceleration, spec.speed, std::numeric_limits<double>::infinity()};
+  return unbounded.travel(first_sample_t) + kTravelEndTolerance;
+}
 
 double max_time_of(const TrialSpec& spec) {
   return spec.max_travel / spec.speed + spec.speed / spec.acceleration + 5.0;

@@ -379,6 +379,13 @@ double max_time_of(const TrialSpec& spec);
 // The longest settling [s]: it gives up at `settle_max_steps` output steps (at least the gown
 // perturbation's 1.2 s).
 double max_settle_time_of(const TrialSpec& spec, const SceneOptions& opt = {});
+// The pull ends at the first sample whose travel is within kTravelEndTolerance [m] of max_travel.
+inline constexpr double kTravelEndTolerance = 1e-12;
+// [m] The max_travel a pull needs to give two samples, the least a trial file holds (a reader
+// refuses one sample: core/dataset.h): the travel of its first sample (3 output steps into the
+// rig's ramp: 0.05 mm at 1 m/s^2 and 300 Hz) plus kTravelEndTolerance. A max_travel at or below
+// it ends the pull at that first sample.
+double least_max_travel_of(const TrialSpec& spec, const SceneOptions& opt = {});
 
 // Several trials with one cloth, the same bits as simulate_trial() on each, in the order of
 // `specs`, but each settling done once where it can be: trials that settle alike (the same

@@ -29,6 +29,22 @@ if(EXISTS /tmp/dg_sim_never.csv)
   message(FATAL_ERROR "a failed simulate wrote its output")
 endif()
 
+# A --max-travel that ends the pull at its first sample (0.05 mm, 0.01 s into the rig's ramp)
+# wrote a trial file of one sample, which every reader of a dataset refuses at its line: refused
+# before the run, naming it, nothing written; just past it the trial has its two samples.
+file(REMOVE ${TMP}/dg_one_sample.csv)
+execute_process(COMMAND ${DG} simulate --gown coarse --height high --max-travel 0.00005 --frames 0
+                        --out ${TMP}/dg_one_sample.csv RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "--max-travel 5e-05 m ends the pull at its first sample, 5e-05 m into"
+   OR EXISTS ${TMP}/dg_one_sample.csv)
+  message(FATAL_ERROR "--max-travel 0.00005: expected exit 2 naming it and no file, got rc=${rc}: ${err}")
+endif()
+execute_process(COMMAND ${DG} simulate --gown coarse --height high --max-travel 0.00006 --frames 0
+                        --out ${TMP}/two_samples.csv --json RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "\"samples\": 2,")
+  message(FATAL_ERROR "--max-travel 0.00006: expected a trial of 2 samples, got rc=${rc}: ${out} ${err}")
+endif()
+
 # --max-travel stops the rig there (a measured trial's own end of travel), and the scene file
 # carries the contact forces on the arm at the end (paper eq. 2).
 execute_process(COMMAND ${DG} simulate --gown coarse --height low --max-travel 0.05 --frames 0 --out ${TMP}/short.csv --json
