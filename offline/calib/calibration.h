@@ -191,8 +191,9 @@ using TrialBatchSimulator =
 TrialBatchSimulator one_by_one(TrialSimulator sim);
 
 // What a simulator throws for values whose scene it cannot build: the cloth simulator's when the
-// gripper's jaws hold none of the gown at the values' rim_shift (sim_bridge.h; gown::NothingGrasped:
-// on the measured gown from rim_shift +0.0431 m, the rim 8.31 cm ahead of the jaws). An InputError,
+// gripper's jaws hold no whole triangle of the gown at the values' rim_shift (sim_bridge.h;
+// gown::NothingGrasped: on the measured gown from rim_shift +0.030 m, the rim 7.0 cm ahead of
+// the jaws; no vertex at all from +0.0431 m, 8.31 cm). An InputError,
 // so a command that simulates a calibration file's values refuses them (exit 2); calibrate ranks
 // such a candidate last, as a simulation that blew up (calibrate's "Failures"), and the command
 // refuses a held rim_shift that builds none before its search (ClothSimulator::build_grasp).

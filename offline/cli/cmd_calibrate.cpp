@@ -284,7 +284,8 @@ int run_calibrate(int argc, char** argv) {
 #else
   const Comm& comm = Comm::world();
   const ClothSimulator sim = make_cloth_simulator(gown);
-  // A held rim_shift whose jaws hold none of the gown (the measured gown's from +0.0431 m) makes
+  // A held rim_shift whose jaws hold none of the gown (the measured gown's from +0.030 m, where
+  // they hold no whole triangle of it, gown.h) makes
   // every candidate unbuildable: the whole budget was spent to end with "no candidate could be
   // simulated" (exit 1). Unlike a fitted box's, which the search may leave, it is refused here.
   if (const ParameterSpace::Person& rim = space.person[kRimShift]; !rim.fit) {

@@ -4,6 +4,7 @@
 #include <optional>
 
 #include "args.h"
+#include "files.h"
 #include "gown.h"
 
 namespace dressguard::cli {
@@ -15,8 +16,9 @@ inline constexpr const char* kGripHelp =
     "                    OpeningGrip)\n"
     "  --rim-ahead M     [m] the opening's rim ahead of the jaws (default 0.04; parametric 0.01).\n"
     "                    The measured sleeve's top falls away behind its rim: the further ahead,\n"
-    "                    the less the jaws hold (14 vertices at 0.04, 2 at 0.08, none from 0.0831,\n"
-    "                    which is refused)\n";
+    "                    the less the jaws hold (14 vertices at 0.04, 5 and one whole triangle at\n"
+    "                    0.065, no triangle from 0.070, which is refused: a point or a line of cloth\n"
+    "                    is no clamp); below 0.13, where the rim reaches the fist's back\n";
 
 // The grip the options ask for, starting from `base` (a calibration's grasp) or else the gown's
 // own; nullopt when neither option is given and there is no base.
@@ -27,7 +29,13 @@ inline std::optional<gown::OpeningGrip> grip_option(const Args& args, bool param
   g.depth = args.number("grip-depth", g.depth);
   g.rim_ahead = args.number("rim-ahead", g.rim_ahead);
   if (!(g.depth > 0 && g.depth < 0.15)) throw UsageError("--grip-depth must be in (0, 0.15) m, the grasp box's depth");
-  if (!(g.rim_ahead >= 0 && g.rim_ahead <= 0.5)) throw UsageError("--rim-ahead must be in [0, 0.5] m");
+  // Short of the fist's back: further ahead the hand would start inside the sleeve.
+  const double limit = gown::rim_ahead_limit(gown::PaperScene{});
+  if (!(g.rim_ahead >= 0 && g.rim_ahead < limit))
+    throw UsageError(format_string("--rim-ahead must be in [0, %g) m: from %g m the opening's rim starts level with or "
+                                   "past the fist's back, the hand inside the sleeve (offline/gown/placement.h, "
+                                   "rim_ahead_limit)",
+                                   limit, limit));
   return g;
 }
 

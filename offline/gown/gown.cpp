@@ -40,6 +40,41 @@ void check_clear_of_arm(const GownMesh& mesh, const PaperScene& scene, const std
   }
 }
 
+// How the refusals of a grasp name the gown: its file, or the parametric gown (no file).
+std::string gown_name(const std::filesystem::path& path) {
+  return path.empty() ? std::string("parametric gown") : path.string();
+}
+
+// The grasp box, for the refusals of a grasp: "the gripper's jaws (x lo..hi, y lo..hi, z lo..hi m)".
+std::string jaws_text(const PaperScene& scene) {
+  const Eigen::Vector3d lo = scene.grasp_box_center_W() - scene.grasp_box_half_extent_W();
+  const Eigen::Vector3d hi = scene.grasp_box_center_W() + scene.grasp_box_half_extent_W();
+  return format_string("the gripper's jaws (x %g..%g, y %g..%g, z %g..%g m)", lo.x(), hi.x(), lo.y(), hi.y(), lo.z(),
+                       hi.z());
+}
+
+// What put the gown where the jaws are, for the same refusals: the grip (with what to change) or
+// the file's own place.
+std::string held_how(const GownOptions& options, const std::filesystem::path& path) {
+  if (path.empty() || (!options.already_in_W && options.placement == GownPlacement::Opening)) {
+    const OpeningGrip g = options.grip.value_or(own_grip(path.empty()));
+    return "with grip depth " + format_number(g.depth) + " m and rim_ahead " + format_number(g.rim_ahead) +
+           " m (placement.h, OpeningGrip: the sleeve's top behind its rim lies below the lower jaw; hold the "
+           "rim nearer the jaws or grip deeper)";
+  }
+  return options.already_in_W ? "where the file puts it (already in W)" : "in the paper's placement";
+}
+
+// Whether every corner of some triangle of `mesh` is among the `held` vertices.
+bool holds_a_triangle(const GownMesh& mesh, const std::vector<int>& held) {
+  std::vector<bool> is_held(mesh.x.size(), false);
+  for (int v : held) is_held[static_cast<size_t>(v)] = true;
+  for (const auto& t : mesh.triangles)
+    if (is_held[static_cast<size_t>(t[0])] && is_held[static_cast<size_t>(t[1])] && is_held[static_cast<size_t>(t[2])])
+      return true;
+  return false;
+}
+
 }  // namespace
 
 GownMesh load_gown(const GownOptions& options) {
@@ -64,24 +99,19 @@ GownMesh load_gown(const GownOptions& options) {
   // OpeningGrip: nothing from 8.31 cm ahead at the default depth), grasped nothing: `gown` said
   // "grasped vertices: 0" and exited 0, and the simulator failed later or a calibration ended.
   // Before the reduction, which keeps the grasped vertices as they are.
-  if (grasp_vertices(mesh, options.scene).empty()) {
-    std::string where;
-    if (path.empty() || (!options.already_in_W && options.placement == GownPlacement::Opening)) {
-      const OpeningGrip g = options.grip.value_or(own_grip(path.empty()));
-      where = "with grip depth " + format_number(g.depth) + " m and rim_ahead " + format_number(g.rim_ahead) +
-              " m (placement.h, OpeningGrip: the sleeve's top behind its rim lies below the lower jaw; hold the "
-              "rim nearer the jaws or grip deeper)";
-    } else {
-      where = options.already_in_W ? "where the file puts it (already in W)" : "in the paper's placement";
-    }
-    const Eigen::Vector3d lo = options.scene.grasp_box_center_W() - options.scene.grasp_box_half_extent_W();
-    const Eigen::Vector3d hi = options.scene.grasp_box_center_W() + options.scene.grasp_box_half_extent_W();
-    throw NothingGrasped(format_string("%s: the gripper's jaws (x %g..%g, y %g..%g, z %g..%g m) hold no vertex of "
-                                       "the gown %s",
-                                       (path.empty() ? std::string("parametric gown") : path.string()).c_str(),
-                                       lo.x(), hi.x(), lo.y(), hi.y(), lo.z(), hi.z(), where.c_str()));
-  }
+  const std::vector<int> held = grasp_vertices(mesh, options.scene);
+  if (held.empty())
+    throw NothingGrasped(format_string("%s: %s hold no vertex of the gown %s", gown_name(path).c_str(),
+                                       jaws_text(options.scene).c_str(), held_how(options, path).c_str()));
   if (!path.empty() && options.already_in_W) check_clear_of_arm(mesh, options.scene, path);
+  // Jaws clamp a strip of cloth, which fixes how the gown hangs from them. Holding no whole
+  // triangle, they hold a vertex (a ball joint) or vertices along edges (hinges), about which the
+  // gown swings freely: the measured gown with its rim 8.1-8.3 cm ahead of the jaws held 1 vertex.
+  if (!holds_a_triangle(mesh, held))
+    throw NothingGrasped(format_string("%s: %s hold %zu vertices of the gown but no whole triangle of it %s: a "
+                                       "point or a line the gown would swing about, not a clamp of its cloth",
+                                       gown_name(path).c_str(), jaws_text(options.scene).c_str(), held.size(),
+                                       held_how(options, path).c_str()));
   mesh.areal_density = options.areal_density;
   if (options.target_triangles > 0) {
     std::vector<bool> frozen(mesh.x.size(), false);

@@ -71,7 +71,8 @@ struct GownOptions {
 // shared/data/gown/fullgown.obj when shared/data is present, else empty.
 std::filesystem::path measured_gown_path();
 
-// What load_gown throws when the gripper's jaws hold no vertex of the gown: an InputError (the
+// What load_gown throws when the gripper's jaws hold no vertex of the gown, or no whole triangle
+// of it (a point or a line of cloth the gown would swing about, not a clamp): an InputError (the
 // grip or the file is at fault) that a calibration takes for a candidate it cannot simulate
 // (offline/calib, sim_bridge.h) rather than for a defect that ends it.
 class NothingGrasped : public InputError {
@@ -84,7 +85,8 @@ class NothingGrasped : public InputError {
 // sleeve opening labelled. Throws InputError for a malformed file or a mesh with fewer than two
 // boundary loops, and NothingGrasped, naming the mesh and the grip, when the jaws hold none of
 // its vertices: a file already in W that puts its sleeve elsewhere, or a grip that misses the
-// measured sleeve's top (placement.h, OpeningGrip: from 8.31 cm ahead at the default depth).
+// measured sleeve's top (placement.h, OpeningGrip: from 8.31 cm ahead at the default depth), or
+// no whole triangle of it (from 7.0 cm ahead; checked after the arm below).
 // A file already in W is also refused (InputError) when its cloth starts inside the arm at any
 // of the three heights (placement.h, vertices_in_arm): the jaws may then hold another part of the
 // gown, as the parametric gown moved 1 m along x has its other sleeve's rim in them.

@@ -8,6 +8,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "files.h"
 #include "gown.h"
 
 namespace dressguard::gown {
@@ -25,8 +26,11 @@ void check_grip(const OpeningGrip& grip, const PaperScene& scene) {
   if (!(grip.depth > 0 && grip.depth < box_depth))
     throw std::invalid_argument("grip depth " + std::to_string(grip.depth) + " m outside (0, " +
                                 std::to_string(box_depth) + ") m, the depth of the grasp box");
-  if (!(grip.rim_ahead >= 0 && grip.rim_ahead <= 0.5))
-    throw std::invalid_argument("rim ahead of the jaws " + std::to_string(grip.rim_ahead) + " m outside [0, 0.5] m");
+  if (!(grip.rim_ahead >= 0 && grip.rim_ahead < rim_ahead_limit(scene)))
+    throw std::invalid_argument(format_string("rim ahead of the jaws %g m outside [0, %g) m: from %g m the rim starts "
+                                              "level with or past the fist's back, the hand inside the sleeve "
+                                              "(placement.h, rim_ahead_limit)",
+                                              grip.rim_ahead, rim_ahead_limit(scene), rim_ahead_limit(scene)));
 }
 
 void place_at_opening(GownMesh& mesh, const PaperScene& scene, const OpeningGrip& grip, int loop_index) {

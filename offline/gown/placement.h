@@ -145,11 +145,13 @@ inline constexpr double kOpeningRimAhead = 0.04;
 // resolution holds the same vertices, load_gown freezes them):
 //   rim_ahead 0     29 vertices, the cloth reaching 1.5 cm above the lower jaw at its front
 //   rim_ahead 0.04  14 vertices, 0.97 cm, over the jaws' front 4.3 cm only (the default)
-//   rim_ahead 0.08   2 vertices, 0.45 cm (1 vertex from 0.081)
+//   rim_ahead 0.065  5 vertices, 1 whole triangle (the most a calibration in models/ takes)
+//   from 0.070 m    4 vertices down to 1 (from 0.081), no whole triangle: refused (load_gown)
 //   from 0.0831 m   none (at depth 0.005, none from the default 0.04 on)
 // So on that gown `rim_ahead` changes both when the fist meets the rim and how much of the sleeve
 // is held (offline/calib's rim_shift does both). This is the placement every calibration in
-// models/ was fitted with, kept as it is; load_gown refuses a grip that holds no vertex. What is
+// models/ was fitted with, kept as it is; load_gown refuses a grip that holds no whole triangle
+// (a point or a line of cloth the gown would swing about, not a clamp). What is
 // held stays flattened across the jaws' width: the deeper the grip, the more of the opening's
 // perimeter is held open across the jaws and the less hangs below them (a loop of perimeter P
 // with a flat top of width b hangs about (P - b) / 2 deep when slack), so the opening is wider and
@@ -160,7 +162,19 @@ struct OpeningGrip {
   double rim_ahead = kOpeningRimAhead;  // [m] >= 0
 };
 
-// Throws std::invalid_argument unless 0 < depth < the grasp box's depth and 0 <= rim_ahead <= 0.5 m.
+// [m] How far ahead of the jaws a grip may hold the rim, short of it: the distance from the jaws'
+// front face to the back of the fist, the arm's point nearest them (the fist's centre less its
+// radius): 0.05 - 0.05 + 0.13 = 0.13 m in the paper's scene. From there on the sleeve's opening
+// starts level with or past the hand, which the task has before it: the parametric gown's cloth
+// starts inside the arm from 0.134 m (the low height; 0.138 m the high, where the fist is in the
+// opening from the rim's 0.13 m on: session 87). The scene's own arm: a calibration's
+// fist_shift or arm_lateral moves the fist within it, and is not taken into account here.
+inline double rim_ahead_limit(const PaperScene& s) {
+  return s.fist_W().x() - s.r_fist - (s.grasp_box_center_W().x() + s.grasp_box_half_extent_W().x());
+}
+
+// Throws std::invalid_argument unless 0 < depth < the grasp box's depth and
+// 0 <= rim_ahead < rim_ahead_limit(scene).
 void check_grip(const OpeningGrip& grip, const PaperScene& scene = {});
 
 // Where the Opening placement puts the sleeve (and where the parametric gown is built): the

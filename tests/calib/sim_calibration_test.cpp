@@ -169,8 +169,9 @@ TEST(SimCalibration, RimShiftIsTheScenesGrasp) {
 // A rim_shift whose grasp holds none of the measured gown (its sleeve's top lies below the lower
 // jaw from the rim 8.31 cm ahead of the jaws on: placement.h, OpeningGrip) is an
 // UnbuildableCandidate naming it, which calibrate ranks last; it was make_scene's
-// std::invalid_argument, which ended the whole calibration. 0.04 ahead of the gown's own still
-// holds some (2 vertices, the rim 8 cm ahead).
+// std::invalid_argument, which ended the whole calibration. So is one whose jaws hold vertices but
+// no whole triangle of it (from the rim 7.0 cm ahead: 2 vertices at 0.04 ahead of the gown's own,
+// the rim 8 cm ahead); 0.025 ahead (6.5 cm) still holds one triangle.
 TEST(SimCalibration, AGraspThatHoldsNothingIsAnUnbuildableCandidate) {
   if (gown::measured_gown_path().empty()) GTEST_SKIP() << "shared/data/gown not present (the measured gown's grip)";
   const ClothSimulator cs = make_cloth_simulator("coarse");
@@ -189,9 +190,17 @@ TEST(SimCalibration, AGraspThatHoldsNothingIsAnUnbuildableCandidate) {
   }
   EXPECT_THROW(cs.trial(c, r), UnbuildableCandidate);
   EXPECT_THROW(cs.build_grasp(0.05), UnbuildableCandidate);  // what calibrate asks of a held rim_shift
-  c.rim_shift = 0.04;
+  try {
+    cs.build_grasp(0.04);
+    ADD_FAILURE() << "a grasp of 2 vertices and no triangle was built";
+  } catch (const UnbuildableCandidate& e) {
+    EXPECT_NE(std::string(e.what()).find("hold 2 vertices of the gown but no whole triangle of it with grip depth "
+                                         "0.015 m and rim_ahead 0.08 m"),
+              std::string::npos) << e.what();
+  }
+  c.rim_shift = 0.025;
   EXPECT_FALSE(cs.trial(c, r).samples.empty());
-  EXPECT_NO_THROW(cs.build_grasp(0.04));
+  EXPECT_NO_THROW(cs.build_grasp(0.025));
   EXPECT_NO_THROW(cs.build_grasp(0.0));
 }
 

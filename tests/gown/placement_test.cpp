@@ -218,8 +218,9 @@ void check_grip(bool parametric) {
   const Held a = hold(base);
   const Held b = hold({base.depth + 0.035, base.rim_ahead});
   EXPECT_GT(b.grasped, a.grasped);
-  const Held c = hold({base.depth, base.rim_ahead + 0.03});
-  EXPECT_NEAR(c.placed.centroid.x() - a.placed.centroid.x(), 0.03, 1e-9);  // a rigid shift along x
+  // 2 cm: the measured gown's jaws hold no whole triangle from 3 cm further ahead (7 cm).
+  const Held c = hold({base.depth, base.rim_ahead + 0.02});
+  EXPECT_NEAR(c.placed.centroid.x() - a.placed.centroid.x(), 0.02, 1e-9);  // a rigid shift along x
   EXPECT_NEAR(c.placed.centroid.z() - a.placed.centroid.z(), 0.0, 1e-9);
   if (!parametric) {
     // 3.5 cm deeper holds about 6 cm more of the 47 cm perimeter flat: wider by at least 2 cm
@@ -246,7 +247,8 @@ TEST(Placement, DeeperGripHoldsTheMeasuredOpeningWiderAndShallower) {
 // hold less the further ahead the rim is: the figures placement.h (OpeningGrip) gives, pinned
 // here because every calibration in models/ was fitted with this placement. From 8.31 cm ahead
 // they hold nothing, and load_gown refuses that naming the mesh and the grip (it returned a gown
-// no jaw held: finding 1 of session 85's gown review).
+// no jaw held: finding 1 of session 85's gown review); from 7.0 cm they hold vertices but no whole
+// triangle (1 vertex from 8.1 cm), which it refuses too (session 87: it took them).
 TEST(Placement, MeasuredJawsHoldLessTheFurtherAheadTheRim) {
   if (measured_gown_path().empty()) GTEST_SKIP() << "shared/data/gown/fullgown.obj is not present; skipping";
   const PaperScene s;
@@ -257,10 +259,10 @@ TEST(Placement, MeasuredJawsHoldLessTheFurtherAheadTheRim) {
     std::size_t grasped;
     double reach;  // [m] the highest vertex in the jaws' x-y footprint above the lower jaw's face
   };
+  const GownMesh raw = read_obj(measured_gown_path());
   for (const Row row : {Row{0.0, 29, 0.0150}, Row{0.04, 14, 0.0097}, Row{0.08, 2, 0.0045}}) {
-    GownOptions o;
-    o.grip = OpeningGrip{kOpeningGripDepth, row.rim_ahead};
-    const GownMesh m = load_gown(o);
+    GownMesh m = raw;  // placed as load_gown places it, without its refusals
+    place_at_opening(m, s, OpeningGrip{kOpeningGripDepth, row.rim_ahead});
     double top = -1e9, back = 1e9;
     for (const auto& p : m.x)
       if (p.x() >= lo.x() && p.x() <= hi.x() && p.y() >= lo.y() && p.y() <= hi.y()) top = std::max(top, p.z());
@@ -285,6 +287,73 @@ TEST(Placement, MeasuredJawsHoldLessTheFurtherAheadTheRim) {
       std::snprintf(grip, sizeof grip, "hold no vertex of the gown with grip depth %g m and rim_ahead %g m", g.depth,
                     g.rim_ahead);
       EXPECT_NE(std::string(e.what()).find(grip), std::string::npos) << e.what();
+    }
+  }
+  // 6.9 cm ahead the jaws hold one whole triangle (5 vertices; the calibrations in models/ hold
+  // the rim at most 6.55 cm ahead); from 7.0 cm vertices along edges only, refused naming them.
+  GownOptions o;
+  o.grip = OpeningGrip{kOpeningGripDepth, 0.069};
+  EXPECT_EQ(grasp_vertices(load_gown(o), s).size(), 5u);
+  for (const auto& [rim_ahead, held] : {std::pair{0.070, 4}, std::pair{0.08, 2}, std::pair{0.082, 1}}) {
+    o.grip = OpeningGrip{kOpeningGripDepth, rim_ahead};
+    try {
+      load_gown(o);
+      ADD_FAILURE() << "a grip holding no whole triangle was returned: rim " << rim_ahead;
+    } catch (const NothingGrasped& e) {
+      char want[160];
+      std::snprintf(want, sizeof want, "hold %d vertices of the gown but no whole triangle of it with grip depth "
+                    "0.015 m and rim_ahead %g m", held, rim_ahead);
+      EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
+    }
+  }
+}
+
+// Without shared/data too: the parametric gown gripped 1 mm deep holds its sleeve's top seam, a
+// line of vertices the gown would swing about, and no whole triangle: refused as holding too
+// little (it was taken). Its own grip, 3 cm deep, holds the seam and two rows below it.
+TEST(Placement, AGripOfNoWholeTriangleIsRefused) {
+  GownOptions o;
+  o.parametric = true;
+  o.grip = OpeningGrip{0.001, kParametricGrip.rim_ahead};
+  try {
+    load_gown(o);
+    ADD_FAILURE() << "the parametric gown held by its seam alone was taken";
+  } catch (const NothingGrasped& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("parametric gown: the gripper's jaws (x -0.21..-0.13", 0), 0u) << e.what();
+    EXPECT_NE(std::string(e.what()).find("vertices of the gown but no whole triangle of it with grip depth 0.001 m"),
+              std::string::npos) << e.what();
+  }
+  o.grip.reset();
+  EXPECT_GE(grasp_vertices(load_gown(o)).size(), 10u);
+}
+
+// The rim may be held short of the fist's back, the arm's point nearest the jaws: 0.13 m in the
+// paper's scene (its fist 0.05 m ahead of x = 0 with radius 0.05, the jaws' front face at
+// -0.13). The parametric gown held 1 mm short of it starts clear of the arm at every height; moved
+// on, its cloth starts inside the arm from 0.134 m (the low height) and 0.138 m (the high). It
+// was taken up to 0.5 m, the arm inside the cloth from the start (session 86's note).
+TEST(Placement, ARimAtTheFistsBackIsRefused) {
+  const PaperScene s;
+  EXPECT_NEAR(rim_ahead_limit(s), 0.13, 1e-12);
+  GownOptions o;
+  o.parametric = true;
+  o.grip = OpeningGrip{kParametricGrip.depth, 0.129};
+  GownMesh g = load_gown(o);
+  for (const double offset : {0.0, s.arm_offset_middle, s.arm_offset_low})
+    EXPECT_TRUE(vertices_in_arm(g, s, offset).empty()) << "arm offset " << offset;
+  for (auto& p : g.x) p.x() += 0.011;  // the rim 0.14 m ahead
+  EXPECT_FALSE(vertices_in_arm(g, s).empty());
+  EXPECT_FALSE(vertices_in_arm(g, s, s.arm_offset_low).empty());
+  for (const double rim_ahead : {0.13, 0.2, 0.5}) {
+    o.grip = OpeningGrip{kParametricGrip.depth, rim_ahead};
+    try {
+      load_gown(o);
+      ADD_FAILURE() << "a rim past the fist's back was taken: " << rim_ahead;
+    } catch (const std::invalid_argument& e) {
+      char want[128];
+      std::snprintf(want, sizeof want, "rim ahead of the jaws %g m outside [0, 0.13) m: from 0.13 m the rim starts "
+                    "level with or past the fist's back", rim_ahead);
+      EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
     }
   }
 }
