@@ -278,6 +278,13 @@ bool set_person_param(ParameterSpace& space, int i, const std::string& word) {
   return true;
 }
 
+std::vector<double> grasp_probes(double lower, double upper) {
+  const int gaps = std::max(1, static_cast<int>(std::ceil((upper - lower) / kGraspProbeStep - 1e-9)));
+  std::vector<double> at;
+  for (int i = 0; i <= gaps; ++i) at.push_back(i == gaps ? upper : lower + i * (upper - lower) / gaps);
+  return at;
+}
+
 bool fit_rim_shift_to_gown(ParameterSpace& space, double rim_ahead, const std::filesystem::path& bounds_file) {
   const PersonParamInfo& info = kPersonParamInfo[kRimShift];
   const ParameterSpace::Person& p = space.person[kRimShift];

@@ -307,6 +307,19 @@ ParamBound& box_of(Bounds& b, const ParamRef& p);  // read_bounds fills a box th
 // still lie within it (std::invalid_argument otherwise).
 bool fit_rim_shift_to_gown(ParameterSpace& space, double rim_ahead, const std::filesystem::path& bounds_file);
 
+// The rim_shifts across [lower, upper] at which calibrate builds a fitted rim_shift box's grasp
+// before its search, to refuse a box none of whose grasps the simulator can build (every
+// candidate unbuildable: the whole budget spent, then "no candidate could be simulated"): both
+// ends and evenly spaced points between, at most kGraspProbeStep apart. The grasp at a rim_shift
+// is the gown's placement moved rigidly along x by it (placement.h, OpeningGrip), so a vertex is
+// in the jaws over an interval of rim_shifts as long as the jaws (8 cm), and a whole triangle
+// (what a grasp must hold, gown.h) over one shorter by the triangle's length along x (the full
+// measured gown's edges are about 1.4 cm): probes 4 cm apart meet every such interval that
+// reaches into the box, so when none of them builds, no rim_shift in the box does. Cheap: a
+// grasp is built in about 0.3 s on the reduced gown, and probing stops at the first that builds.
+inline constexpr double kGraspProbeStep = 0.04;  // [m] half the jaws' length along x
+std::vector<double> grasp_probes(double lower, double upper);
+
 // Person parameter i of `space` from a command line's word: "fit" (search bounds.person[i]),
 // "fixed" (kPersonParamInfo[i].paper), or a value held during the search. False when the word is
 // none of these (or a non-finite number or one outside kPersonParamInfo[i]'s range).

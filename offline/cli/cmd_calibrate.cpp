@@ -23,6 +23,23 @@ using namespace dressguard::calib;
 
 namespace {
 
+#ifdef DRESSGUARD_HAVE_SIM
+// Empty when the simulator builds the grasp of some probe of a fitted rim_shift box (grasp_probes),
+// else why the first probe's grasp cannot be built.
+std::string unbuildable_box(const ClothSimulator& sim, const ParamBound& box) {
+  std::string first;
+  for (double rim_shift : grasp_probes(box.lower, box.upper)) {
+    try {
+      sim.build_grasp(rim_shift);
+      return "";
+    } catch (const UnbuildableCandidate& e) {
+      if (first.empty()) first = e.what();
+    }
+  }
+  return first;
+}
+#endif
+
 [[maybe_unused]] std::string minutes(double s) {
   char buf[32];
   if (s < 120) std::snprintf(buf, sizeof buf, "%.0f s", s);
@@ -296,6 +313,17 @@ int run_calibrate(int argc, char** argv) {
                        "could be simulated (" + e.what() + ")");
     }
   }
+  // A fitted box none of whose grasps holds the gown (a bounds file's rim_shift 0.045 0.06 on the
+  // measured gown) made every candidate unbuildable too: refused alike, probed at both ends and
+  // between (calibration.h, grasp_probes: where no probe builds, no rim_shift of the box does).
+  if (const ParamBound& box = space.bounds.person[kRimShift]; space.person[kRimShift].fit)
+    if (const std::string why = unbuildable_box(sim, box); !why.empty()) {
+      std::string probes;
+      for (double r : grasp_probes(box.lower, box.upper)) probes += (probes.empty() ? "" : ", ") + format_number(r);
+      throw UsageError("rim_shift's box [" + format_number(box.lower) + ", " + format_number(box.upper) + "] m holds " +
+                       "none of the gown at any rim_shift (probed at " + probes + " m: calibration.h, grasp_probes): " +
+                       "no candidate could be simulated (" + why + ")");
+    }
   // Now, not after the first generation (20 minutes on the full gown), and on every rank.
   try {
     probe_checkpoint(o.checkpoint, comm);

@@ -1145,6 +1145,21 @@ TEST(Calibration, RimShiftBoxIsFittedToTheGownsRim) {
   fs::remove_all(dir);
 }
 
+// The rim_shifts at which calibrate builds a fitted box's grasps before its search: both ends and
+// points at most kGraspProbeStep (4 cm, half the jaws' length) apart, so that they meet every
+// interval of rim_shifts at which the jaws hold some triangle of the gown (calibration.h).
+TEST(Calibration, GraspProbesSpanTheRimShiftBox) {
+  EXPECT_EQ(grasp_probes(0.045, 0.06), (std::vector<double>{0.045, 0.06}));
+  EXPECT_EQ(grasp_probes(-0.04, 0.04), (std::vector<double>{-0.04, 0.0, 0.04}));
+  for (const auto& [lower, upper] : {std::pair{-0.04, 0.06}, std::pair{-0.01, 0.04}, std::pair{0.0, 0.0}}) {
+    const std::vector<double> at = grasp_probes(lower, upper);
+    ASSERT_GE(at.size(), 2u);
+    EXPECT_EQ(at.front(), lower);
+    EXPECT_EQ(at.back(), upper);
+    for (std::size_t i = 1; i < at.size(); ++i) EXPECT_LE(at[i] - at[i - 1], kGraspProbeStep + 1e-15);
+  }
+}
+
 // A bounds file's numbers are whole words: a third word that is not a number was dropped (the
 // start went to the box's midpoint, e.g. friction 1 for `initial=0.4`), and a name given twice
 // kept the later box without a word.

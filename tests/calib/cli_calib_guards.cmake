@@ -67,6 +67,13 @@ if(EXISTS ${STUDY}/../gown/fullgown.obj)
   expect_fail("the same, naming the gown and the grip"
               "fullgown.obj: the gripper's jaws (x -0.21..-0.13, y -0.06..0.06, z 0.055..0.205 m) hold no vertex "
               ${quick} --rim-shift 0.0431 --checkpoint ${WORK}/held.ckpt)
+  # The same for a fitted box none of whose rim_shifts holds the gown (session 86 refused only the
+  # held value): every candidate was unbuildable and the budget spent (exit 1). Probed at both ends
+  # and every 4 cm between (calibration.h, grasp_probes), refused before the search.
+  file(WRITE ${WORK}/far.txt "rim_shift 0.045 0.06\n")
+  expect_fail("calibrate with a fitted rim_shift box where the jaws hold none of the measured gown"
+              "rim_shift's box [0.045, 0.06] m holds none of the gown at any rim_shift (probed at 0.045, 0.06 m: "
+              ${quick} --rim-shift fit --bounds ${WORK}/far.txt --checkpoint ${WORK}/held.ckpt)
   if(EXISTS ${WORK}/held.ckpt OR EXISTS ${WORK}/c.json)
     message(FATAL_ERROR "calibrate wrote a checkpoint or a calibration for a rim_shift it refused")
   endif()
