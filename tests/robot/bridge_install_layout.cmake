@@ -1,8 +1,10 @@
 # The bridge's deployment fits together: `cmake --install` of BUILD's `bridge` component (all a
-# bridge's host needs) into a staging DESTDIR puts the binary and the options file where the
-# unit says, the unit runs as a user systemd makes with the rights the bridge's real-time setup
-# and serial line need, and the installed options are accepted (the bridge checks them before it
-# opens any CAN socket).
+# bridge's host needs) into a staging DESTDIR, and with another prefix (`--prefix P`), puts the
+# binary and the options file where the unit says, the unit runs as a user systemd makes with
+# the rights the bridge's real-time setup and serial line need, and the installed options are
+# accepted (the bridge checks them before it opens any CAN socket); the unit is not restarted on
+# exit 2 (bad arguments), passes the instance's interface unescaped, and passes
+# `systemd-analyze verify` where that exists.
 #   cmake -DBUILD=... -DSTAGE=... -P bridge_install_layout.cmake
 include(${CMAKE_CURRENT_LIST_DIR}/../install_layout_checks.cmake)
 
@@ -32,8 +34,10 @@ endfunction()
 function(check_install root tree)
   find_unit("${tree}" dressguard-bridge@.service unit)
   check_rights("${unit}")
-  match_exec("${unit}" "^ExecStart=([^ ]+) --interface %i \\$DRESSGUARD_BRIDGE_OPTIONS$"
-             "BINARY --interface %i $DRESSGUARD_BRIDGE_OPTIONS" bin unused)
+  # %I: the instance unescaped is the interface's name (%i, escaped, names the device unit).
+  match_exec("${unit}" "^ExecStart=([^ ]+) --interface %I \\$DRESSGUARD_BRIDGE_OPTIONS$"
+             "BINARY --interface %I $DRESSGUARD_BRIDGE_OPTIONS" bin unused)
+  check_unit_restart("${unit}")
   file_value("${unit}" "^EnvironmentFile=(/[^ ]+)$" "required EnvironmentFile" env)
   check_placed("${unit}" "${bin}" "${root}" "${tree}")
   check_placed("${unit}" "${env}" "${root}" "${tree}")
@@ -47,10 +51,16 @@ function(check_install root tree)
   if(NOT rc EQUAL 1 OR NOT err MATCHES "dg_none")
     message(FATAL_ERROR "the installed options were not accepted (exit ${rc}): ${err}")
   endif()
+  verify_unit("${unit}" "${root}" "${bin}" "${tree}")
   message(STATUS "installed: ${bin}, ${env}, ${unit}")
 endfunction()
 
 file(REMOVE_RECURSE "${STAGE}")
-install_build("into DESTDIR ${STAGE}" ${CMAKE_COMMAND} -E env DESTDIR=${STAGE}
+install_build("into DESTDIR ${STAGE}/destdir" ${CMAKE_COMMAND} -E env DESTDIR=${STAGE}/destdir
               ${CMAKE_COMMAND} --install ${BUILD} --component bridge)
-check_install("${STAGE}" "${STAGE}")
+check_install("${STAGE}/destdir" "${STAGE}/destdir")
+# Another prefix at install time: the unit must name its paths, not the configured prefix's (it
+# did: a binary that is not there, or an older one, and an options file that is not there).
+install_build("--prefix ${STAGE}/prefix" ${CMAKE_COMMAND} --install ${BUILD} --component bridge
+              --prefix ${STAGE}/prefix)
+check_install("" "${STAGE}/prefix")
