@@ -1,6 +1,7 @@
 // The bridge's Linux event loop.
 #include "bridge_app.h"
 
+#include <signal.h>
 #include <sys/epoll.h>
 #include <sys/eventfd.h>
 #include <sys/timerfd.h>
@@ -66,6 +67,26 @@ BridgeApp::~BridgeApp() {
 void BridgeApp::request_shutdown() noexcept {
   const uint64_t one = 1;
   [[maybe_unused]] ssize_t n = ::write(shutdown_fd_, &one, sizeof one);
+}
+
+namespace {
+// Read by the signal handler: an atomic, not a plain pointer the handler might see half-written.
+std::atomic<BridgeApp*> g_signalled_app{nullptr};
+static_assert(std::atomic<BridgeApp*>::is_always_lock_free);
+
+void shut_down_on_signal(int) {
+  if (BridgeApp* app = g_signalled_app.load()) app->request_shutdown();
+}
+}  // namespace
+
+void handle_signals(BridgeApp* app) {
+  g_signalled_app.store(app);
+  struct sigaction on{};
+  sigemptyset(&on.sa_mask);
+  for (const int sig : {SIGTERM, SIGINT, SIGHUP, SIGPIPE}) {
+    on.sa_handler = sig == SIGTERM || sig == SIGINT ? shut_down_on_signal : SIG_IGN;
+    sigaction(sig, &on, nullptr);
+  }
 }
 
 std::string BridgeApp::last_error() const { return sensor_.last_error(); }

@@ -100,4 +100,11 @@ class BridgeApp {
   uint64_t error_frames_ = 0;     // since the controller's last restart
 };
 
+// The process's signals for `app` (null: none, the shutdown signals then do nothing): SIGTERM
+// and SIGINT shut it down (request_shutdown: a running trial's stop written first). SIGHUP (an
+// operator's "reload", a closed terminal) and SIGPIPE (a log pipe whose reader died) are
+// ignored: by default they ended the bridge at once, mid-trial, with no stop written, and
+// systemd counts that as a clean exit, so the unit was not restarted. There is no reload.
+void handle_signals(BridgeApp* app);
+
 }  // namespace dressguard::bridge

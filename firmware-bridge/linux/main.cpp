@@ -1,7 +1,6 @@
 // dressguard-bridge: force-torque sensor (Modbus, or an FT 300's data stream) -> CAN, and CAN
 // stop -> robot controller.
 #include <sched.h>
-#include <signal.h>
 #include <sys/stat.h>
 
 #include <cerrno>
@@ -20,11 +19,6 @@ using namespace dressguard;
 using namespace dressguard::bridge;
 
 namespace {
-
-BridgeApp* g_app = nullptr;
-void on_signal(int) {
-  if (g_app) g_app->request_shutdown();
-}
 
 const char* kUsage =
     "usage: dressguard-bridge [options]\n"
@@ -72,7 +66,10 @@ const char* kUsage =
     "                          memory is locked (not had: a warning) and the loop runs SCHED_FIFO\n"
     "  --help                  this text\n"
     "Exit codes: 0 clean shutdown (SIGTERM/SIGINT), 1 runtime error, an --rt-priority not had, or a stop\n"
-    "still unwritten at the end of the shutdown grace, 2 bad arguments.";
+    "still unwritten at the end of the shutdown grace, 2 bad arguments.\n"
+    "Signals: SIGTERM and SIGINT shut it down (a running trial's stop written first). SIGHUP and\n"
+    "SIGPIPE are ignored: there is no reload, the options are read at start and a change takes a\n"
+    "restart.";
 
 int bad(const std::string& why) {
   std::fprintf(stderr, "dressguard-bridge: %s (see --help)\n", why.c_str());
@@ -332,19 +329,14 @@ int main(int argc, char** argv) {
       sensor = std::make_unique<ModbusSensor>(sensor_ep, map);
     }
     BridgeApp app(cfg, *sensor, robot.get(), *port);
-    g_app = &app;
-    struct sigaction sa{};
-    sa.sa_handler = on_signal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGTERM, &sa, nullptr);
-    sigaction(SIGINT, &sa, nullptr);
+    handle_signals(&app);
     if (stream)
       std::fprintf(stderr, "dressguard-bridge: %s -> %s, every frame\n", sensor_ep.spec.c_str(), iface.c_str());
     else
       std::fprintf(stderr, "dressguard-bridge: %s -> %s every %d ms\n", sensor_ep.spec.c_str(), iface.c_str(),
                    cfg.sample_period_ms);
     const int rc = app.run();
-    g_app = nullptr;
+    handle_signals(nullptr);
     // After the robot's stop (run() wrote it): the sensor is left answering Modbus.
     if (ft300 && !ft300->stop_stream(1000))
       std::fprintf(stderr, "dressguard-bridge: warning: the FT 300's stream may still run: %s\n",

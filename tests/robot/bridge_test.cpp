@@ -951,6 +951,28 @@ TEST(BridgeModbus, ShutdownDuringATrialStopsTheRobot) {
   }
 }
 
+// SIGHUP (an operator's "reload", a closed terminal) and SIGPIPE (a log pipe whose reader died)
+// ended the bridge at once, mid-trial, with no stop written, and systemd took that for a clean
+// exit and did not restart the unit. Both are now ignored: the bridge goes on carrying the
+// trial's stop, and SIGTERM still shuts it down, writing the running trial's stop first.
+TEST(BridgeModbus, HangupAndBrokenPipeDoNotEndTheBridge) {
+  BridgeRig rig;
+  ASSERT_GT(rig.robot_emu.port(), 0);
+  handle_signals(rig.app.get());
+  rig.predictor->send(protocol::encode(protocol::HeartbeatPredictor{0, protocol::PredictorState::InTrial, 1, 12, 5}));
+  ASSERT_EQ(raise(SIGHUP), 0);
+  ASSERT_EQ(raise(SIGPIPE), 0);
+  std::this_thread::sleep_for(30ms);  // the bridge's loop takes the heartbeat
+  EXPECT_EQ(rig.rc.load(), -1) << "the bridge's loop ended: " << rig.logged();
+  ASSERT_EQ(raise(SIGTERM), 0);
+  rig.loop.join();
+  handle_signals(nullptr);
+  EXPECT_EQ(rig.rc.load(), 0) << "SIGTERM: a clean shutdown. " << rig.logged();
+  EXPECT_EQ(rig.app->stats().stops_written.load(), 1u) << "the running trial's stop. " << rig.logged();
+  const std::string coil = "-p " + std::to_string(rig.robot_emu.port()) + " -a 1 -r 7 -c 1 -t 0 127.0.0.1";
+  EXPECT_NE(mbpoll(coil).find("[7]: \t1"), std::string::npos) << mbpoll(coil);
+}
+
 // The Linux port with the watchdog on: the robot controller starts trial 7, and the predictor
 // beats every 50 ms. Idle (it lost the TrialStart), the bridge writes the stop coil and says
 // why; naming trial 7 in trial, it writes nothing.
