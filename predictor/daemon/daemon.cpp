@@ -6,6 +6,7 @@
 #include <sys/epoll.h>
 #include <sys/eventfd.h>
 #include <sys/mman.h>
+#include <sys/resource.h>
 #include <sys/timerfd.h>
 #include <time.h>
 #include <unistd.h>
@@ -13,6 +14,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
+#include <fstream>
 #include <spdlog/spdlog.h>
 #include <system_error>
 
@@ -325,16 +327,47 @@ void handle_signals(PredictorDaemon* daemon) {
 
 // ---------------------------------------------------------------------------------------------
 
+namespace {
+
+// CAP_IPC_LOCK (bit 14) in the process's effective set, /proc's CapEff: it lifts RLIMIT_MEMLOCK.
+bool has_ipc_lock() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line))
+    if (line.compare(0, 7, "CapEff:") == 0) return (std::stoull(line.substr(7), nullptr, 16) >> 14) & 1u;
+  return false;
+}
+
+// The finite RLIMIT_MEMLOCK in KiB that mlockall would be held to, or -1 when none holds it.
+// Under one, MCL_FUTURE counts every later mapping against it, so an allocation past it fails
+// on the loop (an error, perhaps while a stop is sent) where a page fault was only a delay.
+long long memlock_limit_kib() {
+  rlimit lim{};
+  if (getrlimit(RLIMIT_MEMLOCK, &lim) != 0 || lim.rlim_cur == RLIM_INFINITY || has_ipc_lock()) return -1;
+  return static_cast<long long>(lim.rlim_cur / 1024);
+}
+
+// Locks the process's memory, now and later, and faults in a stack reserve: "", or why not.
+std::string lock_memory() {
+  if (const long long kib = memlock_limit_kib(); kib >= 0)
+    return "mlockall not tried: RLIMIT_MEMLOCK is " + std::to_string(kib) +
+           " KiB without CAP_IPC_LOCK, and locking all later memory under it makes an allocation past it fail on "
+           "the hot path; grant CAP_IPC_LOCK or LimitMEMLOCK=infinity";
+  if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
+    return std::string("mlockall failed (") + std::strerror(errno) +
+           "): pages may fault in on the hot path; grant CAP_IPC_LOCK or LimitMEMLOCK=infinity";
+  // Touch a stack reserve now so that deeper calls later do not fault.
+  volatile char reserve[256 * 1024];
+  for (size_t i = 0; i < sizeof reserve; i += 4096) reserve[i] = 0;
+  return {};
+}
+
+}  // namespace
+
 std::vector<std::string> setup_realtime(const RtOptions& opt) {
   std::vector<std::string> warnings;
-  if (opt.lock_memory) {
-    if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
-      warnings.push_back(std::string("mlockall failed (") + std::strerror(errno) +
-                         "): pages may fault in on the hot path; grant CAP_IPC_LOCK or LimitMEMLOCK=infinity");
-    // Touch a stack reserve now so that deeper calls later do not fault.
-    volatile char reserve[256 * 1024];
-    for (size_t i = 0; i < sizeof reserve; i += 4096) reserve[i] = 0;
-  }
+  if (opt.lock_memory)
+    if (std::string why = lock_memory(); !why.empty()) warnings.push_back(std::move(why));
   if (opt.cpu >= 0) {
     cpu_set_t set;
     CPU_ZERO(&set);
