@@ -7,6 +7,7 @@
 #include <modbus.h>
 #include <signal.h>
 #include <sys/epoll.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -409,13 +410,25 @@ TEST(BridgeCore, ReleasedLatchReportsTheSensorAsItIs) {
 
 // ---- Linux port against Modbus TCP peers ------------------------------------------------------
 
+// An emulator the test forks must not outlive the test. It inherits the test's stderr, ctest's
+// pipe: one left running by a test that died (a crash, an uncaught signal: no destructor runs)
+// kept ctest waiting for that pipe's end until its 900 s timeout, where the test should fail at
+// once. PR_SET_PDEATHSIG survives the exec (dg_modbus_emulator is not set-user-ID) and fires when
+// the forking thread ends: the tests fork from gtest's main thread. The getppid check closes the
+// race of a parent gone before the prctl.
+void die_with_parent(pid_t parent) {
+  if (prctl(PR_SET_PDEATHSIG, SIGKILL) != 0 || getppid() != parent) _exit(127);
+}
+
 class Emulator {
  public:
   Emulator() {
     int fds[2];
     if (pipe(fds) != 0) return;
+    const pid_t parent = getpid();
     pid_ = fork();
     if (pid_ == 0) {
+      die_with_parent(parent);
       dup2(fds[1], 1);
       close(fds[0]);
       execl(DG_EMULATOR, DG_EMULATOR, "--port", "0", static_cast<char*>(nullptr));
@@ -433,6 +446,7 @@ class Emulator {
     }
   }
   int port() const { return port_; }
+  pid_t pid() const { return pid_; }
   std::string spec() const { return "tcp:127.0.0.1:" + std::to_string(port_); }
   // The test's own Modbus client, for setting registers.
   bool write(int addr, std::vector<uint16_t> values) {
@@ -644,6 +658,38 @@ struct BridgeRig {
     return span;
   }
 };
+
+// A test that dies (no destructor runs) takes its emulator with it: the emulator holds the test's
+// stderr, as it holds ctest's pipe, and that pipe ends within 3 s of the test (die_with_parent).
+TEST(BridgeModbus, AnEmulatorDiesWithItsTest) {
+  int held[2], report[2];
+  ASSERT_EQ(pipe(held), 0);
+  ASSERT_EQ(pipe(report), 0);
+  const pid_t test = fork();
+  if (test == 0) {
+    close(held[0]);
+    close(report[0]);
+    dup2(held[1], 2);
+    close(held[1]);
+    const Emulator* e = new Emulator;  // never destroyed: the test dies
+    const pid_t emulator = e->port() > 0 ? e->pid() : -1;
+    _exit(write(report[1], &emulator, sizeof emulator) == sizeof emulator && emulator > 0 ? 0 : 1);
+  }
+  close(held[1]);
+  close(report[1]);
+  pid_t emulator = -1;
+  const bool reported = read(report[0], &emulator, sizeof emulator) == sizeof emulator && emulator > 0;
+  close(report[0]);
+  int status = 0;
+  ASSERT_EQ(waitpid(test, &status, 0), test);
+  ASSERT_TRUE(reported && WIFEXITED(status) && WEXITSTATUS(status) == 0) << "the emulator did not start";
+  pollfd p{held[0], POLLIN, 0};
+  char c;
+  const bool ended = poll(&p, 1, 3000) == 1 && read(held[0], &c, 1) == 0;
+  close(held[0]);
+  if (!ended) kill(emulator, SIGKILL);  // not left behind by this test either
+  EXPECT_TRUE(ended) << "the emulator (pid " << emulator << ") outlived its test, holding the test's stderr";
+}
 
 TEST(BridgeModbus, EmulatorAnswersAnIndependentClient) {
   Emulator emu;
@@ -1070,8 +1116,10 @@ class NullModem {
 TEST(BridgeModbus, RtuSensorOnASerialLine) {
   NullModem cable;
   // The emulator serves the sensor's registers on one end of the cable.
+  const pid_t parent = getpid();
   const pid_t pid = fork();
   if (pid == 0) {
+    die_with_parent(parent);
     const int devnull = ::open("/dev/null", O_WRONLY);
     dup2(devnull, 1);
     execl(DG_EMULATOR, DG_EMULATOR, "--rtu", cable.end(0).c_str(), "--slave", "9", static_cast<char*>(nullptr));
@@ -1195,8 +1243,10 @@ class Ft300OnALine {
   Ft300OnALine(bool streaming, const std::vector<std::string>& commands) {
     int in[2], out[2];
     if (pipe(in) != 0 || pipe(out) != 0) return;
+    const pid_t parent = getpid();
     pid_ = fork();
     if (pid_ == 0) {
+      die_with_parent(parent);
       dup2(in[0], 0);
       dup2(out[1], 1);
       close(in[1]);
