@@ -79,14 +79,20 @@ void shut_down_on_signal(int) {
 }
 }  // namespace
 
+void ignore_hangup_and_broken_pipe() {
+  struct sigaction ignored{};
+  ignored.sa_handler = SIG_IGN;
+  sigemptyset(&ignored.sa_mask);
+  for (const int sig : {SIGHUP, SIGPIPE}) sigaction(sig, &ignored, nullptr);
+}
+
 void handle_signals(BridgeApp* app) {
   g_signalled_app.store(app);
   struct sigaction on{};
+  on.sa_handler = shut_down_on_signal;
   sigemptyset(&on.sa_mask);
-  for (const int sig : {SIGTERM, SIGINT, SIGHUP, SIGPIPE}) {
-    on.sa_handler = sig == SIGTERM || sig == SIGINT ? shut_down_on_signal : SIG_IGN;
-    sigaction(sig, &on, nullptr);
-  }
+  for (const int sig : {SIGTERM, SIGINT}) sigaction(sig, &on, nullptr);
+  ignore_hangup_and_broken_pipe();
 }
 
 std::string BridgeApp::last_error() const { return sensor_.last_error(); }

@@ -100,11 +100,16 @@ class BridgeApp {
   uint64_t error_frames_ = 0;     // since the controller's last restart
 };
 
+// SIGHUP (an operator's "reload", a closed terminal) and SIGPIPE (a log pipe whose reader died)
+// ignored: by default they ended the bridge at once, mid-trial, with no stop written, and systemd
+// counts that as a clean exit, so the unit was not restarted. There is no reload. main's first
+// call: one that came while the bridge probed the robot, set up real time or opened its socket
+// ended it, and the unit stayed down.
+void ignore_hangup_and_broken_pipe();
+
 // The process's signals for `app` (null: none, the shutdown signals then do nothing): SIGTERM
-// and SIGINT shut it down (request_shutdown: a running trial's stop written first). SIGHUP (an
-// operator's "reload", a closed terminal) and SIGPIPE (a log pipe whose reader died) are
-// ignored: by default they ended the bridge at once, mid-trial, with no stop written, and
-// systemd counts that as a clean exit, so the unit was not restarted. There is no reload.
+// and SIGINT shut it down (request_shutdown: a running trial's stop written first); SIGHUP and
+// SIGPIPE stay ignored, as above.
 void handle_signals(BridgeApp* app);
 
 }  // namespace dressguard::bridge

@@ -68,8 +68,8 @@ const char* kUsage =
     "Exit codes: 0 clean shutdown (SIGTERM/SIGINT), 1 runtime error, an --rt-priority not had, or a stop\n"
     "still unwritten at the end of the shutdown grace, 2 bad arguments.\n"
     "Signals: SIGTERM and SIGINT shut it down (a running trial's stop written first). SIGHUP and\n"
-    "SIGPIPE are ignored: there is no reload, the options are read at start and a change takes a\n"
-    "restart.";
+    "SIGPIPE are ignored from the start on: there is no reload, the options are read at start and a\n"
+    "change takes a restart.";
 
 int bad(const std::string& why) {
   std::fprintf(stderr, "dressguard-bridge: %s (see --help)\n", why.c_str());
@@ -195,6 +195,9 @@ int setup_loop_realtime(const RtRequest& request) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // First: a SIGHUP or SIGPIPE at any later step of the start-up must not end the bridge (SIGTERM
+  // and SIGINT keep their default action until the loop takes them: no stop is pending before it).
+  ignore_hangup_and_broken_pipe();
   std::string iface = "can0", robot_spec;
   ModbusEndpoint sensor_ep, robot_ep;
   // The default sensor is the FT 300 on its fixed 19200 8N1 line: its data stream is the one way

@@ -317,12 +317,16 @@ void set_handler(int sig, void (*handler)(int)) {
 
 }  // namespace
 
+void ignore_hangup_and_broken_pipe() {
+  set_handler(SIGHUP, SIG_IGN);
+  set_handler(SIGPIPE, SIG_IGN);
+}
+
 void handle_signals(PredictorDaemon* daemon) {
   g_signalled_daemon.store(daemon);
   set_handler(SIGTERM, on_shutdown_signal);
   set_handler(SIGINT, on_shutdown_signal);
-  set_handler(SIGHUP, SIG_IGN);
-  set_handler(SIGPIPE, SIG_IGN);
+  ignore_hangup_and_broken_pipe();
 }
 
 // ---------------------------------------------------------------------------------------------

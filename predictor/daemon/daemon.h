@@ -122,11 +122,15 @@ class PredictorDaemon final : private PredictorSink {
   bool interface_gone_ = false;
 };
 
+// SIGHUP and SIGPIPE ignored: their default action ends the process at once, with no stop for a
+// running trial, and systemd takes such an end for a clean exit and does not restart the unit.
+// SIGHUP is what an operator sends to "reload" and what a closed terminal sends; the daemon reads
+// its config and model at start only. main's first call: one that came while the daemon read its
+// config or model, set up real time or opened its sockets ended it, and the unit stayed down.
+void ignore_hangup_and_broken_pipe();
+
 // The process's signals, routed to `daemon` (nullptr: to none). SIGTERM and SIGINT ask it to shut
-// down (a running trial is stopped first). SIGHUP and SIGPIPE are ignored: their default action
-// ends the process at once, with no stop for the running trial, and systemd takes such an end
-// for a clean exit and does not restart the unit. SIGHUP is what an operator sends to "reload"
-// and what a closed terminal sends; the daemon reads its config and model at start only.
+// down (a running trial is stopped first); SIGHUP and SIGPIPE stay ignored, as above.
 void handle_signals(PredictorDaemon* daemon);
 
 // Real-time setup, each step optional: a step that is not permitted yields a warning string

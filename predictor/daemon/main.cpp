@@ -35,8 +35,8 @@ const char* kUsage =
     "predictor's: stop_threshold, stop_consecutive, hard_limit_n, sensor_timeout_ms, bad_frame_budget,\n"
     "bad_frame_weight, max_delta_counter, status_period_ms, heartbeat_period_ms, posteriors_period_ms,\n"
     "stop_retry_ms, sample_period_ms, acceleration_m_s2, mount_axes, mount_bias.\n"
-    "Signals: SIGTERM and SIGINT shut down (a running trial is stopped first); SIGHUP is ignored:\n"
-    "the config and model are read at start only, a change takes a restart.\n"
+    "Signals: SIGTERM and SIGINT shut down (a running trial is stopped first); SIGHUP and SIGPIPE are\n"
+    "ignored from the start on: the config and model are read at start only, a change takes a restart.\n"
     "Exit codes: 0 clean shutdown (SIGTERM/SIGINT), 1 runtime error (the interface gone, a stop not\n"
     "confirmed on the bus when the daemon exited, a real-time step failed with rt_required = 1),\n"
     "2 bad arguments or config.";
@@ -89,6 +89,9 @@ bool realtime_ready(const RtOptions& rt, bool required, spdlog::logger& log) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // First: a SIGHUP or SIGPIPE at any later step of the start-up must not end the daemon (SIGTERM
+  // and SIGINT keep their default action until the loop takes them: no trial runs before it).
+  ignore_hangup_and_broken_pipe();
   std::string config_path, iface_arg, model_arg;
   bool iface_given = false;
   std::vector<std::string> sets;

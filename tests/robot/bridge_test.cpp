@@ -8,6 +8,7 @@
 #include <signal.h>
 #include <sys/epoll.h>
 #include <sys/prctl.h>
+#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -1017,6 +1018,75 @@ TEST(BridgeModbus, HangupAndBrokenPipeDoNotEndTheBridge) {
   EXPECT_EQ(rig.app->stats().stops_written.load(), 1u) << "the running trial's stop. " << rig.logged();
   const std::string coil = "-p " + std::to_string(rig.robot_emu.port()) + " -a 1 -r 7 -c 1 -t 0 127.0.0.1";
   EXPECT_NE(mbpoll(coil).find("[7]: \t1"), std::string::npos) << mbpoll(coil);
+}
+
+// The bridge's pid with its stderr on `pipe_out`'s write end, which the test fills first: the
+// bridge's first message on stderr blocks. SIGHUP and SIGPIPE as systemd leaves them for a
+// service (default), whatever this test process set (HangupAndBrokenPipeDoNotEndTheBridge).
+pid_t bridge_with_stderr_held(int pipe_out[2]) {
+  fcntl(pipe_out[1], F_SETFL, O_NONBLOCK);
+  const std::string page(4096, '.');
+  while (write(pipe_out[1], page.data(), page.size()) > 0) {}
+  while (write(pipe_out[1], ".", 1) > 0) {}
+  fcntl(pipe_out[1], F_SETFL, 0);
+  const pid_t parent = getpid();
+  const pid_t pid = fork();
+  if (pid == 0) {
+    die_with_parent(parent);
+    for (const int sig : {SIGHUP, SIGPIPE}) signal(sig, SIG_DFL);
+    dup2(pipe_out[1], 2);
+    close(pipe_out[0]);
+    close(pipe_out[1]);
+    execl(DG_BRIDGE, DG_BRIDGE, "--interface", "dg_none", "--no-rt", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  close(pipe_out[1]);
+  return pid;
+}
+
+// True once `pid` sleeps in a write to its stderr (fd 2), in main: /proc's syscall file names the
+// call it is blocked in and its arguments. False if it ended first or 10 s went by.
+bool blocked_writing_stderr(pid_t pid) {
+  const std::string in_write = std::to_string(SYS_write) + " 0x2 ";
+  const std::string in_writev = std::to_string(SYS_writev) + " 0x2 ";
+  for (int i = 0; i < 1000; ++i) {
+    std::ifstream f("/proc/" + std::to_string(pid) + "/syscall");
+    std::string call;
+    std::getline(f, call);
+    if (call.rfind(in_write, 0) == 0 || call.rfind(in_writev, 0) == 0) return true;
+    siginfo_t ended{};  // WNOWAIT: left for the test's waitpid
+    if (waitid(P_PID, static_cast<id_t>(pid), &ended, WEXITED | WNOHANG | WNOWAIT) != 0 || ended.si_pid == pid)
+      return false;
+    std::this_thread::sleep_for(10ms);
+  }
+  return false;
+}
+
+// SIGHUP and SIGPIPE are ignored from main's first line: one that came during the start-up (the
+// robot's probe, the real-time setup, the CAN socket's opening) ended the bridge, which systemd
+// counts as a clean exit and does not restart. Held in its first message on stderr (no --robot),
+// the bridge gets the signal, then goes on as without it: no interface dg_none, exit 1.
+TEST(BridgeCli, HangupAndBrokenPipeDuringStartUpDoNotEndIt) {
+  for (const int sig : {SIGHUP, SIGPIPE}) {
+    int out[2];
+    ASSERT_EQ(pipe(out), 0);
+    const pid_t pid = bridge_with_stderr_held(out);
+    ASSERT_GT(pid, 0);
+    const bool held = blocked_writing_stderr(pid);
+    if (held) kill(pid, sig);
+    std::string said;
+    char buf[4096];
+    for (ssize_t n; (n = read(out[0], buf, sizeof buf)) > 0;) said.append(buf, static_cast<size_t>(n));
+    close(out[0]);
+    int status = 0;
+    ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    said.erase(0, said.find_first_not_of('.'));
+    ASSERT_TRUE(held) << "the bridge never blocked on its stderr: " << said;
+    EXPECT_FALSE(WIFSIGNALED(status)) << strsignal(sig) << " during the start-up ended the bridge by "
+                                      << strsignal(WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1) << strsignal(sig) << ": " << said;
+    EXPECT_NE(said.find("dg_none"), std::string::npos) << strsignal(sig) << ": " << said;
+  }
 }
 
 // The Linux port with the watchdog on: the robot controller starts trial 7, and the predictor
