@@ -71,11 +71,28 @@ function(check_unit_restart unit)
   endif()
 endfunction()
 
+# systemd's rating of the sandbox of INSTANCE (`systemd-analyze security --offline`, 0.0 for the
+# tightest to 10.0 for none), at most MAX_EXPOSURE (one decimal). The unit's hardening lines are
+# what a robot maker's security review reads; one lost or loosened raises the figure.
+function(check_unit_exposure analyze instance max_exposure)
+  string(REPLACE "." "" threshold "${max_exposure}")
+  execute_process(COMMAND ${analyze} security --offline=yes --man=no --threshold=${threshold} "${instance}"
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT out MATCHES "Overall exposure level for [^:]*: ([0-9.]+)")
+    message(FATAL_ERROR "systemd-analyze security of ${instance} (exit ${rc}) gave no exposure level: ${out}${err}")
+  endif()
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "${instance}: exposure ${CMAKE_MATCH_1}, above ${max_exposure}:\n${out}${err}")
+  endif()
+  message(STATUS "systemd-analyze security: exposure ${CMAKE_MATCH_1} (at most ${max_exposure})")
+endfunction()
+
 # systemd's own check of the unit, where systemd-analyze is (it needs no running systemd): an
 # instance of the template, its binary BIN at the staged path ROOT BIN, in TREE/verify, for an
 # interface whose name has a '-' (the instance `systemd-escape can-arm` gives). Any message is a
 # failure: verify exits 0 on unknown keys and unparsable values, which systemd then ignores.
-function(verify_unit unit root bin tree)
+# Then its sandbox's exposure, at most MAX_EXPOSURE (check_unit_exposure).
+function(verify_unit unit root bin tree max_exposure)
   find_program(SYSTEMD_ANALYZE systemd-analyze)
   if(NOT SYSTEMD_ANALYZE)
     return()
@@ -111,4 +128,5 @@ function(verify_unit unit root bin tree)
     endif()
   endif()
   message(STATUS "systemd-analyze verify: the unit passes")
+  check_unit_exposure(${SYSTEMD_ANALYZE} "${instance}" ${max_exposure})
 endfunction()

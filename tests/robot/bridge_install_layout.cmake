@@ -4,7 +4,7 @@
 # the rights the bridge's real-time setup and serial line need, and the installed options are
 # accepted (the bridge checks them before it opens any CAN socket); the unit is not restarted on
 # exit 2 (bad arguments), passes the instance's interface unescaped, and passes
-# `systemd-analyze verify` where that exists.
+# `systemd-analyze verify` and keeps its sandbox (`systemd-analyze security`) where that exists.
 #   cmake -DBUILD=... -DSTAGE=... -P bridge_install_layout.cmake
 include(${CMAKE_CURRENT_LIST_DIR}/../install_layout_checks.cmake)
 
@@ -23,6 +23,8 @@ function(check_rights unit)
   want("${unit}" "^SupplementaryGroups=.*dialout" "the serial devices belong to group dialout")
   want("${unit}" "^AmbientCapabilities=.*CAP_SYS_NICE" "SCHED_FIFO needs it (a user without it runs SCHED_OTHER)")
   want("${unit}" "^AmbientCapabilities=.*CAP_IPC_LOCK" "mlockall needs it")
+  # DevicePolicy=closed: the serial lines must be allowed by name, the default sensor's first.
+  want("${unit}" "^DeviceAllow=char-ttyUSB rw$" "the default sensor, rtu-stream:/dev/ttyUSB0, is a USB adapter")
   file(STRINGS "${unit}" hidden REGEX "^PrivateDevices=(yes|true|1)$")
   if(hidden)
     message(FATAL_ERROR "${unit}: ${hidden} hides the serial devices from the bridge")
@@ -51,7 +53,10 @@ function(check_install root tree)
   if(NOT rc EQUAL 1 OR NOT err MATCHES "dg_none")
     message(FATAL_ERROR "the installed options were not accepted (exit ${rc}): ${err}")
   endif()
-  verify_unit("${unit}" "${root}" "${bin}" "${tree}")
+  # Exposure 2.1 (systemd 252; 8.4 before its sandbox): what is left is the bridge's need, its
+  # two capabilities, group dialout and the serial lines, SocketCAN and Modbus TCP (IPv4), and
+  # SCHED_FIFO, the host's network and users.
+  verify_unit("${unit}" "${root}" "${bin}" "${tree}" 2.1)
   message(STATUS "installed: ${bin}, ${env}, ${unit}")
 endfunction()
 
