@@ -159,6 +159,28 @@ void check_features(const FeatureConvention& f, const std::string& source) {
   }
 }
 
+// The training conditions (format version 3); 0 is unknown. A period is a sensor's: above 1 s
+// no force sensor the predictor runs on samples. Speeds above 2 m/s are no dressing pull.
+void check_training_period(double period_s, const std::string& source) {
+  check_finite(period_s, source, "sample_period_s");
+  if (period_s != 0.0 && !(period_s > 0.0 && period_s <= 1.0))
+    fail(source, "sample_period_s " + short_number(period_s) + " s is not in (0, 1] (or 0, unknown)");
+}
+
+// Both speeds known, or both unknown (0): a range with one end is no range.
+void check_training_speeds(double min_m_s, double max_m_s, const std::string& source) {
+  check_finite(min_m_s, source, "speed_min_m_s");
+  check_finite(max_m_s, source, "speed_max_m_s");
+  if (min_m_s == 0.0 && max_m_s == 0.0) return;
+  const std::string range =
+      " (speed_min_m_s " + short_number(min_m_s) + ", speed_max_m_s " + short_number(max_m_s) + ")";
+  if (min_m_s == 0.0 || max_m_s == 0.0)
+    fail(source, "speed range is half known" + range + ": both 0 (unknown) or both set");
+  if (!(min_m_s > 0.0)) fail(source, "speed_min_m_s is not positive" + range);
+  if (!(max_m_s <= 2.0)) fail(source, "speed_max_m_s is above 2 m/s" + range);
+  if (!(min_m_s <= max_m_s)) fail(source, "speed_min_m_s is above speed_max_m_s" + range);
+}
+
 void check_class(const ClassHmm& h, const std::string& source) {
   const std::string w = "class '" + h.name + "'";
   if (h.name.empty()) fail(source, "a class has an empty name");
@@ -261,11 +283,18 @@ void validate_model(const OutcomeModel& m, const std::string& source) {
   check_finite(m.stop_threshold, source, "stop threshold");
   if (!(m.stop_threshold > 0.0 && m.stop_threshold < 1.0)) fail(source, "stop threshold is not in (0, 1)");
   if (m.stop_consecutive < 1 || m.stop_consecutive > 100000) fail(source, "stop_consecutive is not in 1..100000");
+  check_training_period(m.sample_period_s, source);
+  check_training_speeds(m.speed_min_m_s, m.speed_max_m_s, source);
   for (const std::string* s : {&m.tool_version, &m.created, &m.source_dataset, &m.training_summary})
     if (s->size() > kMaxString) fail(source, "a metadata string is longer than 65536 bytes");
 }
 
+bool same_period(double a_s, double b_s) noexcept {
+  return std::fabs(a_s - b_s) <= kPeriodTolerance * std::max(std::fabs(a_s), std::fabs(b_s));
+}
+
 uint32_t format_version_of(const OutcomeModel& m) noexcept {
+  if (m.knows_period() || m.knows_speeds()) return 3;
   for (int k = 0; k < kFeatures; ++k)
     if (m.features.axis[k] == kAxisNone) return 2;
   return 1;
@@ -289,6 +318,11 @@ std::vector<uint8_t> encode_model(const OutcomeModel& m) {
   }
   w.f64(m.stop_threshold);
   w.i32(m.stop_consecutive);
+  if (format_version_of(m) >= 3) {
+    w.f64(m.sample_period_s);
+    w.f64(m.speed_min_m_s);
+    w.f64(m.speed_max_m_s);
+  }
   w.u32(static_cast<uint32_t>(m.classes.size()));
   for (const auto& h : m.classes) {
     w.str(h.name);
@@ -350,6 +384,16 @@ OutcomeModel decode_model(const uint8_t* data, size_t size, const std::string& s
   }
   m.stop_threshold = r.f64("stop threshold");
   m.stop_consecutive = r.i32("stop consecutive");
+  if (version >= 3) {
+    m.sample_period_s = r.f64("sample period");
+    m.speed_min_m_s = r.f64("speed min");
+    m.speed_max_m_s = r.f64("speed max");
+    // The writer writes version 3 only for a model that knows one of them: every file it accepts
+    // re-writes to its own bytes.
+    if (!m.knows_period() && !m.knows_speeds())
+      fail(source, "format version 3 with sample_period_s, speed_min_m_s and speed_max_m_s all 0 (unknown): "
+                   "such a model is written as version 1 or 2");
+  }
   const uint32_t n_classes = r.u32("class count");
   if (n_classes < 1 || n_classes > static_cast<uint32_t>(kMaxClasses))
     fail(source, std::to_string(n_classes) + " classes (1.." + std::to_string(kMaxClasses) + " allowed)");
@@ -415,6 +459,29 @@ void write_model(const std::filesystem::path& path, const OutcomeModel& m) {
   }
 }
 
+namespace {
+// "unknown (format version N)" where the file does not say: a version 1 or 2 file never does.
+std::string describe_training_conditions(const OutcomeModel& m) {
+  const std::string unknown = "unknown (format version " + std::to_string(format_version_of(m)) + ")";
+  char buf[160];
+  std::string out = "  sample period: ";
+  if (m.knows_period()) {
+    std::snprintf(buf, sizeof buf, "%.9g s (%.6g Hz)", m.sample_period_s, 1.0 / m.sample_period_s);
+    out += buf;
+  } else {
+    out += unknown;
+  }
+  out += "\n  training speeds: ";
+  if (m.knows_speeds()) {
+    std::snprintf(buf, sizeof buf, "%.6g to %.6g m/s", m.speed_min_m_s, m.speed_max_m_s);
+    out += buf;
+  } else {
+    out += unknown;
+  }
+  return out + "\n";
+}
+}  // namespace
+
 std::string describe_model(const OutcomeModel& m) {
   std::ostringstream o;
   char buf[256];
@@ -435,6 +502,7 @@ std::string describe_model(const OutcomeModel& m) {
   std::snprintf(buf, sizeof buf, "  stop policy: P(stop class) > %.4g for %d consecutive samples\n", m.stop_threshold,
                 m.stop_consecutive);
   o << buf;
+  o << describe_training_conditions(m);
   for (const auto& h : m.classes) {
     std::snprintf(buf, sizeof buf, "  class '%s': %d states, prior %.4f\n", h.name.c_str(), h.n_states, std::exp(h.log_prior));
     o << buf;

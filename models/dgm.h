@@ -94,6 +94,16 @@ struct OutcomeModel {
   double stop_threshold = 0.9;
   int stop_consecutive = 5;
 
+  // The training conditions (format version 3), so that a predictor running at another sensor
+  // rate can refuse the model and a pull faster or slower than any it was trained on can be
+  // noticed. 0 = unknown: what a version 1 or 2 file reads as. The period is known or not on its
+  // own; the speed range is known as a pair (both 0 or both set).
+  double sample_period_s = 0.0;  // the training sequences' sample period [s], in (0, 1]
+  double speed_min_m_s = 0.0;    // the slowest training pull [m/s], 0 < min <= max <= 2
+  double speed_max_m_s = 0.0;    // the fastest training pull [m/s]
+  bool knows_period() const noexcept { return sample_period_s != 0.0; }
+  bool knows_speeds() const noexcept { return speed_min_m_s != 0.0 || speed_max_m_s != 0.0; }
+
   int class_index(std::string_view name) const;  // -1 if absent
 };
 
@@ -125,8 +135,16 @@ inline constexpr double kStochasticTolerance = 1e-9;
 inline constexpr char kMagic[8] = {'D', 'G', 'M', 'O', 'D', 'E', 'L', '\0'};
 // Version 2 (2026-11-23) only adds the axis value kAxisNone; the writer writes version 1 for a
 // model without it, so that readers of version 1 still read every model they can understand.
-inline constexpr uint32_t kFormatVersion = 2;
-uint32_t format_version_of(const OutcomeModel& m) noexcept;  // 1, or 2 when a feature is kAxisNone
+// Version 3 (2026-12-07) adds the training conditions (sample period, speed range); the writer
+// writes it only when one of them is known, so a model read from an older file re-writes to the
+// same bytes.
+inline constexpr uint32_t kFormatVersion = 3;
+// 3 when a training condition is known, else 2 when a feature is kAxisNone, else 1.
+uint32_t format_version_of(const OutcomeModel& m) noexcept;
+// The largest relative difference between two sample periods that counts as the same rate.
+inline constexpr double kPeriodTolerance = 1e-6;
+// Whether two sample periods agree within kPeriodTolerance (relative to the larger).
+bool same_period(double a_s, double b_s) noexcept;
 
 // CRC-32 (IEEE 802.3, reflected, polynomial 0xEDB88320, init and final xor 0xFFFFFFFF), the one
 // zlib and PNG use: crc32("123456789") == 0xCBF43926.

@@ -15,7 +15,8 @@ int run_model(int argc, char** argv) {
     std::puts(
         "usage: dressguard model show MODEL.dgm [--json]\n"
         "  Validates a model file (magic, version, CRC-32, parameters; see models/FORMAT.md) and\n"
-        "  prints its metadata, feature convention, stop defaults and every class's HMM.\n"
+        "  prints its metadata, feature convention, stop defaults, training conditions (sample\n"
+        "  period, pull speeds; 'unknown' before format version 3) and every class's HMM.\n"
         "  --json   print the whole model as one JSON object");
     return 0;
   }

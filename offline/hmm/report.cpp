@@ -25,8 +25,11 @@ std::string model_json(const model::OutcomeModel& m) {
     o << (k ? ", " : "") << "{\"axis\": " << json_string(kAxis[m.features.axis[k]]) << ", \"sign\": "
       << json_number(m.features.sign[k]) << ", \"offset\": " << json_number(m.features.offset[k])
       << ", \"scale\": " << json_number(m.features.scale[k]) << "}";
+  // The training conditions (format version 3): null where the model does not know them.
+  const auto known = [](double v) { return v != 0.0 ? json_number(v) : std::string("null"); };
   o << "], \"stop_threshold\": " << json_number(m.stop_threshold) << ", \"stop_consecutive\": " << m.stop_consecutive
-    << ", \"classes\": [";
+    << ", \"sample_period_s\": " << known(m.sample_period_s) << ", \"speed_min_m_s\": " << known(m.speed_min_m_s)
+    << ", \"speed_max_m_s\": " << known(m.speed_max_m_s) << ", \"classes\": [";
   auto num = [](double v) { return json_number(v); };
   for (size_t c = 0; c < m.classes.size(); ++c) {
     const auto& h = m.classes[c];

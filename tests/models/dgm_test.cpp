@@ -6,9 +6,11 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "dgm.h"
@@ -159,7 +161,7 @@ TEST(ModelFileRejects, WrongMagic) {
 }
 
 TEST(ModelFileRejects, WrongVersion) {
-  for (uint8_t v : {uint8_t{0}, uint8_t{3}}) {
+  for (uint8_t v : {uint8_t{0}, uint8_t{4}}) {
     auto b = encode_model(sample_model());
     b[8] = v;
     fix_crc(b);
@@ -199,6 +201,159 @@ TEST(ModelFile, UnusedFeatureIsZeroAndNeedsVersion2) {
   auto scaled = m;  // FORMAT.md: offset 0 and scale 1 where the axis is none
   scaled.features.scale[1] = 2.0;
   EXPECT_THROW(encode_model(scaled), ModelError);
+}
+
+namespace {
+// The sample model with its training conditions known, each a unique marker in the bytes.
+constexpr double kPeriodMarker = 0.0123456789, kSpeedMinMarker = 0.1234567891, kSpeedMaxMarker = 0.3456789123;
+OutcomeModel trained_at_known_conditions() {
+  auto m = sample_model();
+  m.sample_period_s = kPeriodMarker;
+  m.speed_min_m_s = kSpeedMinMarker;
+  m.speed_max_m_s = kSpeedMaxMarker;
+  return m;
+}
+std::vector<uint8_t> v3_patched(double from, double to) {
+  auto b = encode_model(trained_at_known_conditions());
+  replace_double(b, from, to);
+  fix_crc(b);
+  return b;
+}
+// Where the marker `v` starts in `b`.
+size_t offset_of(const std::vector<uint8_t>& b, double v) {
+  uint8_t f[8];
+  std::memcpy(f, &v, 8);
+  for (size_t i = 0; i + 8 <= b.size(); ++i)
+    if (std::memcmp(&b[i], f, 8) == 0) return i;
+  ADD_FAILURE() << "marker not found";
+  return 0;
+}
+}  // namespace
+
+// Format version 3: the training conditions round-trip bit-exactly right after the stop policy,
+// `model show` prints them, and either kind alone (a period, a speed range) is version 3 too.
+TEST(ModelFileV3, TrainingConditionsRoundTrip) {
+  const auto m = trained_at_known_conditions();
+  const auto b = encode_model(m);
+  EXPECT_EQ(b[8], 3);
+  EXPECT_EQ(b.size(), encode_model(sample_model()).size() + 24);
+  const auto d = decode_model(b.data(), b.size(), "mem");
+  EXPECT_EQ(d.sample_period_s, kPeriodMarker);
+  EXPECT_EQ(d.speed_min_m_s, kSpeedMinMarker);
+  EXPECT_EQ(d.speed_max_m_s, kSpeedMaxMarker);
+  EXPECT_EQ(encode_model(d), b);
+  const std::string text = describe_model(d);
+  EXPECT_NE(text.find("sample period: 0.0123456789 s"), std::string::npos) << text;
+  EXPECT_NE(text.find("training speeds: 0.123457 to 0.345679 m/s"), std::string::npos) << text;
+  // Layout: the three f64 follow the stop consecutive count and precede the class count.
+  const size_t at = offset_of(b, kPeriodMarker);
+  EXPECT_EQ(offset_of(b, kSpeedMinMarker), at + 8);
+  EXPECT_EQ(offset_of(b, kSpeedMaxMarker), at + 16);
+  EXPECT_EQ(b[at - 4], 5);   // stop consecutive 5, little-endian
+  EXPECT_EQ(b[at + 24], 3);  // class count 3
+  auto period_only = sample_model();
+  period_only.sample_period_s = 0.01;
+  auto speeds_only = sample_model();
+  speeds_only.speed_min_m_s = speeds_only.speed_max_m_s = 0.2;
+  for (const auto& one : {period_only, speeds_only}) {
+    const auto e = encode_model(one);
+    EXPECT_EQ(e[8], 3);
+    const auto back = decode_model(e.data(), e.size(), "mem");
+    EXPECT_EQ(back.sample_period_s, one.sample_period_s);
+    EXPECT_EQ(back.speed_max_m_s, one.speed_max_m_s);
+  }
+  EXPECT_NE(describe_model(period_only).find("training speeds: unknown (format version 3)"), std::string::npos);
+  // Version 3 keeps version 2's unused axis.
+  auto none = m;
+  none.features.axis[1] = kAxisNone;
+  none.features.offset[1] = 0.0;
+  none.features.scale[1] = 1.0;
+  const auto n = encode_model(none);
+  EXPECT_EQ(n[8], 3);
+  EXPECT_EQ(decode_model(n.data(), n.size(), "mem").features.axis[1], kAxisNone);
+}
+
+// A model that knows none of them is written as before, byte for byte: version 1 (or 2 with an
+// unused axis) reads as unknown and re-writes to the same bytes.
+TEST(ModelFileV3, OldVersionsReadAsUnknownAndRewriteByteIdentically) {
+  auto none = sample_model();
+  none.features.axis[0] = kAxisNone;
+  none.features.offset[0] = 0.0;
+  none.features.scale[0] = 1.0;
+  for (const auto& [m, version] : {std::pair{sample_model(), 1}, std::pair{none, 2}}) {
+    const auto b = encode_model(m);
+    EXPECT_EQ(b[8], version);
+    const auto d = decode_model(b.data(), b.size(), "old.dgm");
+    EXPECT_FALSE(d.knows_period());
+    EXPECT_FALSE(d.knows_speeds());
+    EXPECT_EQ(encode_model(d), b);
+    const std::string text = describe_model(d);
+    const std::string unknown = "unknown (format version " + std::to_string(version) + ")";
+    EXPECT_NE(text.find("sample period: " + unknown), std::string::npos) << text;
+    EXPECT_NE(text.find("training speeds: " + unknown), std::string::npos) << text;
+  }
+  // The shipped default model (an older version): loads with both unknown, re-writes identically.
+  const auto path = std::filesystem::path(DRESSGUARD_SOURCE_DIR) / "models/default.dgm";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "models/default.dgm is not there";
+  std::ifstream in(path, std::ios::binary);
+  const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_LT(bytes[8], 3);
+  const auto d = read_model(path);
+  EXPECT_FALSE(d.knows_period());
+  EXPECT_FALSE(d.knows_speeds());
+  EXPECT_EQ(encode_model(d), bytes);
+}
+
+// Each bound, on load and on write, with a message naming the field.
+TEST(ModelFileV3Rejects, EachBoundNamingTheField) {
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  expect_rejected(v3_patched(kPeriodMarker, -0.01), "sample_period_s -0.01 s is not in (0, 1]");
+  expect_rejected(v3_patched(kPeriodMarker, 1.5), "sample_period_s 1.5 s is not in (0, 1]");
+  expect_rejected(v3_patched(kPeriodMarker, nan), "sample_period_s is not finite");
+  expect_rejected(v3_patched(kPeriodMarker, inf), "sample_period_s is not finite");
+  expect_rejected(v3_patched(kSpeedMinMarker, nan), "speed_min_m_s is not finite");
+  expect_rejected(v3_patched(kSpeedMaxMarker, inf), "speed_max_m_s is not finite");
+  expect_rejected(v3_patched(kSpeedMinMarker, -0.1), "speed_min_m_s is not positive");
+  expect_rejected(v3_patched(kSpeedMaxMarker, 2.5), "speed_max_m_s is above 2 m/s");
+  expect_rejected(v3_patched(kSpeedMinMarker, 0.5), "speed_min_m_s is above speed_max_m_s");
+  expect_rejected(v3_patched(kSpeedMinMarker, 0.0), "speed range is half known");
+  expect_rejected(v3_patched(kSpeedMaxMarker, 0.0), "speed range is half known");
+  // 1 s and 2 m/s themselves are inside.
+  auto edge = trained_at_known_conditions();
+  edge.sample_period_s = 1.0;
+  edge.speed_min_m_s = edge.speed_max_m_s = 2.0;
+  EXPECT_NO_THROW(encode_model(edge));
+  auto bad = trained_at_known_conditions();
+  bad.sample_period_s = 0.0;
+  bad.speed_max_m_s = 0.0;
+  try {
+    encode_model(bad);
+    ADD_FAILURE() << "wrote a half-known speed range";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("speed range is half known"), std::string::npos) << e.what();
+  }
+  // A version-3 file that knows nothing: the writer never makes one.
+  auto b = encode_model(trained_at_known_conditions());
+  for (double v : {kPeriodMarker, kSpeedMinMarker, kSpeedMaxMarker}) replace_double(b, v, 0.0);
+  fix_crc(b);
+  expect_rejected(b, "format version 3 with sample_period_s, speed_min_m_s and speed_max_m_s all 0");
+}
+
+// A file whose size field and CRC agree but whose body ends inside the new fields.
+TEST(ModelFileV3Rejects, TruncatedInsideTheTrainingConditions) {
+  const auto b = encode_model(trained_at_known_conditions());
+  const size_t at = offset_of(b, kPeriodMarker);
+  const std::pair<size_t, const char*> cuts[] = {
+      {at + 3, "truncated: sample period at byte"}, {at + 8, "truncated: speed min at byte"},
+      {at + 20, "truncated: speed max at byte"}};
+  for (const auto& [body, what] : cuts) {
+    std::vector<uint8_t> c(b.begin(), b.begin() + body);
+    c.resize(body + 4);  // room for the CRC
+    const uint32_t size = static_cast<uint32_t>(c.size());
+    for (int i = 0; i < 4; ++i) c[12 + i] = static_cast<uint8_t>(size >> (8 * i));
+    fix_crc(c);
+    expect_rejected(c, what);
+  }
 }
 
 // A folder given as the model is named as such (the stream's own message named no path).
