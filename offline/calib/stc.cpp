@@ -13,6 +13,7 @@ model::OutcomeModel build_outcome_model(const std::vector<const HapticSequence*>
   mo.uniform_priors = o.uniform_priors;
   mo.features.axis[1] = o.second_axis;
   mo.source_dataset = o.source;
+  mo.trial_name = o.trial_name;
   return hmm::train_outcome_model(trials, mo);
 }
 

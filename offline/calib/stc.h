@@ -3,6 +3,7 @@
 // Built only when dg_hmm is (DRESSGUARD_HAVE_HMM).
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,8 @@ struct StcOptions {
   // kAxisNone (F_motion alone).
   int second_axis = model::kAxisVertical;
   std::string source;          // written into the model's metadata
+  // Names a training trial in an error (its file, where the caller knows it); empty: its id.
+  std::function<std::string(const HapticSequence&)> trial_name;
 };
 
 // Which forces an STC should model, from its calibration. The paper's HMMs are bivariate

@@ -177,17 +177,17 @@ int run_build_model(int argc, char** argv) {
   int left_out = 0;
   for (std::size_t i = 0; i < sets.size(); ++i) {
     Dataset one = load_dataset(sets[i]);
-    if (label_margin > 0) {
-      const std::vector<std::string> drop = ambiguous_labels(sets[i], label_margin);
-      const auto n = one.trials.size();
-      std::erase_if(one.trials, [&](const HapticSequence& t) {
-        return std::find(drop.begin(), drop.end(), t.id) != drop.end();
-      });
-      left_out += static_cast<int>(n - one.trials.size());
+    const std::vector<std::string> drop = label_margin > 0 ? ambiguous_labels(sets[i], label_margin)
+                                                           : std::vector<std::string>{};
+    for (std::size_t k = 0; k < one.trials.size(); ++k) {
+      if (std::find(drop.begin(), drop.end(), one.trials[k].id) != drop.end()) {
+        ++left_out;
+        continue;
+      }
+      if (!discrepancies.empty()) apply_discrepancy(discrepancies[i].second, one.trials[k]);
+      ds.trials.push_back(std::move(one.trials[k]));
+      ds.trial_files.push_back(one.trial_files[k]);  // an error names the trial's file
     }
-    if (!discrepancies.empty())
-      for (auto& t : one.trials) apply_discrepancy(discrepancies[i].second, t);
-    std::move(one.trials.begin(), one.trials.end(), std::back_inserter(ds.trials));
   }
   if (training_out) {
     save_dataset(ds, *training_out);
@@ -222,6 +222,7 @@ int run_build_model(int argc, char** argv) {
   so.source = data + "; forces: " + axes.reason + (priors == "training" ? "; priors: the training shares" : "");
   so.second_axis = axes.second_axis;
   so.uniform_priors = priors == "uniform";
+  so.trial_name = [&ds](const HapticSequence& t) { return trial_file_name(ds, t); };
   // Training refuses what the trials cannot teach (a class whose trials are all shorter than
   // --states, no labelled trial): the input's fault, exit 2 as train's, not a runtime failure.
   model::OutcomeModel m;

@@ -63,6 +63,7 @@ int run_train(int argc, char** argv) {
   if (stop_consecutive < 1 || stop_consecutive > 100000) throw UsageError("--stop-consecutive must be 1..100000");
   const auto excluded = split_list(args.get("exclude-participant").value_or(""));
   const Dataset ds = load_datasets(dataset_list("data", data));
+  opt.trial_name = [&ds](const HapticSequence& t) { return trial_file_name(ds, t); };
   require_known_participants("exclude-participant", excluded, ds, data);
   std::vector<const HapticSequence*> trials;
   for (const auto& t : ds.trials)

@@ -197,6 +197,7 @@ Dataset load_dataset(const fs::path& dir) {
       throw_input_error(manifest, n, "file '" + it->first + "' repeats line " + std::to_string(it->second));
     }
     ds.files.push_back(dir / std::string(f[5]));
+    ds.trial_files.push_back(ds.files.back());
     seq.samples = read_trial_csv(ds.files.back());
     if (const size_t k = unrecorded_samples(seq); k > kMaxUnrecordedSamples)
       throw_input_error(manifest, n,
@@ -222,8 +223,16 @@ Dataset load_datasets(const std::vector<fs::path>& dirs) {
     all.trials.insert(all.trials.end(), std::make_move_iterator(one.trials.begin()),
                       std::make_move_iterator(one.trials.end()));
     all.files.insert(all.files.end(), one.files.begin(), one.files.end());
+    all.trial_files.insert(all.trial_files.end(), one.trial_files.begin(), one.trial_files.end());
   }
   return all;
+}
+
+std::string trial_file_name(const Dataset& ds, const HapticSequence& t) {
+  const auto* first = ds.trials.data();
+  if (ds.trial_files.size() == ds.trials.size() && &t >= first && &t < first + ds.trials.size())
+    return ds.trial_files[static_cast<std::size_t>(&t - first)].string();
+  return "trial '" + t.id + "'";
 }
 
 std::string trial_id_problem(std::string_view id) {

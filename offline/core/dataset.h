@@ -40,7 +40,12 @@ struct Dataset {
   // The files it was read from (load_dataset: the manifest, then each trial's file), so that a
   // command can refuse to write over its own input (same_file); empty for one made in memory.
   std::vector<std::filesystem::path> files;
+  // Each trial's own file, parallel to `trials` (load_dataset); empty for one made in memory.
+  std::vector<std::filesystem::path> trial_files;
 };
+
+// What names `t` (one of ds.trials) in an error: its file where `ds` knows it, else its id.
+std::string trial_file_name(const Dataset& ds, const HapticSequence& t);
 
 // Trial CSV (header then rows). Throws InputError naming file and line on malformed rows.
 std::vector<HapticSample> read_trial_csv(const std::filesystem::path& path);

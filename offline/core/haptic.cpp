@@ -45,10 +45,23 @@ double pull_time_at(double travel, double speed, double acceleration) {
 
 std::size_t unrecorded_samples(const HapticSequence& trial) {
   if (trial.samples.empty() || trial.samples.front().travel <= kLateStart) return 0;
-  const size_t n = trial.samples.size();
-  const double period = n >= 2 ? (trial.samples.back().t - trial.samples.front().t) / static_cast<double>(n - 1) : 0.01;
+  const double period = trial.samples.size() >= 2 ? mean_sample_period(trial) : 0.01;
   if (!(period > 0.0)) return 0;  // a recording without time: nothing to say where it began
   return static_cast<std::size_t>(std::lround(pull_time_at(trial.samples.front().travel, trial.speed) / period));
+}
+
+double mean_sample_period(const HapticSequence& trial) {
+  const size_t n = trial.samples.size();
+  return n >= 2 ? (trial.samples.back().t - trial.samples.front().t) / static_cast<double>(n - 1) : 0.0;
+}
+
+bool same_recorded_period(double a_s, double b_s) {
+  return std::fabs(a_s - b_s) <= kRecordingPeriodTolerance * std::max(std::fabs(a_s), std::fabs(b_s));
+}
+
+double nominal_sample_period(double mean_s) {
+  const double us = std::round(mean_s * 1e6);
+  return us >= 1.0 ? us / 1e6 : mean_s;
 }
 
 bool records_from(const std::vector<HapticSample>& samples, double travel) {

@@ -70,6 +70,18 @@ struct HapticSequence {
 // two samples). s0-middlemiss-10: 0.0958 m at 0.15 m/s is 0.714 s, 71 samples of 10.0 ms.
 std::size_t unrecorded_samples(const HapticSequence& trial);
 
+// A recording's mean sample period [s]: (t_last - t_first) / (n - 1); 0 with fewer than 2 samples.
+double mean_sample_period(const HapticSequence& trial);
+// Two recordings' mean periods are the same rate within this (relative): a recording's clock
+// jitters and drifts. The study's 22 trials' means span 9.99966-10.00041 ms (7.5e-5); a rate that
+// changes a model's meaning (125 Hz for 100 Hz) differs by percent.
+inline constexpr double kRecordingPeriodTolerance = 1e-3;
+bool same_recorded_period(double a_s, double b_s);
+// The nominal period of recordings whose mean is `mean_s`: to the whole microsecond (the study's
+// means all give 10 ms), so that a model trained on them matches a predictor configured at that
+// rate within model::kPeriodTolerance; `mean_s` itself below 1 us.
+double nominal_sample_period(double mean_s);
+
 // Whether a recording holds its pull from `travel` [m] on: its first sample at most kLateStart
 // past it (past 0 for a `travel` before the pull's start). A mean over a window of travel that
 // begins before a late start would hold only its last samples and be set against another curve's

@@ -657,6 +657,34 @@ void set_log_priors(model::OutcomeModel& m, const std::vector<const HapticSequen
   for (auto& h : m.classes) h.log_prior -= std::log(z);
 }
 
+void set_training_conditions(model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials,
+                             const std::function<std::string(const HapticSequence&)>& trial_name) {
+  const auto name = [&](const HapticSequence& t) { return trial_name ? trial_name(t) : "trial '" + t.id + "'"; };
+  const HapticSequence* first = nullptr;  // the trial whose period the others must share
+  double first_period = 0.0, sum = 0.0;
+  size_t timed = 0;
+  for (const auto* t : trials) {
+    const double period = mean_sample_period(*t);
+    if (!(period > 0.0)) continue;
+    if (!first) first = t, first_period = period;
+    if (!same_recorded_period(period, first_period)) {
+      char at[64], first_at[64];
+      std::snprintf(at, sizeof at, " is sampled every %.9g s, ", period);
+      std::snprintf(first_at, sizeof first_at, " every %.9g s", first_period);
+      throw std::invalid_argument(name(*t) + at + name(*first) + first_at +
+                                  ": a model is trained at one sample period (they must agree within 1e-3 relative)");
+    }
+    sum += period;
+    ++timed;
+  }
+  m.sample_period_s = timed ? nominal_sample_period(sum / static_cast<double>(timed)) : 0.0;
+  m.speed_min_m_s = m.speed_max_m_s = 0.0;
+  for (const auto* t : trials) {
+    m.speed_min_m_s = m.speed_min_m_s == 0.0 ? t->speed : std::min(m.speed_min_m_s, t->speed);
+    m.speed_max_m_s = std::max(m.speed_max_m_s, t->speed);
+  }
+}
+
 model::OutcomeModel train_outcome_model(const std::vector<const HapticSequence*>& trials, const ModelOptions& opt,
                                         const std::function<void(const std::string&)>& progress) {
   std::vector<const HapticSequence*> labelled;
@@ -666,6 +694,7 @@ model::OutcomeModel train_outcome_model(const std::vector<const HapticSequence*>
   model::OutcomeModel m;
   m.features = fit_feature_scaling(labelled, opt.features);
   m.source_dataset = opt.source_dataset;
+  set_training_conditions(m, labelled, opt.trial_name);  // before Baum-Welch: a mixed rate fails at once
   std::string summary;
   for (int o = 0; o < kOutcomeCount; ++o) {
     std::vector<FeatureSequence> seqs;

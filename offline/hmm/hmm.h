@@ -169,7 +169,17 @@ struct ModelOptions {
   model::FeatureConvention features;  // the axes and signs to model; offset and scale are fitted
   bool uniform_priors = false;  // log_prior = -log(classes) instead of the training counts
   std::string source_dataset;   // written into the model's metadata
+  // Names a training trial in an error (its file, where the caller knows it); empty: its id.
+  std::function<std::string(const HapticSequence&)> trial_name;
 };
+
+// The training conditions of m (format version 3) from the labelled `trials`: the sample period,
+// from each trial's mean interval, which every trial must share within kRecordingPeriodTolerance
+// (else std::invalid_argument naming the trial by `trial_name`, or its id, and both periods),
+// their mean to the whole microsecond (nominal_sample_period); and the slowest and fastest pull
+// speed. A trial of fewer than 2 samples says no period.
+void set_training_conditions(model::OutcomeModel& m, const std::vector<const HapticSequence*>& trials,
+                             const std::function<std::string(const HapticSequence&)>& trial_name = {});
 
 // The classes' log priors of m: equal (`uniform`, the paper's "highest likelihood"), or each
 // class's share of the labelled `trials` (the Bayes decision for data drawn like the training

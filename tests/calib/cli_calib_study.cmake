@@ -327,9 +327,10 @@ if(HMM)
       message(FATAL_ERROR "build-model --forces ${forces} (${rc}, ${rc2}):\n${out}\n${err}\n${shown}\n${err2}")
     endif()
   endfunction()
-  # F_motion alone: a model of format 2 whose second feature is none, shown as such.
-  build_and_show(motion ${WORK}/m1.dgm "motion" "format 2" "feature 1 = none")
-  # F_motion and F_lateral: a model of format 1 whose second feature is the lateral force.
+  # F_motion alone: a model whose second feature is none, shown as such (format 3: training
+  # records its sample period and speeds, and version 3 keeps version 2's axis none).
+  build_and_show(motion ${WORK}/m1.dgm "motion" "format 3" "feature 1 = none" "sample period: 0.01 s")
+  # F_motion and F_lateral: a model whose second feature is the lateral force.
   build_and_show(lateral ${WORK}/ml.dgm "motion,lateral" "feature 1 = \\([+-]f_lateral ")
   # --priors training: each class's share of the training trials (the study: 8 good, 14 missed),
   # where the default gives each 1/2.

@@ -118,10 +118,52 @@ TEST_F(CliTest, TrainClassifyShowOnSyntheticData) {
   const auto showj = run("model show " + (dir / "m.dgm").string() + " --json");
   ASSERT_EQ(showj.code, 0);
   EXPECT_EQ(json_field(showj.out, "states"), 5.0);
-  // The version the file's bytes carry (two force axes: format 1, models/FORMAT.md), as the
-  // text says, not the newest version this build can write.
-  EXPECT_NE(show.out.find("format 1"), std::string::npos) << show.out;
-  EXPECT_EQ(json_field(showj.out, "format_version"), 1.0) << showj.out;
+  // The version the file's bytes carry (training records its sample period and speeds: format 3,
+  // models/FORMAT.md), as the text says.
+  EXPECT_NE(show.out.find("format 3"), std::string::npos) << show.out;
+  EXPECT_EQ(json_field(showj.out, "format_version"), 3.0) << showj.out;
+}
+
+// Training records what it was trained at (format version 3): the sample period measured from
+// the trials' time column (0.02 s here, not the study's 0.01) and the slowest and fastest pull
+// speed of the manifest; train and build-model alike. A trial at another rate is refused (exit 2),
+// naming its file and both periods.
+TEST_F(CliTest, TrainingRecordsItsSamplePeriodAndSpeeds) {
+  Dataset d = fx::synthetic_dataset(3, 100, 120, 56, 3);
+  for (size_t i = 0; i < d.trials.size(); ++i) {
+    d.trials[i].speed = 0.08 + 0.01 * static_cast<double>(i % 4);  // 0.08 .. 0.11 m/s
+    for (size_t k = 0; k < d.trials[i].samples.size(); ++k) d.trials[i].samples[k].t = 0.02 * static_cast<double>(k);
+  }
+  save_dataset(d, dir / "d");
+  for (const std::string cmd : {"train", "build-model"}) {
+    const auto r = run(cmd + " --data " + (dir / "d").string() + " --states 3 --out " + (dir / "m.dgm").string());
+    ASSERT_EQ(r.code, 0) << cmd << ": " << r.err;
+    const auto m = model::read_model(dir / "m.dgm");
+    EXPECT_NEAR(m.sample_period_s, 0.02, 1e-12) << cmd;
+    EXPECT_DOUBLE_EQ(m.speed_min_m_s, 0.08) << cmd;
+    EXPECT_DOUBLE_EQ(m.speed_max_m_s, 0.11) << cmd;
+    const auto show = run("model show " + (dir / "m.dgm").string());
+    EXPECT_NE(show.out.find("sample period: 0.02 s (50 Hz)"), std::string::npos) << show.out;
+    EXPECT_NE(show.out.find("training speeds: 0.08 to 0.11 m/s"), std::string::npos) << show.out;
+    fs::remove(dir / "m.dgm");
+  }
+  // A recording's clock jitters: a trial 5e-5 slow (the study's spread) is the same rate, and the
+  // model records the nominal period, to the microsecond.
+  for (auto& smp : d.trials[1].samples) smp.t *= 1.00005;
+  save_dataset(d, dir / "jitter");
+  ASSERT_EQ(run("train --data " + (dir / "jitter").string() + " --states 3 --out " + (dir / "j.dgm").string()).code, 0);
+  EXPECT_EQ(model::read_model(dir / "j.dgm").sample_period_s, 0.02);
+  auto& odd = d.trials[4];
+  for (size_t k = 0; k < odd.samples.size(); ++k) odd.samples[k].t = 0.0125 * static_cast<double>(k);
+  save_dataset(d, dir / "mixed");
+  for (const std::string cmd : {"train", "build-model"}) {
+    const auto r = run(cmd + " --data " + (dir / "mixed").string() + " --states 3 --out " + (dir / "m.dgm").string());
+    EXPECT_EQ(r.code, 2) << cmd;
+    const std::string file = (dir / "mixed" / (odd.id + ".csv")).string();
+    EXPECT_NE(r.err.find(file + " is sampled every 0.0125 s, "), std::string::npos) << cmd << ": " << r.err;
+    EXPECT_NE(r.err.find(" every 0.02 s: a model is trained at one sample period"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "m.dgm")) << cmd;
+  }
 }
 
 // A model of "missed" alone cannot be right about a good or a caught trial: classify counts them
