@@ -215,6 +215,12 @@ int run_replay(int argc, char** argv) {
     if (!args.has("allow-model-error")) throw InputError(e.what());
     model_error = e.what();
   }
+  if (m) {  // the daemon's check (predictor_core.h): a model trained at another rate is refused
+    const predictor::PeriodCheck period = predictor::check_model_period(*m, model_path, cfg.sample_period_s);
+    if (period.verdict == predictor::PeriodVerdict::Differs) throw InputError(period.message);
+    if (period.verdict == predictor::PeriodVerdict::Unknown)
+      std::fprintf(stderr, "replay: warning: %s\n", period.message.c_str());
+  }
   auto replay = [&](const std::vector<protocol::LoggedFrame>& frames) {
     try {
       return predictor::replay_frames(m.get(), cfg, frames, tick_ms * 1'000'000);

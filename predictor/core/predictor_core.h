@@ -106,6 +106,18 @@ long config_whole_number(const ConfigEntry& e, long lo, long hi);
 // sensor run on for up to a tick. At least 1.
 long max_tick_ms(const PredictorConfig& cfg);
 
+// Whether a model may run at the config's sample period (models/FORMAT.md, version 3). The HMMs'
+// dwell times are in samples: a model trained at another rate expects every phase of a pull to
+// take another number of samples. The daemon and `dressguard replay` both ask, at start-up.
+enum class PeriodVerdict { Same, Unknown, Differs };
+struct PeriodCheck {
+  PeriodVerdict verdict = PeriodVerdict::Same;
+  std::string message;  // one line naming the model file and both periods (Unknown: a warning)
+};
+// Differs when the model's known period and `sample_period_s` differ by more than
+// model::kPeriodTolerance (relative); Unknown for a model that does not say (format 1 or 2).
+PeriodCheck check_model_period(const model::OutcomeModel& m, const std::string& model_path, double sample_period_s);
+
 // Commanded travel [m] after t seconds of a pull at `speed` with ramp `accel` (trapezoid start):
 //   x(t) = a t^2 / 2                      for t < v/a
 //   x(t) = v^2 / (2a) + v (t - v/a)       after.

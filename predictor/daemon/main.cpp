@@ -187,6 +187,16 @@ int main(int argc, char** argv) {
       model.reset();
     }
   }
+  // A model trained at another sensor rate is the deployer's error, as a bad config is: exit 2
+  // before listening (a model that does not load is the robot's, and keeps the daemon up).
+  if (model) {
+    const predictor::PeriodCheck period = predictor::check_model_period(*model, model_path, cfg.sample_period_s);
+    if (period.verdict == predictor::PeriodVerdict::Differs) {
+      std::fprintf(stderr, "dressguard-predictor: %s\n", period.message.c_str());
+      return 2;
+    }
+    if (period.verdict == predictor::PeriodVerdict::Unknown) log->warn("{}", period.message);
+  }
 
   try {
     static EventQueue events;  // 4096 events: static storage, not on the stack

@@ -486,6 +486,30 @@ TEST(ReplayCli, TheConfigsTickIsTheDefault) {
   fs::remove_all(tmp);
 }
 
+// A model trained at another sensor rate than the config's sample_period_ms is refused, exit 2,
+// one line naming the model file and both periods (models/FORMAT.md, version 3): its HMMs count
+// time in samples. The trained model knows its 10 ms; the segment model (format 1) does not, and
+// runs with one warning at start-up, not one per log.
+TEST(ReplayCli, AModelTrainedAtAnotherRateIsRefused) {
+  ASSERT_NEAR(model::read_model(DG_TRAINED_MODEL).sample_period_s, 0.01, 1e-9);
+  const std::string log = " --logs " + kLogs.string();
+  const std::string trained = std::string(DG_CLI) + " replay --model " + DG_TRAINED_MODEL + log;
+  expect_refused(trained + " --set sample_period_ms=8",
+                 std::string(DG_TRAINED_MODEL) + " was trained at a sample period of 10 ms, the config's "
+                 "sample_period_ms is 8: refusing it");
+  int rc = 0;
+  std::string out = run(trained + " --set sample_period_ms=10.000001 2>&1", rc);  // within 1e-6 relative
+  EXPECT_EQ(WEXITSTATUS(rc), 0) << out;
+  EXPECT_EQ(out.find("sample period"), std::string::npos) << out;
+  out = run(std::string(DG_CLI) + " replay --model " + DG_TEST_MODEL + log + " --set sample_period_ms=8 2>&1", rc);
+  EXPECT_EQ(WEXITSTATUS(rc), 0) << out;
+  const std::string warning = "replay: warning: " + std::string(DG_TEST_MODEL) +
+                              " does not say at which sample period it was trained (format version 1)";
+  const size_t at = out.find(warning);
+  EXPECT_NE(at, std::string::npos) << out;
+  EXPECT_EQ(out.find(warning, at + 1), std::string::npos) << "warned more than once: " << out;
+}
+
 // The study's measured trials as candump logs in tmp/logs (`import`, then `export-candump --data`
 // with `export_options`); "" when shared/data is not here. Logs are generated at test time, never
 // committed (the data is not redistributable).
