@@ -112,6 +112,23 @@ Against pair_against(const std::vector<int>& mine, const std::vector<int>& other
   return a;
 }
 
+// A model that knows its training sample period (models/FORMAT.md, version 3) classifies only
+// trials recorded at it: its HMMs count time in samples. A trial at another rate (beyond a
+// recording's jitter, kRecordingPeriodTolerance) is refused, naming its file and both periods.
+void require_model_rate(const model::OutcomeModel& m, const std::string& model_path, const Dataset& ds,
+                        const std::vector<const HapticSequence*>& trials) {
+  if (!m.knows_period()) return;
+  for (const auto* t : trials) {
+    const double period = mean_sample_period(*t);
+    if (!(period > 0.0) || same_recorded_period(period, m.sample_period_s)) continue;
+    char at[64], trained[64];
+    std::snprintf(at, sizeof at, " is sampled every %.9g s, ", period);
+    std::snprintf(trained, sizeof trained, " was trained at %.9g s", m.sample_period_s);
+    throw InputError(trial_file_name(ds, *t) + at + model_path + trained +
+                     ": its HMMs count time in samples (a recording may differ by 1e-3 relative)");
+  }
+}
+
 }  // namespace
 
 int run_classify(int argc, char** argv) {
@@ -232,6 +249,9 @@ int run_classify(int argc, char** argv) {
   for (const auto& t : ds.trials)
     if (only.empty() || only.count(t.participant)) trials.push_back(&t);
   if (trials.empty()) throw InputError(data + ": no trials" + (only.empty() ? "" : " of the given participants"));
+  for (size_t i = 0; i < models.size(); ++i) require_model_rate(models[i], model_paths[i], ds, trials);
+  for (size_t i = 0; i < against_models.size(); ++i)
+    require_model_rate(against_models[i], against_paths[i], ds, trials);
   const bool json = args.has("json");
   // --against: the pairing, its JSON member and its text line (printed after the summary).
   std::string against_json, against_text;

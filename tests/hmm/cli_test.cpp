@@ -166,6 +166,34 @@ TEST_F(CliTest, TrainingRecordsItsSamplePeriodAndSpeeds) {
   }
 }
 
+// classify refuses a trial recorded at another rate than a model knows it was trained at (exit
+// 2, naming the trial's file and both periods); a model that does not say classifies it as ever.
+TEST_F(CliTest, ClassifyRefusesTrialsOfAnotherRate) {
+  Dataset slow = fx::synthetic_dataset(3, 100, 120, 57, 3);
+  for (auto& t : slow.trials)
+    for (size_t k = 0; k < t.samples.size(); ++k) t.samples[k].t = 0.02 * static_cast<double>(k);
+  save_dataset(slow, dir / "slow");
+  save_dataset(fx::synthetic_dataset(3, 100, 120, 58, 3), dir / "fast");  // 0.01 s
+  const std::string m = (dir / "m.dgm").string();
+  ASSERT_EQ(run("train --data " + (dir / "slow").string() + " --states 3 --out " + m).code, 0);
+  ASSERT_EQ(run("classify --model " + m + " --data " + (dir / "slow").string()).code, 0);
+  auto r = run("classify --model " + m + " --data " + (dir / "fast").string());
+  EXPECT_EQ(r.code, 2);
+  const std::string first = (dir / "fast" / "good--0.csv").string();
+  EXPECT_NE(r.err.find(first + " is sampled every 0.01 s, " + m + " was trained at 0.02 s"), std::string::npos)
+      << r.err;
+  // A model without its period (format 1) is not asked; as --against, the trained one is.
+  auto old = model::read_model(m);
+  old.sample_period_s = old.speed_min_m_s = old.speed_max_m_s = 0.0;
+  const std::string o = (dir / "old.dgm").string();
+  model::write_model(o, old);
+  r = run("classify --model " + o + " --data " + (dir / "fast").string());
+  EXPECT_EQ(r.code, 0) << r.err;
+  r = run("classify --model " + o + " --against " + m + " --data " + (dir / "fast").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find(m + " was trained at 0.02 s"), std::string::npos) << r.err;
+}
+
 // A model of "missed" alone cannot be right about a good or a caught trial: classify counts them
 // wrong (6 of 18), each label in a row of the confusion matrix, and skips none. It once scored
 // such a model 6/6 with "12 trials skipped".
