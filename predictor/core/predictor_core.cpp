@@ -285,11 +285,20 @@ Predictor::Predictor(const model::OutcomeModel* model, const PredictorConfig& cf
     filter_.emplace(*model);
     threshold_ = model->stop_threshold;
     consecutive_needed_ = model->stop_consecutive;
+    if (model->knows_speeds()) {  // in mm/s as the TrialStart says it
+      speed_min_mm_s_ = static_cast<int>(std::lround(model->speed_min_m_s * 1000.0));
+      speed_max_mm_s_ = static_cast<int>(std::lround(model->speed_max_m_s * 1000.0));
+    }
   }
   if (cfg_.stop_threshold > 0.0 && cfg_.stop_threshold < 1.0) threshold_ = cfg_.stop_threshold;
   if (cfg_.stop_consecutive > 0) consecutive_needed_ = cfg_.stop_consecutive;
   if (consecutive_needed_ < 1) consecutive_needed_ = 1;
   decision_.state = filter_ ? PredictorState::Idle : PredictorState::Fault;
+}
+
+bool Predictor::outside_training_speeds(uint16_t speed_mm_s) const noexcept {
+  if (speed_max_mm_s_ == 0) return false;  // the model does not say
+  return speed_mm_s < speed_min_mm_s_ - kSpeedSlackMmS || speed_mm_s > speed_max_mm_s_ + kSpeedSlackMmS;
 }
 
 Event Predictor::make_event(EventKind k, int64_t now_ns) const noexcept {
@@ -397,6 +406,7 @@ void Predictor::on_trial_start(const Frame& f, int64_t now_ns) noexcept {
   ++trials_started_;
   decision_.trial = m.trial_id;
   decision_.speed_m_s = m.speed_mm_s / 1000.0;
+  if (outside_training_speeds(m.speed_mm_s)) ++trials_outside_speeds_;
   decision_.state = filter_ ? PredictorState::InTrial : PredictorState::Fault;
   consecutive_ = 0;
   bad_score_ = 0;

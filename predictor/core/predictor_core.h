@@ -193,6 +193,11 @@ class Predictor {
   uint32_t counter(protocol::StatusCounter c) const noexcept { return counters_[static_cast<int>(c)]; }
   bool stop_pending() const noexcept { return stop_pending_; }
   uint32_t trials_started() const noexcept { return trials_started_; }
+  // Trials whose TrialStart speed lay outside the model's training speed range by more than
+  // kSpeedSlackMmS (models/FORMAT.md, version 3): a pull the model never saw. Not a status
+  // counter: the protocol's status pages have no free field (firmware-bridge/PROTOCOL.md).
+  uint32_t trials_outside_training_speeds() const noexcept { return trials_outside_speeds_; }
+  static constexpr int kSpeedSlackMmS = 5;
   bool has_model() const noexcept { return filter_.has_value(); }
   double threshold() const noexcept { return threshold_; }
   int consecutive() const noexcept { return consecutive_needed_; }
@@ -202,6 +207,7 @@ class Predictor {
  private:
   void on_force(const Frame& f, int64_t now_ns) noexcept;
   void on_trial_start(const Frame& f, int64_t now_ns) noexcept;
+  bool outside_training_speeds(uint16_t speed_mm_s) const noexcept;
   void on_trial_end(const Frame& f, int64_t now_ns) noexcept;
   void resync_events(int64_t now_ns) noexcept;
   static constexpr int64_t kEventResyncNs = int64_t{protocol::kSporadicResyncMs} * 1'000'000;
@@ -229,6 +235,7 @@ class Predictor {
   int caught_ = -1;
   double threshold_ = 0.9;
   int consecutive_needed_ = 5;
+  int speed_min_mm_s_ = 0, speed_max_mm_s_ = 0;  // the model's training speeds; 0: unknown
 
   // Mutable state.
   protocol::E2EChecker chk_force_{protocol::MsgId::FtForce};
@@ -239,6 +246,7 @@ class Predictor {
   Decision decision_;
   std::array<uint32_t, static_cast<int>(protocol::StatusCounter::Count)> counters_{};
   int consecutive_ = 0;
+  uint32_t trials_outside_speeds_ = 0;
   int64_t bad_score_ = 0;
   bool samples_started_ = false;  // first sample of the trial seen (sample indices start)
   int64_t last_sample_ns_ = 0;

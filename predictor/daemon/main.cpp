@@ -236,6 +236,8 @@ int main(int argc, char** argv) {
     for (int c = 0; c < static_cast<int>(protocol::StatusCounter::Count); ++c)
       counters += std::string(c ? " " : "") + protocol::status_counter_name(static_cast<protocol::StatusCounter>(c)) + "=" +
                   std::to_string(daemon.predictor().counter(static_cast<protocol::StatusCounter>(c)));
+    // Not a status counter (the status pages have no free field): reported here only.
+    counters += " speed_outside_training=" + std::to_string(daemon.predictor().trials_outside_training_speeds());
     log->info("shutting down: {}", counters);
     if (latency_report) {
       const auto& h = daemon.processing();

@@ -40,6 +40,8 @@ struct Rig {
   testkit::FrameSource src;
 
   explicit Rig(bool with_model = true) {
+    model.speed_min_m_s = 0.1;  // trained at the study's speeds (format version 3)
+    model.speed_max_m_s = 0.15;
     rx = bus.open({PredictorDaemon::receive_ids(), false, true});
     stop_port = bus.open({{protocol::id_of(protocol::MsgId::Stop)}, true, true});
     sensor = bus.open({{}, false, true});
@@ -106,6 +108,18 @@ TEST(Daemon, CaughtTrialIsStoppedAndConfirmedByEcho) {
   EXPECT_NE(rig.log_text.str().find("confirmed"), std::string::npos) << rig.log_text.str();
   EXPECT_EQ(rig.loop_allocations, 0u) << "the event loop allocated after start-up";
   EXPECT_GE(rig.daemon->processing().count() + rig.daemon->processing_with_stop().count(), 13u);
+}
+
+// A trial at a speed the model was never trained at (300 mm/s against 100-150) is counted on
+// the loop without a log line or an allocation, and reported in the shutdown line's counters.
+TEST(Daemon, ATrialOutsideTheTrainingSpeedsIsCountedWithoutAllocating) {
+  Rig rig;
+  rig.sensor->send(rig.src.trial_start(12, 300));
+  for (int i = 0; i < 200 && rig.daemon->predictor().trials_outside_training_speeds() == 0; ++i)
+    std::this_thread::sleep_for(1ms);
+  rig.shutdown();
+  EXPECT_EQ(rig.daemon->predictor().trials_outside_training_speeds(), 1u);
+  EXPECT_EQ(rig.loop_allocations, 0u) << "the event loop allocated after start-up";
 }
 
 TEST(Daemon, SilentSensorIsAFailSafeStop) {

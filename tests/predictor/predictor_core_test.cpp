@@ -685,3 +685,25 @@ TEST(RealTime, NoHeapAllocationPerSampleTickOrStop) {
 }
 
 }  // namespace
+
+// A TrialStart whose speed lies outside the model's training speed range (format version 3) by
+// more than 5 mm/s is counted: a pull the model never saw. No count for a model that does not
+// know its speeds. The trial runs as ever (nothing is stopped for it).
+TEST(TrialSpeed, AStartOutsideTheTrainingSpeedsIsCounted) {
+  Harness h;
+  h.model.speed_min_m_s = 0.1;
+  h.model.speed_max_m_s = 0.15;
+  h.p = std::make_unique<Predictor>(&h.model, h.cfg, h.sink);
+  uint16_t trial = 1;
+  for (uint16_t speed : {100, 150, 95, 155, 120}) h.p->on_frame(h.src.trial_start(trial++, speed), h.now);
+  EXPECT_EQ(h.p->trials_outside_training_speeds(), 0u);
+  h.p->on_frame(h.src.trial_start(trial++, 156), h.now);
+  EXPECT_EQ(h.p->trials_outside_training_speeds(), 1u);
+  h.p->on_frame(h.src.trial_start(trial++, 94), h.now);
+  EXPECT_EQ(h.p->trials_outside_training_speeds(), 2u);
+  EXPECT_EQ(h.p->decision().state, protocol::PredictorState::InTrial);
+  EXPECT_TRUE(h.sink.stops.empty());
+  Harness unknown;
+  unknown.p->on_frame(unknown.src.trial_start(1, 1000), unknown.now);
+  EXPECT_EQ(unknown.p->trials_outside_training_speeds(), 0u);
+}
