@@ -251,21 +251,26 @@ long max_tick_ms(const PredictorConfig& cfg) {
   return std::max<long>(1, static_cast<long>(cfg.sensor_timeout_ns / 1'000'000));
 }
 
+namespace {
+// A sample period in milliseconds as the config writes it ("10", "8.5").
+std::string period_ms(double period_s) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.9g", period_s * 1000.0);
+  return buf;
+}
+}  // namespace
+
+// The messages are joined strings, not one fixed buffer: a model path may be as long as PATH_MAX.
 PeriodCheck check_model_period(const model::OutcomeModel& m, const std::string& model_path, double sample_period_s) {
-  char buf[512];
-  if (!m.knows_period()) {
-    std::snprintf(buf, sizeof buf,
-                  "%s does not say at which sample period it was trained (format version %u): it is run at "
-                  "sample_period_ms %.9g unchecked",
-                  model_path.c_str(), model::format_version_of(m), sample_period_s * 1000.0);
-    return {PeriodVerdict::Unknown, buf};
-  }
+  if (!m.knows_period())
+    return {PeriodVerdict::Unknown, model_path + " does not say at which sample period it was trained (format version " +
+                                        std::to_string(model::format_version_of(m)) +
+                                        "): it is run at sample_period_ms " + period_ms(sample_period_s) + " unchecked"};
   if (model::same_period(m.sample_period_s, sample_period_s)) return {};
-  std::snprintf(buf, sizeof buf,
-                "%s was trained at a sample period of %.9g ms, the config's sample_period_ms is %.9g: refusing it "
-                "(its HMMs count time in samples; retrain at this rate or fix sample_period_ms)",
-                model_path.c_str(), m.sample_period_s * 1000.0, sample_period_s * 1000.0);
-  return {PeriodVerdict::Differs, buf};
+  return {PeriodVerdict::Differs, model_path + " was trained at a sample period of " + period_ms(m.sample_period_s) +
+                                      " ms, the config's sample_period_ms is " + period_ms(sample_period_s) +
+                                      ": refusing it (its HMMs count time in samples; retrain at this rate or fix "
+                                      "sample_period_ms)"};
 }
 
 // ---------------------------------------------------------------------------------------------

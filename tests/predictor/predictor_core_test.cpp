@@ -707,3 +707,24 @@ TEST(TrialSpeed, AStartOutsideTheTrainingSpeedsIsCounted) {
   unknown.p->on_frame(unknown.src.trial_start(1, 1000), unknown.now);
   EXPECT_EQ(unknown.p->trials_outside_training_speeds(), 0u);
 }
+
+// The start-up check of a model's sample period against the config's (format version 3): the
+// same rate passes, another is refused and an unknown one is a warning; each message names the
+// whole model path (a path of any length: it was formatted into a 512-byte buffer and cut) and
+// both periods in milliseconds.
+TEST(ModelPeriod, SameRatePassesAnotherIsRefusedUnknownIsAWarning) {
+  model::OutcomeModel m = testkit::test_model();
+  const std::string path = "/robot/models/" + std::string(600, 'm') + "/trained.dgm";
+  const PeriodCheck unknown = check_model_period(m, path, 0.01);
+  EXPECT_EQ(unknown.verdict, PeriodVerdict::Unknown);
+  EXPECT_NE(unknown.message.find(path + " does not say"), std::string::npos) << unknown.message;
+  EXPECT_NE(unknown.message.find("sample_period_ms 10 unchecked"), std::string::npos) << unknown.message;
+  m.sample_period_s = 0.01;
+  EXPECT_EQ(check_model_period(m, path, 0.01).verdict, PeriodVerdict::Same);
+  EXPECT_EQ(check_model_period(m, path, 0.01 * (1 + 5e-7)).verdict, PeriodVerdict::Same);  // within 1e-6
+  const PeriodCheck other = check_model_period(m, path, 0.008);
+  EXPECT_EQ(other.verdict, PeriodVerdict::Differs);
+  EXPECT_EQ(other.message.rfind(path + " was trained at a sample period of 10 ms, the config's sample_period_ms is 8:", 0),
+            0u)
+      << other.message;
+}
