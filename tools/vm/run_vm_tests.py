@@ -354,7 +354,12 @@ def main():
           "bridge: took the Stop frame from vcan0 and wrote the robot's stop coil")
     check("has not guarded" not in blog and "no heartbeat from the predictor" not in blog,
           "bridge: the predictor's heartbeat guarded the trial (no stop of the bridge's own)")
-    check(re.search(r"^bridge_exit 0", blog, re.M) is not None, "bridge: exited 0 on SIGTERM")
+    # On failure, the exit status and the bridge's last words: the console keeps only its tail.
+    bexit = re.search(r"^bridge_exit (\d+)", blog, re.M)
+    check(bexit is not None and bexit.group(1) == "0",
+          "bridge: exited 0 on SIGTERM" + ("" if bexit and bexit.group(1) == "0" else
+                                          f" (exit {bexit.group(1) if bexit else 'not recorded'}; its log ends:\n    "
+                                          + "\n    ".join(blog.strip().splitlines()[-8:]) + ")"))
 
     # --- latency ---
     lat = sec.get("latency.out", "")
