@@ -289,8 +289,8 @@ void validate_model(const OutcomeModel& m, const std::string& source) {
     if (s->size() > kMaxString) fail(source, "a metadata string is longer than 65536 bytes");
 }
 
-bool same_period(double a_s, double b_s) noexcept {
-  return std::fabs(a_s - b_s) <= kPeriodTolerance * std::max(std::fabs(a_s), std::fabs(b_s));
+bool same_period(double a_s, double b_s, double tolerance) noexcept {
+  return std::fabs(a_s - b_s) <= tolerance * std::max(std::fabs(a_s), std::fabs(b_s));
 }
 
 uint32_t format_version_of(const OutcomeModel& m) noexcept {

@@ -141,10 +141,12 @@ inline constexpr char kMagic[8] = {'D', 'G', 'M', 'O', 'D', 'E', 'L', '\0'};
 inline constexpr uint32_t kFormatVersion = 3;
 // 3 when a training condition is known, else 2 when a feature is kAxisNone, else 1.
 uint32_t format_version_of(const OutcomeModel& m) noexcept;
-// The largest relative difference between two sample periods that counts as the same rate.
+// The largest relative difference between two nominal sample periods (a model's, a config's) that
+// counts as the same rate.
 inline constexpr double kPeriodTolerance = 1e-6;
-// Whether two sample periods agree within kPeriodTolerance (relative to the larger).
-bool same_period(double a_s, double b_s) noexcept;
+// Whether two sample periods agree within `tolerance` relative to the larger (measured periods of
+// recordings take a looser one: offline/core/haptic.h, kRecordingPeriodTolerance).
+bool same_period(double a_s, double b_s, double tolerance = kPeriodTolerance) noexcept;
 
 // CRC-32 (IEEE 802.3, reflected, polynomial 0xEDB88320, init and final xor 0xFFFFFFFF), the one
 // zlib and PNG use: crc32("123456789") == 0xCBF43926.

@@ -120,7 +120,7 @@ void require_model_rate(const model::OutcomeModel& m, const std::string& model_p
   if (!m.knows_period()) return;
   for (const auto* t : trials) {
     const double period = mean_sample_period(*t);
-    if (!(period > 0.0) || same_recorded_period(period, m.sample_period_s)) continue;
+    if (!(period > 0.0) || model::same_period(period, m.sample_period_s, kRecordingPeriodTolerance)) continue;
     char at[64], trained[64];
     std::snprintf(at, sizeof at, " is sampled every %.9g s, ", period);
     std::snprintf(trained, sizeof trained, " was trained at %.9g s", m.sample_period_s);

@@ -55,10 +55,6 @@ double mean_sample_period(const HapticSequence& trial) {
   return n >= 2 ? (trial.samples.back().t - trial.samples.front().t) / static_cast<double>(n - 1) : 0.0;
 }
 
-bool same_recorded_period(double a_s, double b_s) {
-  return std::fabs(a_s - b_s) <= kRecordingPeriodTolerance * std::max(std::fabs(a_s), std::fabs(b_s));
-}
-
 double nominal_sample_period(double mean_s) {
   const double us = std::round(mean_s * 1e6);
   return us >= 1.0 ? us / 1e6 : mean_s;

@@ -74,9 +74,9 @@ std::size_t unrecorded_samples(const HapticSequence& trial);
 double mean_sample_period(const HapticSequence& trial);
 // Two recordings' mean periods are the same rate within this (relative): a recording's clock
 // jitters and drifts. The study's 22 trials' means span 9.99966-10.00041 ms (7.5e-5); a rate that
-// changes a model's meaning (125 Hz for 100 Hz) differs by percent.
+// changes a model's meaning (125 Hz for 100 Hz) differs by percent. Compared with
+// model::same_period (models/dgm.h), which core/ does not include.
 inline constexpr double kRecordingPeriodTolerance = 1e-3;
-bool same_recorded_period(double a_s, double b_s);
 // The nominal period of recordings whose mean is `mean_s`: to the whole microsecond (the study's
 // means all give 10 ms), so that a model trained on them matches a predictor configured at that
 // rate within model::kPeriodTolerance; `mean_s` itself below 1 us.

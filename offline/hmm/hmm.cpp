@@ -667,7 +667,7 @@ void set_training_conditions(model::OutcomeModel& m, const std::vector<const Hap
     const double period = mean_sample_period(*t);
     if (!(period > 0.0)) continue;
     if (!first) first = t, first_period = period;
-    if (!same_recorded_period(period, first_period)) {
+    if (!model::same_period(period, first_period, kRecordingPeriodTolerance)) {
       char at[64], first_at[64];
       std::snprintf(at, sizeof at, " is sampled every %.9g s, ", period);
       std::snprintf(first_at, sizeof first_at, " every %.9g s", first_period);
