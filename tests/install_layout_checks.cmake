@@ -71,6 +71,24 @@ function(check_unit_restart unit)
   endif()
 endfunction()
 
+# Type=notify with a watchdog (WatchdogSec= above 0), and the daemon's way to the manager open:
+# RestrictAddressFamilies= must allow AF_UNIX, or the daemon's READY=1 never leaves it and the
+# start ends at TimeoutStartSec= (dressguard-predictor and -bridge say READY=1 when their loop
+# runs and WATCHDOG=1 from it: firmware-bridge/protocol/notify_socket.h).
+function(check_unit_notify unit)
+  file(STRINGS "${unit}" lines REGEX "^(Type|WatchdogSec|NotifyAccess|RestrictAddressFamilies)=")
+  if(NOT lines MATCHES "(^|;)Type=notify(;|$)" OR NOT lines MATCHES "(^|;)WatchdogSec=[1-9]")
+    message(FATAL_ERROR "${unit}: not Type=notify with a WatchdogSec: ${lines}")
+  endif()
+  if(lines MATCHES "NotifyAccess=" AND NOT lines MATCHES "NotifyAccess=main")
+    message(FATAL_ERROR "${unit}: NotifyAccess other than main: ${lines}")
+  endif()
+  if(lines MATCHES "RestrictAddressFamilies=" AND NOT lines MATCHES "RestrictAddressFamilies=[^;~]*AF_UNIX")
+    message(FATAL_ERROR "${unit}: RestrictAddressFamilies= without AF_UNIX: the daemon cannot reach "
+                        "$NOTIFY_SOCKET: ${lines}")
+  endif()
+endfunction()
+
 # systemd's rating of the sandbox of INSTANCE (`systemd-analyze security --offline`, 0.0 for the
 # tightest to 10.0 for none), at most MAX_EXPOSURE (one decimal). The unit's hardening lines are
 # what a robot maker's security review reads; one lost or loosened raises the figure.

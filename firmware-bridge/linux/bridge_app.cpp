@@ -15,6 +15,8 @@
 #include <cstring>
 #include <system_error>
 
+#include "notify_socket.h"
+
 namespace dressguard::bridge {
 namespace {
 
@@ -22,6 +24,13 @@ uint32_t now_ms() {
   timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return static_cast<uint32_t>(static_cast<uint64_t>(ts.tv_sec) * 1000 + ts.tv_nsec / 1000000);
+}
+
+// The watchdog's clock: not now_ms(), whose 32 bits wrap after 49.7 days of uptime.
+int64_t now_ns() {
+  timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
 
 constexpr uint64_t kTimer = 1, kCan = 2, kShutdown = 3, kSensor = 4, kTags = 5;
@@ -383,6 +392,8 @@ int BridgeApp::run() {
   epoll_event evs[4];
   bool shutting_down = false;
   uint32_t give_up_ms = 0;
+  // Ready once the loop runs: the CAN socket is open and the robot controller answered.
+  if (cfg_.service) cfg_.service->ready(now_ns());
   for (;;) {
     const int n = epoll_wait(epoll_fd_, evs, 4, -1);
     if (n < 0) {
@@ -397,6 +408,7 @@ int BridgeApp::run() {
       [[maybe_unused]] ssize_t r = ::read(shutdown_fd_, &v, sizeof v);
       if (!shutting_down) {
         shutting_down = true;
+        if (cfg_.service) cfg_.service->notify("STOPPING=1");
         give_up_ms = t + static_cast<uint32_t>(cfg_.shutdown_grace_ms);
         begin_shutdown(t);
       }
@@ -417,6 +429,8 @@ int BridgeApp::run() {
       } else {
         if (expirations > 1) timer_overran(expirations - 1);
         on_timer(t);
+        // The loop's periods keep the manager's watchdog fed: a loop that hangs stops them.
+        if (cfg_.service) cfg_.service->watchdog(now_ns());
       }
     }
     if (shutting_down) {

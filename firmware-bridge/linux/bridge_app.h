@@ -15,6 +15,10 @@
 #include "can_port.h"
 #include "modbus_link.h"
 
+namespace dressguard::service {
+class NotifySocket;
+}
+
 namespace dressguard::bridge {
 
 struct BridgeAppConfig {
@@ -33,6 +37,9 @@ struct BridgeAppConfig {
   // CAN send and receive failures at the 1st, 2nd, 4th, ... in a row and once when they stop,
   // controller error frames at the 1st, 2nd, 4th, ... since the last restart, and the restart.
   std::FILE* log = stderr;
+  // The service manager's socket (null: none): READY=1 when the loop starts, WATCHDOG=1 from
+  // its timer (each a non-blocking send(2)), STOPPING=1 when a shutdown begins.
+  service::NotifySocket* service = nullptr;
 };
 
 struct BridgeStats {

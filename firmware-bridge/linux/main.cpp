@@ -13,6 +13,7 @@
 #include "bridge_app.h"
 #include "candump_log.h"
 #include "ft300_stream.h"
+#include "notify_socket.h"
 #include "rt_setup.h"
 
 using namespace dressguard;
@@ -69,7 +70,9 @@ const char* kUsage =
     "still unwritten at the end of the shutdown grace, 2 bad arguments.\n"
     "Signals: SIGTERM and SIGINT shut it down (a running trial's stop written first). SIGHUP and\n"
     "SIGPIPE are ignored from the start on: there is no reload, the options are read at start and a\n"
-    "change takes a restart.";
+    "change takes a restart.\n"
+    "Service manager: with NOTIFY_SOCKET set (systemd, Type=notify) it sends READY=1 when its loop\n"
+    "starts, WATCHDOG=1 every half WATCHDOG_USEC from the loop's timer, and STOPPING=1 when it shuts down.";
 
 int bad(const std::string& why) {
   std::fprintf(stderr, "dressguard-bridge: %s (see --help)\n", why.c_str());
@@ -331,6 +334,11 @@ int main(int argc, char** argv) {
     } else {
       sensor = std::make_unique<ModbusSensor>(sensor_ep, map);
     }
+    // Under systemd's Type=notify the unit is started when the loop runs, and WatchdogSec=
+    // restarts a loop that stops (notify_socket.h). A socket that does not open is said, not fatal.
+    service::NotifySocket notify = service::NotifySocket::from_environment();
+    if (!notify.error().empty()) std::fprintf(stderr, "dressguard-bridge: %s\n", notify.error().c_str());
+    cfg.service = &notify;
     BridgeApp app(cfg, *sensor, robot.get(), *port);
     handle_signals(&app);
     if (stream)

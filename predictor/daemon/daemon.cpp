@@ -18,6 +18,8 @@
 #include <spdlog/spdlog.h>
 #include <system_error>
 
+#include "notify_socket.h"
+
 namespace dressguard::predictor {
 namespace {
 
@@ -251,6 +253,9 @@ void PredictorDaemon::drain_stop(int64_t now) noexcept {
 int PredictorDaemon::run() {
   epoll_event evs[8];
   int64_t shutdown_at = -1;
+  // Ready once the loop runs: the sockets are bound and the model read, so the units ordered
+  // after this one start with the bus guarded.
+  if (opt_.service) opt_.service->ready(now_ns());
   for (;;) {
     const int n = epoll_wait(epoll_fd_, evs, 8, shutdown_at >= 0 ? 1 : -1);
     if (n < 0) {
@@ -273,13 +278,17 @@ int PredictorDaemon::run() {
     if (timer) {
       uint64_t expirations;
       [[maybe_unused]] ssize_t r = ::read(timer_fd_, &expirations, sizeof expirations);
-      predictor_.on_tick(now_ns());
+      const int64_t t = now_ns();
+      predictor_.on_tick(t);
+      // The loop's ticks keep the manager's watchdog fed: a loop that hangs stops them.
+      if (opt_.service) opt_.service->watchdog(t);
     }
     if (shutdown) {
       uint64_t v;
       [[maybe_unused]] ssize_t r = ::read(shutdown_fd_, &v, sizeof v);
       if (shutdown_at < 0) {
         shutdown_at = now;
+        if (opt_.service) opt_.service->notify("STOPPING=1");
         predictor_.on_shutdown(now);
       }
     }

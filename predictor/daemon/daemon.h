@@ -20,6 +20,9 @@
 namespace spdlog {
 class logger;
 }
+namespace dressguard::service {
+class NotifySocket;
+}
 
 namespace dressguard::predictor {
 
@@ -76,6 +79,9 @@ struct DaemonOptions {
   // Wait this long for a shutdown stop's echo (bus-off recovery takes ~100 ms), well inside the
   // unit's TimeoutStopSec=5.
   int64_t shutdown_grace_ns = 1'000'000'000;
+  // The service manager's socket (null: none): READY=1 when the loop starts, WATCHDOG=1 from
+  // its ticks (each a non-blocking send(2)), STOPPING=1 when a shutdown begins.
+  service::NotifySocket* service = nullptr;
 };
 
 class PredictorDaemon final : private PredictorSink {

@@ -13,6 +13,7 @@
 
 #include "daemon.h"
 #include "dgm.h"
+#include "notify_socket.h"
 
 using namespace dressguard;
 using namespace dressguard::predictor;
@@ -37,6 +38,8 @@ const char* kUsage =
     "stop_retry_ms, sample_period_ms, acceleration_m_s2, mount_axes, mount_bias.\n"
     "Signals: SIGTERM and SIGINT shut down (a running trial is stopped first); SIGHUP and SIGPIPE are\n"
     "ignored from the start on: the config and model are read at start only, a change takes a restart.\n"
+    "Service manager: with NOTIFY_SOCKET set (systemd, Type=notify) it sends READY=1 when it listens,\n"
+    "WATCHDOG=1 every half WATCHDOG_USEC from its loop's ticks, and STOPPING=1 when it shuts down.\n"
     "Exit codes: 0 clean shutdown (SIGTERM/SIGINT), 1 runtime error (the interface gone, a stop not\n"
     "confirmed on the bus when the daemon exited, a real-time step failed with rt_required = 1),\n"
     "2 bad arguments or config.";
@@ -197,6 +200,18 @@ int main(int argc, char** argv) {
     }
     if (period.verdict == predictor::PeriodVerdict::Unknown) log->warn("{}", period.message);
   }
+
+  // Under systemd's Type=notify the unit is started when the loop runs, and WatchdogSec= restarts
+  // a loop that stops ticking (notify_socket.h). A socket that does not open is said, not fatal:
+  // the bus is guarded meanwhile, and the manager ends the start at its timeout.
+  service::NotifySocket notify = service::NotifySocket::from_environment();
+  if (!notify.error().empty()) log->error("{}", notify.error());
+  if (notify.connected())
+    log->info("service manager notified (ready at the loop's start{})",
+              notify.watchdog_period_ns() > 0
+                  ? ", watchdog ping every " + std::to_string(notify.watchdog_period_ns() / 1000000) + " ms"
+                  : std::string());
+  dopt.service = &notify;
 
   try {
     static EventQueue events;  // 4096 events: static storage, not on the stack

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <chrono>
@@ -17,6 +18,8 @@
 
 #include "alloc_counter.h"
 #include "daemon.h"
+#include "notify_listener.h"
+#include "notify_socket.h"
 #include "test_model.h"
 
 using namespace dressguard;
@@ -39,7 +42,7 @@ struct Rig {
   uint64_t loop_allocations = 0;
   testkit::FrameSource src;
 
-  explicit Rig(bool with_model = true) {
+  explicit Rig(bool with_model = true, const DaemonOptions& opt = {}) {
     model.speed_min_m_s = 0.1;  // trained at the study's speeds (format version 3)
     model.speed_max_m_s = 0.15;
     rx = bus.open({PredictorDaemon::receive_ids(), false, true});
@@ -48,7 +51,8 @@ struct Rig {
     robot = bus.open({{protocol::id_of(protocol::MsgId::Stop), protocol::id_of(protocol::MsgId::PredictorStatus)}, false, true});
     log = std::make_shared<spdlog::logger>("test", std::make_shared<spdlog::sinks::ostream_sink_mt>(log_text));
     logger = std::make_unique<EventLogger>(events, log, std::vector<std::string>{"good", "missed", "caught"});
-    daemon = std::make_unique<PredictorDaemon>(with_model ? &model : nullptr, PredictorConfig{}, *rx, *stop_port, events);
+    daemon = std::make_unique<PredictorDaemon>(with_model ? &model : nullptr, PredictorConfig{}, *rx, *stop_port, events,
+                                               opt);
     loop = std::thread([this] {
       testkit::CountAllocations count;
       rc = daemon->run();
@@ -112,6 +116,34 @@ TEST(Daemon, CaughtTrialIsStoppedAndConfirmedByEcho) {
 
 // A trial at a speed the model was never trained at (300 mm/s against 100-150) is counted on
 // the loop without a log line or an allocation, and reported in the shutdown line's counters.
+// Under systemd (Type=notify, WatchdogSec=): READY=1 once the loop runs, WATCHDOG=1 from the
+// loop's ticks at half the manager's interval, STOPPING=1 at shutdown, all from this process;
+// the Rig's destructor asserts that the loop allocated nothing meanwhile.
+TEST(Daemon, TellsTheServiceManagerItIsReadyAndFeedsItsWatchdog) {
+  testkit::NotifyListener manager(false);
+  ASSERT_EQ(manager.error, "");
+  // WatchdogSec=0.04: a ping every 20 ms from the 1 ms ticks.
+  service::NotifySocket notify = service::NotifySocket::open(manager.address.c_str(), "40000", nullptr, ::getpid());
+  ASSERT_TRUE(notify.connected()) << notify.error();
+  DaemonOptions opt;
+  opt.service = &notify;
+  {
+    Rig r(true, opt);
+    const auto start = std::chrono::steady_clock::now();
+    for (int i = 0; i < 100; ++i) {
+      if (i == 60) r.send_sample(-1.0, 0.0);  // a trial's frames do not hold the pings back
+      std::this_thread::sleep_for(5ms);
+      manager.take(::getpid());
+    }
+    const double ran_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    r.shutdown();
+    manager.take(::getpid());
+    // Every 20 ms over ~0.5 s: about 25 pings (a ping late by a tick restarts the period there).
+    EXPECT_EQ(manager.wrong_with_what_was_said(ran_s, 0.020, 0.021), "");
+  }
+  EXPECT_EQ(notify.failed_sends(), 0u);
+}
+
 TEST(Daemon, ATrialOutsideTheTrainingSpeedsIsCountedWithoutAllocating) {
   Rig rig;
   rig.sensor->send(rig.src.trial_start(12, 300));

@@ -40,6 +40,7 @@ function(check_install root tree)
   match_exec("${unit}" "^ExecStart=([^ ]+) --interface %I \\$DRESSGUARD_BRIDGE_OPTIONS$"
              "BINARY --interface %I $DRESSGUARD_BRIDGE_OPTIONS" bin unused)
   check_unit_restart("${unit}")
+  check_unit_notify("${unit}")
   file_value("${unit}" "^EnvironmentFile=(/[^ ]+)$" "required EnvironmentFile" env)
   check_placed("${unit}" "${bin}" "${root}" "${tree}")
   check_placed("${unit}" "${env}" "${root}" "${tree}")

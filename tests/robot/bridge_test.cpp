@@ -38,6 +38,8 @@
 #include "bridge_app.h"
 #include "ft300_stream.h"
 #include "bridge_core.h"
+#include "notify_listener.h"
+#include "notify_socket.h"
 #include "can_port.h"
 
 using namespace dressguard;
@@ -535,6 +537,7 @@ struct RigOptions {
   int period_ms = 10;
   uint32_t predictor_timeout_ms = 0;
   StopTarget stop_target{true, 7, 1};
+  service::NotifySocket* service = nullptr;  // the service manager's socket: none
 };
 
 struct BridgeRig {
@@ -566,6 +569,7 @@ struct BridgeRig {
     cfg.shutdown_grace_ms = o.shutdown_grace_ms;
     cfg.sample_period_ms = o.period_ms;
     cfg.core.predictor_timeout_ms = o.predictor_timeout_ms;
+    cfg.service = o.service;
     app = std::make_unique<BridgeApp>(cfg, o.own_sensor ? *o.own_sensor : *sensor, robot.get(), *bridge_port);
     loop = std::thread([this] { rc = app->run(); });
   }
@@ -1002,6 +1006,31 @@ TEST(BridgeModbus, ShutdownDuringATrialStopsTheRobot) {
 // ended the bridge at once, mid-trial, with no stop written, and systemd took that for a clean
 // exit and did not restart the unit. Both are now ignored: the bridge goes on carrying the
 // trial's stop, and SIGTERM still shuts it down, writing the running trial's stop first.
+// Under systemd (Type=notify, WatchdogSec=): READY=1 once the loop runs, WATCHDOG=1 from its
+// timer at half the manager's interval, STOPPING=1 when the shutdown begins, all from this
+// process.
+TEST(BridgeModbus, TellsTheServiceManagerItIsReadyAndFeedsItsWatchdog) {
+  testkit::NotifyListener manager(false);
+  ASSERT_EQ(manager.error, "");
+  // WatchdogSec=0.06: a ping due every 30 ms, sent at the next of the 10 ms periods.
+  service::NotifySocket notify = service::NotifySocket::open(manager.address.c_str(), "60000", nullptr, ::getpid());
+  ASSERT_TRUE(notify.connected()) << notify.error();
+  RigOptions o;
+  o.service = &notify;
+  BridgeRig rig(o);
+  const auto start = std::chrono::steady_clock::now();
+  for (int i = 0; i < 100; ++i) {
+    std::this_thread::sleep_for(5ms);
+    manager.take(::getpid());
+  }
+  const double ran_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(rig.shut_down(), 0) << rig.logged();
+  manager.take(::getpid());
+  // A ping due every 30 ms, sent at the next 10 ms period: 30-40 ms apart, about 14 in 0.5 s.
+  EXPECT_EQ(manager.wrong_with_what_was_said(ran_s, 0.030, 0.040), "") << rig.logged();
+  EXPECT_EQ(notify.failed_sends(), 0u);
+}
+
 TEST(BridgeModbus, HangupAndBrokenPipeDoNotEndTheBridge) {
   BridgeRig rig;
   ASSERT_GT(rig.robot_emu.port(), 0);

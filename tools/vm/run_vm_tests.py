@@ -116,6 +116,23 @@ def sections(console):
     return out
 
 
+def heard_by_manager(text):
+    """dg_notify_listen's summary: each message kind (count, sender, longest gap) in the order
+    they first came, and the listener's exit and the daemon's pid that vm_tests.sh appended."""
+    out = {"kinds": []}
+    for line in text.splitlines():
+        m = re.match(r"(\S+) count=(\d+) pid=(\d+) first_ms=(\d+)(?: max_gap_ms=(\d+))?( other_senders)?$", line)
+        if m:
+            k = {"message": m.group(1), "count": int(m.group(2)), "pid": m.group(3), "other": bool(m.group(6))}
+            if m.group(5):
+                k["max_gap_ms"] = int(m.group(5))
+            out["kinds"].append(k)
+        m = re.match(r"listener_exit (\d+) daemon_pid (\d+)", line)
+        if m:
+            out["listener_exit"], out["daemon_pid"] = m.group(1), m.group(2)
+    return out
+
+
 def stops_in(rec):
     stops = []
     for line in rec.splitlines():
@@ -153,7 +170,8 @@ def main():
     bins = [os.path.join(args.build, "predictor", "daemon", "dressguard-predictor"),
             os.path.join(args.build, "tools", "bench", "bench_predictor"),
             os.path.join(args.build, "firmware-bridge", "dressguard-bridge"),
-            os.path.join(args.build, "tests", "robot", "dg_modbus_emulator")]
+            os.path.join(args.build, "tests", "robot", "dg_modbus_emulator"),
+            os.path.join(args.build, "tests", "robot", "dg_notify_listen")]
     for b in bins:
         if not os.path.exists(b):
             print(f"FAIL: {b} not built")
@@ -226,6 +244,30 @@ def main():
         m = re.search(rf"DG-VM: \[[\d.]+\] scenario {name} daemon_exit (\d+)", console)
         check(m is not None and m.group(1) == "0", f"{name}: the daemon exited 0 on SIGTERM")
         check("shutting down" in sec.get(f"{name}.log", ""), f"{name}: clean shutdown logged")
+
+    # --- the service manager's socket (Type=notify, WatchdogSec=0.4 as a unit would set them) ---
+    gaps = []
+    for name in ("clean", "hardlimit", "gap", "nomodel", "unconfirmed", "bridge", "latency", "bridge-app"):
+        heard = heard_by_manager(sec.get(f"{name}.notify", ""))
+        who = "the bridge" if name == "bridge-app" else f"{name}: the daemon"
+        daemon = heard.get("daemon_pid")
+        ran = daemon is not None and heard.get("listener_exit") == "0"
+        check(ran, f"{who}: the notify listener ran" +
+              ("" if ran else f" ({sec.get(name + '.notify', 'no section').strip()[-300:]})"))
+        kinds = heard.get("kinds", [])
+        said = {k["message"]: k for k in kinds}
+        check(bool(kinds) and kinds[0]["message"] == "READY=1" and said["READY=1"]["count"] == 1,
+              f"{who} said READY=1 once, before anything else ({[k['message'] for k in kinds]})")
+        check("STOPPING=1" in said and said["STOPPING=1"]["count"] == 1, f"{who} said STOPPING=1 once at SIGTERM")
+        check("WATCHDOG=1" in said, f"{who} fed its watchdog ({said.get('WATCHDOG=1', {}).get('count', 0)} pings)")
+        check(all(k["pid"] == daemon and not k["other"] for k in kinds) and set(said) <= {"READY=1", "WATCHDOG=1",
+                                                                                          "STOPPING=1"},
+              f"{who}: every message from its own process ({daemon}), none other")
+        if "WATCHDOG=1" in said and "max_gap_ms" in said["WATCHDOG=1"]:
+            gaps.append(f"{name} {said['WATCHDOG=1']['max_gap_ms']}")
+    # Not asserted: the emulated VM's clock jumps when the host deschedules it (see the 200 ms
+    # sensor deadline); a systemd watchdog at 0.4 s would fire at a gap above 400 ms.
+    print(f"  watchdog pings' longest gap (ms; due every 200): {', '.join(gaps)}")
 
     facts = {f: log_facts(os.path.join(logs_dir, f)) for f in os.listdir(logs_dir)}
 

@@ -27,6 +27,22 @@ wait_listening() {
   done
 }
 
+# notify_listen ADDRESS OUT: dg_notify_listen on ADDRESS, its summary into OUT at SIGTERM; returns
+# once it listens (a daemon started earlier would find no socket). notify_heard NAME PID: stops
+# it and prints the summary with the daemon's PID, for the host to check who said what.
+notify_listen() {
+  dg_notify_listen "$1" > "$2" 2>&1 &
+  npid=$!
+  i=0
+  while ! grep -q "listening on" "$2" 2>/dev/null && [ $i -lt 100 ]; do i=$((i + 1)); sleep 0.1; done
+}
+notify_heard() {
+  kill -TERM $npid
+  wait $npid
+  echo "listener_exit $? daemon_pid $2" >> /tmp/$1.notify
+  section $1.notify /tmp/$1.notify
+}
+
 # scenario NAME "DAEMON ARGS" RECORD_FILTER then the commands to play (as a function "play_NAME").
 scenario() {
   name=$1; dargs=$2; filter=$3
@@ -34,7 +50,11 @@ scenario() {
   cpid=$!
   # The VM's clock jumps when this shared host deschedules the emulator, so the VM runs use a
   # 200 ms sensor deadline (the deadline logic itself is tested exactly on the host).
-  dressguard-predictor --interface vcan0 --set sensor_timeout_ms=200 $dargs --latency-report > /tmp/$name.log 2>&1 &
+  # systemd's notification socket, as a unit with Type=notify and WatchdogSec=0.4 would give it
+  # (a ping due every 200 ms): READY=1, WATCHDOG=1 and STOPPING=1 must come from the daemon.
+  notify_listen @dg-notify-$name /tmp/$name.notify
+  NOTIFY_SOCKET=@dg-notify-$name WATCHDOG_USEC=400000 \
+    dressguard-predictor --interface vcan0 --set sensor_timeout_ms=200 $dargs --latency-report > /tmp/$name.log 2>&1 &
   dpid=$!
   sleep 0.5   # candump (started above) is up by then
   wait_listening /tmp/$name.log $name
@@ -44,6 +64,7 @@ scenario() {
   kill -TERM $dpid
   wait $dpid
   say "scenario $name daemon_exit $?"
+  notify_heard $name $dpid
   kill $cpid 2>/dev/null
   wait $cpid 2>/dev/null
   section $name.rec /tmp/$name.rec
@@ -130,7 +151,11 @@ play_bridge() {
   sport=$(wait_port /tmp/sensor.out)
   rport=$(wait_port /tmp/robot.out)
   [ -n "$sport" ] && [ -n "$rport" ] || say "scenario bridge: emulator not listening ($sport, $rport)"
-  dressguard-bridge --interface vcan0 --sensor tcp:127.0.0.1:$sport --robot tcp:127.0.0.1:$rport \
+  # The scenario's listener is the predictor's (npid): the bridge's is its own.
+  pred_npid=$npid
+  notify_listen @dg-notify-bridge-app /tmp/bridge-app.notify
+  NOTIFY_SOCKET=@dg-notify-bridge-app WATCHDOG_USEC=400000 \
+    dressguard-bridge --interface vcan0 --sensor tcp:127.0.0.1:$sport --robot tcp:127.0.0.1:$rport \
     --predictor-timeout-ms 300 > /tmp/bridge.log 2>&1 &
   bpid=$!
   sleep 1.5   # readings and heartbeats flow
@@ -139,6 +164,8 @@ play_bridge() {
   kill -TERM $bpid
   wait $bpid
   echo "bridge_exit $?" >> /tmp/bridge.log
+  notify_heard bridge-app $bpid
+  npid=$pred_npid
   kill $spid $rpid 2>/dev/null
   section bridge-app.log /tmp/bridge.log
 }
