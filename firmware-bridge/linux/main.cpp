@@ -364,6 +364,9 @@ int main(int argc, char** argv) {
                  (unsigned long long)s.release_write_failures.load(), (unsigned long long)s.overruns.load(),
                  (unsigned long long)s.periods_overrun.load(), (unsigned long long)s.receive_failures.load(),
                  (unsigned long long)s.error_frames.load());
+    if (notify.failed_sends() > 0)
+      std::fprintf(stderr, "dressguard-bridge: service manager: %llu notifications not sent (the last: %s)\n",
+                   static_cast<unsigned long long>(notify.failed_sends()), std::strerror(notify.last_errno()));
     if (ft300)
       std::fprintf(stderr, "dressguard-bridge: stream frames=%llu crc_failures=%llu resyncs=%llu skipped_bytes=%llu\n",
                    (unsigned long long)ft300->stats().frames.load(),

@@ -254,6 +254,10 @@ int main(int argc, char** argv) {
     // Not a status counter (the status pages have no free field): reported here only.
     counters += " speed_outside_training=" + std::to_string(daemon.predictor().trials_outside_training_speeds());
     log->info("shutting down: {}", counters);
+    // Off the loop: it only counts (a full manager queue loses a ping, not the loop its time).
+    if (notify.failed_sends() > 0)
+      log->warn("service manager: {} notifications not sent (the last: {})", notify.failed_sends(),
+                std::strerror(notify.last_errno()));
     if (latency_report) {
       const auto& h = daemon.processing();
       const auto& hs = daemon.processing_with_stop();
