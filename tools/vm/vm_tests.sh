@@ -151,23 +151,25 @@ play_bridge() {
   sport=$(wait_port /tmp/sensor.out)
   rport=$(wait_port /tmp/robot.out)
   [ -n "$sport" ] && [ -n "$rport" ] || say "scenario bridge: emulator not listening ($sport, $rport)"
-  # The scenario's listener is the predictor's (npid): the bridge's is its own.
+  # The scenario's listener is the predictor's (npid): the bridge's is its own. So is its log:
+  # /tmp/bridge.log is this scenario's predictor's, and the two, each at its own file offset,
+  # overwrote each other's lines (the bridge's exit status among them: a failure under load).
   pred_npid=$npid
   notify_listen @dg-notify-bridge-app /tmp/bridge-app.notify
   NOTIFY_SOCKET=@dg-notify-bridge-app WATCHDOG_USEC=400000 \
     dressguard-bridge --interface vcan0 --sensor tcp:127.0.0.1:$sport --robot tcp:127.0.0.1:$rport \
-    --predictor-timeout-ms 300 > /tmp/bridge.log 2>&1 &
+    --predictor-timeout-ms 300 > /tmp/bridge-app.log 2>&1 &
   bpid=$!
   sleep 1.5   # readings and heartbeats flow
   cansend vcan0 "$(cat $D/bridge-trial-start.txt)" || say "scenario bridge: cansend failed"
   sleep 1.5
   kill -TERM $bpid
   wait $bpid
-  echo "bridge_exit $?" >> /tmp/bridge.log
+  echo "bridge_exit $?" >> /tmp/bridge-app.log
   notify_heard bridge-app $bpid
   npid=$pred_npid
   kill $spid $rpid 2>/dev/null
-  section bridge-app.log /tmp/bridge.log
+  section bridge-app.log /tmp/bridge-app.log
 }
 scenario bridge "--model $MODEL" ",080:7FF,100:7FF,180:7FF,700:7FF"
 
