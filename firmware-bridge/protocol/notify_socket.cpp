@@ -96,8 +96,8 @@ NotifySocket::NotifySocket(NotifySocket&& o) noexcept
       error_(std::move(o.error_)),
       watchdog_period_ns_(o.watchdog_period_ns_),
       next_ping_ns_(o.next_ping_ns_),
-      failed_sends_(o.failed_sends_),
-      last_errno_(o.last_errno_) {}
+      failed_sends_(o.failed_sends()),
+      last_errno_(o.last_errno()) {}
 
 NotifySocket& NotifySocket::operator=(NotifySocket&& o) noexcept {
   if (this != &o) {
@@ -106,8 +106,8 @@ NotifySocket& NotifySocket::operator=(NotifySocket&& o) noexcept {
     error_ = std::move(o.error_);
     watchdog_period_ns_ = o.watchdog_period_ns_;
     next_ping_ns_ = o.next_ping_ns_;
-    failed_sends_ = o.failed_sends_;
-    last_errno_ = o.last_errno_;
+    failed_sends_ = o.failed_sends();
+    last_errno_ = o.last_errno();
   }
   return *this;
 }
@@ -120,8 +120,8 @@ bool NotifySocket::notify(const char* state) noexcept {
   if (fd_ < 0) return true;
   // MSG_NOSIGNAL: a manager gone is an error here, not a SIGPIPE.
   if (::send(fd_, state, std::strlen(state), MSG_DONTWAIT | MSG_NOSIGNAL) >= 0) return true;
-  last_errno_ = errno;
-  ++failed_sends_;
+  last_errno_.store(errno, std::memory_order_relaxed);
+  failed_sends_.fetch_add(1, std::memory_order_relaxed);
   return false;
 }
 

@@ -20,6 +20,7 @@
 // ping, not the loop its time). Without a service manager every call does nothing.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <string>
 
@@ -51,6 +52,8 @@ class NotifySocket {
   int64_t watchdog_period_ns() const { return watchdog_period_ns_; }
 
   // One message (sd_notify(3)'s assignments). True when it was sent or there is no manager.
+  // Safe from several threads (the predictor's loop pings, its logging thread sets STATUS=): a
+  // datagram goes out whole, and the failure counts are atomic.
   bool notify(const char* state) noexcept;
   // "READY=1", and the watchdog's first ping is due one period after `now_ns`.
   bool ready(int64_t now_ns) noexcept;
@@ -59,16 +62,16 @@ class NotifySocket {
   // (and sent, or counted in failed_sends()).
   bool watchdog(int64_t now_ns) noexcept;
   // Sends that failed (the manager's queue full, the manager gone); the last one's errno.
-  uint64_t failed_sends() const { return failed_sends_; }
-  int last_errno() const { return last_errno_; }
+  uint64_t failed_sends() const { return failed_sends_.load(std::memory_order_relaxed); }
+  int last_errno() const { return last_errno_.load(std::memory_order_relaxed); }
 
  private:
   int fd_ = -1;
   std::string error_;
   int64_t watchdog_period_ns_ = 0;
   int64_t next_ping_ns_ = 0;
-  uint64_t failed_sends_ = 0;
-  int last_errno_ = 0;
+  std::atomic<uint64_t> failed_sends_{0};
+  std::atomic<int> last_errno_{0};
 };
 
 }  // namespace dressguard::service

@@ -54,8 +54,9 @@ void LatencyHistogram::merge(const LatencyHistogram& o) {
 
 // ---------------------------------------------------------------------------------------------
 
-EventLogger::EventLogger(EventQueue& q, std::shared_ptr<spdlog::logger> log, const std::vector<std::string>& names)
-    : q_(q), log_(std::move(log)), names_(names), thread_([this] { run(); }) {}
+EventLogger::EventLogger(EventQueue& q, std::shared_ptr<spdlog::logger> log, const std::vector<std::string>& names,
+                         service::NotifySocket* service)
+    : q_(q), log_(std::move(log)), names_(names), service_(service), thread_([this] { run(); }) {}
 
 EventLogger::~EventLogger() { stop(); }
 
@@ -136,6 +137,28 @@ void EventLogger::log_one(const Event& e) {
       break;
     case EventKind::Posteriors: break;
   }
+  if (service_) tell_status(e);
+}
+
+void EventLogger::tell_status(const Event& e) {
+  std::string now;
+  switch (e.kind) {
+    case EventKind::TrialStarted:
+      ++trials_;
+      now = fmt::format("trial {} running", e.trial);
+      break;
+    case EventKind::StopSent:
+      ++stopped_;
+      last_stop_ = fmt::format("trial {}, {}", e.trial, protocol::stop_reason_name(e.reason));
+      now = fmt::format("trial {} stopped: {}", e.trial, protocol::stop_reason_name(e.reason));
+      break;
+    case EventKind::TrialEnded: now = "idle"; break;
+    case EventKind::ModelMissing: now = fmt::format("trial {} refused: no model", e.trial); break;
+    default: return;
+  }
+  const std::string status = fmt::format("STATUS={}; trials {}, stopped {}{}", now, trials_, stopped_,
+                                         last_stop_.empty() ? "" : " (last: " + last_stop_ + ")");
+  service_->notify(status.c_str());
 }
 
 // ---------------------------------------------------------------------------------------------

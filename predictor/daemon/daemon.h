@@ -55,22 +55,30 @@ class LatencyHistogram {
   int64_t max_ = 0;
 };
 
-// Drains the event queue into spdlog on a normal-priority thread (spdlog takes locks).
+// Drains the event queue into spdlog on a normal-priority thread (spdlog takes locks). With a
+// service manager's socket it also keeps the unit's one-line status (`systemctl status`, STATUS=)
+// current at each trial's start, stop and end: "trial 12 running; trials 12, stopped 2 (last:
+// trial 9, caught)". Formatted here, off the real-time loop.
 class EventLogger {
  public:
-  EventLogger(EventQueue& q, std::shared_ptr<spdlog::logger> log, const std::vector<std::string>& class_names);
+  EventLogger(EventQueue& q, std::shared_ptr<spdlog::logger> log, const std::vector<std::string>& class_names,
+              service::NotifySocket* service = nullptr);
   ~EventLogger();  // drains what is left, then joins
   void stop();
 
  private:
   void run();
   void log_one(const Event& e);
+  void tell_status(const Event& e);
   static bool power_of_two(uint64_t n) { return n != 0 && (n & (n - 1)) == 0; }
   EventQueue& q_;
   std::shared_ptr<spdlog::logger> log_;
   std::vector<std::string> names_;
   std::atomic<bool> stop_{false};
   uint64_t tx_errors_ = 0;  // failed sends seen (the logging thread's own count)
+  service::NotifySocket* service_ = nullptr;
+  uint64_t trials_ = 0, stopped_ = 0;  // for the status line: trials started, trials stopped
+  std::string last_stop_;              // "trial 9, caught"
   std::thread thread_;
 };
 

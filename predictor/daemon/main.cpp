@@ -215,7 +215,7 @@ int main(int argc, char** argv) {
 
   try {
     static EventQueue events;  // 4096 events: static storage, not on the stack
-    EventLogger logger(events, log, names);  // before the RT setup: it must not inherit SCHED_FIFO
+    EventLogger logger(events, log, names, &notify);  // before the RT setup: it must not inherit SCHED_FIFO
     // Before the sockets: with rt_required, a step that fails ends the daemon before it listens.
     if (!no_rt && !realtime_ready(rt, rt_required, *log)) return 1;
     can::PortOptions rx_opt;
@@ -235,6 +235,9 @@ int main(int argc, char** argv) {
                 rx->receive_buffer(), rx_opt.receive_buffer);
     PredictorDaemon daemon(model.get(), cfg, *rx, *stop_port, events, dopt);
     handle_signals(&daemon);
+    // The unit's status line until the first trial (the logging thread keeps it from then on).
+    notify.notify(("STATUS=listening on " + iface +
+                   (model ? ", model " + model_path : std::string(", no model: every trial refused"))).c_str());
     log->info("listening on {} (threshold {}, k {}, hard limit {} N, sensor timeout {} ms)", iface,
               daemon.predictor().threshold(), daemon.predictor().consecutive(), cfg.hard_limit_n,
               cfg.sensor_timeout_ns / 1000000);

@@ -50,7 +50,8 @@ struct Rig {
     sensor = bus.open({{}, false, true});
     robot = bus.open({{protocol::id_of(protocol::MsgId::Stop), protocol::id_of(protocol::MsgId::PredictorStatus)}, false, true});
     log = std::make_shared<spdlog::logger>("test", std::make_shared<spdlog::sinks::ostream_sink_mt>(log_text));
-    logger = std::make_unique<EventLogger>(events, log, std::vector<std::string>{"good", "missed", "caught"});
+    logger = std::make_unique<EventLogger>(events, log, std::vector<std::string>{"good", "missed", "caught"},
+                                           opt.service);
     daemon = std::make_unique<PredictorDaemon>(with_model ? &model : nullptr, PredictorConfig{}, *rx, *stop_port, events,
                                                opt);
     loop = std::thread([this] {
@@ -114,8 +115,6 @@ TEST(Daemon, CaughtTrialIsStoppedAndConfirmedByEcho) {
   EXPECT_GE(rig.daemon->processing().count() + rig.daemon->processing_with_stop().count(), 13u);
 }
 
-// A trial at a speed the model was never trained at (300 mm/s against 100-150) is counted on
-// the loop without a log line or an allocation, and reported in the shutdown line's counters.
 // Under systemd (Type=notify, WatchdogSec=): READY=1 once the loop runs, WATCHDOG=1 from the
 // loop's ticks at half the manager's interval, STOPPING=1 at shutdown, all from this process;
 // the Rig's destructor asserts that the loop allocated nothing meanwhile.
@@ -144,6 +143,47 @@ TEST(Daemon, TellsTheServiceManagerItIsReadyAndFeedsItsWatchdog) {
   EXPECT_EQ(notify.failed_sends(), 0u);
 }
 
+// The unit's status line (`systemctl status`) follows the trials: set by the logging thread at
+// each trial's start, stop and end, never by the loop.
+TEST(Daemon, TheUnitsStatusLineFollowsTheTrials) {
+  testkit::NotifyListener manager(false);
+  ASSERT_EQ(manager.error, "");
+  service::NotifySocket notify = service::NotifySocket::open(manager.address.c_str(), nullptr, nullptr, ::getpid());
+  ASSERT_TRUE(notify.connected()) << notify.error();
+  DaemonOptions opt;
+  opt.service = &notify;
+  Rig rig(true, opt);
+  rig.sensor->send(rig.src.trial_start(11));
+  for (int i = 0; i < 10; ++i) rig.send_sample(-2.0, 0.0);
+  protocol::Stop s{};
+  for (int i = 0; i < 30 && !rig.wait_stop(s, 5ms); ++i) rig.send_sample(-6.0, -1.0);
+  ASSERT_EQ(s.reason, protocol::StopReason::Caught);
+  rig.sensor->send(rig.src.trial_end(11, 20));
+  rig.sensor->send(rig.src.trial_start(12));
+  const std::string second_running = "STATUS=trial 12 running; trials 2, stopped 1 (last: trial 11, caught)";
+  for (int i = 0; i < 200 && manager.count(second_running) == 0; ++i) {
+    std::this_thread::sleep_for(5ms);
+    manager.take(::getpid());
+  }
+  rig.shutdown();
+  manager.take(::getpid());
+  std::vector<std::string> statuses;
+  for (const auto& m : manager.heard)
+    if (m.rfind("STATUS=", 0) == 0) statuses.push_back(m);
+  const std::vector<std::string> want = {
+      "STATUS=trial 11 running; trials 1, stopped 0",
+      "STATUS=trial 11 stopped: caught; trials 1, stopped 1 (last: trial 11, caught)",
+      "STATUS=idle; trials 1, stopped 1 (last: trial 11, caught)",
+      "STATUS=trial 12 running; trials 2, stopped 1 (last: trial 11, caught)",
+      // The shutdown stops the running trial first.
+      "STATUS=trial 12 stopped: shutdown; trials 2, stopped 2 (last: trial 12, shutdown)",
+  };
+  EXPECT_EQ(statuses, want);
+  EXPECT_FALSE(manager.other_sender);
+}
+
+// A trial at a speed the model was never trained at (300 mm/s against 100-150) is counted on
+// the loop without a log line or an allocation, and reported in the shutdown line's counters.
 TEST(Daemon, ATrialOutsideTheTrainingSpeedsIsCountedWithoutAllocating) {
   Rig rig;
   rig.sensor->send(rig.src.trial_start(12, 300));

@@ -6,11 +6,14 @@
 // in the order each kind first came (first_ms from the listener's start; max_gap_ms, for a kind
 // heard more than once, the longest time between two of them: for WATCHDOG=1, how near the
 // daemon's loop came to its watchdog's limit). A sender other than the first is named too.
+// STATUS= lines are one kind, whatever they say: "STATUS= count=N ..." and then the first and
+// the last one heard, as "status_first TEXT" and "status_last TEXT".
 //   usage: dg_notify_listen ADDRESS
 #include <poll.h>
 #include <signal.h>
 #include <time.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -59,6 +62,7 @@ int main(int argc, char** argv) {
   std::fflush(stdout);
   const double t0 = now_ms();
   std::vector<Kind> kinds;
+  std::string status_first, status_last;
   while (!g_stop) {
     pollfd p{listener.fd, POLLIN, 0};
     if (poll(&p, 1, 100) <= 0) continue;
@@ -67,6 +71,11 @@ int main(int argc, char** argv) {
       for (char& c : m)
         if (c == '\n') c = ' ';  // one message, one line
       const double t = now_ms() - t0;
+      if (m.rfind("STATUS=", 0) == 0) {
+        if (status_first.empty()) status_first = m.substr(7);
+        status_last = m.substr(7);
+        m = "STATUS=";
+      }
       Kind* k = nullptr;
       for (Kind& x : kinds)
         if (x.message == m) k = &x;
@@ -86,5 +95,7 @@ int main(int argc, char** argv) {
     if (k.count > 1) std::printf(" max_gap_ms=%.0f", k.max_gap_ms);
     std::printf("%s\n", k.other_sender ? " other_senders" : "");
   }
+  if (!status_first.empty())
+    std::printf("status_first %s\nstatus_last %s\n", status_first.c_str(), status_last.c_str());
   return 0;
 }

@@ -127,6 +127,9 @@ def heard_by_manager(text):
             if m.group(5):
                 k["max_gap_ms"] = int(m.group(5))
             out["kinds"].append(k)
+        m = re.match(r"status_(first|last) (.*)$", line)
+        if m:
+            out["status_" + m.group(1)] = m.group(2)
         m = re.match(r"listener_exit (\d+) daemon_pid (\d+)", line)
         if m:
             out["listener_exit"], out["daemon_pid"] = m.group(1), m.group(2)
@@ -256,13 +259,25 @@ def main():
               ("" if ran else f" ({sec.get(name + '.notify', 'no section').strip()[-300:]})"))
         kinds = heard.get("kinds", [])
         said = {k["message"]: k for k in kinds}
-        check(bool(kinds) and kinds[0]["message"] == "READY=1" and said["READY=1"]["count"] == 1,
-              f"{who} said READY=1 once, before anything else ({[k['message'] for k in kinds]})")
+        # A status line may come first (the predictor's "listening on", set before its loop runs).
+        order = [k["message"] for k in kinds if k["message"] != "STATUS="]
+        check(bool(order) and order[0] == "READY=1" and said["READY=1"]["count"] == 1,
+              f"{who} said READY=1 once, before any ping or STOPPING ({[k['message'] for k in kinds]})")
         check("STOPPING=1" in said and said["STOPPING=1"]["count"] == 1, f"{who} said STOPPING=1 once at SIGTERM")
         check("WATCHDOG=1" in said, f"{who} fed its watchdog ({said.get('WATCHDOG=1', {}).get('count', 0)} pings)")
         check(all(k["pid"] == daemon and not k["other"] for k in kinds) and set(said) <= {"READY=1", "WATCHDOG=1",
-                                                                                          "STOPPING=1"},
+                                                                                          "STOPPING=1", "STATUS="},
               f"{who}: every message from its own process ({daemon}), none other")
+        if name != "bridge-app":
+            # The unit's status line: where it listens until the first trial, then the trials.
+            first = heard.get("status_first", "")
+            check(first.startswith("listening on vcan0, ") and
+                  ("no model" in first) == (name == "nomodel"),
+                  f"{who}'s first status line says where it listens ('{first}')")
+            if name in ("clean", "hardlimit"):
+                last = heard.get("status_last", "")
+                counted = re.match(r"(idle|trial \d+ (running|stopped: \w+)); trials [1-9]\d*, stopped \d+", last)
+                check(counted is not None, f"{who}'s last status line counts its trials ('{last}')")
         if "WATCHDOG=1" in said and "max_gap_ms" in said["WATCHDOG=1"]:
             gaps.append(f"{name} {said['WATCHDOG=1']['max_gap_ms']}")
     # Not asserted: the emulated VM's clock jumps when the host deschedules it (see the 200 ms
