@@ -107,14 +107,29 @@ void handle_signals(BridgeApp* app) {
 std::string BridgeApp::last_error() const { return sensor_.last_error(); }
 
 void BridgeApp::say(const char* fmt, ...) {
-  if (!cfg_.log) return;
+  if (!cfg_.log && !cfg_.service) return;
   char line[512];
   va_list ap;
   va_start(ap, fmt);
   std::vsnprintf(line, sizeof line, fmt, ap);
   va_end(ap);
-  std::fprintf(cfg_.log, "dressguard-bridge: %s\n", line);
-  std::fflush(cfg_.log);
+  if (cfg_.log) {
+    std::fprintf(cfg_.log, "dressguard-bridge: %s\n", line);
+    std::fflush(cfg_.log);
+  }
+  tell_status(line);
+}
+
+// The unit's status line (`systemctl status`, STATUS=), set whenever the bridge says something:
+// its sensor's state, the stops it wrote, and what it said last. Into a buffer on the stack.
+void BridgeApp::tell_status(const char* last) {
+  if (!cfg_.service) return;
+  char status[700];
+  std::snprintf(status, sizeof status, "STATUS=sensor %s; stops written %llu%s; last: %s",
+                !sensor_.connected() ? "not connected" : sensor_failures_ ? "failing" : "ok",
+                static_cast<unsigned long long>(stats_.stops_written.load()), stop_pending_ ? ", one pending" : "",
+                last);
+  cfg_.service->notify(status);
 }
 
 void BridgeApp::sensor_failed(const char* what) {

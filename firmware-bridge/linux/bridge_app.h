@@ -38,7 +38,8 @@ struct BridgeAppConfig {
   // controller error frames at the 1st, 2nd, 4th, ... since the last restart, and the restart.
   std::FILE* log = stderr;
   // The service manager's socket (null: none): READY=1 when the loop starts, WATCHDOG=1 from
-  // its timer (each a non-blocking send(2)), STOPPING=1 when a shutdown begins.
+  // its timer (each a non-blocking send(2)), STOPPING=1 when a shutdown begins, and the unit's
+  // status line (STATUS=) whenever the bridge says something on `log`.
   service::NotifySocket* service = nullptr;
 };
 
@@ -84,6 +85,7 @@ class BridgeApp {
   int loop_failed(int err);
   void say_stop_unwritten();
   void say(const char* fmt, ...) __attribute__((format(printf, 2, 3)));
+  void tell_status(const char* last);
   void sensor_failed(const char* what);
 
   BridgeAppConfig cfg_;

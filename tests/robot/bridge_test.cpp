@@ -1031,6 +1031,34 @@ TEST(BridgeModbus, TellsTheServiceManagerItIsReadyAndFeedsItsWatchdog) {
   EXPECT_EQ(notify.failed_sends(), 0u);
 }
 
+// The unit's status line (`systemctl status`) says the sensor's state, the stops written and
+// what the bridge said last: here a predictor's stop, written to the robot.
+TEST(BridgeModbus, TheUnitsStatusLineSaysWhatTheBridgeSaidLast) {
+  testkit::NotifyListener manager(false);
+  ASSERT_EQ(manager.error, "");
+  service::NotifySocket notify = service::NotifySocket::open(manager.address.c_str(), nullptr, nullptr, ::getpid());
+  ASSERT_TRUE(notify.connected()) << notify.error();
+  RigOptions o;
+  o.service = &notify;
+  BridgeRig rig(o);
+  ASSERT_GE(rig.collect_at_least(3, 2000ms), 3) << "the sensor is read";
+  rig.predictor->send(protocol::encode(protocol::Stop{0, protocol::StopReason::Caught, 240, 3, 250}));
+  // The stop is written in the wakeup that reads the frame, then its cause is said. (Other lines
+  // may come between, e.g. a timer overrun on a loaded host.)
+  const std::string written = "STATUS=sensor ok; stops written 1; last: stop written to the robot controller";
+  const std::string cause = "STATUS=sensor ok; stops written 1; last: stop frame from the predictor: caught";
+  for (int i = 0; i < 400 && manager.count(cause) == 0; ++i) {
+    std::this_thread::sleep_for(5ms);
+    manager.take(::getpid());
+  }
+  const auto& h = manager.heard;
+  ASSERT_FALSE(h.empty());
+  EXPECT_EQ(h.front(), "READY=1");
+  const auto w = std::find(h.begin(), h.end(), written);
+  EXPECT_TRUE(w != h.end() && std::find(w, h.end(), cause) != h.end()) << ::testing::PrintToString(h) << rig.logged();
+  EXPECT_FALSE(manager.other_sender);
+}
+
 TEST(BridgeModbus, HangupAndBrokenPipeDoNotEndTheBridge) {
   BridgeRig rig;
   ASSERT_GT(rig.robot_emu.port(), 0);

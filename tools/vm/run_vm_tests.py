@@ -268,7 +268,11 @@ def main():
         check(all(k["pid"] == daemon and not k["other"] for k in kinds) and set(said) <= {"READY=1", "WATCHDOG=1",
                                                                                           "STOPPING=1", "STATUS="},
               f"{who}: every message from its own process ({daemon}), none other")
-        if name != "bridge-app":
+        if name == "bridge-app":
+            last = heard.get("status_last", "")
+            check(re.match(r"sensor ok; stops written [1-9]", last) is not None,
+                  f"the bridge's last status line counts the stop it wrote ('{last}')")
+        else:
             # The unit's status line: where it listens until the first trial, then the trials.
             first = heard.get("status_first", "")
             check(first.startswith("listening on vcan0, ") and
