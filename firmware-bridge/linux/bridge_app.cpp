@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstring>
 #include <system_error>
+#include <utility>
 
 #include "notify_socket.h"
 
@@ -247,9 +248,9 @@ bool BridgeApp::take_reading(uint32_t t) {
     for (int i = 0; i < n; ++i) send(frames[i]);
     ++stats_.readings;
     backoff_ms_ = 0;
-    if (sensor_failures_ > 0)
-      say("sensor answers again after %llu failures", static_cast<unsigned long long>(sensor_failures_));
-    sensor_failures_ = 0;
+    // Cleared before it is said: the status line said with it is the sensor's state now.
+    if (const uint64_t failed = std::exchange(sensor_failures_, 0); failed > 0)
+      say("sensor answers again after %llu failures", static_cast<unsigned long long>(failed));
     return true;
   }
   bridge_on_sensor_error(core_, t);
@@ -442,10 +443,13 @@ int BridgeApp::run() {
       if (shutting_down) {
         try_stop(t);  // no more readings: only the stop's retries
       } else {
+        // The loop's periods keep the manager's watchdog fed (and resend a READY=1 that met a
+        // full queue): a loop that hangs stops them. Before the sensor and the robot, whose
+        // reads and writes may block up to their response timeouts: a slow device delays the
+        // next ping, not this one (main checks those timeouts against the watchdog).
+        if (cfg_.service) cfg_.service->on_tick(now_ns());
         if (expirations > 1) timer_overran(expirations - 1);
         on_timer(t);
-        // The loop's periods keep the manager's watchdog fed: a loop that hangs stops them.
-        if (cfg_.service) cfg_.service->watchdog(now_ns());
       }
     }
     if (shutting_down) {

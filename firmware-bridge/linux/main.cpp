@@ -67,7 +67,8 @@ const char* kUsage =
     "                          memory is locked (not had: a warning) and the loop runs SCHED_FIFO\n"
     "  --help                  this text\n"
     "Exit codes: 0 clean shutdown (SIGTERM/SIGINT), 1 runtime error, an --rt-priority not had, or a stop\n"
-    "still unwritten at the end of the shutdown grace, 2 bad arguments.\n"
+    "still unwritten at the end of the shutdown grace, 2 bad arguments or a NOTIFY_SOCKET that cannot\n"
+    "be reached.\n"
     "Signals: SIGTERM and SIGINT shut it down (a running trial's stop written first). SIGHUP and\n"
     "SIGPIPE are ignored from the start on: there is no reload, the options are read at start and a\n"
     "change takes a restart.\n"
@@ -313,6 +314,31 @@ int main(int argc, char** argv) {
     std::fprintf(stderr,
                  "dressguard-bridge: warning: --predictor-timeout-ms 0: a predictor that goes silent or misses a "
                  "trial does not stop the robot (a deployment sets it, e.g. 300)\n");
+  // Under systemd's Type=notify the unit is started when the loop runs, and WatchdogSec= restarts
+  // a loop that stops (notify_socket.h). A manager that cannot be told is the deployment's error
+  // (a unit without AF_UNIX): exit 2 now, not a start that times out and restarts for ever.
+  service::NotifySocket notify = service::NotifySocket::from_environment();
+  if (notify.requested() && !notify.connected()) {
+    std::fprintf(stderr, "dressguard-bridge: %s\n", notify.error().c_str());
+    return 2;
+  }
+  if (!notify.error().empty()) std::fprintf(stderr, "dressguard-bridge: warning: %s\n", notify.error().c_str());
+  // A ping goes out at the first tick after it is due, and one tick can wait on the devices: a
+  // connect and a read of the sensor, a connect and a write of the robot, each up to its response
+  // timeout. The manager's limit (twice the ping period) holds only while that wait is shorter
+  // than a ping period; past it a slow device, not a hung loop, would have the bridge killed.
+  if (const int64_t ping_ms = notify.watchdog_period_ns() / 1000000; ping_ms > 0) {
+    const int64_t longest_ms = 2 * int64_t{stream ? 0 : sensor_ep.response_timeout_ms} +
+                               2 * int64_t{robot_spec.empty() ? 0 : robot_ep.response_timeout_ms} + cfg.sample_period_ms;
+    if (longest_ms >= ping_ms)
+      std::fprintf(stderr,
+                   "dressguard-bridge: warning: one loop period can wait %lld ms on the sensor and the robot "
+                   "(connect and answer, each up to its response timeout), not less than the watchdog's ping "
+                   "period of %lld ms: set WatchdogSec= to more than %lld ms or shorten --timeout-ms, or slow "
+                   "devices will have the service manager kill the bridge\n",
+                   static_cast<long long>(longest_ms), static_cast<long long>(ping_ms),
+                   static_cast<long long>(2 * longest_ms));
+  }
   std::unique_ptr<RobotStopWriter> robot;
   if (!robot_spec.empty()) {
     robot_ep.spec = robot_spec;
@@ -334,10 +360,6 @@ int main(int argc, char** argv) {
     } else {
       sensor = std::make_unique<ModbusSensor>(sensor_ep, map);
     }
-    // Under systemd's Type=notify the unit is started when the loop runs, and WatchdogSec=
-    // restarts a loop that stops (notify_socket.h). A socket that does not open is said, not fatal.
-    service::NotifySocket notify = service::NotifySocket::from_environment();
-    if (!notify.error().empty()) std::fprintf(stderr, "dressguard-bridge: %s\n", notify.error().c_str());
     cfg.service = &notify;
     BridgeApp app(cfg, *sensor, robot.get(), *port);
     handle_signals(&app);

@@ -57,6 +57,7 @@ NotifySocket NotifySocket::open(const char* notify_socket, const char* watchdog_
     s.watchdog_period_ns_ = 0;
     return s;
   }
+  s.requested_ = true;
   sockaddr_un addr{};
   addr.sun_family = AF_UNIX;
   const size_t len = std::strlen(notify_socket);
@@ -91,20 +92,17 @@ NotifySocket NotifySocket::open(const char* notify_socket, const char* watchdog_
   return s;
 }
 
-NotifySocket::NotifySocket(NotifySocket&& o) noexcept
-    : fd_(std::exchange(o.fd_, -1)),
-      error_(std::move(o.error_)),
-      watchdog_period_ns_(o.watchdog_period_ns_),
-      next_ping_ns_(o.next_ping_ns_),
-      failed_sends_(o.failed_sends()),
-      last_errno_(o.last_errno()) {}
+NotifySocket::NotifySocket(NotifySocket&& o) noexcept { *this = std::move(o); }
 
 NotifySocket& NotifySocket::operator=(NotifySocket&& o) noexcept {
   if (this != &o) {
     if (fd_ >= 0) ::close(fd_);
     fd_ = std::exchange(o.fd_, -1);
+    requested_ = o.requested_;
+    ready_pending_ = std::exchange(o.ready_pending_, false);
     error_ = std::move(o.error_);
-    watchdog_period_ns_ = o.watchdog_period_ns_;
+    // The moved-from object has no socket: it pings nothing.
+    watchdog_period_ns_ = std::exchange(o.watchdog_period_ns_, 0);
     next_ping_ns_ = o.next_ping_ns_;
     failed_sends_ = o.failed_sends();
     last_errno_ = o.last_errno();
@@ -116,25 +114,38 @@ NotifySocket::~NotifySocket() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-bool NotifySocket::notify(const char* state) noexcept {
-  if (fd_ < 0) return true;
+int NotifySocket::send_state(const char* state) noexcept {
+  if (fd_ < 0) return 0;
   // MSG_NOSIGNAL: a manager gone is an error here, not a SIGPIPE.
-  if (::send(fd_, state, std::strlen(state), MSG_DONTWAIT | MSG_NOSIGNAL) >= 0) return true;
-  last_errno_.store(errno, std::memory_order_relaxed);
+  if (::send(fd_, state, std::strlen(state), MSG_DONTWAIT | MSG_NOSIGNAL) >= 0) return 0;
+  const int err = errno;
+  last_errno_.store(err, std::memory_order_relaxed);
   failed_sends_.fetch_add(1, std::memory_order_relaxed);
-  return false;
+  return err;
 }
+
+bool NotifySocket::notify(const char* state) noexcept { return send_state(state) == 0; }
+
+namespace {
+// The manager's queue was full (or the call was interrupted): the same message may go out later.
+bool transient(int err) { return err == EAGAIN || err == EWOULDBLOCK || err == ENOBUFS || err == EINTR; }
+}  // namespace
 
 bool NotifySocket::ready(int64_t now_ns) noexcept {
   next_ping_ns_ = now_ns + watchdog_period_ns_;
-  return notify("READY=1");
+  const int err = send_state("READY=1");
+  ready_pending_ = transient(err);
+  return err == 0;
 }
 
-bool NotifySocket::watchdog(int64_t now_ns) noexcept {
+bool NotifySocket::on_tick(int64_t now_ns) noexcept {
+  if (ready_pending_) ready_pending_ = transient(send_state("READY=1"));
   if (watchdog_period_ns_ <= 0 || now_ns < next_ping_ns_) return false;
-  next_ping_ns_ = now_ns + watchdog_period_ns_;
-  notify("WATCHDOG=1");
-  return true;
+  const int err = send_state("WATCHDOG=1");
+  // Sent, or refused for good (the manager gone): the next one a period on. A full queue: the
+  // next tick tries again.
+  if (!transient(err)) next_ping_ns_ = now_ns + watchdog_period_ns_;
+  return err == 0;
 }
 
 }  // namespace dressguard::service

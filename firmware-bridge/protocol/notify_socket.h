@@ -41,11 +41,14 @@ class NotifySocket {
   NotifySocket& operator=(const NotifySocket&) = delete;
   ~NotifySocket();
 
+  // NOTIFY_SOCKET was set: a service manager expects to hear from this process.
+  bool requested() const { return requested_; }
   // A service manager listens (the socket is open and connected).
   bool connected() const { return fd_ >= 0; }
   // What went wrong reading the environment or opening the socket, one line naming the variable
-  // and its value; empty when nothing did. The daemon runs on without the manager hearing it
-  // (under Type=notify the manager then ends the start at TimeoutStartSec=): it is logged.
+  // and its value; empty when nothing did. With requested() and not connected(), the manager
+  // would never hear READY=1 and would end the start at TimeoutStartSec=, then restart the unit,
+  // over and over: the daemons exit 2 at start instead (the unit's RestartPreventExitStatus=).
   const std::string& error() const { return error_; }
   // The watchdog's ping period, half of WATCHDOG_USEC, in ns; 0 when no watchdog is asked for
   // this process (none, or WATCHDOG_PID names another).
@@ -55,18 +58,26 @@ class NotifySocket {
   // Safe from several threads (the predictor's loop pings, its logging thread sets STATUS=): a
   // datagram goes out whole, and the failure counts are atomic.
   bool notify(const char* state) noexcept;
-  // "READY=1", and the watchdog's first ping is due one period after `now_ns`.
+  // "READY=1", and the watchdog's first ping is due one period after `now_ns`. True when sent;
+  // when the manager's queue was full (EAGAIN, ENOBUFS) on_tick() sends it again, as a lost
+  // READY=1 would have the manager end the start at its timeout.
   bool ready(int64_t now_ns) noexcept;
-  // "WATCHDOG=1" when a period has passed since the last one (or since ready()); call it from
-  // the loop on each wakeup it gets anyway (the daemons' timer ticks). True when one was due
-  // (and sent, or counted in failed_sends()).
-  bool watchdog(int64_t now_ns) noexcept;
+  // Call from the loop on each wakeup it gets anyway (the daemons' timer ticks): READY=1 again if
+  // it is still to go out, and "WATCHDOG=1" when a period has passed since the last one (or since
+  // ready()); one that met a full queue is tried again at the next tick, not a period later (two
+  // lost pings in a row would be the watchdog's end). True when it sent a ping.
+  bool on_tick(int64_t now_ns) noexcept;
   // Sends that failed (the manager's queue full, the manager gone); the last one's errno.
   uint64_t failed_sends() const { return failed_sends_.load(std::memory_order_relaxed); }
   int last_errno() const { return last_errno_.load(std::memory_order_relaxed); }
 
  private:
+  // 0 when `state` went out, else the send's errno (counted).
+  int send_state(const char* state) noexcept;
+
   int fd_ = -1;
+  bool requested_ = false;
+  bool ready_pending_ = false;  // READY=1 met a full queue: on_tick() sends it again
   std::string error_;
   int64_t watchdog_period_ns_ = 0;
   int64_t next_ping_ns_ = 0;

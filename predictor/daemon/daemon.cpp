@@ -303,8 +303,9 @@ int PredictorDaemon::run() {
       [[maybe_unused]] ssize_t r = ::read(timer_fd_, &expirations, sizeof expirations);
       const int64_t t = now_ns();
       predictor_.on_tick(t);
-      // The loop's ticks keep the manager's watchdog fed: a loop that hangs stops them.
-      if (opt_.service) opt_.service->watchdog(t);
+      // The loop's ticks keep the manager's watchdog fed (and resend a READY=1 that met a full
+      // queue): a loop that hangs stops them.
+      if (opt_.service) opt_.service->on_tick(t);
     }
     if (shutdown) {
       uint64_t v;

@@ -42,7 +42,7 @@ const char* kUsage =
     "WATCHDOG=1 every half WATCHDOG_USEC from its loop's ticks, and STOPPING=1 when it shuts down.\n"
     "Exit codes: 0 clean shutdown (SIGTERM/SIGINT), 1 runtime error (the interface gone, a stop not\n"
     "confirmed on the bus when the daemon exited, a real-time step failed with rt_required = 1),\n"
-    "2 bad arguments or config.";
+    "2 bad arguments or config, or a NOTIFY_SOCKET that cannot be reached.";
 
 std::string read_text(const std::string& path) {
   FILE* f = std::fopen(path.c_str(), "rb");
@@ -202,10 +202,15 @@ int main(int argc, char** argv) {
   }
 
   // Under systemd's Type=notify the unit is started when the loop runs, and WatchdogSec= restarts
-  // a loop that stops ticking (notify_socket.h). A socket that does not open is said, not fatal:
-  // the bus is guarded meanwhile, and the manager ends the start at its timeout.
+  // a loop that stops ticking (notify_socket.h).
   service::NotifySocket notify = service::NotifySocket::from_environment();
-  if (!notify.error().empty()) log->error("{}", notify.error());
+  if (notify.requested() && !notify.connected()) {
+    // The manager would never hear READY=1: a start that times out and restarts for ever. The
+    // deployment's error (a unit without AF_UNIX), as a bad config is: exit 2, not restarted.
+    std::fprintf(stderr, "dressguard-predictor: %s\n", notify.error().c_str());
+    return 2;
+  }
+  if (!notify.error().empty()) log->warn("{}", notify.error());
   if (notify.connected())
     log->info("service manager notified (ready at the loop's start{})",
               notify.watchdog_period_ns() > 0
@@ -236,8 +241,11 @@ int main(int argc, char** argv) {
     PredictorDaemon daemon(model.get(), cfg, *rx, *stop_port, events, dopt);
     handle_signals(&daemon);
     // The unit's status line until the first trial (the logging thread keeps it from then on).
+    // At most 1000 bytes: systemd drops a message of 4096 or more (a model path may be long).
     notify.notify(("STATUS=listening on " + iface +
-                   (model ? ", model " + model_path : std::string(", no model: every trial refused"))).c_str());
+                   (model ? ", model " + model_path : std::string(", no model: every trial refused")))
+                      .substr(0, 1000)
+                      .c_str());
     log->info("listening on {} (threshold {}, k {}, hard limit {} N, sensor timeout {} ms)", iface,
               daemon.predictor().threshold(), daemon.predictor().consecutive(), cfg.hard_limit_n,
               cfg.sensor_timeout_ns / 1000000);

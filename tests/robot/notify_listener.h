@@ -6,6 +6,7 @@
 
 #include <sys/socket.h>
 #include <sys/un.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -49,6 +50,8 @@ struct NotifyListener {
     if (fd < 0) error = std::string("socket: ") + std::strerror(errno);
     else if (::setsockopt(fd, SOL_SOCKET, SO_PASSCRED, &one, sizeof one) != 0)
       error = std::string("SO_PASSCRED: ") + std::strerror(errno);
+    else if (::setsockopt(fd, SOL_SOCKET, SO_TIMESTAMPNS, &one, sizeof one) != 0)
+      error = std::string("SO_TIMESTAMPNS: ") + std::strerror(errno);
     else if (::bind(fd, reinterpret_cast<sockaddr*>(&a), len) != 0)
       error = address + ": bind: " + std::strerror(errno);
   }
@@ -59,16 +62,23 @@ struct NotifyListener {
   NotifyListener(const NotifyListener&) = delete;
   NotifyListener& operator=(const NotifyListener&) = delete;
 
-  // What take() heard, in order, and whether any of it came from another process than asked.
+  // What take() heard, in order, when the kernel queued each (SO_TIMESTAMPNS: the send's time,
+  // however late the test reads it; CLOCK_REALTIME, s), and whether any of it came from another
+  // process than asked.
   std::vector<std::string> heard;
+  std::vector<double> heard_at_s;
   bool other_sender = false;
   // Every message waiting, into `heard`. Call it as systemd reads, as the messages come: a
   // datagram socket queues only net.unix.max_dgram_qlen (10) of them, and a send to a full one
   // fails.
   void take(pid_t from) {
-    pid_t sender = 0;
-    for (std::string m; !(m = receive(&sender)).empty();) {
+    for (;;) {
+      pid_t sender = 0;
+      double at_s = 0;
+      const std::string m = receive(&sender, &at_s);
+      if (m.empty()) return;
       heard.push_back(m);
+      heard_at_s.push_back(at_s);
       if (sender != from) other_sender = true;
     }
   }
@@ -77,28 +87,38 @@ struct NotifyListener {
     for (const auto& m : heard) n += m == message;
     return n;
   }
-  // What is wrong with `heard` for a daemon that ran `ran_s` seconds with its watchdog's pings
-  // `least_s` to `most_s` apart: READY=1 first, STOPPING=1 last, WATCHDOG=1 between and nothing
-  // else, all from the process asked; at least half the pings the longest spacing gives (a slow
-  // host), never more than the shortest allows. Empty when nothing is.
-  std::string wrong_with_what_was_said(double ran_s, double least_s, double most_s) const {
+  // What is wrong with `heard` for a daemon whose watchdog's pings come `least_s` to `most_s`
+  // apart: READY=1 first, STOPPING=1 last, WATCHDOG=1 between, and nothing else but status
+  // lines (STATUS=), all from the process asked; between READY's and STOPPING's arrival at
+  // least half the pings the longest spacing gives (a slow host), never more than the shortest
+  // allows. Empty when nothing is.
+  std::string wrong_with_what_was_said(double least_s, double most_s) const {
+    std::vector<std::string> said;
+    std::vector<double> at;
+    for (size_t i = 0; i < heard.size(); ++i)
+      if (heard[i].rfind("STATUS=", 0) != 0) {
+        said.push_back(heard[i]);
+        at.push_back(heard_at_s[i]);
+      }
+    const double window_s = said.empty() ? 0 : at.back() - at.front();
     const std::string got =
-        " (heard " + std::to_string(heard.size()) + " messages over " + std::to_string(ran_s) + " s)";
-    if (heard.size() < 3) return "fewer than 3 messages" + got;
-    if (heard.front() != "READY=1") return "first '" + heard.front() + "', not READY=1" + got;
-    if (heard.back() != "STOPPING=1") return "last '" + heard.back() + "', not STOPPING=1" + got;
+        " (heard " + std::to_string(said.size()) + " messages over " + std::to_string(window_s) + " s)";
+    if (said.size() < 3) return "fewer than 3 messages" + got;
+    if (said.front() != "READY=1") return "first '" + said.front() + "', not READY=1" + got;
+    if (said.back() != "STOPPING=1") return "last '" + said.back() + "', not STOPPING=1" + got;
     if (other_sender) return "a message from another process" + got;
     const long pings = count("WATCHDOG=1");
-    if (static_cast<size_t>(pings) + 2 != heard.size()) return "other messages than READY, WATCHDOG and STOPPING" + got;
-    if (pings < static_cast<long>(ran_s / most_s / 2)) return std::to_string(pings) + " pings: too few" + got;
-    if (pings > static_cast<long>(ran_s / least_s) + 1) return std::to_string(pings) + " pings: too many" + got;
+    if (static_cast<size_t>(pings) + 2 != said.size()) return "other messages than READY, WATCHDOG, STOPPING" + got;
+    if (pings < static_cast<long>(window_s / most_s / 2)) return std::to_string(pings) + " pings: too few" + got;
+    if (pings > static_cast<long>(window_s / least_s) + 1) return std::to_string(pings) + " pings: too many" + got;
     return "";
   }
-  // The next message and its sender's process ID; "" when none is waiting.
-  std::string receive(pid_t* sender = nullptr) {
-    char buf[256];
+  // The next message, its sender's process ID and when the kernel queued it; "" when none is
+  // waiting. A message longer than systemd's own 4096-byte buffer comes back as "TRUNCATED".
+  std::string receive(pid_t* sender = nullptr, double* at_s = nullptr) {
+    char buf[4096];
     iovec iov{buf, sizeof buf};
-    alignas(cmsghdr) char control[CMSG_SPACE(sizeof(ucred))];
+    alignas(cmsghdr) char control[CMSG_SPACE(sizeof(ucred)) + CMSG_SPACE(sizeof(timespec))];
     msghdr m{};
     m.msg_iov = &iov;
     m.msg_iovlen = 1;
@@ -106,12 +126,19 @@ struct NotifyListener {
     m.msg_controllen = sizeof control;
     const ssize_t n = ::recvmsg(fd, &m, MSG_DONTWAIT);
     if (n < 0) return "";
-    for (cmsghdr* c = CMSG_FIRSTHDR(&m); c; c = CMSG_NXTHDR(&m, c))
+    if (m.msg_flags & MSG_TRUNC) return "TRUNCATED";
+    for (cmsghdr* c = CMSG_FIRSTHDR(&m); c; c = CMSG_NXTHDR(&m, c)) {
       if (sender && c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_CREDENTIALS) {
         ucred cred;
         std::memcpy(&cred, CMSG_DATA(c), sizeof cred);
         *sender = cred.pid;
       }
+      if (at_s && c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS) {
+        timespec ts;
+        std::memcpy(&ts, CMSG_DATA(c), sizeof ts);
+        *at_s = static_cast<double>(ts.tv_sec) + ts.tv_nsec * 1e-9;
+      }
+    }
     return std::string(buf, static_cast<size_t>(n));
   }
 };

@@ -43,7 +43,7 @@ TEST(NotifySocket, ReadyReachesTheManagerWithThisProcessAsSender) {
     EXPECT_EQ(sender, ::getpid());
     EXPECT_TRUE(s.notify("STOPPING=1"));
     EXPECT_EQ(m.receive(), "STOPPING=1");
-    EXPECT_FALSE(s.watchdog(1'000'000 * kMs)) << "no watchdog asked for: no ping";
+    EXPECT_FALSE(s.on_tick(1'000'000 * kMs)) << "no watchdog asked for: no ping";
     EXPECT_EQ(m.receive(), "");
     EXPECT_EQ(s.failed_sends(), 0u);
   }
@@ -61,7 +61,7 @@ TEST(NotifySocket, WatchdogPingsAtHalfTheManagersInterval) {
   // The loop's 1 ms ticks: one ping per period, the first a period after ready.
   int pings = 0;
   for (int64_t t = t0; t <= t0 + 3500 * kMs; t += kMs) {
-    const bool sent = s.watchdog(t);
+    const bool sent = s.on_tick(t);
     if (sent) {
       ++pings;
       EXPECT_EQ(m.receive(), "WATCHDOG=1") << "at " << (t - t0) / kMs << " ms";
@@ -71,9 +71,9 @@ TEST(NotifySocket, WatchdogPingsAtHalfTheManagersInterval) {
   EXPECT_EQ(pings, 3) << "1 s, 2 s and 3 s after ready";
   EXPECT_EQ(m.receive(), "");
   // A late loop pings at its next tick and the period runs from there: no burst to catch up.
-  EXPECT_TRUE(s.watchdog(t0 + 9000 * kMs));
-  EXPECT_FALSE(s.watchdog(t0 + 9500 * kMs));
-  EXPECT_TRUE(s.watchdog(t0 + 10000 * kMs));
+  EXPECT_TRUE(s.on_tick(t0 + 9000 * kMs));
+  EXPECT_FALSE(s.on_tick(t0 + 9500 * kMs));
+  EXPECT_TRUE(s.on_tick(t0 + 10000 * kMs));
 }
 
 TEST(NotifySocket, WatchdogOfAnotherProcessIsNotFed) {
@@ -96,7 +96,7 @@ TEST(NotifySocket, WithoutAManagerEveryCallDoesNothing) {
     EXPECT_FALSE(s.connected());
     EXPECT_EQ(s.error(), "");
     EXPECT_TRUE(s.ready(0));
-    EXPECT_FALSE(s.watchdog(1'000'000 * kMs));
+    EXPECT_FALSE(s.on_tick(1'000'000 * kMs));
     EXPECT_EQ(s.failed_sends(), 0u);
   }
 }
@@ -144,10 +144,46 @@ TEST(NotifySocket, AManagerGoneIsCountedNotSignalled) {
     ASSERT_TRUE(s.connected()) << s.error();
   }
   // Its socket closed: the sends fail (ECONNREFUSED, then ENOTCONN: the kernel drops the
-  // association), counted; no SIGPIPE ends the test.
+  // association), counted, and not retried at each tick; no SIGPIPE ends the test.
   EXPECT_FALSE(s.ready(0));
   EXPECT_EQ(s.last_errno(), ECONNREFUSED) << std::strerror(s.last_errno());
-  EXPECT_TRUE(s.watchdog(kMs));
-  EXPECT_EQ(s.failed_sends(), 2u);
+  EXPECT_FALSE(s.on_tick(kMs)) << "a ping was due, and failed";
+  EXPECT_EQ(s.failed_sends(), 2u) << "READY=1 is not sent again to a manager that is gone";
   EXPECT_TRUE(s.last_errno() == ECONNREFUSED || s.last_errno() == ENOTCONN) << std::strerror(s.last_errno());
+  EXPECT_FALSE(s.on_tick(kMs + 100'000)) << "the next ping a period later, not at the next tick";
+  EXPECT_EQ(s.failed_sends(), 2u);
+}
+
+// A manager whose queue is full (systemd busy at boot; a datagram socket queues only
+// net.unix.max_dgram_qlen messages): READY=1 and a ping that met it go out at the next tick
+// once there is room, not never (READY) or a period later (two lost pings end the watchdog).
+TEST(NotifySocket, AFullQueueIsRetriedAtTheNextTick) {
+  NotifyListener m(false);
+  ASSERT_EQ(m.error, "");
+  NotifySocket s = NotifySocket::open(m.address.c_str(), "20000", nullptr, ::getpid());  // a ping every 10 ms
+  ASSERT_TRUE(s.connected()) << s.error();
+  auto fill = [&] {
+    for (int i = 0; i < 10000 && s.notify("STATUS=filler"); ++i) {
+    }
+    return s.last_errno();
+  };
+  auto drain = [&] {
+    while (!m.receive().empty()) {
+    }
+  };
+  ASSERT_EQ(fill(), EAGAIN) << std::strerror(s.last_errno());
+  const int64_t t0 = 1000 * kMs;
+  EXPECT_FALSE(s.ready(t0)) << "the queue is full";
+  EXPECT_FALSE(s.on_tick(t0 + kMs));  // still full: READY=1 tried again, in vain
+  drain();
+  EXPECT_FALSE(s.on_tick(t0 + 2 * kMs)) << "READY=1 goes out; no ping is due yet";
+  EXPECT_EQ(m.receive(), "READY=1");
+  EXPECT_EQ(m.receive(), "") << "READY=1 once";
+  ASSERT_EQ(fill(), EAGAIN);
+  EXPECT_FALSE(s.on_tick(t0 + 10 * kMs)) << "the ping was due and met a full queue";
+  drain();
+  EXPECT_TRUE(s.on_tick(t0 + 11 * kMs)) << "tried again at the next tick";
+  EXPECT_EQ(m.receive(), "WATCHDOG=1");
+  EXPECT_FALSE(s.on_tick(t0 + 12 * kMs)) << "and the period runs from there";
+  EXPECT_TRUE(s.on_tick(t0 + 21 * kMs));
 }
