@@ -293,7 +293,7 @@ TEST(ModelFileV3, OldVersionsReadAsUnknownAndRewriteByteIdentically) {
     EXPECT_NE(text.find("training speeds: " + unknown), std::string::npos) << text;
   }
   // The shipped default model (bundled, so its absence is a failure): re-writes to its own bytes,
-  // and knows its training conditions exactly when its version (1 until it is rebuilt) says so.
+  // and knows its training conditions exactly when its version says so (3 since session 89).
   const auto path = std::filesystem::path(DRESSGUARD_SOURCE_DIR) / "models/default.dgm";
   ASSERT_TRUE(std::filesystem::exists(path)) << path << " is missing: the project bundles it";
   std::ifstream in(path, std::ios::binary);
