@@ -21,18 +21,16 @@
 namespace dressguard::bridge {
 namespace {
 
-uint32_t now_ms() {
-  timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<uint32_t>(static_cast<uint64_t>(ts.tv_sec) * 1000 + ts.tv_nsec / 1000000);
-}
-
-// The watchdog's clock: not now_ms(), whose 32 bits wrap after 49.7 days of uptime.
+// CLOCK_MONOTONIC in ns: the watchdog's clock (notify_socket.h).
 int64_t now_ns() {
   timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return static_cast<int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
+
+// The loop's clock, in ms: 32 bits that wrap after 49.7 days of uptime (the core compares with
+// due(), across the wrap); not for the watchdog, whose ping times are absolute.
+uint32_t now_ms() { return static_cast<uint32_t>(static_cast<uint64_t>(now_ns()) / 1000000); }
 
 constexpr uint64_t kTimer = 1, kCan = 2, kShutdown = 3, kSensor = 4, kTags = 5;
 
