@@ -159,10 +159,7 @@ TEST(Daemon, TheUnitsStatusLineFollowsTheTrials) {
   rig.sensor->send(rig.src.trial_end(11, 20));
   rig.sensor->send(rig.src.trial_start(12));
   const std::string second_running = "STATUS=trial 12 running; trials 2, stopped 1 (last: trial 11, caught)";
-  for (int i = 0; i < 200 && manager.count(second_running) == 0; ++i) {
-    std::this_thread::sleep_for(5ms);
-    manager.take(::getpid());
-  }
+  manager.wait_for(second_running, ::getpid());
   rig.shutdown();
   manager.take(::getpid());
   std::vector<std::string> statuses;

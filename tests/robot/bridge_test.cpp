@@ -1051,10 +1051,7 @@ TEST(BridgeModbus, TheUnitsStatusLineSaysWhatTheBridgeSaidLast) {
   // may come between, e.g. a timer overrun on a loaded host.)
   const std::string written = "STATUS=sensor ok; stops written 1; last: stop written to the robot controller";
   const std::string cause = "STATUS=sensor ok; stops written 1; last: stop frame from the predictor: caught";
-  for (int i = 0; i < 400 && manager.count(cause) == 0; ++i) {
-    std::this_thread::sleep_for(5ms);
-    manager.take(::getpid());
-  }
+  manager.wait_for(cause, ::getpid());
   const auto& h = manager.heard;
   ASSERT_FALSE(h.empty());
   EXPECT_EQ(h.front(), "READY=1");

@@ -82,6 +82,15 @@ struct NotifyListener {
       if (sender != from) other_sender = true;
     }
   }
+  // Takes, as systemd reads, until `message` has come or `most_ms` has passed: whether it came.
+  bool wait_for(const std::string& message, pid_t from, int most_ms = 2000) {
+    for (int waited = 0; count(message) == 0 && waited < most_ms; waited += 5) {
+      const timespec pause{0, 5'000'000};
+      nanosleep(&pause, nullptr);
+      take(from);
+    }
+    return count(message) > 0;
+  }
   long count(const std::string& message) const {
     long n = 0;
     for (const auto& m : heard) n += m == message;
