@@ -90,8 +90,8 @@ std::pair<double, int> real_person_median(const Dataset& ds, const HapticSequenc
                                           ObjectiveKind kind) {
   std::vector<double> l;
   for (const auto& other : ds.trials)
-    if (predictable(other) && other.height == target.height && other.participant != target.participant &&
-        other.participant != calibrated)
+    if (predictable(other) && other.height == target.height && same_pull_speed(other.speed, target.speed) &&
+        other.participant != target.participant && other.participant != calibrated)
       l.push_back(sequence_objective(kind, other.samples, target.samples));
   return {median_of(l), static_cast<int>(l.size())};
 }

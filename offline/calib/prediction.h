@@ -7,14 +7,15 @@
 // labelled, non-caught measured trial of every *other* participant (the trial's height, speed and
 // end of travel, calibration.h: request_for), and its curve is scored against that trial with
 // the calibration's objective (eq. 3-5, w = 20). Beside it, the same objective from every real
-// trial of the same height of a third participant (neither the target's nor the calibrated
-// one's) to the target: the real-person yardstick. The simulator predicts a trial "no worse than
+// trial of the same height and speed of a third participant (neither the target's nor the
+// calibrated one's) to the target: the real-person yardstick. The simulator predicts a trial "no worse than
 // another real person would" when its L is at most the median of those.
 //
 // Heights that the calibration did not fit (a participant whose inputs hold no middle trial) are
 // simulated at the nominal height, offset 0, as synthesis does.
 #pragma once
 
+#include <cmath>
 #include <functional>
 #include <string>
 #include <vector>
@@ -102,8 +103,19 @@ struct Discrepancy;
 void add_discrepancy(Prediction& p, const Discrepancy& d, const Dataset& ds, ObjectiveKind kind);
 
 // The real-person yardstick of one target: L(other, target) for every labelled, non-caught trial
-// of the same height whose participant is neither the target's nor `calibrated`, with the
-// objective `kind`; their median (NaN when none) and count.
+// of the same height and pull speed whose participant is neither the target's nor `calibrated`,
+// with the objective `kind`; their median (NaN when none) and count.
+//
+// The same speed, because eq. 3-5 pairs the two curves sample by sample: at 0.15 against 0.1 m/s
+// sample i of the faster pull runs 5 cm further ahead each second, and it ends its travel seconds
+// earlier, so w = 20 weighs the slower one's whole tail. Such an L measures the rig's speed,
+// not how another person differs: the study's one 0.15 m/s trial (s0-middlemiss-10) put the
+// middle arm's yardstick at 0.71-0.97 where the same-speed trials give 0.25-0.32 (session 90's
+// review). A target with no other trial at its speed has no yardstick (NaN, count 0), and
+// `summarize` makes no claim for it.
+inline constexpr double kSamePullSpeed = 0.005;  // [m/s] 5 % of the study's 0.1 m/s: about 3.5 cm
+                                                 // of travel apart after a 7 s pull
+inline bool same_pull_speed(double a, double b) { return std::abs(a - b) <= kSamePullSpeed; }
 std::pair<double, int> real_person_median(const Dataset& ds, const HapticSequence& target, const std::string& calibrated,
                                           ObjectiveKind kind);
 

@@ -666,5 +666,42 @@ TEST(Prediction, RealPersonYardstickOnTheStudy) {
   EXPECT_LT(m, 0.9);
 }
 
+// The middle arm's yardstick on the study: its trials pull at 0.1 m/s but one (s0-middlemiss-10)
+// at 0.15. Eq. 3-5 pairs samples by index, so that trial against a 0.1 m/s one measures the
+// rig's speed, not another person: it is kept out of the 0.1 m/s targets' yardsticks, and it has
+// none of its own (no other person pulled at 0.15). The L it would have added is printed and must
+// lie above every same-speed yardstick: it is what made the middle arm's bar 2.6-3.9x easier.
+TEST(Prediction, RealPersonYardstickComparesPullsOfOneSpeed) {
+  const auto dir = study_dir();
+  if (dir.empty()) GTEST_SKIP() << "shared/data/kapusta2016-calibration-trials not present";
+  const Dataset ds = import_study(dir);
+  const HapticSequence* fast = nullptr;
+  for (const auto& t : ds.trials)
+    if (t.height == ArmHeight::Middle && t.speed > 0.12) fast = &t;
+  ASSERT_NE(fast, nullptr) << "the study's 0.15 m/s middle trial";
+  int slow_targets = 0;
+  for (const HapticSequence* t : prediction_targets(ds, "4")) {
+    if (t->height != ArmHeight::Middle) continue;
+    const auto [median, count] = real_person_median(ds, *t, "4", ObjectiveKind::Area);
+    if (t == fast) {
+      EXPECT_EQ(count, 0) << t->id << ": no other person pulled at 0.15 m/s";
+      EXPECT_TRUE(std::isnan(median)) << t->id;
+      continue;
+    }
+    ++slow_targets;
+    // Third persons at 0.1 m/s: the middle trials of participants 2, 3 and 7, less the target's.
+    int expected = 0;
+    for (const auto& o : ds.trials)
+      expected += o.height == ArmHeight::Middle && o.participant != t->participant && o.participant != "4" &&
+                  o.participant != fast->participant;
+    EXPECT_EQ(count, expected) << t->id;
+    const double mixed = sequence_objective(ObjectiveKind::Area, fast->samples, t->samples);
+    std::printf("  %s: yardstick %.3f over %d trials at 0.1 m/s; L from the 0.15 m/s trial %.3f\n", t->id.c_str(),
+                median, count, mixed);
+    EXPECT_GT(mixed, 1.5 * median) << t->id;
+  }
+  EXPECT_EQ(slow_targets, 5);  // participants 2 (two), 3 and 7 (two)
+}
+
 }  // namespace
 }  // namespace dressguard::calib
