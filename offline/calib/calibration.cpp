@@ -649,20 +649,17 @@ Checkpoint decode_checkpoint(const std::string& text, const std::filesystem::pat
 }  // namespace
 
 void probe_checkpoint(const std::filesystem::path& path, const Comm& comm) {
-  std::string failed;
-  if (comm.is_root()) {
-    try {
+  try {
+    comm.on_root([&] {
       if (std::filesystem::is_directory(path)) throw std::runtime_error("it is a folder");
       std::filesystem::path probe = path;
       probe += ".probe";
       write_file_atomic(probe, "");
       std::filesystem::remove(probe);
-    } catch (const std::exception& e) {
-      failed = *e.what() ? e.what() : "unknown error";
-    }
+    });
+  } catch (const std::exception& e) {
+    throw_input_error(path, 0, "cannot write a checkpoint there: " + std::string(e.what()));
   }
-  comm.broadcast(failed);
-  if (!failed.empty()) throw_input_error(path, 0, "cannot write a checkpoint there: " + failed);
 }
 
 TrialBatchSimulator one_by_one(TrialSimulator sim) {
@@ -760,7 +757,9 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   if (!options.checkpoint.empty()) {
     probe_checkpoint(options.checkpoint, comm);
     std::string text;
-    if (comm.is_root() && std::filesystem::exists(options.checkpoint)) text = read_file(options.checkpoint);
+    comm.on_root([&] {
+      if (std::filesystem::exists(options.checkpoint)) text = read_file(options.checkpoint);
+    });
     comm.broadcast(text);
     if (!text.empty()) {
       const Checkpoint c = decode_checkpoint(text, options.checkpoint);
@@ -953,20 +952,17 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
       // Rank 0 writes it, and every rank learns whether it could: a failure ends them all. The
       // other ranks used to go on to the next generation and wait in its MPI_Allreduce for a rank
       // 0 that had died (a full quota held a Slurm job to its time limit: finding 1).
-      std::string failed;
-      if (comm.is_root()) {
-        try {
+      try {
+        comm.on_root([&] {
           write_file_atomic(options.checkpoint, encode_checkpoint(Checkpoint{fp, done, best_fits, es.save_state()}));
-        } catch (const std::exception& e) {
-          failed = *e.what() ? e.what() : "unknown error";
-        }
-      }
-      comm.broadcast(failed);
-      if (!failed.empty())
+        });
+      } catch (const std::exception& e) {
         throw std::runtime_error("the checkpoint of generation " + std::to_string(done) + " could not be written: " +
-                                 failed);
+                                 e.what());
+      }
     }
-    if (comm.is_root()) {
+    // A library caller's progress may throw too (the CLI's prints): on rank 0 alone, told to all.
+    comm.on_root([&] {
       if (progress) {
         GenerationProgress p;
         p.generation = done;
@@ -987,7 +983,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
         p.resumed = resumed;
         progress(p);
       }
-    }
+    });
   }
 
   CalibrationResult r;

@@ -7,6 +7,8 @@
 #include <cstdlib>
 #include <exception>
 #include <mutex>
+#include <stdexcept>
+#include <string>
 #include <thread>
 
 #ifdef DRESSGUARD_HAVE_MPI
@@ -32,7 +34,14 @@ Comm& Comm::world() {
       int initialised = 0;
       MPI_Initialized(&initialised);
       if (!initialised) {
-        MPI_Init(nullptr, nullptr);
+        // Funneled: run_batch's threads simulate, and only the thread that called it talks MPI
+        // (the collectives come after its workers have joined); MPI_Init would promise one
+        // thread in the whole process (MPI_THREAD_SINGLE).
+        int provided = MPI_THREAD_SINGLE;
+        MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
+        if (provided < MPI_THREAD_FUNNELED)
+          std::fprintf(stderr, "dressguard: warning: this MPI library gives no MPI_THREAD_FUNNELED (level %d); "
+                               "run with --threads 1 under mpirun\n", provided);
         std::atexit([] {
           int finalised = 0;
           MPI_Finalized(&finalised);
@@ -70,6 +79,29 @@ void Comm::broadcast(std::string& s) const {
   s.resize(static_cast<std::size_t>(n));
   MPI_Bcast(s.data(), static_cast<int>(n), MPI_CHAR, 0, MPI_COMM_WORLD);
 #endif
+}
+
+void Comm::on_root(const std::function<void()>& work) const {
+  if (size_ == 1) {
+    work();
+    return;
+  }
+  std::exception_ptr error;
+  std::string failed;  // empty: rank 0's work is done
+  if (is_root()) {
+    try {
+      work();
+    } catch (const std::exception& e) {
+      error = std::current_exception();
+      failed = *e.what() ? e.what() : "unknown error";
+    } catch (...) {
+      error = std::current_exception();
+      failed = "unknown error";
+    }
+  }
+  broadcast(failed);
+  if (error) std::rethrow_exception(error);
+  if (!failed.empty()) throw std::runtime_error("rank 0: " + failed);
 }
 
 std::uint64_t mix_seed(std::uint64_t seed, std::uint64_t key) {

@@ -31,6 +31,12 @@ class Comm {
   void barrier() const;
   // Rank 0's string on every rank.
   void broadcast(std::string& s) const;
+  // Runs `work` on rank 0 alone (a file only it writes or reads) and tells every rank how it
+  // went. A rank 0 that ended on its own would leave the others waiting in their next
+  // collective (barrier, allreduce, broadcast) until the job's time limit; so an exception on
+  // rank 0 is rethrown there as it was, and on every other rank as std::runtime_error("rank 0:
+  // " + its message), and every rank ends. One process: work() alone. A collective itself.
+  void on_root(const std::function<void()>& work) const;
   // True when compiled with MPI support (DRESSGUARD_WITH_MPI).
   static bool built_with_mpi();
 

@@ -340,8 +340,9 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
                       "this folder holds a synthesis with other settings (calibration, count, noise or seed); "
                       "choose another --out or remove it");
   comm.barrier();
-  if (comm.is_root()) write_file_atomic(record_path, record);
-  comm.barrier();
+  // Files that rank 0 alone writes go through Comm::on_root: a rank 0 that could not write one
+  // would otherwise end while the others wait for it at the next barrier, for good.
+  comm.on_root([&] { write_file_atomic(record_path, record); });
 
   MiddleEdge edge;
   double middle_base = 0.0;
@@ -353,21 +354,25 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
   if (options.high_low == HighLowArm::RepeatBand && options.arm_noise) {
     const fs::path band_path = out / ".synth" / "repeat-band.json";
     if (fs::exists(band_path)) {
-      const Json j = Json::parse(read_file(band_path), band_path);
-      high_band = band_from_json(j.at("high"), band_path);
-      low_band = band_from_json(j.at("low"), band_path);
+      try {
+        const Json j = Json::parse(read_file(band_path), band_path);
+        high_band = band_from_json(j.at("high"), band_path);
+        low_band = band_from_json(j.at("low"), band_path);
+      } catch (const InputError&) {
+        throw;
+      } catch (const std::exception& e) {  // a key missing or of another type: name the file
+        throw_input_error(band_path, 0, e.what());
+      }
     } else {
       high_band = locate_repeat_band(cal, sim, ArmHeight::High, options.threads, comm);
       low_band = locate_repeat_band(cal, sim, ArmHeight::Low, options.threads, comm);
-      comm.barrier();
-      if (comm.is_root()) {
+      comm.on_root([&] {
         Json j = Json::object();
         j.set("high", band_to_json(high_band));
         j.set("low", band_to_json(low_band));
         write_file_atomic(band_path, j.dump() + "\n");
-      }
+      });
     }
-    comm.barrier();
   }
   if (!options.arm_noise) high_band.lower = high_band.upper = low_band.lower = low_band.upper = 0.0;
   auto band_of = [&](ArmHeight h) -> const ArmBand& { return h == ArmHeight::Low ? low_band : high_band; };
@@ -432,7 +437,7 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
     s.per_height_label[static_cast<int>(heights[t / options.per_height])][label]++;
     s.resumed += res[kBlock * t + 1] > 0.5;
   }
-  if (comm.is_root()) {
+  comm.on_root([&] {
     Dataset ds;
     std::vector<double> arm_offsets, d_behind, d_ahead;
     for (int t = 0; t < total; ++t) {
@@ -453,8 +458,7 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
     }
     save_dataset(ds, out);
     write_file_atomic(out / "labels.csv", labels_csv(ds.trials, arm_offsets, d_behind, d_ahead));
-  }
-  comm.barrier();
+  });
   s.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return s;
 }

@@ -6,6 +6,7 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -1853,6 +1854,23 @@ TEST(Synthesis, RepeatBandEndsAtTheFistEdge) {
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find("repeat-band.json"), std::string::npos) << e.what();
       EXPECT_NE(std::string(e.what()).find("must hold 0"), std::string::npos) << e.what();
+    }
+    write_file_atomic(band_file, kept);
+  }
+  {  // A key missing: the reader's own message, and the file's name with it.
+    std::string bad = kept;
+    const auto at = bad.find("\"tolerance\"");
+    ASSERT_NE(at, std::string::npos);
+    bad.replace(at, std::strlen("\"tolerance\""), "\"tolerant\"");
+    write_file_atomic(band_file, bad);
+    try {
+      synthesize(cal, sim, o, a, Comm::world());
+      ADD_FAILURE() << "a band without its tolerance was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("repeat-band.json"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("tolerance"), std::string::npos) << e.what();
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << "not an InputError naming the file: " << e.what();
     }
     write_file_atomic(band_file, kept);
   }

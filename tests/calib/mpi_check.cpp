@@ -6,7 +6,12 @@
 // `calib_mpi_check --checkpoint-fails WORKDIR`: a calibration whose checkpoint cannot be written
 // after its first generation (its folder turns into a file while the generation is simulated).
 // Every rank must end with the error, printed as "rank R: ..." with exit 3
-// (mpi_checkpoint.cmake); rank 0 alone used to, and the others waited for it for good.
+// (mpi_root_failure.cmake); rank 0 alone used to, and the others waited for it for good.
+//
+// `calib_mpi_check --synthesis-fails WORKDIR`: a synthesis whose labels.csv, which rank 0 alone
+// writes once every rank's trials are in, cannot be written (a folder holds its place). Every
+// rank must end with the error too; rank 0 alone used to, the others waiting at the barrier
+// after it (session 90's review).
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -49,16 +54,42 @@ int checkpoint_fails(const std::filesystem::path& dir, const std::vector<HapticS
   return 0;
 }
 
+// The last file of a synthesis on `comm`, written by rank 0 alone, cannot be written.
+int synthesis_fails(const std::filesystem::path& dir, const Comm& comm) {
+  namespace fs = std::filesystem;
+  if (comm.is_root()) {
+    fs::remove_all(dir / "sf");
+    fs::create_directories(dir / "sf" / "labels.csv");
+  }
+  comm.barrier();
+  Calibration cal;
+  cal.cloth = ClothValues{0.4, 0.6, 0.3, 1.1, 0.5};
+  SynthesisOptions so;
+  so.per_height = 2;
+  so.threads = 1;
+  try {
+    synthesize(cal, testing::fake_simulate, so, dir / "sf", comm);
+  } catch (const std::exception& e) {
+    std::printf("rank %d: %s\n", comm.rank(), e.what());
+    std::fflush(stdout);
+    return 3;
+  }
+  std::printf("rank %d: synthesized, labels.csv's failure unnoticed\n", comm.rank());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   const bool fails = argc == 3 && std::strcmp(argv[1], "--checkpoint-fails") == 0;
-  if (argc != 2 && !fails) {
-    std::fprintf(stderr, "usage: calib_mpi_check [--checkpoint-fails] WORKDIR\n");
+  const bool synthesis = argc == 3 && std::strcmp(argv[1], "--synthesis-fails") == 0;
+  if (argc != 2 && !fails && !synthesis) {
+    std::fprintf(stderr, "usage: calib_mpi_check [--checkpoint-fails | --synthesis-fails] WORKDIR\n");
     return 2;
   }
   const std::filesystem::path dir = argv[argc - 1];
   const Comm& comm = Comm::world();
+  if (synthesis) return synthesis_fails(dir, comm);
   std::vector<HapticSequence> inputs;
   for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
     HapticSequence s;
