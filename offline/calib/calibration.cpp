@@ -519,22 +519,6 @@ double simulated_time(const std::vector<SimulatedTrial>& sts) {
   return s;
 }
 
-// Pruning's rule for the mu best (calibration.h): the cut candidates (cut[c]) to simulate in
-// whole, the lowest bounds f[c] first, so that mu whole candidates score at or below every
-// bound left; none when that already holds.
-std::vector<int> to_simulate_again(const std::vector<double>& f, const std::vector<char>& cut, int mu) {
-  std::vector<int> cuts;
-  for (std::size_t c = 0; c < f.size(); ++c)
-    if (cut[c]) cuts.push_back(static_cast<int>(c));
-  if (cuts.empty()) return {};
-  std::stable_sort(cuts.begin(), cuts.end(), [&](int a, int b) { return f[a] < f[b]; });
-  int below = 0;
-  for (std::size_t c = 0; c < f.size(); ++c) below += !cut[c] && f[c] <= f[cuts.front()] ? 1 : 0;
-  const int need = std::min(mu - below, static_cast<int>(cuts.size()));
-  cuts.resize(static_cast<std::size_t>(std::max(need, 0)));
-  return cuts;
-}
-
 // What must match for a checkpoint to continue this run.
 std::string fingerprint(const std::vector<HapticSequence>& inputs, const ParameterSpace& space,
                         const CalibrationOptions& o) {
@@ -647,6 +631,27 @@ Checkpoint decode_checkpoint(const std::string& text, const std::filesystem::pat
 }
 
 }  // namespace
+
+std::vector<int> cut_candidates_to_finish(const Cmaes& es, const std::vector<double>& f, const std::vector<char>& cut) {
+  // The cut candidates that must be whole for the mu lowest of `v` to be whole ones: the lowest
+  // first, `mu minus the whole ones at or below every cut one` of them.
+  auto needed_by = [&](const std::vector<double>& v) {
+    std::vector<int> cuts;
+    for (std::size_t c = 0; c < v.size(); ++c)
+      if (cut[c]) cuts.push_back(static_cast<int>(c));
+    if (cuts.empty()) return cuts;
+    std::stable_sort(cuts.begin(), cuts.end(), [&](int a, int b) { return v[a] < v[b]; });
+    int below = 0;
+    for (std::size_t c = 0; c < v.size(); ++c) below += !cut[c] && v[c] <= v[cuts.front()] ? 1 : 0;
+    const int need = std::min(es.mu() - below, static_cast<int>(cuts.size()));
+    cuts.resize(static_cast<std::size_t>(std::max(need, 0)));
+    return cuts;
+  };
+  std::vector<int> out = needed_by(es.ranking_values(f));  // those that set the mean
+  for (int c : needed_by(f))                                 // the best point and its L
+    if (std::find(out.begin(), out.end(), c) == out.end()) out.push_back(c);
+  return out;
+}
 
 void probe_checkpoint(const std::filesystem::path& path, const Comm& comm) {
   try {
@@ -928,7 +933,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
     // Keep the mu best exact (calibration.h): finish in whole the cut candidates of the lowest
     // bounds until mu fully simulated ones score at or below every bound left.
     int resimulated = 0;
-    for (std::vector<int> again; !(again = to_simulate_again(f, cut, es.mu())).empty();) {
+    for (std::vector<int> again; !(again = cut_candidates_to_finish(es, f, cut)).empty();) {
       const std::vector<double> redo = finish_cut(xs, again, done + 1);
       for (int c : again) {
         std::copy_n(redo.begin() + static_cast<long>(c) * W, W, per.begin() + static_cast<long>(c) * W);

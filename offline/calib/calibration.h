@@ -537,14 +537,16 @@ double lateral_term(const std::vector<HapticSequence>& inputs, const std::vector
 // that misses where the measured one caught runs the rig's whole travel, charged at w = 20 from
 // where the measurement stopped. Afterwards, while fewer than mu of the fully simulated candidates
 // score at or below the lowest bound among the cut ones, the `mu minus that count` cut candidates
-// with the lowest bounds are simulated in whole: each cut trial goes on from where it was cut
-// when the simulator kept its state (SimulatedTrial::rest: the cloth simulator does), else the
-// candidate is simulated again; both give the same bits. So the mu best candidates, which set the
-// mean and the positive weights (tutorial eq. 41-47), are always known exactly. What the bound
-// leaves approximate is the order among the rest: the negative weights of active CMA (eq. 53)
-// go by it, and the boundary penalty's scale (the values' inter-quartile range) uses it, so a
-// pruned search is not the unpruned one to the bit. It is deterministic, the same on any thread
-// or rank count, and resumes to the same bits.
+// with the lowest bounds are simulated in whole, and the same by Cmaes::ranking_values (f plus the
+// boundary penalty, what sets the mean; cut_candidates_to_finish: until session 90 it went by f
+// alone, and a repaired candidate's penalty could put a cut one among the mu that set it): each cut
+// trial goes on from where it was cut when the simulator kept its state (SimulatedTrial::rest: the
+// cloth simulator does), else the candidate is simulated again; both give the same bits. So the mu
+// candidates that set the mean and the positive weights (tutorial eq. 41-47), and the generation's
+// best, are always known exactly. What the bound leaves approximate is the order among the rest:
+// the negative weights of active CMA (eq. 53) go by it, and the boundary penalty's scale (the
+// values' inter-quartile range) uses it, so a pruned search is not the unpruned one to the bit. It
+// is deterministic, the same on any thread or rank count, and resumes to the same bits.
 //
 // Failures. options.checkpoint is probed before the start is simulated (probe_checkpoint), and a
 // checkpoint that cannot be written after a generation ends every rank with std::runtime_error
@@ -564,6 +566,16 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
 CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const ParameterSpace& space,
                             const TrialBatchSimulator& sim, const CalibrationOptions& options, const Comm& comm,
                             const std::function<void(const GenerationProgress&)>& progress = {});
+
+// Pruning's rule (above), for a generation whose candidates c with cut[c] are known only by the
+// lower bound f[c]: the cut candidates to simulate in whole so that the mu candidates of lowest
+// ranking value (es.ranking_values(f): those that set the mean, eq. 41) and the mu of lowest f
+// (the generation's best point and its L, which the result reports) are all whole ones, lowest
+// first; none when that already holds. Finishing a candidate raises its f and
+// can change the penalty's weight, so the caller asks again until none are left. Between
+// es.ask() and es.tell().
+class Cmaes;
+std::vector<int> cut_candidates_to_finish(const Cmaes& es, const std::vector<double>& f, const std::vector<char>& cut);
 
 // Whether a checkpoint can be written at `path`, asked before a search, which writes its first
 // only after a generation (20 minutes into a run on the full gown): rank 0 makes its folder and

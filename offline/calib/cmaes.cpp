@@ -208,11 +208,42 @@ void Cmaes::minimize(const Objective& f) {
   while (!stopped()) step(f);
 }
 
+std::vector<double> Cmaes::ranking_values(const std::vector<double>& f) const {
+  if (!asked_) throw std::logic_error("cmaes: ranking_values() without a matching ask()");
+  const int lambda = state_.lambda;
+  if (static_cast<int>(f.size()) != lambda) throw std::invalid_argument("cmaes: ranking_values() needs lambda values");
+  // Ranking values: the repaired point's value plus the boundary penalty (cmaes.h, Appendix B.5).
+  // The penalty's weight is the spread of the values that were evaluated: the IQR of the finite
+  // ones. A failed evaluation has no value; counted as DBL_MAX, a quarter of a generation failing
+  // made the weight DBL_MAX and every repaired candidate's rank value infinite, behind the failures,
+  // which then took positive weights in eq. 41 (session 84's review, finding 6).
+  std::vector<double> rank_f(f);
+  std::vector<double> sorted;
+  for (int k = 0; k < lambda; ++k) {
+    if (std::isfinite(f[k]))
+      sorted.push_back(f[k]);
+    else
+      rank_f[k] = std::numeric_limits<double>::infinity();
+  }
+  if (settings_.lower) {
+    std::sort(sorted.begin(), sorted.end());
+    const std::size_t m = sorted.size();
+    const double iqr = m == 0 ? 0.0 : sorted[(3 * (m - 1)) / 4] - sorted[(m - 1) / 4];
+    const double gamma = std::max(iqr, 1e-12);
+    for (int k = 0; k < lambda; ++k) {
+      const double d2 = (x_unrepaired_[k] - x_repaired_[k]).squaredNorm();
+      if (d2 > 0 && std::isfinite(f[k])) rank_f[k] = f[k] + gamma * d2 / (state_.sigma * state_.sigma);
+    }
+  }
+  return rank_f;
+}
+
 void Cmaes::tell(const std::vector<double>& f_in) {
   if (!asked_) throw std::logic_error("cmaes: tell() without a matching ask()");
   const int n = state_.n;
   const int lambda = state_.lambda;
   if (static_cast<int>(f_in.size()) != lambda) throw std::invalid_argument("cmaes: tell() needs lambda values");
+  const std::vector<double> rank_f = ranking_values(f_in);
   asked_ = false;
   std::vector<double> f(f_in);
   std::vector<char> failed(static_cast<std::size_t>(lambda), 0);
@@ -227,25 +258,6 @@ void Cmaes::tell(const std::vector<double>& f_in) {
     if (f[k] < state_.best_f) {
       state_.best_f = f[k];
       state_.best_x = x_repaired_[k];
-    }
-  }
-  // Ranking values: the repaired point's value plus the boundary penalty (cmaes.h, Appendix B.5).
-  // The penalty's weight is the spread of the values that were evaluated: the IQR of the finite
-  // ones. A failed evaluation has no value; counted as DBL_MAX, a quarter of a generation failing
-  // made the weight DBL_MAX and every repaired candidate's rank value infinite, behind the failures,
-  // which then took positive weights in eq. 41 (session 84's review, finding 6).
-  std::vector<double> rank_f(f);
-  if (settings_.lower) {
-    std::vector<double> sorted;
-    for (int k = 0; k < lambda; ++k)
-      if (!failed[k]) sorted.push_back(f[k]);
-    std::sort(sorted.begin(), sorted.end());
-    const std::size_t m = sorted.size();
-    const double iqr = m == 0 ? 0.0 : sorted[(3 * (m - 1)) / 4] - sorted[(m - 1) / 4];
-    const double gamma = std::max(iqr, 1e-12);
-    for (int k = 0; k < lambda; ++k) {
-      const double d2 = (x_unrepaired_[k] - x_repaired_[k]).squaredNorm();
-      if (d2 > 0 && !failed[k]) rank_f[k] = f[k] + gamma * d2 / (state_.sigma * state_.sigma);
     }
   }
   // Failures last whatever a penalty adds to the others (a rank value may overflow to infinity),

@@ -105,6 +105,12 @@ class Cmaes {
   std::vector<Eigen::VectorXd> ask();
   // Objective values of the candidates from the last ask(). NaN or inf counts as worst.
   void tell(const std::vector<double>& f);
+  // The values tell(f) ranks the last ask()'s candidates by: f at the repaired point plus the
+  // boundary penalty (above), +infinity for a failed evaluation (NaN or inf, ranked last). The
+  // mu lowest set the mean (eq. 41), so a caller that knows some f only as lower bounds
+  // (calibration's pruning) must know these mu exactly, not the mu lowest f: a repaired
+  // candidate's penalty can put a lower f behind a higher one. Between ask() and tell().
+  std::vector<double> ranking_values(const std::vector<double>& f) const;
 
   // The serial driver for a cheap objective on one thread: step() is one ask, f at every
   // candidate in order, tell; minimize() steps until a stopping criterion fires. Calibration
