@@ -43,7 +43,8 @@ enum class StopReason {
   ConditionCov,       // cond(C) above 1e14 (local)
   NoEffectAxis,       // adding 0.1 sigma along a principal axis leaves the mean unchanged (local)
   NoEffectCoord,      // adding 0.2 sigma to a coordinate leaves it unchanged (local)
-  Stagnation,         // no improvement of the median over many generations (local)
+  Stagnation,         // over the last 20 % of generations (>= 120 + 30 n / lambda, <= 20 000), the
+                      // newest 30 % improve on the oldest 30 % neither in best nor in median (local)
 };
 const char* stop_reason_name(StopReason r);
 
@@ -83,7 +84,8 @@ struct CmaesState {
   double sigma = 0.0;
   Eigen::VectorXd mean, pc, ps;
   Eigen::MatrixXd C;
-  // History for TolFun and stagnation (best and median of each generation of this restart).
+  // History for TolFun and stagnation (best and median of each generation of this restart): the
+  // newest max(20 000, TolFun's window) generations, all that the two criteria look at.
   std::vector<double> best_history, median_history;
   // Best point seen over the whole run (repaired, i.e. feasible).
   Eigen::VectorXd best_x;
