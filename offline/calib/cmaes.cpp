@@ -3,8 +3,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <numeric>
 #include <random>
 #include <sstream>
@@ -498,21 +500,49 @@ std::string Cmaes::save_state() const {
   return o.str();
 }
 
+// A state is read as a whole and checked before it replaces the current one: every key exactly
+// once, every value one that save_state() can have written. A missing `sigma` line used to leave
+// sigma at 0, and every candidate of the resumed search was the mean (session 90's review).
+// The messages name the key; the calibration adds the checkpoint's file.
 void Cmaes::restore_state(const std::string& text) {
   std::istringstream in(text);
-  std::string key;
+  std::string key;  // the key being read, for the messages
   CmaesState s;
   auto fail = [](const std::string& what) { throw std::runtime_error("cmaes state: " + what); };
-  auto read_double = [&](double& v) {
+  auto number = [](double v) {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    return std::string(buf);
+  };
+  auto read_token = [&]() {
     std::string tok;
-    if (!(in >> tok)) fail("truncated");
+    if (!(in >> tok)) fail("'" + key + "': truncated");
+    return tok;
+  };
+  auto read_double = [&](double& v) {
+    const std::string tok = read_token();
     char* end = nullptr;
     v = std::strtod(tok.c_str(), &end);
-    if (end == tok.c_str() || *end) fail("bad number '" + tok + "'");
+    if (end == tok.c_str() || *end) fail("'" + key + "': bad number '" + tok + "'");
+  };
+  auto read_long = [&](long& v) {
+    const std::string tok = read_token();
+    char* end = nullptr;
+    errno = 0;
+    v = std::strtol(tok.c_str(), &end, 10);
+    if (end == tok.c_str() || *end || errno == ERANGE) fail("'" + key + "': bad whole number '" + tok + "'");
+  };
+  auto read_int = [&](int& v) {
+    long l = 0;
+    read_long(l);
+    if (l < std::numeric_limits<int>::min() || l > std::numeric_limits<int>::max())
+      fail("'" + key + "': " + std::to_string(l) + " is out of range");
+    v = static_cast<int>(l);
   };
   auto read_vec = [&](Eigen::VectorXd& v) {
     long size = 0;
-    if (!(in >> size) || size < 0 || size > 1000000) fail("bad vector size");
+    read_long(size);
+    if (size < 0 || size > 1000000) fail("'" + key + "': bad vector size " + std::to_string(size));
     v.resize(size);
     for (long i = 0; i < size; ++i) read_double(v[i]);
   };
@@ -523,28 +553,35 @@ void Cmaes::restore_state(const std::string& text) {
   };
   int version = 0;
   if (!(in >> key >> version) || key != "cmaes-state" || version != 1) fail("not a cmaes state (version 1)");
+  // The keys save_state() writes, each exactly once.
+  static const char* const kKeys[] = {
+      "n", "lambda", "restart", "generation", "generations_total", "evaluations", "bipop_large_evals",
+      "bipop_small_evals", "bipop_large_restarts", "bipop_small_regime", "stopped", "sigma",
+      "sigma_this_restart", "best_f", "mean", "pc", "ps", "best_x", "C", "best_history", "median_history"};
+  std::vector<std::string> seen;
   bool ended = false;
   Eigen::VectorXd cflat;
+  int small_regime = 0, stopped = 0;
   while (in >> key) {
     if (key == "end") {
       ended = true;
       break;
     }
-    if (key == "n") in >> s.n;
-    else if (key == "lambda") in >> s.lambda;
-    else if (key == "restart") in >> s.restart;
-    else if (key == "generation") in >> s.generation;
-    else if (key == "generations_total") in >> s.generations_total;
-    else if (key == "evaluations") in >> s.evaluations;
-    else if (key == "bipop_large_evals") in >> s.bipop_large_evals;
-    else if (key == "bipop_small_evals") in >> s.bipop_small_evals;
-    else if (key == "bipop_large_restarts") in >> s.bipop_large_restarts;
-    else if (key == "bipop_small_regime") in >> s.bipop_small_regime;
-    else if (key == "stopped") {
-      int v = 0;
-      in >> v;
-      s.stopped = static_cast<StopReason>(v);
-    } else if (key == "sigma") read_double(s.sigma);
+    if (std::find(std::begin(kKeys), std::end(kKeys), key) == std::end(kKeys)) fail("unknown key '" + key + "'");
+    if (std::find(seen.begin(), seen.end(), key) != seen.end()) fail("key '" + key + "' given twice");
+    seen.push_back(key);
+    if (key == "n") read_int(s.n);
+    else if (key == "lambda") read_int(s.lambda);
+    else if (key == "restart") read_int(s.restart);
+    else if (key == "generation") read_long(s.generation);
+    else if (key == "generations_total") read_long(s.generations_total);
+    else if (key == "evaluations") read_long(s.evaluations);
+    else if (key == "bipop_large_evals") read_long(s.bipop_large_evals);
+    else if (key == "bipop_small_evals") read_long(s.bipop_small_evals);
+    else if (key == "bipop_large_restarts") read_int(s.bipop_large_restarts);
+    else if (key == "bipop_small_regime") read_int(small_regime);
+    else if (key == "stopped") read_int(stopped);
+    else if (key == "sigma") read_double(s.sigma);
     else if (key == "sigma_this_restart") read_double(s.sigma_this_restart);
     else if (key == "best_f") read_double(s.best_f);
     else if (key == "mean") read_vec(s.mean);
@@ -554,15 +591,88 @@ void Cmaes::restore_state(const std::string& text) {
     else if (key == "C") read_vec(cflat);
     else if (key == "best_history") read_list(s.best_history);
     else if (key == "median_history") read_list(s.median_history);
-    else fail("unknown key '" + key + "'");
-    if (!in) fail("bad value for '" + key + "'");
   }
-  if (!ended) fail("missing 'end' (truncated file)");
+  if (!ended) fail("missing 'end' (truncated state)");
+  if (in >> key) fail("text after 'end': '" + key + "'");
+  for (const char* k : kKeys)
+    if (std::find(seen.begin(), seen.end(), k) == seen.end()) fail(std::string("missing key '") + k + "'");
+
+  // Values. Counters first: they size and bound the rest.
   if (s.n != state_.n) fail("dimension " + std::to_string(s.n) + " does not match " + std::to_string(state_.n));
-  if (s.mean.size() != s.n || s.pc.size() != s.n || s.ps.size() != s.n || s.best_x.size() != s.n ||
-      cflat.size() != static_cast<long>(s.n) * s.n || s.lambda < 2)
-    fail("inconsistent sizes");
+  if (s.lambda < 2) fail("'lambda' " + std::to_string(s.lambda) + " is below 2");
+  for (const auto& [name, v] : {std::pair<const char*, long>{"restart", s.restart},
+                                {"generation", s.generation},
+                                {"generations_total", s.generations_total},
+                                {"evaluations", s.evaluations},
+                                {"bipop_large_evals", s.bipop_large_evals},
+                                {"bipop_small_evals", s.bipop_small_evals},
+                                {"bipop_large_restarts", s.bipop_large_restarts}})
+    if (v < 0) fail(std::string("'") + name + "' " + std::to_string(v) + " is negative");
+  if (s.generations_total < s.generation)
+    fail("'generations_total' " + std::to_string(s.generations_total) + " is below 'generation' " +
+         std::to_string(s.generation));
+  // This restart's generations alone took lambda evaluations each.
+  if (s.evaluations / s.lambda < s.generation)
+    fail("'evaluations' " + std::to_string(s.evaluations) + " is below lambda x generation (" +
+         std::to_string(s.lambda) + " x " + std::to_string(s.generation) + ")");
+  if (s.bipop_large_restarts > s.restart)
+    fail("'bipop_large_restarts' " + std::to_string(s.bipop_large_restarts) + " is above 'restart' " +
+         std::to_string(s.restart));
+  if (small_regime != 0 && small_regime != 1)
+    fail("'bipop_small_regime' is " + std::to_string(small_regime) + ", not 0 or 1");
+  s.bipop_small_regime = small_regime != 0;
+  if (stopped < 0 || stopped > static_cast<int>(StopReason::Stagnation))
+    fail("'stopped' " + std::to_string(stopped) + " is no stop reason");
+  s.stopped = static_cast<StopReason>(stopped);
+  // Step sizes: sigma 0 samples every candidate at the mean; sigma0 of the restart scales nothing
+  // yet but is a step size too.
+  for (const auto& [name, v] : {std::pair<const char*, double>{"sigma", s.sigma},
+                                {"sigma_this_restart", s.sigma_this_restart}})
+    if (!(std::isfinite(v) && v > 0)) fail(std::string("'") + name + "' must be finite and above 0, not " + number(v));
+  // best_f is a value that tell() kept: a failure's is DBL_MAX, never NaN or infinite.
+  if (!std::isfinite(s.best_f)) fail("'best_f' must be finite, not " + number(s.best_f));
+  for (const auto& [name, v] : {std::pair<const char*, const Eigen::VectorXd*>{"mean", &s.mean},
+                                {"pc", &s.pc},
+                                {"ps", &s.ps},
+                                {"best_x", &s.best_x}}) {
+    if (v->size() != s.n)
+      fail(std::string("'") + name + "' has " + std::to_string(v->size()) + " values, not n = " + std::to_string(s.n));
+    if (!v->allFinite()) fail(std::string("'") + name + "' must be finite");
+  }
+  if (cflat.size() != static_cast<long>(s.n) * s.n)
+    fail("'C' has " + std::to_string(cflat.size()) + " values, not n^2 = " + std::to_string(s.n * s.n));
+  if (!cflat.allFinite()) fail("'C' must be finite");
   s.C = Eigen::Map<Eigen::MatrixXd>(cflat.data(), s.n, s.n);
+  // A covariance matrix: positive variances and symmetric. save_state() writes C as update_eigen()
+  // left it, (C + C^T) / 2, which is symmetric to the bit (a + b == b + a, and halving is exact),
+  // so a written state passes with equality; the tolerance is for a hand-made one. Each pair is
+  // measured against sqrt(C_ii C_jj), the bound on |C_ij| of any covariance (Cauchy-Schwarz), so
+  // the test is as tight for a badly conditioned C as for the identity; 1e-12 of it admits
+  // decimal text of 13 or more significant digits and no asymmetry that could move the search
+  // (restore symmetrises C as update_eigen does). Positive definiteness is not asked: near
+  // ConditionCov's 1e14 the rounding of an eigen decomposition may call a valid C indefinite,
+  // and update_eigen() keeps the eigenvalues at 1e-300 or above.
+  for (int i = 0; i < s.n; ++i)
+    if (!(s.C(i, i) > 0)) fail("'C' has the variance " + number(s.C(i, i)) + " at (" + std::to_string(i) + ", " +
+                               std::to_string(i) + "); a variance must be above 0");
+  for (int i = 0; i < s.n; ++i)
+    for (int j = i + 1; j < s.n; ++j)
+      if (!(std::abs(s.C(i, j) - s.C(j, i)) <= 1e-12 * std::sqrt(s.C(i, i) * s.C(j, j))))
+        fail("'C' is not symmetric: " + number(s.C(i, j)) + " at (" + std::to_string(i) + ", " + std::to_string(j) +
+             "), " + number(s.C(j, i)) + " at (" + std::to_string(j) + ", " + std::to_string(i) + ")");
+  // One value per generation of this restart, the newest history_capacity() of them (a longer
+  // history of a state written before the cap is cut to it).
+  const std::size_t capacity = history_capacity(s.n, s.lambda);
+  const std::size_t generations = static_cast<std::size_t>(s.generation);
+  for (const auto& [name, h] : {std::pair<const char*, std::vector<double>*>{"best_history", &s.best_history},
+                                {"median_history", &s.median_history}}) {
+    if (h->size() != std::min(generations, capacity) && h->size() != generations)
+      fail(std::string("'") + name + "' has " + std::to_string(h->size()) + " values for " +
+           std::to_string(generations) + " generations (one each, the newest " + std::to_string(capacity) + ")");
+    if (!std::all_of(h->begin(), h->end(), [](double v) { return std::isfinite(v); }))
+      fail(std::string("'") + name + "' must be finite");
+    if (h->size() > capacity) h->erase(h->begin(), h->end() - static_cast<long>(capacity));
+  }
   state_ = std::move(s);
   derive_strategy();
   update_eigen();

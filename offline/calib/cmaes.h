@@ -130,7 +130,11 @@ class Cmaes {
   double best_f() const { return state_.best_f; }
 
   // Exact text serialisation of the state (hex floats): restore_state(save_state()) continues
-  // with identical bits. Throws std::runtime_error on a malformed or mismatching text.
+  // with identical bits. restore_state takes only a text that save_state can have written: each
+  // key exactly once, counters not negative and consistent, sigma finite and above 0, mean, paths
+  // and C finite, C with positive variances and symmetric, one history value per generation.
+  // Otherwise it throws std::runtime_error naming the key and what is wrong, and the search
+  // stays as it was.
   std::string save_state() const;
   void restore_state(const std::string& text);
 

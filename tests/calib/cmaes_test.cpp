@@ -8,6 +8,8 @@
 #include <functional>
 #include <limits>
 #include <numeric>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "cmaes.h"
@@ -111,6 +113,125 @@ TEST(Cmaes, RestoreRejectsTruncatedState) {
   s4.x0 = Eigen::VectorXd::Zero(4);
   Cmaes c(s4);
   EXPECT_THROW(c.restore_state(text), std::runtime_error);
+}
+
+// A state's text with one key's line changed: `value` replaces what follows the key ("" removes
+// the line, "twice" writes it twice).
+std::string with_line(const std::string& text, const std::string& key, const std::string& value) {
+  const std::size_t at = text.find("\n" + key + " ");
+  EXPECT_NE(at, std::string::npos) << key;
+  if (at == std::string::npos) return text;
+  const std::size_t end = text.find('\n', at + 1);
+  const std::string line = text.substr(at + 1, end - at - 1);
+  std::string out = text.substr(0, at + 1);
+  if (value == "twice") out += line + "\n" + line;
+  else if (!value.empty()) out += key + " " + value;
+  else return out + text.substr(end + 1);
+  return out + text.substr(end);
+}
+
+// The numbers of a vector's line (after its count), and the line's text for numbers (their count,
+// then each in hex, as save_state writes them).
+std::vector<double> numbers_of(const std::string& text, const std::string& key) {
+  const std::size_t at = text.find("\n" + key + " ") + key.size() + 2;
+  std::istringstream in(text.substr(at, text.find('\n', at) - at));
+  std::size_t count = 0;
+  in >> count;
+  std::vector<double> v;
+  for (std::string tok; in >> tok;) v.push_back(std::strtod(tok.c_str(), nullptr));
+  EXPECT_EQ(v.size(), count) << key;
+  return v;
+}
+std::string hex_list(const std::vector<double>& v) {
+  std::string out = std::to_string(v.size());
+  char buf[64];
+  for (double x : v) {
+    std::snprintf(buf, sizeof buf, " %a", x);
+    out += buf;
+  }
+  return out;
+}
+
+// restore_state takes only what save_state can have written (session 90's review: a checkpoint
+// without its `sigma` line was accepted with sigma = 0, and every candidate was the mean). Each
+// key must be there exactly once and hold a valid value; the message names the key, and a refused
+// text leaves the search as it was.
+TEST(Cmaes, RestoreRequiresEachKeyOnceWithAValidValue) {
+  CmaesSettings s;
+  s.x0 = Eigen::VectorXd::Constant(3, 0.4);
+  s.seed = 2;
+  Cmaes a(s);
+  for (int g = 0; g < 6; ++g) a.step(ellipsoid);
+  const std::string text = a.save_state();
+  Cmaes b(s);
+  b.step(sphere);
+  const std::string before = b.save_state();
+  auto refused = [&](const std::string& changed, const std::string& why) {
+    try {
+      b.restore_state(changed);
+      ADD_FAILURE() << "accepted; expected a refusal naming \"" << why << "\"";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << "message: " << e.what();
+    }
+    EXPECT_EQ(b.save_state(), before) << "a refused state changed the search (" << why << ")";
+  };
+  const char* const keys[] = {"n", "lambda", "restart", "generation", "generations_total", "evaluations",
+                              "bipop_large_evals", "bipop_small_evals", "bipop_large_restarts",
+                              "bipop_small_regime", "stopped", "sigma", "sigma_this_restart", "best_f", "mean",
+                              "pc", "ps", "best_x", "C", "best_history", "median_history"};
+  for (const char* key : keys) {
+    refused(with_line(text, key, ""), std::string("missing key '") + key + "'");
+    refused(with_line(text, key, "twice"), std::string("key '") + key + "' given twice");
+  }
+  refused(text + "sigma 0x1p+0\n", "text after 'end'");
+  refused(with_line(text, "sigma", "0x1p+0\nsigma2 0x1p+0"), "unknown key 'sigma2'");
+  for (const char* v : {"0x0p+0", "-0x1p-3", "inf", "nan"}) {
+    refused(with_line(text, "sigma", v), "'sigma' must be finite and above 0");
+    refused(with_line(text, "sigma_this_restart", v), "'sigma_this_restart' must be finite and above 0");
+  }
+  refused(with_line(text, "best_f", "nan"), "'best_f' must be finite");
+  for (const char* key : {"mean", "pc", "ps", "best_x"}) {
+    std::vector<double> v = numbers_of(text, key);
+    v[2] = std::numeric_limits<double>::quiet_NaN();
+    refused(with_line(text, key, hex_list(v)), std::string("'") + key + "' must be finite");
+    v.pop_back();  // two values for n = 3
+    refused(with_line(text, key, hex_list(v)), std::string("'") + key + "' has 2 values");
+  }
+  // C, 3 x 3 column-major: (0, 0) is at 0, (1, 0) at 1, (0, 1) at 3, (1, 1) at 4.
+  const std::vector<double> c = numbers_of(text, "C");
+  ASSERT_EQ(c.size(), 9u);
+  ASSERT_EQ(c[1], c[3]) << "save_state wrote a C that is not symmetric to the bit";
+  std::vector<double> bad = c;
+  bad[3] = c[3] + 1e-9 * std::sqrt(c[0] * c[4]);
+  refused(with_line(text, "C", hex_list(bad)), "'C' is not symmetric");
+  bad = c;
+  bad[4] = 0;
+  refused(with_line(text, "C", hex_list(bad)), "'C' has the variance 0 at (1, 1)");
+  bad = c;
+  bad[7] = std::numeric_limits<double>::infinity();
+  refused(with_line(text, "C", hex_list(bad)), "'C' must be finite");
+  // Counters.
+  refused(with_line(text, "generation", "-1"), "'generation' -1 is negative");
+  refused(with_line(text, "evaluations", "-60"), "'evaluations' -60 is negative");
+  refused(with_line(text, "restart", "-2"), "'restart' -2 is negative");
+  refused(with_line(text, "generations_total", "5"), "'generations_total' 5 is below 'generation' 6");
+  refused(with_line(text, "evaluations", "41"), "'evaluations' 41 is below lambda x generation (7 x 6)");
+  refused(with_line(text, "bipop_large_restarts", "1"), "'bipop_large_restarts' 1 is above 'restart' 0");
+  refused(with_line(text, "lambda", "1"), "'lambda' 1 is below 2");
+  refused(with_line(text, "lambda", "7.5"), "'lambda': bad whole number '7.5'");
+  refused(with_line(text, "bipop_small_regime", "2"), "'bipop_small_regime' is 2, not 0 or 1");
+  refused(with_line(text, "stopped", "42"), "'stopped' 42 is no stop reason");
+  refused(with_line(text, "best_history", "2 0x1p+0 0x1p+0"), "'best_history' has 2 values for 6 generations");
+  std::vector<double> h = numbers_of(text, "median_history");
+  h[3] = std::numeric_limits<double>::infinity();
+  refused(with_line(text, "median_history", hex_list(h)), "'median_history' must be finite");
+  // Within the tolerance (1e-12 of sqrt(C_ii C_jj)): a hand-written C that rounded one entry.
+  bad = c;
+  bad[3] = c[3] + 1e-14 * std::sqrt(c[0] * c[4]);
+  EXPECT_NO_THROW(b.restore_state(with_line(text, "C", hex_list(bad))));
+  // And the text as written restores.
+  EXPECT_NO_THROW(b.restore_state(text));
+  EXPECT_EQ(b.save_state(), text);
 }
 
 // Bounds: the optimum of a shifted sphere lies outside the box [0, 1]^n at x = -1 in the first
