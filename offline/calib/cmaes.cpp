@@ -96,6 +96,7 @@ const char* stop_reason_name(StopReason r) {
     case StopReason::NoEffectAxis: return "no-effect-axis";
     case StopReason::NoEffectCoord: return "no-effect-coord";
     case StopReason::Stagnation: return "stagnation";
+    case StopReason::SmallRunBudget: return "small-run-budget";
   }
   return "?";
 }
@@ -421,33 +422,70 @@ StopReason Cmaes::local_stop(double generation_range) const {
     };
     if (newest(bh) >= oldest(bh) && newest(mh) >= oldest(mh)) return StopReason::Stagnation;
   }
+  // A BIPOP small-regime run: at most half the evaluations of the latest large run (Hansen 2009,
+  // section 2, the second regime's budget; see on_local_stop). Its population is at most half the
+  // large run's, so the budget is at least that run's generation count, never 0.
+  if (settings_.restarts == Restarts::Bipop && state_.bipop_small_regime &&
+      state_.generation >= state_.bipop_last_large_evals / 2 / state_.lambda)
+    return StopReason::SmallRunBudget;
   return StopReason::None;
 }
 
 void Cmaes::on_local_stop(StopReason r) {
-  if (settings_.restarts == Restarts::None || state_.restart >= settings_.max_restarts) {
+  if (settings_.restarts == Restarts::None) {
     state_.stopped = r;
     return;
   }
   const int lambda_default = settings_.lambda > 0 ? settings_.lambda : default_lambda(state_.n);
-  const long spent = static_cast<long>(state_.lambda) * state_.generation;
-  state_.restart += 1;
   if (settings_.restarts == Restarts::Ipop) {
     // IPOP: double the population, same sigma0 (Auger & Hansen 2005).
+    if (state_.restart >= settings_.max_restarts) {
+      state_.stopped = r;
+      return;
+    }
+    state_.restart += 1;
     start_restart(state_.lambda * 2, settings_.sigma0, /*reset_mean=*/true);
     return;
   }
-  // BIPOP (Hansen 2009): account the finished run to its regime, then run the regime that has
-  // used fewer evaluations. Large regime: lambda = 2^k lambda_default, sigma0. Small regime:
-  // lambda = floor(lambda_default (lambda_large / (2 lambda_default))^(u^2)), sigma0 10^(-2u).
-  (state_.bipop_small_regime ? state_.bipop_small_evals : state_.bipop_large_evals) += spent;
+  // BIPOP (Hansen 2009, section 2): after the first run with the default population, two regimes
+  // of restarts, each time the one that has used fewer evaluations; cmaes.h, Restarts, has the
+  // rules. Where the sources differ, the choices made here:
+  // - The first run counts to neither regime (Hansen 2009 runs it before the two regimes begin;
+  //   so does DEAP's port of the paper; pycma counts it to the small regime), and a tie goes to
+  //   the large regime, so the first restart is a large one. Counted to the large regime (as
+  //   here until session 90), it made the first restarts small ones with lambda_large =
+  //   lambda_def, which the formula below turns into floor(lambda_def 0.5^(U^2)), under the
+  //   default (n = 8: 7 and 8 against 10; session 90's review).
+  // - lambda_large in lambda_s = floor(lambda_def (lambda_large / (2 lambda_def))^(U^2)) is the
+  //   latest large run's population, so lambda_def <= lambda_s <= lambda_large / 2 (the paper's
+  //   range); pycma's fmin draws up to the latest large population itself.
+  // - A small run's budget is half the evaluations of the latest large run (Hansen 2009 limits
+  //   the second regime's runs to half the budget of the first regime's last run; so does DEAP's
+  //   port); pycma allows half of all the large regime's evaluations. local_stop() applies it.
+  const long spent = static_cast<long>(state_.lambda) * state_.generation;
+  if (state_.bipop_small_regime) {
+    state_.bipop_small_evals += spent;
+  } else if (state_.restart > 0) {
+    state_.bipop_large_evals += spent;
+    state_.bipop_last_large_evals = spent;
+  }
+  const bool small_next = state_.bipop_small_evals < state_.bipop_large_evals;
+  // max_restarts counts the large regime's restarts: the search ends when the last of them (or
+  // the first run) stops. A small run begins only while the large regime has a restart left, so
+  // after one the large regime may still run; the `!small_next` half only keeps a hand-made state
+  // from going past max_restarts.
+  if ((!state_.bipop_small_regime || !small_next) && state_.bipop_large_restarts >= settings_.max_restarts) {
+    state_.stopped = r;
+    return;
+  }
+  state_.restart += 1;
   Normal rng(stream_seed(settings_.seed, state_.restart, -2));
-  if (state_.bipop_small_evals < state_.bipop_large_evals) {
-    const double u1 = rng.uniform(), u2 = rng.uniform();
+  if (small_next) {
+    const double u_lambda = rng.uniform(), u_sigma = rng.uniform();
     const double lambda_large = std::ldexp(static_cast<double>(lambda_default), state_.bipop_large_restarts);
-    const int lambda_s = std::max(
-        2, static_cast<int>(std::floor(lambda_default * std::pow(0.5 * lambda_large / lambda_default, u1 * u1))));
-    start_restart(lambda_s, settings_.sigma0 * std::pow(10.0, -2.0 * u2), /*reset_mean=*/true);
+    const int lambda_s = static_cast<int>(
+        std::floor(lambda_default * std::pow(0.5 * lambda_large / lambda_default, u_lambda * u_lambda)));
+    start_restart(lambda_s, settings_.sigma0 * std::pow(10.0, -2.0 * u_sigma), /*reset_mean=*/true);
     state_.bipop_small_regime = true;
   } else {
     state_.bipop_large_restarts += 1;
@@ -480,12 +518,15 @@ void put_list(std::ostringstream& o, const char* key, const std::vector<double>&
 
 std::string Cmaes::save_state() const {
   std::ostringstream o;
-  o << "cmaes-state 1\n";
+  // Version 2 (session 90) adds bipop_last_large_evals; restore_state reads version 1 too.
+  o << "cmaes-state 2\n";
   o << "n " << state_.n << "\nlambda " << state_.lambda << "\nrestart " << state_.restart
     << "\ngeneration " << state_.generation << "\ngenerations_total " << state_.generations_total
     << "\nevaluations " << state_.evaluations << "\nbipop_large_evals " << state_.bipop_large_evals
-    << "\nbipop_small_evals " << state_.bipop_small_evals << "\nbipop_large_restarts "
-    << state_.bipop_large_restarts << "\nbipop_small_regime " << state_.bipop_small_regime << "\nstopped " << static_cast<int>(state_.stopped) << '\n';
+    << "\nbipop_small_evals " << state_.bipop_small_evals << "\nbipop_last_large_evals "
+    << state_.bipop_last_large_evals << "\nbipop_large_restarts " << state_.bipop_large_restarts
+    << "\nbipop_small_regime " << state_.bipop_small_regime << "\nstopped " << static_cast<int>(state_.stopped)
+    << '\n';
   put(o, "sigma", state_.sigma);
   put(o, "sigma_this_restart", state_.sigma_this_restart);
   put(o, "best_f", state_.best_f);
@@ -552,12 +593,16 @@ void Cmaes::restore_state(const std::string& text) {
     v.assign(e.data(), e.data() + e.size());
   };
   int version = 0;
-  if (!(in >> key >> version) || key != "cmaes-state" || version != 1) fail("not a cmaes state (version 1)");
-  // The keys save_state() writes, each exactly once.
+  if (!(in >> key >> version) || key != "cmaes-state" || (version != 1 && version != 2))
+    fail("not a cmaes state (version 1 or 2)");
+  // The keys save_state() writes, each exactly once; version 1 (before session 90) has no
+  // bipop_last_large_evals.
   static const char* const kKeys[] = {
       "n", "lambda", "restart", "generation", "generations_total", "evaluations", "bipop_large_evals",
-      "bipop_small_evals", "bipop_large_restarts", "bipop_small_regime", "stopped", "sigma",
-      "sigma_this_restart", "best_f", "mean", "pc", "ps", "best_x", "C", "best_history", "median_history"};
+      "bipop_small_evals", "bipop_last_large_evals", "bipop_large_restarts", "bipop_small_regime", "stopped",
+      "sigma", "sigma_this_restart", "best_f", "mean", "pc", "ps", "best_x", "C", "best_history",
+      "median_history"};
+  const auto version_has = [&](const std::string& k) { return version >= 2 || k != "bipop_last_large_evals"; };
   std::vector<std::string> seen;
   bool ended = false;
   Eigen::VectorXd cflat;
@@ -567,7 +612,8 @@ void Cmaes::restore_state(const std::string& text) {
       ended = true;
       break;
     }
-    if (std::find(std::begin(kKeys), std::end(kKeys), key) == std::end(kKeys)) fail("unknown key '" + key + "'");
+    if (std::find(std::begin(kKeys), std::end(kKeys), key) == std::end(kKeys) || !version_has(key))
+      fail("unknown key '" + key + "'" + (version_has(key) ? "" : " in a version 1 state"));
     if (std::find(seen.begin(), seen.end(), key) != seen.end()) fail("key '" + key + "' given twice");
     seen.push_back(key);
     if (key == "n") read_int(s.n);
@@ -578,6 +624,7 @@ void Cmaes::restore_state(const std::string& text) {
     else if (key == "evaluations") read_long(s.evaluations);
     else if (key == "bipop_large_evals") read_long(s.bipop_large_evals);
     else if (key == "bipop_small_evals") read_long(s.bipop_small_evals);
+    else if (key == "bipop_last_large_evals") read_long(s.bipop_last_large_evals);
     else if (key == "bipop_large_restarts") read_int(s.bipop_large_restarts);
     else if (key == "bipop_small_regime") read_int(small_regime);
     else if (key == "stopped") read_int(stopped);
@@ -595,7 +642,11 @@ void Cmaes::restore_state(const std::string& text) {
   if (!ended) fail("missing 'end' (truncated state)");
   if (in >> key) fail("text after 'end': '" + key + "'");
   for (const char* k : kKeys)
-    if (std::find(seen.begin(), seen.end(), k) == seen.end()) fail(std::string("missing key '") + k + "'");
+    if (version_has(k) && std::find(seen.begin(), seen.end(), k) == seen.end())
+      fail(std::string("missing key '") + k + "'");
+  // A version 1 state's small run (there were no BIPOP calibrations) gets pycma's budget: half
+  // of all the large regime's evaluations.
+  if (version == 1) s.bipop_last_large_evals = s.bipop_large_evals;
 
   // Values. Counters first: they size and bound the rest.
   if (s.n != state_.n) fail("dimension " + std::to_string(s.n) + " does not match " + std::to_string(state_.n));
@@ -606,6 +657,7 @@ void Cmaes::restore_state(const std::string& text) {
                                 {"evaluations", s.evaluations},
                                 {"bipop_large_evals", s.bipop_large_evals},
                                 {"bipop_small_evals", s.bipop_small_evals},
+                                {"bipop_last_large_evals", s.bipop_last_large_evals},
                                 {"bipop_large_restarts", s.bipop_large_restarts}})
     if (v < 0) fail(std::string("'") + name + "' " + std::to_string(v) + " is negative");
   if (s.generations_total < s.generation)
@@ -615,13 +667,16 @@ void Cmaes::restore_state(const std::string& text) {
   if (s.evaluations / s.lambda < s.generation)
     fail("'evaluations' " + std::to_string(s.evaluations) + " is below lambda x generation (" +
          std::to_string(s.lambda) + " x " + std::to_string(s.generation) + ")");
+  if (s.bipop_last_large_evals > s.bipop_large_evals)
+    fail("'bipop_last_large_evals' " + std::to_string(s.bipop_last_large_evals) + " is above 'bipop_large_evals' " +
+         std::to_string(s.bipop_large_evals));
   if (s.bipop_large_restarts > s.restart)
     fail("'bipop_large_restarts' " + std::to_string(s.bipop_large_restarts) + " is above 'restart' " +
          std::to_string(s.restart));
   if (small_regime != 0 && small_regime != 1)
     fail("'bipop_small_regime' is " + std::to_string(small_regime) + ", not 0 or 1");
   s.bipop_small_regime = small_regime != 0;
-  if (stopped < 0 || stopped > static_cast<int>(StopReason::Stagnation))
+  if (stopped < 0 || stopped > static_cast<int>(StopReason::SmallRunBudget))
     fail("'stopped' " + std::to_string(stopped) + " is no stop reason");
   s.stopped = static_cast<StopReason>(stopped);
   // Step sizes: sigma 0 samples every candidate at the mean; sigma0 of the restart scales nothing

@@ -29,7 +29,16 @@
 namespace dressguard::calib {
 
 // Restart strategy after a local stop (tutorial Appendix B.3 recommends restarts with increasing
-// population: IPOP, Auger & Hansen 2005; BIPOP, Hansen 2009).
+// population: IPOP, Auger & Hansen 2005; BIPOP, Hansen 2009). Each restart starts from a mean
+// drawn uniformly in the box (without bounds, from x0).
+//   IPOP: every restart doubles the population, sigma0 as given.
+//   BIPOP (Hansen 2009, section 2): the first run has the default population (settings.lambda,
+//   or eq. 48's) and sigma0 and counts to neither regime; each restart then runs the regime that
+//   has used fewer evaluations so far, the large one on a tie (so the first restart is a large
+//   one). Large regime, k-th restart: lambda_def 2^k, sigma0. Small regime: lambda_s =
+//   floor(lambda_def (lambda_large / (2 lambda_def))^(U^2)), lambda_large the latest large run's
+//   population, so lambda_def <= lambda_s <= lambda_large / 2; sigma0 10^(-2 U'); at most half
+//   the evaluations of the latest large run (U, U' uniform in (0, 1), drawn from the seed).
 enum class Restarts { None = 0, Ipop = 1, Bipop = 2 };
 
 // Why the run (or the current restart) stopped. Local reasons trigger a restart when enabled.
@@ -45,6 +54,7 @@ enum class StopReason {
   NoEffectCoord,      // adding 0.2 sigma to a coordinate leaves it unchanged (local)
   Stagnation,         // over the last 20 % of generations (>= 120 + 30 n / lambda, <= 20 000), the
                       // newest 30 % improve on the oldest 30 % neither in best nor in median (local)
+  SmallRunBudget,     // a BIPOP small-regime run used its budget, half the last large run's (local)
 };
 const char* stop_reason_name(StopReason r);
 
@@ -70,6 +80,11 @@ struct CmaesSettings {
   double tol_fun = 1e-12;
   double tol_x = 1e-12;         // relative to sigma0
   Restarts restarts = Restarts::None;
+  // How many restarts with a larger population follow the first run. IPOP: every restart (the
+  // last has 2^max_restarts times the first's population). BIPOP: the large regime's restarts
+  // (the last has lambda_def 2^max_restarts); the small-regime runs between them are not counted
+  // (as pycma's fmin counts its `restarts`), the budget rule bounds them. The search ends with
+  // the local stop of the last counted run (with 0, of the first run). Ignored without restarts.
   int max_restarts = 9;
 };
 
@@ -90,8 +105,9 @@ struct CmaesState {
   // Best point seen over the whole run (repaired, i.e. feasible).
   Eigen::VectorXd best_x;
   double best_f = 1e300;
-  // BIPOP bookkeeping: evaluations spent in the large- and small-population regimes.
-  long bipop_large_evals = 0, bipop_small_evals = 0;
+  // BIPOP bookkeeping: evaluations spent in the large- and small-population regimes (the first
+  // run in neither), and in the latest large run (a small run's budget is half of it).
+  long bipop_large_evals = 0, bipop_small_evals = 0, bipop_last_large_evals = 0;
   int bipop_large_restarts = 0;  // how many large-regime restarts (lambda = 2^k * default)
   bool bipop_small_regime = false;  // the current restart is a small-regime one
   double sigma_this_restart = 0.0;  // sigma0 of the current restart (BIPOP's small regime shrinks it)

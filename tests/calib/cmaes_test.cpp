@@ -176,9 +176,10 @@ TEST(Cmaes, RestoreRequiresEachKeyOnceWithAValidValue) {
     EXPECT_EQ(b.save_state(), before) << "a refused state changed the search (" << why << ")";
   };
   const char* const keys[] = {"n", "lambda", "restart", "generation", "generations_total", "evaluations",
-                              "bipop_large_evals", "bipop_small_evals", "bipop_large_restarts",
-                              "bipop_small_regime", "stopped", "sigma", "sigma_this_restart", "best_f", "mean",
-                              "pc", "ps", "best_x", "C", "best_history", "median_history"};
+                              "bipop_large_evals", "bipop_small_evals", "bipop_last_large_evals",
+                              "bipop_large_restarts", "bipop_small_regime", "stopped", "sigma",
+                              "sigma_this_restart", "best_f", "mean", "pc", "ps", "best_x", "C", "best_history",
+                              "median_history"};
   for (const char* key : keys) {
     refused(with_line(text, key, ""), std::string("missing key '") + key + "'");
     refused(with_line(text, key, "twice"), std::string("key '") + key + "' given twice");
@@ -217,6 +218,7 @@ TEST(Cmaes, RestoreRequiresEachKeyOnceWithAValidValue) {
   refused(with_line(text, "generations_total", "5"), "'generations_total' 5 is below 'generation' 6");
   refused(with_line(text, "evaluations", "41"), "'evaluations' 41 is below lambda x generation (7 x 6)");
   refused(with_line(text, "bipop_large_restarts", "1"), "'bipop_large_restarts' 1 is above 'restart' 0");
+  refused(with_line(text, "bipop_last_large_evals", "1"), "'bipop_last_large_evals' 1 is above 'bipop_large_evals' 0");
   refused(with_line(text, "lambda", "1"), "'lambda' 1 is below 2");
   refused(with_line(text, "lambda", "7.5"), "'lambda': bad whole number '7.5'");
   refused(with_line(text, "bipop_small_regime", "2"), "'bipop_small_regime' is 2, not 0 or 1");
@@ -481,6 +483,160 @@ TEST(Cmaes, RestartsEscapeLocalOptima) {
   std::printf("  rastrigin-5 mean best f: none %.3f ipop %.3f bipop %.3f\n", none / 5, ipop / 5, bipop / 5);
   EXPECT_LT(ipop, none);
   EXPECT_LT(bipop, none);
+}
+
+// BIPOP as Hansen 2009 (section 2) describes it. The first run has the default population and
+// sigma0, and counts to neither regime. Each restart then runs the regime that has used fewer
+// evaluations, the large one on a tie: the large regime's k-th restart has lambda_def 2^k and
+// sigma0; a small run has lambda_s = floor(lambda_def (lambda_large / (2 lambda_def))^(U^2)),
+// lambda_large the latest large run's, so lambda_def <= lambda_s <= lambda_large / 2, sigma0
+// 10^(-2U'), and at most half the last large run's evaluations. max_restarts counts the large
+// regime's restarts: the search ends with the last one's local stop. Two functions: on Rastrigin
+// the runs end in local optima and the small populations reach above the default; on a shifted
+// sphere without TolFun and TolX the small runs go on until their budget stops them. Session 90's
+// review: the first run counted to the large regime, so restarts 1 and 2 were small ones with
+// lambda 7 and 8, below the default 10; small runs had no budget, and max_restarts counted both
+// regimes.
+TEST(Cmaes, BipopAlternatesItsRegimesAsHansen2009) {
+  const int n = 8, max_restarts = 4;
+  const int lambda_def = Cmaes::default_lambda(n);
+  const std::pair<const char*, Fn> functions[] = {
+      {"rastrigin", rastrigin},
+      {"shifted sphere", [](const Eigen::VectorXd& x) { return (x.array() - 1).square().sum(); }}};
+  int small_above_default = 0, small_at_budget = 0;
+  for (const auto& [name, f] : functions) {
+    CmaesSettings s;
+    s.x0 = Eigen::VectorXd::Zero(n);
+    s.sigma0 = 2.0;
+    s.lower = Eigen::VectorXd::Constant(n, -5.0);
+    s.upper = Eigen::VectorXd::Constant(n, 5.0);
+    s.seed = 5;
+    s.restarts = Restarts::Bipop;
+    s.max_restarts = max_restarts;
+    s.tol_fun = 1e-9;
+    if (std::string(name) != "rastrigin") s.tol_fun = s.tol_x = -1;  // the small runs' budget ends them
+    Cmaes es(s);
+    ASSERT_EQ(es.state().lambda, lambda_def);
+    struct Run {
+      int lambda;
+      double sigma0;
+      bool small;
+      long generations = 0;
+    };
+    std::vector<Run> runs{{es.state().lambda, es.state().sigma_this_restart, es.state().bipop_small_regime}};
+    while (!es.stopped()) {
+      const long generation = es.state().generation;
+      const int restart = es.state().restart;
+      es.step(f);
+      if (es.state().restart != restart) {
+        runs.back().generations = generation + 1;
+        runs.push_back({es.state().lambda, es.state().sigma_this_restart, es.state().bipop_small_regime});
+      } else {
+        runs.back().generations = es.state().generation;
+      }
+    }
+    std::printf("  %s: stopped by %s\n", name, stop_reason_name(es.stop_reason()));
+    long small_used = 0, large_used = 0, last_large = 0;
+    int large_runs = 0;
+    for (std::size_t r = 0; r < runs.size(); ++r) {
+      const Run& run = runs[r];
+      const long evals = static_cast<long>(run.lambda) * run.generations;
+      std::printf("    run %zu: %s, lambda %d, sigma0 %.4g, %ld generations", r,
+                  r == 0 ? "first" : (run.small ? "small" : "large"), run.lambda, run.sigma0, run.generations);
+      if (run.small) std::printf(" (budget %ld)", last_large / 2 / run.lambda);
+      std::printf("\n");
+      if (r == 0) {
+        EXPECT_FALSE(run.small);
+        EXPECT_EQ(run.lambda, lambda_def);
+        EXPECT_EQ(run.sigma0, s.sigma0);
+        continue;
+      }
+      EXPECT_EQ(run.small, small_used < large_used)
+          << name << " run " << r << ": small " << small_used << ", large " << large_used;
+      if (run.small) {
+        const int lambda_large = lambda_def << large_runs;
+        EXPECT_GE(run.lambda, lambda_def) << name << " run " << r;
+        EXPECT_LE(run.lambda, lambda_large / 2) << name << " run " << r;
+        EXPECT_GE(run.sigma0, s.sigma0 / 100) << name << " run " << r;
+        EXPECT_LE(run.sigma0, s.sigma0) << name << " run " << r;
+        EXPECT_LE(run.generations, last_large / 2 / run.lambda) << name << " run " << r << ": its budget";
+        small_above_default += run.lambda > lambda_def;
+        small_at_budget += run.generations == last_large / 2 / run.lambda;
+        small_used += evals;
+      } else {
+        large_runs += 1;
+        EXPECT_EQ(run.lambda, lambda_def << large_runs) << name << " run " << r;
+        EXPECT_EQ(run.sigma0, s.sigma0) << name << " run " << r;
+        large_used += evals;
+        last_large = evals;
+      }
+    }
+    EXPECT_EQ(large_runs, max_restarts) << name;
+    EXPECT_FALSE(runs.back().small) << name << ": the search ends with the last large run";
+    EXPECT_EQ(es.state().bipop_large_restarts, max_restarts) << name;
+  }
+  EXPECT_GT(small_above_default, 0) << "no small run above the default population: the case shows little";
+  EXPECT_GT(small_at_budget, 0) << "no small run met its budget: the case shows little";
+}
+
+// A checkpoint inside a BIPOP small run continues bit-identically: the state carries the latest
+// large run's evaluations, the small run's budget (state version 2, session 90). The small run
+// after the second large one, where the latest large run's evaluations are not all of the large
+// regime's.
+TEST(Cmaes, BipopCheckpointInASmallRunContinuesBitIdentically) {
+  CmaesSettings s;
+  const int n = 8;
+  s.x0 = Eigen::VectorXd::Zero(n);
+  s.sigma0 = 2.0;
+  s.lower = Eigen::VectorXd::Constant(n, -5.0);
+  s.upper = Eigen::VectorXd::Constant(n, 5.0);
+  s.seed = 5;
+  s.restarts = Restarts::Bipop;
+  s.max_restarts = 3;
+  s.tol_fun = s.tol_x = -1;
+  const Fn f = [](const Eigen::VectorXd& x) { return (x.array() - 1).square().sum(); };
+  Cmaes a(s);
+  while (!a.stopped() &&
+         !(a.state().bipop_small_regime && a.state().bipop_large_restarts == 2 && a.state().generation == 40))
+    a.step(f);
+  ASSERT_FALSE(a.stopped());
+  ASSERT_GT(a.state().bipop_last_large_evals, 0);
+  ASSERT_LT(a.state().bipop_last_large_evals, a.state().bipop_large_evals);
+  Cmaes b(s);
+  b.restore_state(a.save_state());
+  a.minimize(f);
+  b.minimize(f);
+  EXPECT_EQ(a.save_state(), b.save_state());
+  EXPECT_EQ(a.state().restart, b.state().restart);
+}
+
+// A version 1 state (before session 90: no bipop_last_large_evals, as the committed checkpoints of
+// offline/calib/runs/ are) still restores, to the same search; version 1 with the key is refused.
+TEST(Cmaes, RestoreReadsVersionOneStates) {
+  CmaesSettings s;
+  s.x0 = Eigen::VectorXd::Constant(4, 0.3);
+  s.lambda = 12;
+  s.max_generations = 30;
+  Cmaes a(s);
+  for (int g = 0; g < 10; ++g) a.step(rosenbrock);
+  const std::string v2 = a.save_state();
+  ASSERT_EQ(v2.rfind("cmaes-state 2\n", 0), 0u);
+  const std::string v1_with_key = "cmaes-state 1\n" + v2.substr(v2.find('\n') + 1);
+  const std::string v1 = with_line(v1_with_key, "bipop_last_large_evals", "");
+  Cmaes b(s);
+  b.restore_state(v1);
+  EXPECT_EQ(b.save_state(), v2);
+  a.minimize(rosenbrock);
+  b.minimize(rosenbrock);
+  EXPECT_EQ(a.save_state(), b.save_state());
+  try {
+    b.restore_state(v1_with_key);
+    ADD_FAILURE() << "a version 1 state with bipop_last_large_evals was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown key 'bipop_last_large_evals' in a version 1 state"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace
