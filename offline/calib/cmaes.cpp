@@ -124,6 +124,26 @@ Cmaes::Cmaes(CmaesSettings settings) : settings_(std::move(settings)) {
   state_.best_x = settings_.x0;
   const int lambda = settings_.lambda > 0 ? settings_.lambda : default_lambda(state_.n);
   if (lambda < 2) throw std::invalid_argument("cmaes: lambda must be at least 2");
+  if (lambda > kMaxPopulation)
+    throw std::invalid_argument("cmaes: population " + std::to_string(lambda) + " is above the largest, 2^30 = " +
+                                std::to_string(kMaxPopulation));
+  if (settings_.max_restarts < 0)
+    throw std::invalid_argument("cmaes: max_restarts " + std::to_string(settings_.max_restarts) + " is negative");
+  if (settings_.restarts != Restarts::None) {
+    // The last counted restart runs lambda 2^max_restarts (IPOP: the first run's lambda doubled at
+    // each restart; BIPOP: lambda_def 2^k for the k-th large restart, lambda_def = this lambda).
+    // Refused rather than saturated: a search that asked for more doublings than an int holds
+    // would silently run other restarts than it asked for (session 90's review: lambda * 2 and
+    // lambda_def << k overflowed, undefined, beyond about 27 restarts).
+    int most = 0;
+    while ((static_cast<long>(lambda) << (most + 1)) <= kMaxPopulation) ++most;
+    if (settings_.max_restarts > most)
+      throw std::invalid_argument("cmaes: max_restarts " + std::to_string(settings_.max_restarts) +
+                                  " would double the population " + std::to_string(lambda) + " to " +
+                                  std::to_string(lambda) + " x 2^" + std::to_string(settings_.max_restarts) +
+                                  ", above the largest population, 2^30 = " + std::to_string(kMaxPopulation) +
+                                  "; at most " + std::to_string(most) + " restarts with this population");
+  }
   start_restart(lambda, settings_.sigma0, /*reset_mean=*/false);
 }
 
@@ -438,8 +458,9 @@ void Cmaes::on_local_stop(StopReason r) {
   }
   const int lambda_default = settings_.lambda > 0 ? settings_.lambda : default_lambda(state_.n);
   if (settings_.restarts == Restarts::Ipop) {
-    // IPOP: double the population, same sigma0 (Auger & Hansen 2005).
-    if (state_.restart >= settings_.max_restarts) {
+    // IPOP: double the population, same sigma0 (Auger & Hansen 2005). The constructor bounds
+    // the doublings; the second test only keeps a hand-made state within the largest population.
+    if (state_.restart >= settings_.max_restarts || state_.lambda > kMaxPopulation / 2) {
       state_.stopped = r;
       return;
     }
@@ -651,6 +672,9 @@ void Cmaes::restore_state(const std::string& text) {
   // Values. Counters first: they size and bound the rest.
   if (s.n != state_.n) fail("dimension " + std::to_string(s.n) + " does not match " + std::to_string(state_.n));
   if (s.lambda < 2) fail("'lambda' " + std::to_string(s.lambda) + " is below 2");
+  if (s.lambda > kMaxPopulation)
+    fail("'lambda' " + std::to_string(s.lambda) + " is above the largest population, 2^30 = " +
+         std::to_string(kMaxPopulation));
   for (const auto& [name, v] : {std::pair<const char*, long>{"restart", s.restart},
                                 {"generation", s.generation},
                                 {"generations_total", s.generations_total},
@@ -673,6 +697,10 @@ void Cmaes::restore_state(const std::string& text) {
   if (s.bipop_large_restarts > s.restart)
     fail("'bipop_large_restarts' " + std::to_string(s.bipop_large_restarts) + " is above 'restart' " +
          std::to_string(s.restart));
+  // The large regime's population lambda_def 2^k must stay within the constructor's bound.
+  if (settings_.restarts == Restarts::Bipop && s.bipop_large_restarts > settings_.max_restarts)
+    fail("'bipop_large_restarts' " + std::to_string(s.bipop_large_restarts) + " is above max_restarts " +
+         std::to_string(settings_.max_restarts));
   if (small_regime != 0 && small_regime != 1)
     fail("'bipop_small_regime' is " + std::to_string(small_regime) + ", not 0 or 1");
   s.bipop_small_regime = small_regime != 0;

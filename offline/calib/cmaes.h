@@ -62,7 +62,7 @@ const char* stop_reason_name(StopReason r);
 struct CmaesSettings {
   Eigen::VectorXd x0;          // initial mean m (size n >= 1)
   double sigma0 = 0.3;         // initial step size
-  int lambda = 0;              // population; 0 = default 4 + floor(3 ln n) (eq. 48)
+  int lambda = 0;              // population; 0 = default 4 + floor(3 ln n) (eq. 48); <= kMaxPopulation
   std::uint64_t seed = 1;
   // Box bounds (both or neither, size n). Method: a candidate outside the box is evaluated at its
   // projection onto the box (the "repair"), and its value for ranking is f(repaired) plus
@@ -84,7 +84,10 @@ struct CmaesSettings {
   // last has 2^max_restarts times the first's population). BIPOP: the large regime's restarts
   // (the last has lambda_def 2^max_restarts); the small-regime runs between them are not counted
   // (as pycma's fmin counts its `restarts`), the budget rule bounds them. The search ends with
-  // the local stop of the last counted run (with 0, of the first run). Ignored without restarts.
+  // the local stop of the last counted run (with 0, of the first run). Not negative; with
+  // restarts, the last counted run's population, lambda 2^max_restarts, must not pass
+  // Cmaes::kMaxPopulation (2^30): the constructor refuses a larger one (std::invalid_argument
+  // naming both), as the doubling would overflow int past about 27 restarts.
   int max_restarts = 9;
 };
 
@@ -156,6 +159,9 @@ class Cmaes {
 
   // The tutorial's default population for dimension n (eq. 48).
   static int default_lambda(int n);
+  // The largest population, 2^30: IPOP's and BIPOP's doublings and eq. 49's lambda + 1 stay in an
+  // int, and a generation of 2^30 samples (8n GiB) is beyond any machine this runs on anyway.
+  static constexpr int kMaxPopulation = 1 << 30;
 
  private:
   struct Strategy;  // weights and learning rates for the current lambda (eq. 49-58)

@@ -579,6 +579,60 @@ TEST(Cmaes, BipopAlternatesItsRegimesAsHansen2009) {
   EXPECT_GT(small_at_budget, 0) << "no small run met its budget: the case shows little";
 }
 
+// Each restart of IPOP, and each large one of BIPOP, doubles the population: lambda 2^max_restarts
+// overflowed an int beyond about 27 restarts (lambda * 2 and lambda_def << k, undefined; session
+// 90's review). The constructor refuses a max_restarts whose last population would pass 2^30,
+// naming the value and the limit; with the default population 10 (n = 8), 26 restarts reach
+// 671 088 640 and are accepted, 27 would reach 1 342 177 280.
+TEST(Cmaes, RestartsThatWouldOverflowThePopulationAreRefused) {
+  for (const Restarts r : {Restarts::Ipop, Restarts::Bipop}) {
+    CmaesSettings s;
+    s.x0 = Eigen::VectorXd::Zero(8);
+    s.restarts = r;
+    s.max_restarts = 26;
+    EXPECT_NO_THROW(Cmaes{s});
+    for (const int m : {27, 31, 40, 1000}) {
+      s.max_restarts = m;
+      try {
+        Cmaes es(s);
+        ADD_FAILURE() << "max_restarts " << m << " accepted";
+      } catch (const std::invalid_argument& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("max_restarts " + std::to_string(m) + " would double the population 10"),
+                  std::string::npos)
+            << what;
+        EXPECT_NE(what.find("2^30 = 1073741824; at most 26 restarts"), std::string::npos) << what;
+      }
+    }
+    s.lambda = 1000;  // 1000 x 2^20 = 1 048 576 000 fits, 2^21 does not
+    s.max_restarts = 20;
+    EXPECT_NO_THROW(Cmaes{s});
+    s.max_restarts = 21;
+    EXPECT_THROW(Cmaes{s}, std::invalid_argument);
+    s.max_restarts = -1;
+    EXPECT_THROW(Cmaes{s}, std::invalid_argument);
+  }
+  // Without restarts max_restarts is not used (the population's own limit, 2^30, is not built
+  // here: a generation of 2^30 samples).
+  CmaesSettings s;
+  s.x0 = Eigen::VectorXd::Zero(8);
+  s.max_restarts = 1000;
+  EXPECT_NO_THROW(Cmaes{s});
+  // Nor does a restored BIPOP state go past the bound: more large restarts than max_restarts are
+  // refused.
+  s.restarts = Restarts::Bipop;
+  s.max_restarts = 4;
+  Cmaes es(s);
+  const std::string text = with_line(with_line(es.save_state(), "restart", "5"), "bipop_large_restarts", "5");
+  try {
+    es.restore_state(text);
+    ADD_FAILURE() << "5 large restarts of 4 accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("'bipop_large_restarts' 5 is above max_restarts 4"), std::string::npos)
+        << e.what();
+  }
+}
+
 // A checkpoint inside a BIPOP small run continues bit-identically: the state carries the latest
 // large run's evaluations, the small run's budget (state version 2, session 90). The small run
 // after the second large one, where the latest large run's evaluations are not all of the large
