@@ -416,6 +416,12 @@ void rescore(Calibration& c, const std::vector<HapticSequence>& inputs, const st
   if (!kind || !combine)
     throw std::invalid_argument("rescore: unknown objective '" + c.objective_kind + "' or combination '" + c.combine +
                                 "'");
+  // A curve that blew up scores infinity, which a calibration file cannot hold (JSON has no inf:
+  // it was written as null, and read_calibration refused the file it had just written).
+  for (std::size_t k = 0; k < inputs.size(); ++k)
+    if (!simulated[k].finite || simulated[k].samples.empty())
+      throw std::runtime_error("rescore: " + inputs[k].id + "'s simulation did not stay finite in this build, so its "
+                               "L would be infinite; the file's values give no calibration here");
   Json before = Json::object();
   before.set("objective", c.objective);
   Json fits = Json::object();

@@ -150,7 +150,7 @@ struct TrialRequest {
   double arm_offset = 0.0;   // [m] added to the height's nominal arm height
   double speed = 0.1;        // [m/s]
   std::uint64_t seed = 0;    // the gown perturbation's random stream
-  bool gown_noise = false;   // paper V-A perturbation (6 N, 0.5 s) on or off
+  bool gown_noise = false;   // paper V-A perturbation (x and lateral each up to 6 N, 0.5 s) on or off
   double max_travel = 0.85;  // [m] end of the rig's travel (the paper's 0.85 m; see request_for)
   // Optional (calibrate --prune): asked after each simulated sample with the samples so far and
   // whether the trial has ended; `true` stops a trial that has not (SimulatedTrial::cut). A
@@ -526,8 +526,10 @@ double lateral_term(const std::vector<HapticSequence>& inputs, const std::vector
 // rank of `comm` must call it with the same arguments; they evaluate shares of each generation
 // and end with identical results; only rank 0 writes the checkpoint and calls `progress`. A
 // generation's tasks are its candidates, each simulating all input sequences with one batch
-// call; a one-trial simulator runs them one after another (one_by_one). The result does not
-// depend on which is given.
+// call; a one-trial simulator runs them one after another (one_by_one). Without pruning the
+// result does not depend on which is given; with it, it may: the cloth simulator's batch pulls a
+// settling group's later trials before the first (sim::simulate_trials), so each trial's watch
+// sees other partial sums and cuts at other samples (each way deterministic).
 //
 // Pruning (options.prune = kappa > 0). Every term of eq. 3-5 is >= 0, so a candidate's objective
 // summed over the samples simulated so far bounds its whole objective from below. From the second
@@ -642,7 +644,8 @@ Calibration calibration_of(const std::string& participant, const CalibrationResu
 // the objective's definition (session 45: objective.h, "Where the pairs begin"), so that a file's
 // figures are what this build computes from it. The figures it replaces go into provenance
 // "rescored" (a list: when, why, before). Throws std::invalid_argument when the inputs are not
-// the file's sequences.
+// the file's sequences, and std::runtime_error, `c` unchanged, when a simulation did not stay
+// finite.
 void rescore(Calibration& c, const std::vector<HapticSequence>& inputs, const std::vector<SimulatedTrial>& simulated,
              const std::string& why, const std::string& when);
 

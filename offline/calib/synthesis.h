@@ -1,10 +1,12 @@
 // Haptic data synthesis with the calibrated simulator (paper section V-A).
 //
 // Per arm height, `per_height` trials (paper: 100), the first half at 0.1 m/s and the second
-// half at 0.15 m/s (the study's protocol). Two noise models, each switchable for the paper's
-// ablations (section VII):
-//   gown:  the simulator's initial-state perturbation, a uniform random force up to 6 N in the
-//          horizontal plane over all vertices for 0.5 s before the pull (TrialRequest::gown_noise);
+// half at 0.15 m/s (the study's protocol; an odd count puts the extra trial at 0.15 m/s). Two
+// noise models, each switchable for the paper's ablations (section VII):
+//   gown:  the simulator's initial-state perturbation, a random force in the horizontal plane
+//          over all vertices for 0.5 s before the pull, its x and lateral components each
+//          uniform in [-6, 6] N (the paper's "maximum magnitude 6 N" read per direction, so |F|
+//          reaches 8.5 N; sim/trial.h, TrialSpec::gown_noise; TrialRequest::gown_noise);
 //   arm:   high and low: calibrated offset + U[-1.5, +1.5] cm; middle: U[-6, 0] cm added to the
 //          nominal middle height directly ("not all participants have an optimised middle arm
 //          height", and only negative noise to compensate gravity).

@@ -94,10 +94,11 @@ int run_synthesize(int argc, char** argv) {
   if (args.has("help")) {
     std::puts(
         "usage: dressguard synthesize --calibration CAL.json --out DATASET [options]\n"
-        "  Simulates --per-height trials at each arm height (half at 0.1, half at 0.15 m/s) with the\n"
-        "  calibrated simulator and labels them automatically (paper V-A).\n"
+        "  Simulates --per-height trials at each arm height (half at 0.1, half at 0.15 m/s; an odd\n"
+        "  count puts the extra one at 0.15) with the calibrated simulator and labels them\n"
+        "  automatically (paper V-A).\n"
         "  --per-height N    default 100 (the paper)\n"
-        "  --no-gown-noise   no initial gown perturbation (6 N, 0.5 s)\n"
+        "  --no-gown-noise   no initial gown perturbation (x and lateral each up to 6 N, 0.5 s)\n"
         "  --no-arm-noise    no arm-height noise (+-1.5 cm high/low, [-6, 0] cm middle)\n"
         "  --middle M        nominal | caught-edge: where the middle arm's [-6, 0] cm noise sits: the\n"
         "                    nominal middle height (default, the paper) or the simulator's own edge\n"

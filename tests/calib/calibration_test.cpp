@@ -455,6 +455,12 @@ TEST(Calibration, RescoreScoresTheFileAgainAndKeepsWhatItReplaced) {
   EXPECT_EQ(c.objective, first);
   std::swap(inputs[0], inputs[1]);  // not in the file's order
   EXPECT_THROW(rescore(c, inputs, sims, "", ""), std::invalid_argument);
+  std::swap(inputs[0], inputs[1]);
+  // A curve that blew up: no figures (an infinite L was written as null, a file nothing reads).
+  sims[1].finite = false;
+  EXPECT_THROW(rescore(c, inputs, sims, "", ""), std::runtime_error);
+  EXPECT_EQ(c.objective, first);
+  EXPECT_EQ(c.provenance.at("rescored").items().size(), 2u);
 }
 
 // Two sequences that no single cloth fits (made with friction 0.9 and 0.3, no offsets to fit):
