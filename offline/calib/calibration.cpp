@@ -308,6 +308,18 @@ bool fit_rim_shift_to_gown(ParameterSpace& space, double rim_ahead, const std::f
   return true;
 }
 
+void require_simulated_rate(const Dataset& ds, const HapticSequence& t) {
+  const double period = mean_sample_period(t);
+  if (!(period > 0.0)) return;  // fewer than two samples, no period (a dataset's readers refuse it)
+  if (std::abs(period - kSimulatedSamplePeriod) <= kRecordingPeriodTolerance * kSimulatedSamplePeriod) return;
+  char what[200];
+  std::snprintf(what, sizeof what,
+                " is sampled every %.9g s and the simulator every %g s: eq. 3-5 pairs the two curves sample by "
+                "sample (resample it to %g Hz)",
+                period, kSimulatedSamplePeriod, 1.0 / kSimulatedSamplePeriod);
+  throw InputError(trial_file_name(ds, t) + what);
+}
+
 std::vector<HapticSequence> select_inputs(const Dataset& ds, const std::string& participant, std::uint64_t seed) {
   std::vector<HapticSequence> out;
   for (ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
@@ -317,6 +329,7 @@ std::vector<HapticSequence> select_inputs(const Dataset& ds, const std::string& 
     if (pool.empty()) continue;  // e.g. a middle height with only caught trials: 2 sequences
     std::sort(pool.begin(), pool.end(), [](auto* a, auto* b) { return a->id < b->id; });
     const std::uint64_t pick = mix_seed(seed, 100 + static_cast<std::uint64_t>(h)) % pool.size();
+    require_simulated_rate(ds, *pool[pick]);
     out.push_back(*pool[pick]);
   }
   if (out.empty())
@@ -336,6 +349,7 @@ std::vector<HapticSequence> inputs_by_id(const Dataset& ds, const std::string& p
     if (!t->label) throw InputError("trial '" + id + "' has no outcome label");
     if (*t->label == Outcome::Caught)
       throw InputError("trial '" + id + "' is caught; calibration fits good and missed trials only (IV-B.1)");
+    require_simulated_rate(ds, *t);
     const HapticSequence*& slot = by_height[static_cast<int>(t->height)];
     if (slot)
       throw InputError("trials '" + slot->id + "' and '" + id + "' are both at the " +

@@ -327,6 +327,18 @@ bool set_person_param(ParameterSpace& space, int i, const std::string& word);
 
 // ---- input selection (paper IV-B.1) -------------------------------------------------------------
 
+// [s] The simulator's sample period: one haptic sample per 3 output steps at 300 Hz (sim/trial.h).
+inline constexpr double kSimulatedSamplePeriod = 0.01;
+// Eq. 3-5 pairs a simulated and a measured curve sample by sample, so a measured sequence can be
+// scored against the simulator only when it was recorded at the simulator's rate: a repeat of a
+// study trial kept at 50 Hz scores L = 12.9 against itself at 100 Hz, where two real repeats
+// differ by 0.22 (session 90's review). Throws InputError naming the trial's file (dataset.h,
+// trial_file_name) and both periods when `t`'s mean period is not kSimulatedSamplePeriod within
+// kRecordingPeriodTolerance (relative, a recording's jitter); a trial of fewer than two samples
+// has no period to compare (a dataset's readers refuse it). What select_inputs, inputs_by_id,
+// prediction_targets and calibration_inputs return has passed it.
+void require_simulated_rate(const Dataset& ds, const HapticSequence& t);
+
 // One measured sequence per arm height of `participant`, chosen at random (by `seed`) among its
 // labelled non-caught trials; heights with only caught trials are left out (2 sequences).
 // Throws InputError when the participant has none.

@@ -134,6 +134,7 @@ std::vector<HapticSequence> calibration_inputs(const Calibration& cal, const std
       throw_input_error(where, 0,
                         "holds no trial '" + fit.trial_id + "', an input of participant " + cal.participant +
                             "'s calibration (give the dataset it was calibrated on)");
+    require_simulated_rate(measured, *t);
     inputs.push_back(*t);
   }
   return inputs;

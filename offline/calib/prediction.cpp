@@ -82,7 +82,10 @@ std::vector<std::vector<int>> groups_by_height(const std::vector<const HapticSeq
 std::vector<const HapticSequence*> prediction_targets(const Dataset& ds, const std::string& calibrated) {
   std::vector<const HapticSequence*> out;
   for (const auto& t : ds.trials)
-    if (predictable(t) && t.participant != calibrated) out.push_back(&t);
+    if (predictable(t) && t.participant != calibrated) {
+      require_simulated_rate(ds, t);
+      out.push_back(&t);
+    }
   return out;
 }
 

@@ -65,7 +65,8 @@ struct PredictionSummary {
 };
 
 // The trials predicted: every labelled, non-caught trial of `ds` whose participant is not
-// `calibrated`. Empty when there is none.
+// `calibrated`. Empty when there is none; InputError for one not recorded at the simulator's
+// rate (calibration.h, require_simulated_rate).
 std::vector<const HapticSequence*> prediction_targets(const Dataset& ds, const std::string& calibrated);
 
 // Progress of predict_others on this rank: targets done of this rank's, elapsed and estimated

@@ -20,6 +20,8 @@
 
 #include "calibration.h"
 #include "cmaes.h"
+#include "discrepancy.h"
+#include "prediction.h"
 #include "fake_sim.h"
 #include "files.h"
 #include "synthesis.h"
@@ -1474,6 +1476,52 @@ TEST(Calibration, InputsByIdFollowTheSelectionRules) {
   EXPECT_NE(refused({"s1-unknown"}).find("trial 's1-unknown' has no outcome label"), std::string::npos);
   EXPECT_NE(refused({"s1-good-1", "s1-good-3"}).find("trials 's1-good-1' and 's1-good-3' are both at the high arm"),
             std::string::npos);
+}
+
+// Eq. 3-5 pairs curves sample by sample, so a measured sequence recorded at another rate than the
+// simulator's 100 Hz is refused wherever one is chosen to be scored against the simulator: as a
+// calibration input (chosen by seed or by id), as a prediction target and as a discrepancy's
+// input; the error names the trial and both periods. A recording's jitter (the study's trials:
+// 9.99966-10.00041 ms) passes.
+TEST(Calibration, MeasuredSequencesAtAnotherRateThanTheSimulatorsAreRefused) {
+  Dataset ds;
+  const auto add = [&](std::string id, std::string who, ArmHeight h, double period) {
+    HapticSequence t;
+    t.id = std::move(id);
+    t.participant = std::move(who);
+    t.height = h;
+    t.label = h == ArmHeight::High ? Outcome::Good : Outcome::Missed;
+    for (int i = 0; i < 300; ++i) t.samples.push_back({i * period, 0.1 * i * period, -1.0, 0.0, 0.0});
+    ds.trials.push_back(t);
+  };
+  add("s1-good-1", "1", ArmHeight::High, 0.0100041);  // the study's slowest clock
+  add("s1-miss-1", "1", ArmHeight::Low, 0.02);        // 50 Hz
+  add("s2-good-1", "2", ArmHeight::High, 0.0099966);  // and its fastest
+  add("s2-miss-1", "2", ArmHeight::Low, 0.008);       // 125 Hz
+  const auto refusal = [](const std::function<void()>& f) {
+    try {
+      f();
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(inputs_by_id(ds, "1", {"s1-good-1"}).size(), 1u);
+  EXPECT_EQ(inputs_by_id(ds, "2", {"s2-good-1"}).size(), 1u);
+  const std::string by_id = refusal([&] { inputs_by_id(ds, "1", {"s1-good-1", "s1-miss-1"}); });
+  EXPECT_NE(by_id.find("'s1-miss-1' is sampled every 0.02 s and the simulator every 0.01 s"), std::string::npos) << by_id;
+  const std::string by_seed = refusal([&] { select_inputs(ds, "2", 1); });
+  EXPECT_NE(by_seed.find("'s2-miss-1' is sampled every 0.008 s"), std::string::npos) << by_seed;
+  EXPECT_NE(refusal([&] { prediction_targets(ds, "3"); }).find("is sampled every"), std::string::npos);
+  Calibration cal;
+  cal.participant = "1";
+  cal.fits.resize(2);
+  cal.fits[0].trial_id = "s1-good-1";
+  cal.fits[1].trial_id = "s1-miss-1";
+  EXPECT_NE(refusal([&] { calibration_inputs(cal, "cal.json", ds, "manifest.csv"); }).find("'s1-miss-1' is sampled"),
+            std::string::npos);
+  cal.fits.resize(1);
+  EXPECT_EQ(calibration_inputs(cal, "cal.json", ds, "manifest.csv").size(), 1u);
 }
 
 TEST(Calibration, CalibrationFileRoundTripAndErrors) {
