@@ -580,6 +580,40 @@ std::string fingerprint(const std::vector<HapticSequence>& inputs, const Paramet
   return f.str();
 }
 
+// The inputs' arm heights and pull speeds, which request_for simulates them at: a manifest whose
+// row was corrected (a speed, a height) changes the run as much as its samples would.
+std::string inputs_runs(const std::vector<HapticSequence>& inputs) {
+  std::string out;
+  for (const auto& s : inputs) out += std::string(arm_height_name(s.height)) + '@' + hexd(s.speed) + ',';
+  return out;
+}
+
+// Which part of two fingerprints differs first (their ';'-separated "key=value" fields), for the
+// refusal to say what is another run: "its seed= (here 12, in the checkpoint 11)".
+std::string first_difference(const std::string& here, const std::string& there) {
+  const auto fields = [](const std::string& f) {
+    std::vector<std::string> out;
+    std::size_t b = 0;
+    for (std::size_t e; (e = f.find(';', b)) != std::string::npos; b = e + 1) out.push_back(f.substr(b, e - b));
+    out.push_back(f.substr(b));
+    return out;
+  };
+  const auto key_of = [](const std::string& field) { return field.substr(0, field.find('=') + 1); };
+  const auto cut = [](const std::string& v) { return v.size() > 60 ? v.substr(0, 57) + "..." : v; };
+  const std::vector<std::string> a = fields(here), b = fields(there);
+  for (const std::string& x : a) {
+    const auto y = std::find_if(b.begin(), b.end(), [&](const std::string& f) { return key_of(f) == key_of(x); });
+    if (y == b.end()) return "its " + key_of(x) + " (here " + cut(x.substr(key_of(x).size())) + ", not in the checkpoint)";
+    if (*y != x)
+      return "its " + key_of(x) + " (here " + cut(x.substr(key_of(x).size())) + ", in the checkpoint " +
+             cut(y->substr(key_of(x).size())) + ")";
+  }
+  for (const std::string& y : b)
+    if (std::none_of(a.begin(), a.end(), [&](const std::string& f) { return key_of(f) == key_of(y); }))
+      return "the checkpoint's " + key_of(y) + " (" + cut(y.substr(key_of(y).size())) + ", not set here)";
+  return "nothing that can be named";
+}
+
 // FNV-1a (64 bits) over the bit patterns of every sample of the inputs: a checkpoint's inputs are
 // the same data, not only the same trial ids and lengths (a corrected file once resumed).
 std::string samples_hash(const std::vector<HapticSequence>& inputs) {
@@ -770,8 +804,13 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
 
   // Checkpoints carry the samples' hash since session 82; an older one (without it) still resumes
   // on the rest of the fingerprint, as it did.
+  // The fingerprint a checkpoint must carry, and the shorter ones of older checkpoints, which
+  // resume with a note of what they could not confirm: before session 90 the inputs' heights
+  // and speeds were not recorded, before the samples' hash only their ids and lengths.
   const std::string fp_before_hash = fingerprint(inputs, space, options);
-  const std::string fp = fp_before_hash + ";samples=" + samples_hash(inputs);
+  const std::string fp_before_runs = fp_before_hash + ";samples=" + samples_hash(inputs);
+  const std::string fp = fp_before_runs + ";runs=" + inputs_runs(inputs);
+  std::string resume_note;
   // The search's best candidate's terms; infinite until a candidate scores a finite objective
   // (they were zeros, which a search where every simulation failed reported as L = 0 for each
   // sequence: session 84's review, finding 5).
@@ -788,10 +827,17 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
     comm.broadcast(text);
     if (!text.empty()) {
       const Checkpoint c = decode_checkpoint(text, options.checkpoint);
-      if (c.fingerprint != fp && c.fingerprint != fp_before_hash)
+      if (c.fingerprint == fp_before_runs)
+        resume_note = "the checkpoint predates the inputs' heights and speeds in its fingerprint; they were taken "
+                      "as this run's";
+      else if (c.fingerprint == fp_before_hash)
+        resume_note = "the checkpoint predates its inputs' samples, heights and speeds in its fingerprint (only their "
+                      "ids and lengths were checked); they were taken as this run's";
+      else if (c.fingerprint != fp)
         throw_input_error(options.checkpoint, 2,
-                          "checkpoint belongs to a different calibration (inputs, seed, budget, bounds, gown or "
-                          "objective differ); remove it or choose another --checkpoint");
+                          "checkpoint belongs to a different calibration: " + first_difference(fp, c.fingerprint) +
+                              " differs (inputs, seed, budget, bounds, gown or objective); remove it or choose "
+                              "another --checkpoint");
       if (static_cast<int>(c.best_fits.size()) != T) throw_input_error(options.checkpoint, 4, "wrong number of fits");
       try {
         es.restore_state(c.cmaes_state);
@@ -1012,6 +1058,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
   }
 
   CalibrationResult r;
+  r.resume_note = resume_note;
   r.complete = es.stopped();
   if (r.complete) r.stopped_by = stop_reason_name(es.stop_reason());
   r.generations_done = done;

@@ -511,6 +511,9 @@ struct CalibrationResult {
                                   // the fits, contrast and lateral (with Sum: their sum)
   double lateral = 0;             // its weighted lateral term
   double elapsed_s = 0;
+  // Non-empty when the run resumed a checkpoint written before its fingerprint recorded all it
+  // does now: what that checkpoint could not confirm (e.g. the inputs' heights and speeds).
+  std::string resume_note;
 };
 
 // The weighted contrast term of options.contrast_weight for one candidate's simulated inputs

@@ -416,6 +416,8 @@ int run_calibrate(int argc, char** argv) {
                  p.generation, p.generations, p.best, per.c_str(), p.generation_best, pruned,
                  minutes(p.elapsed_s).c_str(), minutes(p.eta_s).c_str(), p.simulated_s, resumed);
   });
+  if (!r.resume_note.empty() && comm.is_root())
+    std::fprintf(stderr, "calibrate: note: %s: %s\n", o.checkpoint.string().c_str(), r.resume_note.c_str());
   if (!r.complete) {
     if (comm.is_root()) {
       if (args.has("json"))

@@ -679,6 +679,21 @@ TEST(Calibration, ResumeFromCheckpointGivesTheUninterruptedResult) {
   EXPECT_EQ(resumed.objective, full.objective);
   EXPECT_TRUE(resumed.best_unit == full.best_unit);
   for (std::size_t k = 0; k < full.fits.size(); ++k) EXPECT_EQ(resumed.fits[k].objective, full.fits[k].objective);
+  EXPECT_EQ(resumed.resume_note, "");
+  // A checkpoint written before the fingerprint held the inputs' heights and speeds (session 90)
+  // resumes to the same bits, and the result says what it could not confirm.
+  o.stop_after_generations = 5;
+  calibrate(inputs, space, testing::fake_simulate, o, Comm::world());
+  std::string text = read_file(o.checkpoint);
+  const std::size_t runs = text.find(";runs=");
+  ASSERT_NE(runs, std::string::npos);
+  text.erase(runs, text.find('\n', runs) - runs);
+  write_file_atomic(o.checkpoint, text);
+  o.stop_after_generations = 0;
+  const auto old = calibrate(inputs, space, testing::fake_simulate, o, Comm::world());
+  EXPECT_NE(old.resume_note.find("predates the inputs' heights and speeds"), std::string::npos) << old.resume_note;
+  EXPECT_TRUE(old.best_unit == full.best_unit);
+  EXPECT_EQ(old.objective, full.objective);
   fs::remove_all(dir);
 }
 
@@ -995,9 +1010,28 @@ TEST(Calibration, CheckpointOfAnotherRunIsRefused) {
   auto o = quick(3, 1);
   o.checkpoint = dir / "run.ckpt";
   calibrate(inputs, space, testing::fake_simulate, o, Comm::world());
-  o.seed = 12;  // another run
-  EXPECT_THROW(calibrate(inputs, space, testing::fake_simulate, o, Comm::world()), InputError);
+  o.seed = 12;  // another run, and the refusal names what differs
+  try {
+    calibrate(inputs, space, testing::fake_simulate, o, Comm::world());
+    FAIL() << "another seed's checkpoint resumed";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("its seed= (here 12, in the checkpoint 11) differs"), std::string::npos)
+        << e.what();
+  }
   o.seed = 11;  // back to the first run's
+  {  // The same trials at another speed or height (a manifest's row corrected) are another run.
+    auto faster = inputs;
+    faster[0].speed = 0.15;
+    try {
+      calibrate(faster, space, testing::fake_simulate, o, Comm::world());
+      FAIL() << "a checkpoint of the inputs at 0.1 m/s resumed them at 0.15";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("its runs= (here"), std::string::npos) << e.what();
+    }
+    auto lower = inputs;
+    lower[0].height = lower[0].height == ArmHeight::Low ? ArmHeight::Middle : ArmHeight::Low;
+    EXPECT_THROW(calibrate(lower, space_for(lower), testing::fake_simulate, o, Comm::world()), InputError);
+  }
   auto hemmed = space;  // the same run on a gown with a cuff is another run too
   hemmed.hem_width = 0.03;
   hemmed.hem_bend_ratio = 30;
