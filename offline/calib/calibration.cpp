@@ -539,6 +539,28 @@ double simulated_time(const std::vector<SimulatedTrial>& sts) {
   return s;
 }
 
+// Every rank runs ask() and tell() itself and they must agree to the bit: the candidates a rank
+// simulates are its share of its own ask(). On one machine kind they do (runner.h); nodes of
+// different kinds need not, since glibc picks exp, log and pow variants by CPU (with or without
+// FMA), and diverged ranks would then simulate shares of different generations and sum them
+// into a search that no one ran, without a sign. So after each tell() every rank compares its
+// state (the checkpoint's exact text) with rank 0's, and all end when any differs. One
+// broadcast of a few kB a generation, beside minutes of simulation.
+void require_one_state(const Cmaes& es, const Comm& comm, int generation) {
+  if (comm.size() == 1) return;
+  const std::string mine = es.save_state();
+  std::string root = mine;
+  comm.broadcast(root);
+  std::vector<double> differ{root == mine ? 0.0 : 1.0};
+  comm.allreduce_sum(differ);
+  if (differ[0] > 0)
+    throw std::runtime_error("generation " + std::to_string(generation) + ": the CMA-ES state of " +
+                             std::to_string(static_cast<int>(differ[0])) + " of " + std::to_string(comm.size()) +
+                             " ranks differs from rank 0's (this rank's " + (root == mine ? "agrees" : "differs") +
+                             "): the ranks compute differently (nodes of different CPU kinds, or other arguments); "
+                             "run on one node kind");
+}
+
 // What must match for a checkpoint to continue this run.
 std::string fingerprint(const std::vector<HapticSequence>& inputs, const ParameterSpace& space,
                         const CalibrationOptions& o) {
@@ -1019,6 +1041,7 @@ CalibrationResult calibrate(const std::vector<HapticSequence>& inputs, const Par
       for (int k = 0; k < T; ++k) best_fits[k] = per[static_cast<std::size_t>(arg) * W + k];
     ++done;
     ++done_here;
+    require_one_state(es, comm, done);
     if (!options.checkpoint.empty()) {
       // Rank 0 writes it, and every rank learns whether it could: a failure ends them all. The
       // other ranks used to go on to the next generation and wait in its MPI_Allreduce for a rank

@@ -12,6 +12,10 @@
 // writes once every rank's trials are in, cannot be written (a folder holds its place). Every
 // rank must end with the error too; rank 0 alone used to, the others waiting at the barrier
 // after it (session 90's review).
+//
+// `calib_mpi_check --ranks-disagree WORKDIR`: a calibration whose ranks compute different
+// generations (here each rank gets another seed, as nodes of different CPU kinds could round
+// differently): every rank must end after the first generation, saying the states differ.
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -78,13 +82,32 @@ int synthesis_fails(const std::filesystem::path& dir, const Comm& comm) {
   return 0;
 }
 
+// Rank r searches with seed 5 + r: their states part at the first tell().
+int ranks_disagree(const std::vector<HapticSequence>& inputs, const ParameterSpace& space, const Comm& comm) {
+  CalibrationOptions o;
+  o.generations = 3;
+  o.population = 6;
+  o.threads = 1;
+  o.seed = 5 + static_cast<std::uint64_t>(comm.rank());
+  try {
+    calibrate(inputs, space, testing::fake_simulate, o, comm);
+  } catch (const std::exception& e) {
+    std::printf("rank %d: %s\n", comm.rank(), e.what());
+    std::fflush(stdout);
+    return 3;
+  }
+  std::printf("rank %d: calibrated, the ranks' disagreement unnoticed\n", comm.rank());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   const bool fails = argc == 3 && std::strcmp(argv[1], "--checkpoint-fails") == 0;
   const bool synthesis = argc == 3 && std::strcmp(argv[1], "--synthesis-fails") == 0;
-  if (argc != 2 && !fails && !synthesis) {
-    std::fprintf(stderr, "usage: calib_mpi_check [--checkpoint-fails | --synthesis-fails] WORKDIR\n");
+  const bool disagree = argc == 3 && std::strcmp(argv[1], "--ranks-disagree") == 0;
+  if (argc != 2 && !fails && !synthesis && !disagree) {
+    std::fprintf(stderr, "usage: calib_mpi_check [--checkpoint-fails | --synthesis-fails | --ranks-disagree] WORKDIR\n");
     return 2;
   }
   const std::filesystem::path dir = argv[argc - 1];
@@ -105,6 +128,7 @@ int main(int argc, char** argv) {
   space.bounds = default_bounds();
   for (const auto& s : inputs) space.offset_heights.push_back(s.height);
   if (fails) return checkpoint_fails(dir, inputs, space, comm);
+  if (disagree) return ranks_disagree(inputs, space, comm);
   CalibrationOptions o;
   o.generations = 10;
   o.population = 12;

@@ -1,10 +1,11 @@
-# Two MPI ranks where rank 0 alone cannot write a file (calib_mpi_check MODE): both ranks must
-# end, each naming it. MODE --checkpoint-fails: a calibration's checkpoint after the first
-# generation; rank 0 alone used to end, and rank 1 waited for it in the next generation's
-# MPI_Allreduce until killed (a Slurm job's whole time limit). MODE --synthesis-fails: a
-# synthesis's labels.csv, whose failure left rank 1 at the barrier after it. The TIMEOUT turns
-# such a hang into a failure.
-# -DCHECK=<binary> -DMPIEXEC=<mpiexec> -DWORK=<dir> -DMODE=<--checkpoint-fails|--synthesis-fails>
+# Two MPI ranks where something goes wrong on one or between them (calib_mpi_check MODE): both
+# ranks must end, each saying so, where one used to end alone and leave the other waiting in
+# its next collective until killed (a Slurm job's whole time limit).
+#   --checkpoint-fails: a calibration's checkpoint, written by rank 0 after the first generation;
+#   --synthesis-fails: a synthesis's labels.csv, written by rank 0 after every rank's trials;
+#   --ranks-disagree: ranks whose CMA-ES states part (as nodes of different CPU kinds could).
+# The TIMEOUT turns a hang into a failure.
+# -DCHECK=<binary> -DMPIEXEC=<mpiexec> -DWORK=<dir> -DMODE=<one of the above>
 #   -DEXPECT=<regex that a line of each rank must match after "rank R: ">
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
