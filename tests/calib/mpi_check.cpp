@@ -19,6 +19,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <sstream>
 
 #include "calibration.h"
@@ -30,6 +31,20 @@ using namespace dressguard;
 using namespace dressguard::calib;
 
 namespace {
+
+// Runs one of the failure modes: each rank prints "rank R: " and the error it ended with (exit 3),
+// or that it went on, `unnoticed` (exit 0).
+int each_rank_ends(const Comm& comm, const char* unnoticed, const std::function<void()>& run) {
+  try {
+    run();
+  } catch (const std::exception& e) {
+    std::printf("rank %d: %s\n", comm.rank(), e.what());
+    std::fflush(stdout);
+    return 3;
+  }
+  std::printf("rank %d: %s\n", comm.rank(), unnoticed);
+  return 0;
+}
 
 // The checkpoint of a calibration on `comm` becomes unwritable during its first generation.
 int checkpoint_fails(const std::filesystem::path& dir, const std::vector<HapticSequence>& inputs,
@@ -47,15 +62,8 @@ int checkpoint_fails(const std::filesystem::path& dir, const std::vector<HapticS
     fs::remove_all(dir / "ck");
     write_file_atomic(dir / "ck", "in the checkpoint's folder's place\n");
   };
-  try {
-    calibrate(inputs, space, testing::fake_simulate, o, comm);
-  } catch (const std::exception& e) {
-    std::printf("rank %d: %s\n", comm.rank(), e.what());
-    std::fflush(stdout);
-    return 3;
-  }
-  std::printf("rank %d: calibrated, the checkpoint's failure unnoticed\n", comm.rank());
-  return 0;
+  return each_rank_ends(comm, "calibrated, the checkpoint's failure unnoticed",
+                        [&] { calibrate(inputs, space, testing::fake_simulate, o, comm); });
 }
 
 // The last file of a synthesis on `comm`, written by rank 0 alone, cannot be written.
@@ -71,15 +79,8 @@ int synthesis_fails(const std::filesystem::path& dir, const Comm& comm) {
   SynthesisOptions so;
   so.per_height = 2;
   so.threads = 1;
-  try {
-    synthesize(cal, testing::fake_simulate, so, dir / "sf", comm);
-  } catch (const std::exception& e) {
-    std::printf("rank %d: %s\n", comm.rank(), e.what());
-    std::fflush(stdout);
-    return 3;
-  }
-  std::printf("rank %d: synthesized, labels.csv's failure unnoticed\n", comm.rank());
-  return 0;
+  return each_rank_ends(comm, "synthesized, labels.csv's failure unnoticed",
+                        [&] { synthesize(cal, testing::fake_simulate, so, dir / "sf", comm); });
 }
 
 // Rank r searches with seed 5 + r: their states part at the first tell().
@@ -89,15 +90,8 @@ int ranks_disagree(const std::vector<HapticSequence>& inputs, const ParameterSpa
   o.population = 6;
   o.threads = 1;
   o.seed = 5 + static_cast<std::uint64_t>(comm.rank());
-  try {
-    calibrate(inputs, space, testing::fake_simulate, o, comm);
-  } catch (const std::exception& e) {
-    std::printf("rank %d: %s\n", comm.rank(), e.what());
-    std::fflush(stdout);
-    return 3;
-  }
-  std::printf("rank %d: calibrated, the ranks' disagreement unnoticed\n", comm.rank());
-  return 0;
+  return each_rank_ends(comm, "calibrated, the ranks' disagreement unnoticed",
+                        [&] { calibrate(inputs, space, testing::fake_simulate, o, comm); });
 }
 
 }  // namespace
