@@ -199,6 +199,10 @@ fs::path marker_path(const fs::path& out, const std::string& id) { return out / 
 
 // A finished trial's marker: its label, then the label's evidence (d_behind d_ahead, exact).
 // Markers of earlier versions hold the label alone; their evidence reads as NaN (unknown).
+// The marker of a trial whose simulation did not stay finite (no CSV beside it).
+constexpr const char* kNotFiniteMarker = "not-finite\n";
+constexpr double kNotFiniteCode = -1.0;  // its label code in the results
+
 std::string marker_text(const SimulatedTrial& st) {
   char buf[128];
   std::snprintf(buf, sizeof buf, "%s\n%.17g %.17g\n", std::string(outcome_name(st.outcome)).c_str(), st.d_behind,
@@ -392,7 +396,10 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
         const fs::path csv = out / (id + ".csv");
         const fs::path marker = marker_path(out, id);
         bool resumed = false;
-        if (fs::exists(marker) && fs::exists(csv)) {
+        if (fs::exists(marker) && read_file(marker) == kNotFiniteMarker) {
+          r[0] = kNotFiniteCode;
+          resumed = true;
+        } else if (fs::exists(marker) && fs::exists(csv)) {
           if (const auto m = read_marker(marker)) {
             r[0] = static_cast<double>(m->label);
             r[2] = m->d_behind;
@@ -402,13 +409,16 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
         }
         if (!resumed) {
           const SimulatedTrial st = sim(cal.cloth, synthesis_request(cal, h, index, options, middle_base, band_of(h)));
-          if (!st.finite || st.samples.empty())
-            throw std::runtime_error("simulation of " + id + " did not stay finite; check the calibration");
-          write_file_atomic(csv, format_trial_csv(st.samples));
-          write_file_atomic(marker, marker_text(st));
-          r[0] = static_cast<double>(st.outcome);
-          r[2] = st.d_behind;
-          r[3] = st.d_ahead;
+          if (!st.finite || st.samples.empty()) {
+            write_file_atomic(marker, kNotFiniteMarker);
+            r[0] = kNotFiniteCode;
+          } else {
+            write_file_atomic(csv, format_trial_csv(st.samples));
+            write_file_atomic(marker, marker_text(st));
+            r[0] = static_cast<double>(st.outcome);
+            r[2] = st.d_behind;
+            r[3] = st.d_ahead;
+          }
         }
         r[1] = resumed ? 1.0 : 0.0;
         const int d = ++done;
@@ -432,10 +442,23 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
   s.high_band = high_band;
   s.low_band = low_band;
   for (int t = 0; t < total; ++t) {
+    s.resumed += res[kBlock * t + 1] > 0.5;
+    if (res[kBlock * t] == kNotFiniteCode) {
+      s.not_finite.push_back(synthesis_trial_id(heights[t / options.per_height], t % options.per_height));
+      continue;
+    }
     const int label = static_cast<int>(res[kBlock * t]);
     s.per_label[label]++;
     s.per_height_label[static_cast<int>(heights[t / options.per_height])][label]++;
-    s.resumed += res[kBlock * t + 1] > 0.5;
+  }
+  if (static_cast<double>(s.not_finite.size()) > kMaxNotFiniteShare * total) {
+    std::string ids;
+    for (std::size_t k = 0; k < s.not_finite.size() && k < 5; ++k) ids += (k ? ", " : "") + s.not_finite[k];
+    throw std::runtime_error(std::to_string(s.not_finite.size()) + " of " + std::to_string(total) +
+                             " trials did not stay finite (" + ids + (s.not_finite.size() > 5 ? ", ..." : "") +
+                             "), more than one in twenty: the calibrated simulator is unstable where the noise "
+                             "models take it; no dataset written (the finished trials are kept in " +
+                             out.string() + ")");
   }
   comm.on_root([&] {
     Dataset ds;
@@ -444,6 +467,7 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
       HapticSequence seq;
       const ArmHeight h = heights[t / options.per_height];
       const int index = t % options.per_height;
+      if (res[kBlock * t] == kNotFiniteCode) continue;  // left out (SynthesisSummary::not_finite)
       const TrialRequest request = synthesis_request(cal, h, index, options, middle_base, band_of(h));
       seq.id = synthesis_trial_id(h, index);
       seq.participant = "";

@@ -148,8 +148,17 @@ struct SynthesisSummary {
   // that no person showed, in the arm's noise or the gown's push (offline/calib/MEASUREMENTS.md,
   // session 61: that push is what cost participant 3's support file its STC).
   int per_height_label[3][kOutcomeCount] = {};
+  // The trials whose simulation did not stay finite, left out of the dataset (not counted above).
+  // A trial's randomness is its (seed, height, index) alone, so a rerun would blow up again: it is
+  // marked and skipped rather than ending the whole synthesis, as it did before session 90. More
+  // than kMaxNotFiniteShare of them ends it instead (std::runtime_error; the finished trials kept).
+  std::vector<std::string> not_finite;
   double elapsed_s = 0;
 };
+
+// One trial in twenty: a simulator that blows up more often than that, at settings the noise
+// models draw from, is no stand-in for a population of people, and its set is not written.
+inline constexpr double kMaxNotFiniteShare = 0.05;
 
 // The trials of a synthesized set whose label the rule's 7 cm decides by less than `margin` [m]
 // (build-model --label-margin): those that stopped before the end of travel with
@@ -164,7 +173,8 @@ std::vector<std::string> ambiguous_labels(const std::filesystem::path& set, doub
 
 // Simulates the missing trials into `out` (a dataset folder) and writes its manifest. Every rank
 // of `comm` calls it; trials are spread over ranks (index % size) and threads; rank 0 writes
-// the manifest after all ranks have finished. Returns the same summary on every rank.
+// the manifest after all ranks have finished. Returns the same summary on every rank. A trial
+// that does not stay finite is left out (SynthesisSummary::not_finite).
 SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, const SynthesisOptions& options,
                             const std::filesystem::path& out, const Comm& comm,
                             const std::function<void(const SynthesisProgress&)>& progress = {});

@@ -77,6 +77,12 @@ SynthesisSummary run_synthesis(const Calibration& cal, const std::string& gown, 
                    "%s; eq. 3-5 distance <= %.3f)\n",
                    b == &s.high_band ? "high" : "low", b->lower, b->upper,
                    std::string(outcome_name(b->at_calibrated)).c_str(), b->tolerance);
+  if (!s.not_finite.empty() && comm.is_root()) {
+    std::string ids;
+    for (const std::string& id : s.not_finite) ids += (ids.empty() ? "" : ", ") + id;
+    std::fprintf(stderr, "synthesize: note: %zu of %d trials did not stay finite and are left out of the dataset: %s\n",
+                 s.not_finite.size(), s.trials, ids.c_str());
+  }
   // The study never caught the high arm (synthesis.h, SynthesisSummary::per_height_label).
   const int high_caught = s.per_height_label[static_cast<int>(ArmHeight::High)][static_cast<int>(Outcome::Caught)];
   if (high_caught > 0 && comm.is_root())
@@ -138,16 +144,19 @@ int run_synthesize(int argc, char** argv) {
         heights += buf;
       }
       std::printf("{\"trials\": %d, \"resumed\": %d, \"good\": %d, \"missed\": %d, \"caught\": %d, "
-                  "\"per_height\": {%s}, "
+                  "\"not_finite\": %zu, \"per_height\": {%s}, "
                   "\"middle\": \"%s\", \"middle_base_m\": %.6f, \"high_low\": \"%s\", \"high_band_m\": [%.6f, %.6f], "
                   "\"low_band_m\": [%.6f, %.6f], \"out\": %s}\n",
-                  s.trials, s.resumed, s.per_label[g], s.per_label[m], s.per_label[c], heights.c_str(),
+                  s.trials, s.resumed, s.per_label[g], s.per_label[m], s.per_label[c], s.not_finite.size(),
+                  heights.c_str(),
                   middle_arm_name(o.middle), o.middle == MiddleArm::CaughtEdge ? s.edge.offset : 0.0,
                   high_low_arm_name(o.high_low), s.high_band.lower, s.high_band.upper, s.low_band.lower,
                   s.low_band.upper, json_string(out).c_str());
     } else {
-      std::printf("synthesized %d trials (%d kept from an earlier run): %d good, %d missed, %d caught -> %s\n",
-                  s.trials, s.resumed, s.per_label[g], s.per_label[m], s.per_label[c], out.c_str());
+      std::printf("synthesized %d trials (%d kept from an earlier run): %d good, %d missed, %d caught%s -> %s\n",
+                  s.trials, s.resumed, s.per_label[g], s.per_label[m], s.per_label[c],
+                  s.not_finite.empty() ? "" : (", " + std::to_string(s.not_finite.size()) + " not finite, left out").c_str(),
+                  out.c_str());
       for (const ArmHeight h : {ArmHeight::High, ArmHeight::Middle, ArmHeight::Low}) {
         const auto& n = by[static_cast<int>(h)];
         std::printf("  %-6s arm: %d good, %d missed, %d caught\n", std::string(arm_height_name(h)).c_str(), n[g],

@@ -2123,6 +2123,64 @@ TEST(Synthesis, LabelsCsvRecordsWhatDecidedEachLabel) {
   fs::remove_all(dir);
 }
 
+// A trial whose simulation does not stay finite is left out of the set, not the end of the
+// synthesis: its randomness is its (seed, height, index) alone, so every rerun met it again and
+// the synthesis could never finish (session 90's review). It is marked, and a rerun keeps it out
+// without simulating it; more than one in twenty ends the synthesis instead, naming them.
+TEST(Synthesis, ATrialThatDoesNotStayFiniteIsLeftOut) {
+  Calibration cal;
+  SynthesisOptions o;
+  o.per_height = 10;
+  o.threads = 2;
+  const TrialRequest bad = synthesis_request(cal, ArmHeight::Middle, 3, o);
+  std::atomic<int> calls{0};
+  const TrialSimulator blows_up_once = [&](const ClothValues& c, const TrialRequest& r) {
+    ++calls;
+    SimulatedTrial st = testing::fake_simulate(c, r);
+    if (r.height == bad.height && r.seed == bad.seed) st.finite = false;
+    return st;
+  };
+  const fs::path dir = temp_dir("synth_not_finite");
+  const auto s = synthesize(cal, blows_up_once, o, dir, Comm::world());
+  const std::string id = synthesis_trial_id(ArmHeight::Middle, 3);
+  ASSERT_EQ(s.not_finite, std::vector<std::string>{id});
+  EXPECT_EQ(calls.load(), 30);
+  int counted = 0;
+  for (int l = 0; l < kOutcomeCount; ++l) counted += s.per_label[l];
+  EXPECT_EQ(counted, 29);
+  const Dataset ds = load_dataset(dir);
+  ASSERT_EQ(ds.trials.size(), 29u);
+  for (const auto& t : ds.trials) EXPECT_NE(t.id, id);
+  EXPECT_FALSE(fs::exists(dir / (id + ".csv")));
+  EXPECT_EQ(read_file(dir / "labels.csv").find(id), std::string::npos);
+  // A rerun simulates nothing and leaves it out again.
+  calls = 0;
+  const auto again = synthesize(cal, blows_up_once, o, dir, Comm::world());
+  EXPECT_EQ(calls.load(), 0);
+  EXPECT_EQ(again.resumed, 30);
+  EXPECT_EQ(again.not_finite, s.not_finite);
+  EXPECT_EQ(load_dataset(dir).trials.size(), 29u);
+  // Every middle trial blowing up (10 of 30) ends the synthesis, naming them.
+  const TrialSimulator middle_blows_up = [&](const ClothValues& c, const TrialRequest& r) {
+    SimulatedTrial st = testing::fake_simulate(c, r);
+    st.finite = r.height != ArmHeight::Middle;
+    return st;
+  };
+  const fs::path worse = temp_dir("synth_unstable");
+  try {
+    synthesize(cal, middle_blows_up, o, worse, Comm::world());
+    ADD_FAILURE() << "a synthesis with a third of its trials not finite was written";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("10 of 30 trials did not stay finite (" +
+                                         synthesis_trial_id(ArmHeight::Middle, 0)),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(fs::exists(worse / "manifest.csv"));
+  fs::remove_all(dir);
+  fs::remove_all(worse);
+}
+
 TEST(Synthesis, DatasetIsIndependentOfThreadsAndResumes) {
   Calibration cal;
   SynthesisOptions o;
