@@ -3,6 +3,8 @@
 // refusal an InputError that names the file and the line.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <string>
 
 #include "files.h"
@@ -33,6 +35,8 @@ TEST(Json, NumbersAreJsonNumbers) {
   const std::vector<double> want = {0, -0.0, 12, -3.25, 1.5e-3, 200, 7, 1e308, 4.9e-324};
   ASSERT_EQ(j.items().size(), want.size());
   for (std::size_t k = 0; k < want.size(); ++k) EXPECT_EQ(j.items()[k].number(), want[k]) << k;
+  EXPECT_TRUE(std::signbit(j.items()[1].number())) << "-0 read as +0 (EXPECT_EQ cannot tell them apart)";
+  EXPECT_FALSE(std::signbit(j.items()[0].number()));
   // What dump() writes reads back to the same double (17 significant digits).
   const double third = 1.0 / 3.0;
   EXPECT_EQ(Json::parse(Json(third).dump()).number(), third);

@@ -662,8 +662,9 @@ TEST(Prediction, RealPersonYardstickOnTheStudy) {
   std::sort(medians.begin(), medians.end());
   const double m = medians[medians.size() / 2];
   std::printf("  missed: median of the per-trial real-person medians %.3f over %zu trials\n", m, medians.size());
-  EXPECT_GT(m, 0.3);
-  EXPECT_LT(m, 0.9);
+  // The yardstick for two people's missed trials is a median of 0.55; this pools per-trial
+  // medians of third persons, so a percent or two apart (measured 0.555).
+  EXPECT_NEAR(m, 0.55, 0.02);
 }
 
 // The middle arm's yardstick on the study: its trials pull at 0.1 m/s but one (s0-middlemiss-10)

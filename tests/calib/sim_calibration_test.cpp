@@ -23,17 +23,48 @@ namespace {
 // A calibration's values reach the simulator whole: the five cloth values, the person's arm and
 // the gown's cuff and its density (calibrate --hem / --density record them in the file,
 // synthesis simulates with them).
+// Every field gets a value of its own, none the simulator's default, so that a copy dropped
+// (the default would stand in) or two swapped shows (session 90's test audit: half of them were
+// set to their defaults or not checked).
 TEST(SimCalibration, ClothParamsCarryEveryCalibratedValue) {
-  ClothValues c{0.1, 0.2, 0.3, 0.4, 0.5, 0.006, 0.05, 0.03, 30, 0.0, 0.1};
+  ClothValues c;
+  c.stretch = 0.11;
+  c.shear = 0.22;
+  c.bend = 0.33;
+  c.friction = 0.44;
+  c.self_friction = 0.55;
+  c.arm_compliance = 0.006;
+  c.fist_shift = 0.05;
+  c.hem_width = 0.03;
+  c.hem_bend_ratio = 30;
+  c.rim_shift = 0.01;  // not a ClothParams: it picks the scene (make_cloth_simulator)
+  c.areal_density = 0.1;
+  c.arm_lateral = 0.011;
+  c.fist_lateral = -0.012;
+  c.support_depth = 0.65;
+  c.support_lateral = 0.013;
+  const sim::ClothParams d;  // the defaults, none of which may equal a value above
+  for (double v : {d.stretch, d.shear, d.bend, d.friction, d.self_friction, d.arm_compliance, d.fist_shift,
+                   d.hem_width, d.hem_bend_ratio, d.areal_density, d.arm_lateral, d.fist_lateral, d.support_depth,
+                   d.support_lateral})
+    for (double set : {0.11, 0.22, 0.33, 0.44, 0.55, 0.006, 0.05, 0.03, 30.0, 0.1, 0.011, -0.012, 0.65, 0.013})
+      ASSERT_NE(v, set) << "a default equals a value the test sets: it could not tell a dropped copy";
   const sim::ClothParams p = cloth_params_of(c);
-  EXPECT_EQ(p.stretch, 0.1);
-  EXPECT_EQ(p.self_friction, 0.5);
+  EXPECT_EQ(p.stretch, 0.11);
+  EXPECT_EQ(p.shear, 0.22);
+  EXPECT_EQ(p.bend, 0.33);
+  EXPECT_EQ(p.friction, 0.44);
+  EXPECT_EQ(p.self_friction, 0.55);
   EXPECT_EQ(p.arm_compliance, 0.006);
   EXPECT_EQ(p.fist_shift, 0.05);
   EXPECT_EQ(p.hem_width, 0.03);
   EXPECT_EQ(p.hem_bend_ratio, 30.0);
   EXPECT_EQ(p.areal_density, 0.1);
-  EXPECT_EQ(p.damping, sim::ClothParams{}.damping);  // not calibrated (paper IV-B.2)
+  EXPECT_EQ(p.arm_lateral, 0.011);
+  EXPECT_EQ(p.fist_lateral, -0.012);
+  EXPECT_EQ(p.support_depth, 0.65);
+  EXPECT_EQ(p.support_lateral, 0.013);
+  EXPECT_EQ(p.damping, d.damping);  // not calibrated (paper IV-B.2)
 }
 
 // The bridge is deterministic and thread-safe: the same trial simulated on two threads at once
