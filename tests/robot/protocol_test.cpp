@@ -91,18 +91,135 @@ TEST(E2E, ClassifiesGoodRepeatedLostLateCorrupted) {
   EXPECT_FALSE(accepted(E2EStatus::Late));
 }
 
+// How many of the nine decoders take `f`: a frame of the protocol is exactly one message.
+int decoders_taking(const Frame& f) {
+  FtForce a{};
+  FtTorque b{};
+  TrialStart c{};
+  TrialEnd d{};
+  Stop e{};
+  PredictorStatus g{};
+  Posteriors h{};
+  HeartbeatBridge i{};
+  HeartbeatPredictor j{};
+  return decode(f, a) + decode(f, b) + decode(f, c) + decode(f, d) + decode(f, e) + decode(f, g) + decode(f, h) +
+         decode(f, i) + decode(f, j);
+}
+
+// Encodes `m`, checks the frame's envelope as the header documents it (the identifier in the
+// MsgId comment, kFrameLength bytes, the alive counter in byte 1, a CRC the receiver's E2E check
+// accepts under that identifier), that its own decoder and no other takes it and none takes it
+// at 7 bytes, and returns what its decoder makes of it.
+template <class M>
+M round_trip(const M& m, uint32_t documented_id) {
+  const Frame f = encode(m);
+  EXPECT_EQ(f.id, documented_id);
+  EXPECT_EQ(f.len, 8);
+  EXPECT_EQ(f.data[1], m.counter) << "the alive counter is byte 1";
+  E2EChecker chk(static_cast<MsgId>(documented_id));
+  uint32_t lost = 0;
+  EXPECT_EQ(chk.check(f, lost), E2EStatus::Initial) << "byte 0 is not the E2E CRC under this identifier";
+  EXPECT_EQ(decoders_taking(f), 1) << "decode must refuse a frame of another identifier";
+  Frame short_frame = f;
+  short_frame.len = 7;
+  EXPECT_EQ(decoders_taking(short_frame), 0) << "decode must refuse a frame of another length";
+  M back{};  // all zero: every field below is non-zero, so a field decode leaves alone shows
+  EXPECT_TRUE(decode(f, back));
+  return back;
+}
+
+// Every message of the header, each field a distinct non-zero value (16-bit ones with two
+// different non-zero bytes, enums not their first enumerator), so that a field dropped, written
+// over a neighbour's bytes, swapped with another or byte-swapped shows; every field is compared
+// after decoding. (The byte layout itself is ProtocolDocument's: PROTOCOL.md's examples.)
 TEST(Messages, RoundTripEveryMessage) {
-  Stop s{3, StopReason::Caught, 240, 17, 321}, s2{};
-  ASSERT_TRUE(decode(encode(s), s2));
-  EXPECT_EQ(s2.reason, StopReason::Caught);
-  EXPECT_EQ(s2.sample, 321);
-  EXPECT_EQ(s2.trial_id, 17);
-  TrialStart t{1, 42, 150, HeightClass::Middle}, t2{};
-  ASSERT_TRUE(decode(encode(t), t2));
-  EXPECT_EQ(t2.speed_mm_s, 150);
-  EXPECT_EQ(t2.height, HeightClass::Middle);
-  FtForce f{};
-  EXPECT_FALSE(decode(encode(t), f)) << "decode must refuse a frame of another identifier";
+  {
+    SCOPED_TRACE("FtForce");
+    const FtForce m{0x11, -12345, 23456, -3210};
+    const FtForce b = round_trip(m, 0x100);
+    EXPECT_EQ(b.counter, m.counter);
+    EXPECT_EQ(b.fx, m.fx);
+    EXPECT_EQ(b.fy, m.fy);
+    EXPECT_EQ(b.fz, m.fz);
+  }
+  {
+    SCOPED_TRACE("FtTorque");
+    const FtTorque m{0x22, 4321, -8765, 30001};
+    const FtTorque b = round_trip(m, 0x101);
+    EXPECT_EQ(b.counter, m.counter);
+    EXPECT_EQ(b.mx, m.mx);
+    EXPECT_EQ(b.my, m.my);
+    EXPECT_EQ(b.mz, m.mz);
+  }
+  {
+    SCOPED_TRACE("TrialStart");
+    const TrialStart m{0x33, 0x1234, 450, HeightClass::Low};
+    const TrialStart b = round_trip(m, 0x180);
+    EXPECT_EQ(b.counter, m.counter);
+    EXPECT_EQ(b.trial_id, m.trial_id);
+    EXPECT_EQ(b.speed_mm_s, m.speed_mm_s);
+    EXPECT_EQ(b.height, m.height);
+  }
+  {
+    SCOPED_TRACE("TrialEnd");
+    const TrialEnd m{0x44, 0x2345, 3000, TrialEndReason::StoppedByPredictor};
+    const TrialEnd b = round_trip(m, 0x181);
+    EXPECT_EQ(b.counter, m.counter);
+    EXPECT_EQ(b.trial_id, m.trial_id);
+    EXPECT_EQ(b.samples, m.samples);
+    EXPECT_EQ(b.reason, m.reason);
+  }
+  {
+    SCOPED_TRACE("Stop");
+    const Stop m{0x55, StopReason::StopUnconfirmed, 200, 0x3456, 0x0321};
+    const Stop b = round_trip(m, 0x080);
+    EXPECT_EQ(b.counter, m.counter);
+    EXPECT_EQ(b.reason, m.reason);
+    EXPECT_EQ(b.p_caught, m.p_caught);
+    EXPECT_EQ(b.trial_id, m.trial_id);
+    EXPECT_EQ(b.sample, m.sample);
+  }
+  {
+    SCOPED_TRACE("PredictorStatus");
+    const PredictorStatus m{0x66, 5, PredictorState::Fault, 0x4567, 0x5678};
+    const PredictorStatus b = round_trip(m, 0x300);
+    EXPECT_EQ(b.counter, m.counter);
+    EXPECT_EQ(b.page, m.page);
+    EXPECT_EQ(b.state, m.state);
+    EXPECT_EQ(b.value0, m.value0);
+    EXPECT_EQ(b.value1, m.value1);
+  }
+  {
+    SCOPED_TRACE("Posteriors");
+    const Posteriors m{0x77, 0x6789, {10, 200, 45}, PredictorState::InTrial};
+    const Posteriors b = round_trip(m, 0x301);
+    EXPECT_EQ(b.counter, m.counter);
+    EXPECT_EQ(b.sample, m.sample);
+    EXPECT_EQ(b.p[0], m.p[0]);
+    EXPECT_EQ(b.p[1], m.p[1]);
+    EXPECT_EQ(b.p[2], m.p[2]);
+    EXPECT_EQ(b.state, m.state);
+  }
+  {
+    SCOPED_TRACE("HeartbeatBridge");
+    const HeartbeatBridge m{0x88, BridgeState::StopLatched, 9, 0x789A, 3600};
+    const HeartbeatBridge b = round_trip(m, 0x700);
+    EXPECT_EQ(b.counter, m.counter);
+    EXPECT_EQ(b.state, m.state);
+    EXPECT_EQ(b.sensor_errors, m.sensor_errors);
+    EXPECT_EQ(b.reconnects, m.reconnects);
+    EXPECT_EQ(b.uptime_s, m.uptime_s);
+  }
+  {
+    SCOPED_TRACE("HeartbeatPredictor");
+    const HeartbeatPredictor m{0x99, PredictorState::Stopped, 1, 0x89AB, 7200};
+    const HeartbeatPredictor b = round_trip(m, 0x701);
+    EXPECT_EQ(b.counter, m.counter);
+    EXPECT_EQ(b.state, m.state);
+    EXPECT_EQ(b.model_loaded, m.model_loaded);
+    EXPECT_EQ(b.trial_id, m.trial_id);
+    EXPECT_EQ(b.uptime_s, m.uptime_s);
+  }
 }
 
 // ---- PROTOCOL.md examples -------------------------------------------------------------------
