@@ -400,19 +400,31 @@ TEST(ReplayCli, LogsFolderTalliesTheStopsPerOutcome) {
 }
 
 TEST(ReplayCli, EverySetOverridesItsKey) {
-  // Two --set options both apply. A threshold of 0.01 alone (with the model's 5 samples) stops
-  // every trial, since P(caught) starts near 1/3. 100000 consecutive samples, longer than any
-  // trial, stops none. If only the last --set counted, as before session 32, every trial would
-  // stop here.
+  // Two --set options both apply, whichever comes first, and each key's effect shows on its own,
+  // so that applying only the first, only the last or both give three different answers. The
+  // test model (threshold 0.95, 10 consecutive samples) never stops this good trial. A threshold
+  // of 0.01 alone stops it for "caught" at sample 9: P(caught) starts near 1/3, above 0.01 from
+  // the first sample, so the model's ten samples in a row end at index 9. 7 consecutive samples
+  // alone stop nothing (the 0.95 threshold is never crossed). Both together stop it at sample 6.
+  // If only the last --set counted, as before session 32, one order would stop at 9 and the
+  // other not at all; if only the first counted, the other way round.
   int rc = 0;
-  const std::string base = std::string(DG_CLI) + " replay --model " + DG_TEST_MODEL + " --logs " + kLogs.string();
-  const std::string lone = run(base + " --set stop_threshold=0.01 --json", rc);
-  ASSERT_EQ(rc, 0) << lone;
-  EXPECT_NE(lone.find("\"good\": {\"logs\": 3, \"trials\": 3, \"caught_stops\": 3"), std::string::npos) << lone;
-  const std::string two = run(base + " --set stop_consecutive=100000 --set stop_threshold=0.01 --json", rc);
-  ASSERT_EQ(rc, 0) << two;
-  // (The fault logs still stop, for their faults: no caught stop is what the two keys decide.)
-  EXPECT_EQ(two.find("\"reason\": \"caught\""), std::string::npos) << two;
+  const std::string base = std::string(DG_CLI) + " replay --model " + DG_TEST_MODEL + " --log " +
+                           (kLogs / "syn2-good-0-good.log").string();
+  // '"stopped": ..., "reason": ..., "stop_sample": N' of the trial replayed with `sets`.
+  const auto stop_with = [&](const std::string& sets) {
+    const std::string out = run(base + " " + sets + " --json", rc);
+    EXPECT_EQ(rc, 0) << sets << "\n" << out;
+    const auto from = out.find("\"stopped\"");
+    const auto to = out.find(", \"stop_time\"", from);
+    return from == std::string::npos || to == std::string::npos ? out : out.substr(from, to - from);
+  };
+  EXPECT_EQ(stop_with(""), "\"stopped\": false, \"reason\": \"none\", \"stop_sample\": 0");
+  EXPECT_EQ(stop_with("--set stop_threshold=0.01"), "\"stopped\": true, \"reason\": \"caught\", \"stop_sample\": 9");
+  EXPECT_EQ(stop_with("--set stop_consecutive=7"), "\"stopped\": false, \"reason\": \"none\", \"stop_sample\": 0");
+  for (const std::string sets : {"--set stop_threshold=0.01 --set stop_consecutive=7",
+                                 "--set stop_consecutive=7 --set stop_threshold=0.01"})
+    EXPECT_EQ(stop_with(sets), "\"stopped\": true, \"reason\": \"caught\", \"stop_sample\": 6") << sets;
   // Any other option given twice is refused, naming it and both values, not silently replaced.
   const std::string twice = run(base + " --model other.dgm 2>&1", rc);
   EXPECT_EQ(WEXITSTATUS(rc), 2);
