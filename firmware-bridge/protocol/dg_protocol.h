@@ -155,8 +155,9 @@ struct Stop { uint8_t counter; StopReason reason; uint8_t p_caught; uint16_t tri
 enum class PredictorState : uint8_t { Idle = 0, InTrial = 1, Stopped = 2, Fault = 3 };
 const char* predictor_state_name(PredictorState s);  // "idle", "in_trial", "stopped", "fault"
 
-// 0x300: status, paged: page p carries counters 2p and 2p+1 of StatusCounter (saturating u16),
-// so one page per status period cycles the whole set.
+// 0x300: status, paged: page p carries counters 2p and 2p+1 of StatusCounter (saturating u16,
+// but Samples mod 65536, as PROTOCOL.md's page table says), so one page per status period
+// cycles the whole set.
 enum class StatusCounter : uint8_t {
   Corrupted = 0, Repeated = 1, WrongSequence = 2, LostFrames = 3, Late = 4, BadLength = 5,
   KernelDrops = 6, Timeouts = 7, TxRetries = 8, TxErrors = 9, Samples = 10, Stops = 11,

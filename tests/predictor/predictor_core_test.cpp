@@ -3,6 +3,7 @@
 // heap allocations per sample.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <random>
@@ -441,35 +442,113 @@ TEST(Status, HeartbeatUptimeSaturates) {
   EXPECT_EQ(uptime(5 * s + 70'000 * s), 65535) << "saturates, does not wrap to 4464";
 }
 
-TEST(Status, PagesCarryEveryCounter) {
-  Harness h;
-  h.start();
-  for (int i = 0; i < 5; ++i) h.sample(-2.0, 0.0);
-  Frame bad = h.src.force(-2.0, 0.0);
-  bad.data[3] ^= 1;
-  h.p->on_frame(bad, h.now);
-  h.p->on_frame(bad, h.now);
+// Ticks through `periods` status periods and checks every PredictorStatus frame against the
+// header: page p < kStatusPages carries counters 2p and 2p+1 as `want` gives them and the
+// predictor's state; every page comes by.
+static_assert(static_cast<int>(StatusCounter::Count) == 12, "a new counter needs its step in PagesCarryEveryCounter");
+void check_status_pages(Harness& h, const std::array<uint32_t, 12>& want, int periods = 7) {
   h.sink.others.clear();
-  for (int i = 0; i < 700; ++i) h.p->on_tick(h.now += kMs);  // 7 status periods
-  uint32_t seen[12] = {};
-  bool page_seen[6] = {};
-  int heartbeats = 0;
-  for (const auto& f : h.sink.others) {
+  for (int i = 0; i < periods * 100; ++i) h.p->on_tick(h.now += kMs);
+  std::vector<int> seen(protocol::kStatusPages, 0);
+  for (const Frame& f : h.sink.others) {
     protocol::PredictorStatus st;
-    if (protocol::decode(f, st)) {
-      ASSERT_LT(st.page, 6);
-      page_seen[st.page] = true;
-      seen[2 * st.page] = st.value0;
-      seen[2 * st.page + 1] = st.value1;
-    }
-    protocol::HeartbeatPredictor hb;
-    if (protocol::decode(f, hb)) ++heartbeats;
+    if (!protocol::decode(f, st)) continue;
+    EXPECT_LT(st.page, protocol::kStatusPages);
+    if (st.page >= protocol::kStatusPages) continue;
+    ++seen[st.page];
+    const auto name = [](int c) { return protocol::status_counter_name(static_cast<StatusCounter>(c)); };
+    EXPECT_EQ(st.value0, want[2 * st.page]) << "page " << int{st.page} << " value0, " << name(2 * st.page);
+    EXPECT_EQ(st.value1, want[2 * st.page + 1]) << "page " << int{st.page} << " value1, " << name(2 * st.page + 1);
+    EXPECT_EQ(st.state, h.p->decision().state) << "page " << int{st.page};
   }
-  for (bool b : page_seen) EXPECT_TRUE(b);
-  EXPECT_EQ(seen[static_cast<int>(StatusCounter::Corrupted)], 2u);
-  EXPECT_EQ(seen[static_cast<int>(StatusCounter::Samples)], 5u);
-  EXPECT_EQ(seen[static_cast<int>(StatusCounter::Stops)], 1u) << "the 50 ms timeout stopped the silent trial";
-  EXPECT_GE(heartbeats, 6);  // 10 Hz over 0.7 s
+  for (int p = 0; p < protocol::kStatusPages; ++p) EXPECT_GE(seen[p], 1) << "page " << p << " never sent";
+}
+
+// Each of the twelve counters is driven to a value of its own (1 to 10, 14 and 30), so that a
+// page carrying another page's counters, a page's two values swapped, or a counter left off a
+// page shows; every page must carry exactly the core's counter(c) for its two counters, and its
+// state. (The test once compared 3 of the 12.) The scenario, one counter per step:
+//   trial 1: 20 samples; 3 corrupted force frames; 4 repeated (the last sample's counter again);
+//   5 late (4 behind it); 6 frames of 6 bytes (bad length); 7 samples lost, force and torque
+//   both: a jump of 8 > max_delta 3, so 2 wrong sequences and 14 lost frames; the 21st sample;
+//   the kernel's cumulative drops 4, then 9; then silence: one timeout, the first stop, its
+//   first two sends failing (2 tx errors), retried every 2 ms for 16 ms (8 retries) before its
+//   echo; 5 bus errors (7 tx errors in all);
+//   trials 2..10: one sample over the hard limit each, a stop each (10 stops, 30 samples), the
+//   last left stopped (its stop confirmed, no TrialEnd): the pages must say "stopped".
+// The bad-frame budget is raised: the 23 bad and lost frames charged would otherwise stop trial 1.
+TEST(Status, PagesCarryEveryCounter) {
+  PredictorConfig cfg;
+  cfg.bad_frame_budget = 1000;
+  Harness h(true, cfg);
+  h.start(1);
+  for (int i = 0; i < 20; ++i) h.sample(-2.0, 0.0);
+  for (int i = 0; i < 3; ++i) {
+    Frame bad = h.src.force(-2.0, 0.0);
+    bad.data[3] ^= 1;
+    h.p->on_frame(bad, h.now);
+  }
+  testkit::FrameSource old = h.src;
+  old.sample_counter = static_cast<uint8_t>(h.src.sample_counter - 1);
+  for (int i = 0; i < 4; ++i) h.p->on_frame(old.force(-2.0, 0.0), h.now);
+  old.sample_counter = static_cast<uint8_t>(h.src.sample_counter - 5);
+  for (int i = 0; i < 5; ++i) h.p->on_frame(old.force(-2.0, 0.0), h.now);
+  for (int i = 0; i < 6; ++i) {
+    Frame shorter = h.src.force(-2.0, 0.0);
+    shorter.len = 6;
+    h.p->on_frame(shorter, h.now);
+  }
+  for (int i = 0; i < 7; ++i) h.src.next();
+  h.sample(-2.0, 0.0);
+  h.p->on_kernel_drops(4, h.now);
+  h.p->on_kernel_drops(9, h.now);
+  h.sink.fail_next = 2;
+  while (!h.p->stop_pending()) h.p->on_tick(h.now += kMs);
+  ASSERT_EQ(h.p->decision().reason, protocol::StopReason::SensorTimeout);
+  for (int i = 0; i < 16; ++i) h.p->on_tick(h.now += kMs);
+  h.p->on_stop_echo(h.sink.stops.back(), h.now);
+  ASSERT_FALSE(h.p->stop_pending());
+  for (int i = 0; i < 5; ++i) h.p->on_bus_error(0x04 /* CAN_ERR_CRTL */, h.now);
+  h.p->on_frame(h.src.trial_end(1, 28), h.now);
+  for (uint16_t t = 2; t <= 10; ++t) {
+    h.start(t);
+    h.sample(-20.0, 0.0);
+    ASSERT_EQ(h.p->decision().reason, protocol::StopReason::HardLimit) << "trial " << t;
+    h.p->on_stop_echo(h.sink.stops.back(), h.now);
+    if (t < 10) h.p->on_frame(h.src.trial_end(t, 1), h.now);
+  }
+  ASSERT_EQ(h.p->decision().state, PredictorState::Stopped);
+  ASSERT_FALSE(h.p->stop_pending());
+
+  // The scenario reached what it meant to: if it did not, the pages below would be compared
+  // with counters that are zero or equal, and prove little.
+  const std::array<std::pair<StatusCounter, uint32_t>, 12> meant = {{
+      {StatusCounter::Corrupted, 3}, {StatusCounter::Repeated, 4}, {StatusCounter::WrongSequence, 2},
+      {StatusCounter::LostFrames, 14}, {StatusCounter::Late, 5}, {StatusCounter::BadLength, 6},
+      {StatusCounter::KernelDrops, 9}, {StatusCounter::Timeouts, 1}, {StatusCounter::TxRetries, 8},
+      {StatusCounter::TxErrors, 7}, {StatusCounter::Samples, 30}, {StatusCounter::Stops, 10},
+  }};
+  std::array<uint32_t, 12> want{};
+  for (int c = 0; c < 12; ++c) {
+    ASSERT_EQ(meant[c].first, static_cast<StatusCounter>(c));
+    want[c] = h.p->counter(static_cast<StatusCounter>(c));
+    EXPECT_EQ(want[c], meant[c].second) << protocol::status_counter_name(meant[c].first);
+  }
+  check_status_pages(h, want);
+
+  // What a u16 cannot hold: every counter saturates at 65535 but samples, sent mod 65536
+  // (PROTOCOL.md's page table). 70,000 kernel drops and 65,536 more samples (outside a trial,
+  // still counted) leave kernel_drops' value at 65535 and samples' at 30 again.
+  h.p->on_kernel_drops(70'009, h.now);
+  for (int i = 0; i < 65536; ++i) {
+    h.p->on_frame(h.src.force(-2.0, 0.0), h.now);
+    h.src.next();
+  }
+  ASSERT_EQ(h.p->counter(StatusCounter::KernelDrops), 70'009u);
+  ASSERT_EQ(h.p->counter(StatusCounter::Samples), 30u + 65536u);
+  want[static_cast<int>(StatusCounter::KernelDrops)] = 65535;
+  want[static_cast<int>(StatusCounter::Samples)] = 30;
+  check_status_pages(h, want);
 }
 
 TEST(Mounting, SensorAxesMapToRigAxes) {
