@@ -162,6 +162,9 @@ struct SimulatedTrial {
   std::vector<HapticSample> samples;
   Outcome outcome = Outcome::Missed;  // the automatic label of paper V-A
   bool finite = true;                 // false: the simulation blew up (ranked worst)
+  // false: the gown was still moving when its settling gave up (sim::TrialResult::settled,
+  // sim::TrialSpec::settle_max_steps) and the pull began from it; the paper's robot waits.
+  bool settled = true;
   // The label's evidence (sim::TrialResult): how far the lower half of the sleeve opening ended
   // behind the elbow centre (forearm side) and past it [m], 0 for a missed trial; NaN when the
   // simulator does not say (a test's stand-in).

@@ -110,6 +110,7 @@ SimulatedTrial simulated(sim::TrialResult&& res, const std::shared_ptr<const sim
   out.samples = std::move(res.seq.samples);
   out.outcome = res.outcome;
   out.finite = res.finite;
+  out.settled = res.settled;
   out.d_behind = res.d_behind;
   out.d_ahead = res.d_ahead;
   out.cut = res.cut;

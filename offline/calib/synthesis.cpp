@@ -203,15 +203,18 @@ fs::path marker_path(const fs::path& out, const std::string& id) { return out / 
 constexpr const char* kNotFiniteMarker = "not-finite\n";
 constexpr double kNotFiniteCode = -1.0;  // its label code in the results
 
+// A finished trial's marker: its label, its evidence, and a third line "unsettled" when its gown
+// had not settled (absent from markers written before session 90: taken as settled).
 std::string marker_text(const SimulatedTrial& st) {
-  char buf[128];
-  std::snprintf(buf, sizeof buf, "%s\n%.17g %.17g\n", std::string(outcome_name(st.outcome)).c_str(), st.d_behind,
-                st.d_ahead);
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "%s\n%.17g %.17g\n%s", std::string(outcome_name(st.outcome)).c_str(), st.d_behind,
+                st.d_ahead, st.settled ? "" : "unsettled\n");
   return buf;
 }
 struct Marker {
   Outcome label = Outcome::Missed;
   double d_behind = std::numeric_limits<double>::quiet_NaN(), d_ahead = std::numeric_limits<double>::quiet_NaN();
+  bool settled = true;
 };
 std::optional<Marker> read_marker(const fs::path& file) {
   const std::string text = read_file(file);
@@ -224,6 +227,7 @@ std::optional<Marker> read_marker(const fs::path& file) {
     double b = 0, a = 0;
     if (std::sscanf(text.c_str() + eol + 1, "%lf %lf", &b, &a) == 2) m.d_behind = b, m.d_ahead = a;
   }
+  m.settled = text.find("\nunsettled\n") == std::string::npos;
   return m;
 }
 
@@ -386,8 +390,8 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
   std::atomic<int> done{0}, skipped{0};
   std::mutex progress_mutex;
   const int mine = (total - comm.rank() + comm.size() - 1) / comm.size();
-  // Result block per trial: label code, resumed flag, d_behind, d_ahead.
-  constexpr int kBlock = 4;
+  // Result block per trial: label code, resumed flag, d_behind, d_ahead, settled flag.
+  constexpr int kBlock = 5;
   const std::vector<double> res =
       run_batch(total, kBlock, thread_count(options.threads), comm, [&](int t, double* r) {
         const ArmHeight h = heights[t / options.per_height];
@@ -404,6 +408,7 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
             r[0] = static_cast<double>(m->label);
             r[2] = m->d_behind;
             r[3] = m->d_ahead;
+            r[4] = m->settled ? 1.0 : 0.0;
             resumed = true;
           }
         }
@@ -418,6 +423,7 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
             r[0] = static_cast<double>(st.outcome);
             r[2] = st.d_behind;
             r[3] = st.d_ahead;
+            r[4] = st.settled ? 1.0 : 0.0;
           }
         }
         r[1] = resumed ? 1.0 : 0.0;
@@ -448,6 +454,8 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
       continue;
     }
     const int label = static_cast<int>(res[kBlock * t]);
+    if (res[kBlock * t + 4] < 0.5)
+      s.unsettled.push_back(synthesis_trial_id(heights[t / options.per_height], t % options.per_height));
     s.per_label[label]++;
     s.per_height_label[static_cast<int>(heights[t / options.per_height])][label]++;
   }

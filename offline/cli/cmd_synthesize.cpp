@@ -83,6 +83,11 @@ SynthesisSummary run_synthesis(const Calibration& cal, const std::string& gown, 
     std::fprintf(stderr, "synthesize: note: %zu of %d trials did not stay finite and are left out of the dataset: %s\n",
                  s.not_finite.size(), s.trials, ids.c_str());
   }
+  if (!s.unsettled.empty() && comm.is_root())
+    std::fprintf(stderr,
+                 "synthesize: note: %zu of %d trials began their pull from a gown that had not settled when its "
+                 "settling gave up (the first: %s); the paper's robot waits for it (synthesis.h, unsettled)\n",
+                 s.unsettled.size(), s.trials, s.unsettled.front().c_str());
   // The study never caught the high arm (synthesis.h, SynthesisSummary::per_height_label).
   const int high_caught = s.per_height_label[static_cast<int>(ArmHeight::High)][static_cast<int>(Outcome::Caught)];
   if (high_caught > 0 && comm.is_root())
@@ -144,11 +149,11 @@ int run_synthesize(int argc, char** argv) {
         heights += buf;
       }
       std::printf("{\"trials\": %d, \"resumed\": %d, \"good\": %d, \"missed\": %d, \"caught\": %d, "
-                  "\"not_finite\": %zu, \"per_height\": {%s}, "
+                  "\"not_finite\": %zu, \"unsettled\": %zu, \"per_height\": {%s}, "
                   "\"middle\": \"%s\", \"middle_base_m\": %.6f, \"high_low\": \"%s\", \"high_band_m\": [%.6f, %.6f], "
                   "\"low_band_m\": [%.6f, %.6f], \"out\": %s}\n",
                   s.trials, s.resumed, s.per_label[g], s.per_label[m], s.per_label[c], s.not_finite.size(),
-                  heights.c_str(),
+                  s.unsettled.size(), heights.c_str(),
                   middle_arm_name(o.middle), o.middle == MiddleArm::CaughtEdge ? s.edge.offset : 0.0,
                   high_low_arm_name(o.high_low), s.high_band.lower, s.high_band.upper, s.low_band.lower,
                   s.low_band.upper, json_string(out).c_str());

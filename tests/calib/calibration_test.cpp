@@ -2181,6 +2181,31 @@ TEST(Synthesis, ATrialThatDoesNotStayFiniteIsLeftOut) {
   fs::remove_all(worse);
 }
 
+// A trial whose gown had not settled when its settling gave up is kept and counted, also by a
+// rerun that takes it from its marker (the paper's robot waits for the gown; a set full of such
+// pulls should be seen, not trained on unseen).
+TEST(Synthesis, TrialsFromAnUnsettledGownAreCounted) {
+  Calibration cal;
+  SynthesisOptions o;
+  o.per_height = 6;
+  o.threads = 2;
+  const TrialRequest moving = synthesis_request(cal, ArmHeight::Low, 4, o);
+  const TrialSimulator sim = [&](const ClothValues& c, const TrialRequest& r) {
+    SimulatedTrial st = testing::fake_simulate(c, r);
+    st.settled = !(r.height == moving.height && r.seed == moving.seed);
+    return st;
+  };
+  const fs::path dir = temp_dir("synth_unsettled");
+  const std::vector<std::string> want{synthesis_trial_id(ArmHeight::Low, 4)};
+  const auto s = synthesize(cal, sim, o, dir, Comm::world());
+  EXPECT_EQ(s.unsettled, want);
+  EXPECT_EQ(load_dataset(dir).trials.size(), 18u);  // kept
+  const auto again = synthesize(cal, sim, o, dir, Comm::world());
+  EXPECT_EQ(again.resumed, 18);
+  EXPECT_EQ(again.unsettled, want);
+  fs::remove_all(dir);
+}
+
 TEST(Synthesis, DatasetIsIndependentOfThreadsAndResumes) {
   Calibration cal;
   SynthesisOptions o;
