@@ -1322,6 +1322,8 @@ Calibration calibration_from_json(const Json& j, const std::filesystem::path& so
     if (j.has("provenance")) c.provenance = j.at("provenance");
   } catch (const InputError&) {
     throw;
+  } catch (const JsonError& e) {  // a value of the wrong type or a key missing: its line
+    throw_input_error(source, e.line(), e.what());
   } catch (const std::exception& e) {
     throw_input_error(source, 0, e.what());
   }

@@ -12,24 +12,31 @@
 
 namespace dressguard::calib {
 
+void Json::wrong_type(const char* expected) const {
+  static constexpr const char* kNames[] = {"null", "true or false", "a number", "a string", "an array", "an object"};
+  const int t = static_cast<int>(type_);
+  throw JsonError(std::string("json: expected ") + expected + ", found " +
+                      (t >= 0 && t < 6 ? kNames[t] : "another value"),
+                  line_);
+}
 double Json::number() const {
-  if (type_ != Type::Number) throw std::runtime_error("json: expected a number");
+  if (type_ != Type::Number) wrong_type("a number");
   return num_;
 }
 const std::string& Json::string() const {
-  if (type_ != Type::String) throw std::runtime_error("json: expected a string");
+  if (type_ != Type::String) wrong_type("a string");
   return str_;
 }
 bool Json::boolean() const {
-  if (type_ != Type::Bool) throw std::runtime_error("json: expected true or false");
+  if (type_ != Type::Bool) wrong_type("true or false");
   return bool_;
 }
 const std::vector<Json>& Json::items() const {
-  if (type_ != Type::Array) throw std::runtime_error("json: expected an array");
+  if (type_ != Type::Array) wrong_type("an array");
   return arr_;
 }
 const std::vector<std::pair<std::string, Json>>& Json::members() const {
-  if (type_ != Type::Object) throw std::runtime_error("json: expected an object");
+  if (type_ != Type::Object) wrong_type("an object");
   return obj_;
 }
 bool Json::has(const std::string& key) const {
@@ -41,7 +48,7 @@ bool Json::has(const std::string& key) const {
 const Json& Json::at(const std::string& key) const {
   for (const auto& [k, v] : members())
     if (k == key) return v;
-  throw std::runtime_error("json: missing key \"" + key + "\"");
+  throw JsonError("json: missing key \"" + key + "\" in the object", line_);
 }
 Json& Json::push(Json v) {
   if (type_ != Type::Array) throw std::runtime_error("json: push on a non-array");
@@ -230,7 +237,22 @@ struct Parser {
   // calibration file nests 6 deep (provenance "rescored").
   static constexpr int kMaxDepth = 256;
   int depth = 0;
+  // The line of position `pos`, counted on from the last position asked (values are met in order).
+  std::size_t scanned = 0;
+  long line = 1;
+  long line_of(std::size_t pos) {
+    for (; scanned < pos && scanned < s.size(); ++scanned) line += s[scanned] == '\n';
+    return line;
+  }
+  // A value, which remembers the line it begins on (Json::line, for the accessors' errors).
   Json value() {
+    ws();
+    const long at = line_of(i);
+    Json v = value_here();
+    v.from_line(at);
+    return v;
+  }
+  Json value_here() {
     ws();
     if (i >= s.size()) fail("unexpected end");
     const char c = s[i];

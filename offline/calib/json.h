@@ -15,6 +15,18 @@
 
 namespace dressguard::calib {
 
+// What a typed accessor (number(), at(), ...) throws: what was wrong, and the line of the source
+// text where the value it was asked of begins (0 for a value built in code), so that a reader of
+// a file can name the file and the line (throw_input_error).
+class JsonError : public std::runtime_error {
+ public:
+  JsonError(const std::string& what, long line) : std::runtime_error(what), line_(line) {}
+  long line() const { return line_; }
+
+ private:
+  long line_;
+};
+
 class Json {
  public:
   enum class Type { Null, Bool, Number, String, Array, Object };
@@ -38,6 +50,12 @@ class Json {
   const std::vector<std::pair<std::string, Json>>& members() const;
   bool has(const std::string& key) const;
   const Json& at(const std::string& key) const;  // throws naming the missing key
+  // The line of the parsed text where this value begins; 0 for one built in code.
+  long line() const { return line_; }
+  Json& from_line(long line) {  // the parser's
+    line_ = line;
+    return *this;
+  }
   // Building.
   Json& push(Json v);
   Json& set(const std::string& key, Json v);  // replaces an existing key, keeps insertion order
@@ -53,6 +71,8 @@ class Json {
   std::string str_;
   std::vector<Json> arr_;
   std::vector<std::pair<std::string, Json>> obj_;
+  long line_ = 0;
+  [[noreturn]] void wrong_type(const char* expected) const;
 };
 
 }  // namespace dressguard::calib

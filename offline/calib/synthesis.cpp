@@ -368,8 +368,8 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
         low_band = band_from_json(j.at("low"), band_path);
       } catch (const InputError&) {
         throw;
-      } catch (const std::exception& e) {  // a key missing or of another type: name the file
-        throw_input_error(band_path, 0, e.what());
+      } catch (const JsonError& e) {  // a key missing or of another type: name the file and line
+        throw_input_error(band_path, e.line(), e.what());
       }
     } else {
       high_band = locate_repeat_band(cal, sim, ArmHeight::High, options.threads, comm);

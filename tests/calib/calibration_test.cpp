@@ -3,6 +3,7 @@
 // bounds files, input selection on the measured data, the calibration file.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cmath>
@@ -1623,6 +1624,23 @@ TEST(Calibration, CalibrationFileRoundTripAndErrors) {
     }
   };
   expect_refused("cal_hem.json", "hem_bend_ratio", "\"hem_bend_ratio\": 30", "\"hem_bend_ratio\": 0.5");
+  {  // A value of the wrong type is refused at its line (it was line 0, 'json: expected a string').
+    std::string text = read_file(dir / "cal_hem.json");
+    const std::size_t at = text.find("\"participant\": \"4\"");
+    ASSERT_NE(at, std::string::npos);
+    const long line = 1 + std::count(text.begin(), text.begin() + static_cast<long>(at), '\n');
+    text.replace(at, std::strlen("\"participant\": \"4\""), "\"participant\": 4");
+    write_file_atomic(dir / "typed.json", text);
+    try {
+      read_calibration(dir / "typed.json");
+      ADD_FAILURE() << "a numeric participant was read";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("typed.json:" + std::to_string(line) +
+                                           ": json: expected a string, found a number"),
+                std::string::npos)
+          << e.what();
+    }
+  }
   c.cloth.hem_width = 0;
   c.cloth.hem_bend_ratio = 1;
   // The density: absent is the paper's 0.145 (not written); another reads back; out of range

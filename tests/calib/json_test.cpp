@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
+#include <utility>
 
 #include <string>
 
@@ -37,6 +39,22 @@ TEST(Json, NumbersAreJsonNumbers) {
   for (std::size_t k = 0; k < want.size(); ++k) EXPECT_EQ(j.items()[k].number(), want[k]) << k;
   EXPECT_TRUE(std::signbit(j.items()[1].number())) << "-0 read as +0 (EXPECT_EQ cannot tell them apart)";
   EXPECT_FALSE(std::signbit(j.items()[0].number()));
+  // An accessor's error says what it found and the line its value begins on (JsonError), for a
+  // reader to name the file and line; a value built in code has line 0.
+  const Json doc = Json::parse("{\n  \"a\": 1,\n  \"b\":\n    \"text\",\n  \"c\": [true]\n}\n");
+  const auto error = [](const std::function<void()>& f) -> std::pair<std::string, long> {
+    try {
+      f();
+    } catch (const JsonError& e) {
+      return {e.what(), e.line()};
+    }
+    return {"accepted", -1};
+  };
+  EXPECT_EQ(error([&] { doc.at("b").number(); }), std::make_pair(std::string("json: expected a number, found a string"), 4L));
+  EXPECT_EQ(error([&] { doc.at("c").items()[0].string(); }).second, 5L);
+  EXPECT_EQ(error([&] { doc.at("z"); }), std::make_pair(std::string("json: missing key \"z\" in the object"), 1L));
+  EXPECT_EQ(error([] { Json(1.0).string(); }).second, 0L);
+  EXPECT_EQ(doc.at("a").line(), 2L);
   // What dump() writes reads back to the same double (17 significant digits).
   const double third = 1.0 / 3.0;
   EXPECT_EQ(Json::parse(Json(third).dump()).number(), third);
