@@ -197,14 +197,13 @@ std::string stored_record(const fs::path& path) {
 
 fs::path marker_path(const fs::path& out, const std::string& id) { return out / ".synth" / (id + ".done"); }
 
-// A finished trial's marker: its label, then the label's evidence (d_behind d_ahead, exact).
-// Markers of earlier versions hold the label alone; their evidence reads as NaN (unknown).
 // The marker of a trial whose simulation did not stay finite (no CSV beside it).
 constexpr const char* kNotFiniteMarker = "not-finite\n";
 constexpr double kNotFiniteCode = -1.0;  // its label code in the results
 
-// A finished trial's marker: its label, its evidence, and a third line "unsettled" when its gown
-// had not settled (absent from markers written before session 90: taken as settled).
+// A finished trial's marker: its label, then the label's evidence (d_behind d_ahead, exact), and
+// a third line "unsettled" when its gown had not settled. Markers of earlier versions hold the
+// label alone (their evidence reads as NaN, unknown) or no third line (taken as settled).
 std::string marker_text(const SimulatedTrial& st) {
   char buf[160];
   std::snprintf(buf, sizeof buf, "%s\n%.17g %.17g\n%s", std::string(outcome_name(st.outcome)).c_str(), st.d_behind,
