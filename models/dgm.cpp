@@ -14,6 +14,8 @@
 #include <stdexcept>
 #include <system_error>
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace dressguard::model {
@@ -90,6 +92,37 @@ std::string short_number(double v) {
 constexpr uint32_t kMaxString = 65536;
 // Fixed part: magic(8) + version(4) + size(4); trailer: CRC(4).
 constexpr size_t kHeaderBytes = 16, kTrailerBytes = 4;
+
+// The largest file the format allows (FORMAT.md's layout with every count and string at its
+// limit), which kMaxFileBytes must not refuse.
+constexpr size_t kLargestString = 4 + kMaxString;
+constexpr size_t kLargestHmm = 8 * (kMaxStates + kMaxStates * kMaxStates + 6 * kMaxStates);  // pi, A, emissions
+constexpr size_t kLargestClass = kLargestString + 4 + 8 + kLargestHmm;  // name, state count, log prior
+constexpr size_t kLargestFile = kHeaderBytes + 4 * kLargestString + kFeatures * (4 + 3 * 8) + (8 + 4) + 3 * 8 +
+                                4 + kMaxClasses * kLargestClass + kTrailerBytes;
+static_assert(kLargestFile == 866564 && kLargestFile <= kMaxFileBytes, "dgm.h's kMaxFileBytes comment is stale");
+
+// Closes a descriptor on every way out of a scope (read_model's, write_model's error paths).
+struct FdGuard {
+  int fd = -1;
+  ~FdGuard() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
+// What a stat mode is, for "not a regular file" messages.
+const char* file_kind(mode_t mode) {
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "of another kind";
+}
+
+std::string too_large(uintmax_t size) {
+  return std::to_string(size) + " bytes is larger than any model file (at most " + std::to_string(kMaxFileBytes) +
+         " bytes read; FORMAT.md)";
+}
 
 // ---- validation: one small function per rule --------------------------------------------------
 
@@ -428,13 +461,34 @@ OutcomeModel decode_model(const uint8_t* data, size_t size, const std::string& s
 }
 
 OutcomeModel read_model(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) fail(path.string(), "is a folder, not a model file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path.string(), std::string("cannot open: ") + std::strerror(errno));
-  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) fail(path.string(), "read error");
-  return decode_model(bytes.data(), bytes.size(), path.string());
+  const std::string name = path.string();
+  // stat before open: opening a FIFO for reading waits for a writer, and a device may never end.
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) fail(name, std::string("cannot open: ") + std::strerror(errno));
+  if (S_ISDIR(st.st_mode)) fail(name, "is a folder, not a model file");
+  if (!S_ISREG(st.st_mode)) fail(name, std::string("not a regular file (") + file_kind(st.st_mode) + ")");
+  if (static_cast<uintmax_t>(st.st_size) > kMaxFileBytes) fail(name, too_large(static_cast<uintmax_t>(st.st_size)));
+  // O_NONBLOCK: should the path have become a FIFO since the stat, open does not wait (the fstat
+  // then refuses it); it changes nothing for a regular file.
+  FdGuard in{::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK)};
+  if (in.fd < 0) fail(name, std::string("cannot open: ") + std::strerror(errno));
+  if (::fstat(in.fd, &st) != 0) fail(name, std::string("cannot stat: ") + std::strerror(errno));
+  if (!S_ISREG(st.st_mode)) fail(name, std::string("not a regular file (") + file_kind(st.st_mode) + ")");
+  // At most one byte past the limit: a file that grew since the stat is refused as too large.
+  std::vector<uint8_t> bytes(kMaxFileBytes + 1);
+  size_t got = 0;
+  while (got < bytes.size()) {
+    const ssize_t n = ::read(in.fd, bytes.data() + got, bytes.size() - got);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) fail(name, std::string("read error: ") + std::strerror(errno));
+    if (n == 0) break;
+    got += static_cast<size_t>(n);
+  }
+  if (got > kMaxFileBytes)
+    fail(name, "grew while being read to more than " + std::to_string(kMaxFileBytes) +
+                   " bytes, larger than any model file (FORMAT.md)");
+  bytes.resize(got);
+  return decode_model(bytes.data(), bytes.size(), name);
 }
 
 void write_model(const std::filesystem::path& path, const OutcomeModel& m) {

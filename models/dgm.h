@@ -113,8 +113,16 @@ class ModelError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// The largest file read_model reads: 1 MiB. The largest valid file is 866,564 bytes (version 3, 8
+// classes of 32 states, the four metadata strings and eight class names each at the 65,536-byte
+// limit; dgm.cpp checks the sum at compile time), so no valid model is refused, and a wrong file
+// costs at most this much memory and time to refuse.
+inline constexpr size_t kMaxFileBytes = size_t{1} << 20;
+
 // Loading checks everything FORMAT.md lists (magic, version, size, CRC-32, bounds, finite
-// numbers, stochastic rows within kStochasticTolerance, positive-definite covariances).
+// numbers, stochastic rows within kStochasticTolerance, positive-definite covariances). Before
+// reading a byte it refuses what is not a regular file (a FIFO would block the predictor until a
+// writer came; /dev/zero never ends) and a file larger than kMaxFileBytes, naming the path.
 OutcomeModel read_model(const std::filesystem::path& path);
 // Validates, encodes and writes through a temporary file and a rename (never a torn file).
 void write_model(const std::filesystem::path& path, const OutcomeModel& m);

@@ -2,16 +2,22 @@
 // message that names the problem; the shipped default model's checksum.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <future>
 #include <iterator>
 #include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "dgm.h"
 
@@ -364,6 +370,54 @@ TEST(ModelFileRejects, AFolder) {
   } catch (const ModelError& e) {
     EXPECT_NE(std::string(e.what()).find("is a folder, not a model file"), std::string::npos) << e.what();
   }
+}
+
+namespace {
+// What read_model says of `path`: the ModelError's message, else what went wrong instead.
+std::string read_error(const std::filesystem::path& path) {
+  try {
+    read_model(path);
+    return "accepted";
+  } catch (const ModelError& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    return std::string("not a ModelError: ") + e.what();
+  }
+}
+}  // namespace
+
+// read_model refuses, before reading, a file larger than any model (kMaxFileBytes) and what is not
+// a regular file, naming the path: it read the whole input first, so a FIFO blocked it for ever,
+// /dev/zero ended in std::bad_alloc, and a 300 MB file took seconds and 528 MB.
+TEST(ModelFileRejects, TooLargeOrNotARegularFile) {
+  const auto dir = std::filesystem::temp_directory_path() / ("dgm_size_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto big = dir / "big.dgm";
+  {
+    const auto b = encode_model(sample_model());
+    std::ofstream out(big, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(b.data()), static_cast<std::streamsize>(b.size()));
+  }
+  std::filesystem::resize_file(big, size_t{2} << 20);  // a model followed by zeros, 2 MiB in all
+  std::string what = read_error(big);
+  EXPECT_EQ(what.rfind(big.string() + ": 2097152 bytes is larger than any model file (at most 1048576", 0), 0u)
+      << what;
+  // A FIFO with no writer: open() for reading would wait for one. Should read_model wait, the
+  // test becomes that writer (open and close: the reader sees an empty file) and fails.
+  const auto fifo = dir / "fifo.dgm";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0) << std::strerror(errno);
+  auto pending = std::async(std::launch::async, [&] { return read_error(fifo); });
+  if (pending.wait_for(std::chrono::seconds(10)) != std::future_status::ready) {
+    ADD_FAILURE() << "read_model blocked on a FIFO";
+    const int w = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+    if (w >= 0) ::close(w);
+  }
+  what = pending.get();
+  EXPECT_EQ(what, fifo.string() + ": not a regular file (a FIFO)");
+  // A device that never ends (it ran out of memory: std::bad_alloc, no path).
+  what = read_error("/dev/zero");
+  EXPECT_EQ(what, "/dev/zero: not a regular file (a character device)");
+  std::filesystem::remove_all(dir);
 }
 
 TEST(ModelFileRejects, BadCrc) {
