@@ -3,11 +3,11 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <limits>
 #include <set>
 #include <sstream>
@@ -491,25 +491,61 @@ OutcomeModel read_model(const std::filesystem::path& path) {
   return decode_model(bytes.data(), bytes.size(), name);
 }
 
+namespace {
+// Writes all of [p, p + n) to `fd` through short writes and signals; false with errno set.
+bool write_all(int fd, const uint8_t* p, size_t n) {
+  while (n > 0) {
+    const ssize_t w = ::write(fd, p, n);
+    if (w < 0 && errno == EINTR) continue;
+    if (w < 0) return false;
+    p += w;
+    n -= static_cast<size_t>(w);
+  }
+  return true;
+}
+}  // namespace
+
 void write_model(const std::filesystem::path& path, const OutcomeModel& m) {
   const std::vector<uint8_t> bytes = encode_model(m);
+  const std::string name = path.string();
+  const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
   std::error_code ec;
-  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path(), ec);
-  const std::filesystem::path tmp = path.string() + ".tmp." + std::to_string(::getpid());
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) fail(path.string(), std::string("cannot write: ") + std::strerror(errno));
-    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    out.flush();
-    if (!out) {
-      std::filesystem::remove(tmp, ec);
-      fail(path.string(), "write failed");
+  std::filesystem::create_directories(dir, ec);  // if it cannot be made, opening the temporary file says why
+  // The temporary file sits beside the target, so the rename replaces it in one step; O_EXCL, so
+  // it is never a file or symlink someone else left under that name (such a name is skipped).
+  static std::atomic<unsigned> serial{0};
+  std::string tmp;
+  FdGuard out;
+  for (int attempt = 0; out.fd < 0; ++attempt) {
+    tmp = name + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(serial++);
+    out.fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    if (out.fd < 0 && (errno != EEXIST || attempt == 100)) {
+      const int error = errno;
+      fail(name, "cannot create the temporary file " + tmp + ": " + std::strerror(error));
     }
   }
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    fail(path.string(), "cannot rename the temporary file into place: " + ec.message());
+  // Every failure from here on removes the temporary file; errno is read before anything else.
+  const auto give_up = [&](const char* verb, const char* after = "") {
+    const int error = errno;
+    if (out.fd >= 0) ::close(out.fd);
+    out.fd = -1;
+    ::unlink(tmp.c_str());
+    fail(name, std::string("cannot ") + verb + " the temporary file " + tmp + after + ": " + std::strerror(error));
+  };
+  if (!write_all(out.fd, bytes.data(), bytes.size())) give_up("write");
+  // The bytes reach the disk before the rename makes them the model: else a crash could leave
+  // the new name on a file whose data never arrived.
+  if (::fsync(out.fd) != 0) give_up("fsync");
+  const int fd = out.fd;
+  out.fd = -1;
+  if (::close(fd) != 0) give_up("close");  // NFS, for one, reports a failed write only here
+  if (::rename(tmp.c_str(), name.c_str()) != 0) give_up("rename", " into place");
+  // The rename itself is durable once the folder is. Some file systems cannot fsync a folder
+  // (EINVAL): the model is in place, only that promise is weaker, which is no error.
+  FdGuard folder{::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC)};
+  if (folder.fd < 0 || (::fsync(folder.fd) != 0 && errno != EINVAL)) {
+    const int error = errno;
+    fail(name, "written, but its folder " + dir.string() + " cannot be fsynced: " + std::strerror(error));
   }
 }
 

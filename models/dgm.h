@@ -124,7 +124,11 @@ inline constexpr size_t kMaxFileBytes = size_t{1} << 20;
 // reading a byte it refuses what is not a regular file (a FIFO would block the predictor until a
 // writer came; /dev/zero never ends) and a file larger than kMaxFileBytes, naming the path.
 OutcomeModel read_model(const std::filesystem::path& path);
-// Validates, encodes and writes through a temporary file and a rename (never a torn file).
+// Validates and encodes `m`, then writes it to a new temporary file beside `path` (fsynced and
+// closed, each checked), renames that onto `path` and fsyncs the folder: a reader sees the old
+// file or the new one, never a torn one, and once it returns a crash keeps the new one. A missing
+// folder is created. Any failure is a ModelError naming the path and the system's reason; it
+// removes the temporary file and leaves an existing model at `path` as it was.
 void write_model(const std::filesystem::path& path, const OutcomeModel& m);
 // The file's bytes; throws ModelError if `m` is not valid (the same checks as loading).
 std::vector<uint8_t> encode_model(const OutcomeModel& m);

@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cerrno>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -16,6 +18,7 @@
 #include <vector>
 
 #include <fcntl.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -157,6 +160,67 @@ TEST(ModelFile, WriteIsAtomicAndReadBack) {
   } catch (const ModelError& e) {
     EXPECT_NE(std::string(e.what()).find("absent.dgm"), std::string::npos);
   }
+  std::filesystem::remove_all(dir);
+}
+
+namespace {
+std::vector<uint8_t> file_bytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+int regular_files_in(const std::filesystem::path& dir) {
+  int files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) files += e.is_regular_file();
+  return files;
+}
+// What write_model says: the ModelError's message, or "written".
+std::string write_error(const std::filesystem::path& path, const OutcomeModel& m) {
+  try {
+    write_model(path, m);
+    return "written";
+  } catch (const ModelError& e) {
+    return e.what();
+  }
+}
+}  // namespace
+
+// A write that fails part-way leaves the old model as it was and no temporary file, and says why
+// with the path and the system's reason. The file-size limit (1 KiB of the 4.3 KB) makes the
+// write fail as root too, whom a read-only folder does not stop; the short write it first gets
+// goes through the write loop. It said "write failed", without the reason.
+TEST(ModelFile, AFailedWriteLeavesTheOldFileAndNoTemporary) {
+  const auto dir = std::filesystem::temp_directory_path() / ("dgm_write_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto path = dir / "m.dgm";
+  write_model(path, sample_model());
+  const std::vector<uint8_t> old = file_bytes(path);
+  auto other = sample_model();
+  other.created = "2026-12-31T00:00:00Z";
+  rlimit saved{};
+  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &saved), 0);
+  rlimit small = saved;
+  small.rlim_cur = 1024;
+  const auto handler = std::signal(SIGXFSZ, SIG_IGN);  // else exceeding the limit kills the process
+  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
+  std::string what = write_error(path, other);
+  ::setrlimit(RLIMIT_FSIZE, &saved);
+  std::signal(SIGXFSZ, handler);
+  EXPECT_EQ(what.rfind(path.string() + ": cannot write the temporary file " + path.string() + ".tmp.", 0), 0u)
+      << what;
+  EXPECT_NE(what.find(std::string(": ") + std::strerror(EFBIG)), std::string::npos) << what;
+  EXPECT_EQ(file_bytes(path), old) << "the old model was changed";
+  EXPECT_EQ(regular_files_in(dir), 1) << "a temporary file was left behind";
+  // A folder that cannot exist (its parent is a file): named, with the reason, nothing made.
+  const auto under = path / "m.dgm";
+  what = write_error(under, other);
+  EXPECT_EQ(what.rfind(under.string() + ": cannot create the temporary file ", 0), 0u) << what;
+  EXPECT_NE(what.find(std::strerror(ENOTDIR)), std::string::npos) << what;
+  EXPECT_EQ(file_bytes(path), old);
+  EXPECT_EQ(regular_files_in(dir), 1);
+  // And the write itself, once nothing is in the way: the new model replaces the old.
+  EXPECT_EQ(write_error(path, other), "written");
+  EXPECT_EQ(file_bytes(path), encode_model(other));
+  EXPECT_EQ(regular_files_in(dir), 1);
   std::filesystem::remove_all(dir);
 }
 
