@@ -214,9 +214,49 @@ void check_training_speeds(double min_m_s, double max_m_s, const std::string& so
   if (!(min_m_s <= max_m_s)) fail(source, "speed_min_m_s is above speed_max_m_s" + range);
 }
 
+// Where `s` stops being well-formed UTF-8 (RFC 3629: no overlong forms, no surrogates, nothing
+// above U+10FFFF): the offset of the first byte that begins no valid sequence, or npos.
+size_t invalid_utf8_at(std::string_view s) {
+  size_t i = 0;
+  while (i < s.size()) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    if (c < 0x80) {
+      ++i;
+      continue;
+    }
+    if (c < 0xC0 || c > 0xF7) return i;  // a continuation byte with no lead, or no lead at all
+    const size_t len = c >= 0xF0 ? 4 : c >= 0xE0 ? 3 : 2;
+    const uint32_t least = len == 4 ? 0x10000 : len == 3 ? 0x800 : 0x80;  // below: overlong
+    uint32_t cp = c & (0x7Fu >> len);
+    if (len > s.size() - i) return i;
+    for (size_t k = 1; k < len; ++k) {
+      const auto t = static_cast<unsigned char>(s[i + k]);
+      if ((t & 0xC0u) != 0x80u) return i;
+      cp = (cp << 6) | (t & 0x3Fu);
+    }
+    if (cp < least || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return i;
+    i += len;
+  }
+  return std::string_view::npos;
+}
+
+// A class name is what messages, `model show`, the predictor's logs and JSON print and what
+// "caught" is looked up by: at most kMaxString bytes (what the reader accepts: a longer one was
+// written and then refused), UTF-8 as FORMAT.md says, and no NUL (printed through %s it cut the
+// name short, so two names could look the same). `index` names it where the name cannot.
+void check_class_name(const std::string& name, size_t index, const std::string& source) {
+  const std::string w = "class " + std::to_string(index) + "'s name";
+  if (name.empty()) fail(source, "class " + std::to_string(index) + " has an empty name");
+  if (name.size() > kMaxString)
+    fail(source, w + " is " + std::to_string(name.size()) + " bytes long (at most " + std::to_string(kMaxString) + ")");
+  if (const size_t at = name.find('\0'); at != std::string::npos)
+    fail(source, w + " holds a NUL byte (byte " + std::to_string(at) + ")");
+  if (const size_t at = invalid_utf8_at(name); at != std::string_view::npos)
+    fail(source, w + " is not UTF-8 (byte " + std::to_string(at) + ")");
+}
+
 void check_class(const ClassHmm& h, const std::string& source) {
   const std::string w = "class '" + h.name + "'";
-  if (h.name.empty()) fail(source, "a class has an empty name");
   if (h.n_states < 1 || h.n_states > kMaxStates)
     fail(source, w + " has " + std::to_string(h.n_states) + " states (1.." + std::to_string(kMaxStates) + " allowed)");
   const size_t n = static_cast<size_t>(h.n_states);
@@ -306,7 +346,9 @@ void validate_model(const OutcomeModel& m, const std::string& source) {
     fail(source, std::to_string(m.classes.size()) + " classes (1.." + std::to_string(kMaxClasses) + " allowed)");
   std::set<std::string> names;
   double prior_sum = 0.0;
-  for (const auto& h : m.classes) {
+  for (size_t c = 0; c < m.classes.size(); ++c) {
+    const ClassHmm& h = m.classes[c];
+    check_class_name(h.name, c, source);
     check_class(h, source);
     if (!names.insert(h.name).second) fail(source, "class name '" + h.name + "' appears twice");
     prior_sum += std::exp(h.log_prior);

@@ -2,6 +2,7 @@
 // message that names the problem; the shipped default model's checksum.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cerrno>
 #include <cmath>
@@ -560,6 +561,67 @@ TEST(ModelFileRejects, CovarianceADoubleCannotInvert) {
   // (it read "det 0.000000").
   expect_rejected(patched(0.6543210987, std::nextafter(0.125 * 0.125 / 0.5, 1.0)),
                   "not positive definite (det 3.46945e-18)");
+}
+
+namespace {
+// The sample model's bytes with its one "caught" (a class name) replaced by `to`, same length.
+std::vector<uint8_t> renamed_caught(const std::string& to) {
+  auto b = encode_model(sample_model());
+  const std::string from = "caught";
+  EXPECT_EQ(to.size(), from.size());
+  const auto at = std::search(b.begin(), b.end(), from.begin(), from.end());
+  EXPECT_NE(at, b.end());
+  EXPECT_EQ(std::search(at + 1, b.end(), from.begin(), from.end()), b.end()) << "not unique";
+  std::copy(to.begin(), to.end(), at);
+  fix_crc(b);
+  return b;
+}
+}  // namespace
+
+// A class name the reader refuses is refused on write too: one over the reader's 65,536 bytes
+// was written, and the file then could not be read. A name must also be UTF-8 (FORMAT.md) and
+// hold no NUL (printed, it ended there). Each in a file and on encode.
+TEST(ModelFileRejects, ClassNamesTheReaderCannotRead) {
+  auto m = sample_model();
+  m.classes[1].name = std::string(70000, 'm');
+  try {
+    encode_model(m);
+    ADD_FAILURE() << "encoded a 70,000-byte class name";
+  } catch (const ModelError& e) {
+    EXPECT_STREQ(e.what(), "model to encode: class 1's name is 70000 bytes long (at most 65536)");
+  }
+  m.classes[1].name = std::string(65536, 'm');  // the limit itself is a name
+  const auto at_limit = encode_model(m);
+  EXPECT_EQ(decode_model(at_limit.data(), at_limit.size(), "mem").classes[1].name.size(), 65536u);
+  expect_rejected(renamed_caught(std::string("cau\0ht", 6)), "class 2's name holds a NUL byte (byte 3)");
+  expect_rejected(renamed_caught("caugh\xff"), "class 2's name is not UTF-8 (byte 5)");
+  // UTF-8 by RFC 3629: what is refused, and at which byte.
+  const std::pair<std::string, std::string> cases[] = {
+      {"caf\xc3\xa9", ""},                                // é
+      {"\xf0\x9f\x98\x80", ""},                           // U+1F600, 4 bytes
+      {"ok\x80", "is not UTF-8 (byte 2)"},                 // a continuation byte with no lead
+      {"ok\xc3", "is not UTF-8 (byte 2)"},                 // cut short
+      {"\xc3(", "is not UTF-8 (byte 0)"},                  // lead without its continuation
+      {"\xc0\xaf", "is not UTF-8 (byte 0)"},               // overlong '/'
+      {"a\xe0\x80\xaf", "is not UTF-8 (byte 1)"},          // overlong, 3 bytes
+      {"\xed\xa0\x80", "is not UTF-8 (byte 0)"},           // a surrogate, U+D800
+      {"\xf4\x90\x80\x80", "is not UTF-8 (byte 0)"},       // U+110000, past Unicode
+      {"\xf8\x88\x80\x80\x80", "is not UTF-8 (byte 0)"},   // a 5-byte form
+  };
+  for (const auto& [name, want] : cases) {
+    auto u = sample_model();
+    u.classes[0].name = name;
+    std::string what = "accepted";
+    try {
+      encode_model(u);
+    } catch (const ModelError& e) {
+      what = e.what();
+    }
+    if (want.empty())
+      EXPECT_EQ(what, "accepted") << name;
+    else
+      EXPECT_EQ(what, "model to encode: class 0's name " + want) << name;
+  }
 }
 
 TEST(ModelFileRejects, SemanticChecksOnEncode) {
