@@ -421,6 +421,15 @@ std::vector<uint8_t> encode_model(const OutcomeModel& m) {
   return std::move(out);
 }
 
+namespace {
+// Why a model is written at version `v` (format_version_of), for messages.
+const char* version_reason(uint32_t v) {
+  if (v == 3) return "a training condition is known";
+  if (v == 2) return "a feature is 'none', no training condition is known";
+  return "no feature is 'none', no training condition is known";
+}
+}  // namespace
+
 OutcomeModel decode_model(const uint8_t* data, size_t size, const std::string& source) {
   if (size < kHeaderBytes + kTrailerBytes)
     fail(source, "truncated: " + std::to_string(size) + " bytes, shorter than the 20-byte header and CRC");
@@ -499,6 +508,13 @@ OutcomeModel decode_model(const uint8_t* data, size_t size, const std::string& s
   if (r.pos() != body_end)
     fail(source, std::to_string(body_end - r.pos()) + " unexplained bytes before the CRC at byte " + std::to_string(r.pos()));
   validate_model(m, source);
+  // The writer writes each model at exactly one version (format_version_of), so every file the
+  // loader accepts re-writes to its own bytes (FORMAT.md, Versioning): a version-2 file without
+  // a 'none' axis was accepted and re-written as version 1. The checks above name the version-1
+  // and version-3 cases; this one covers what they do not.
+  if (const uint32_t own = format_version_of(m); version != own)
+    fail(source, "format version " + std::to_string(version) + " for a model the writer writes as version " +
+                     std::to_string(own) + " (" + version_reason(own) + "): a file must carry its model's version");
   return m;
 }
 

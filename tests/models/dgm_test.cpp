@@ -266,6 +266,12 @@ TEST(ModelFile, UnusedFeatureIsZeroAndNeedsVersion2) {
   v1[8] = 1;
   fix_crc(v1);
   expect_rejected(v1, "needs format version 2");
+  // The reverse: a version-2 file that uses no axis 3 was accepted and re-written as version 1;
+  // every accepted file must re-write to its own bytes (FORMAT.md, Versioning).
+  auto v2 = encode_model(sample_model());
+  v2[8] = 2;
+  fix_crc(v2);
+  expect_rejected(v2, "format version 2 for a model the writer writes as version 1 (no feature is 'none'");
   auto both = m;
   both.features.axis[0] = kAxisNone;
   EXPECT_THROW(encode_model(both), ModelError);

@@ -1,6 +1,7 @@
 // dg_fuzz_seeds KIND DIR: writes a fuzz target's seed corpus at test time.
 //   dgm        fuzz_dgm: valid models of several shapes (1 class x 1 state, 2 x 5, 3 x 10, a
-//              general topology, a format-version-3 one with its training conditions), each
+//              general topology, a format-version-3 one with its training conditions, a
+//              format-version-2 one whose feature 1 is 'none'), each
 //              with mode byte 0 (as is) and 1 (size and CRC repaired by the harness), plus a
 //              truncated and a bit-flipped file;
 //   predictor  fuzz_predictor: trials as the bus carries them (traffic.h): a good
@@ -109,13 +110,14 @@ int dgm_seeds(const std::filesystem::path& dir) {
   int k = 0;
   bool ok = true;
   for (auto [c, s, g] : {std::tuple{1, 1, false}, std::tuple{2, 5, false}, std::tuple{3, 10, false},
-                         std::tuple{2, 4, true}, std::tuple{3, 4, false}}) {
+                         std::tuple{2, 4, true}, std::tuple{3, 4, false}, std::tuple{2, 3, false}}) {
     auto m = make(c, s, g);
     if (k == 4) {  // format version 3: the training conditions after the stop policy
       m.sample_period_s = 0.01;
       m.speed_min_m_s = 0.1;
       m.speed_max_m_s = 0.3;
     }
+    if (k == 5) m.features.axis[1] = kAxisNone;  // format version 2 (offset 0 and scale 1 already)
     const auto b = encode_model(m);
     ok &= put(dir / ("valid" + std::to_string(k) + "_raw"), 0, b);
     ok &= put(dir / ("valid" + std::to_string(k) + "_fixed"), 1, b);
