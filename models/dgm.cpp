@@ -20,10 +20,22 @@
 
 namespace dressguard::model {
 
+namespace {
+// The symmetric matrix [[a b][b d]] the filter and the trainer use for a stored covariance (b the
+// mean of the two off-diagonals), and its determinant: one function, so that validation checks
+// the very det that emission_terms inverts.
+struct SymmetricCovariance {
+  double a, b, d, det;
+};
+SymmetricCovariance symmetric_covariance(const GaussianEmission& e) noexcept {
+  const double a = e.cov[0][0], b = 0.5 * (e.cov[0][1] + e.cov[1][0]), d = e.cov[1][1];
+  return {a, b, d, a * d - b * b};
+}
+}  // namespace
+
 EmissionTerms emission_terms(const GaussianEmission& e) noexcept {
   constexpr double kLog2Pi = 1.8378770664093454835606594728112;  // log(2 pi)
-  const double a = e.cov[0][0], b = 0.5 * (e.cov[0][1] + e.cov[1][0]), d = e.cov[1][1];
-  const double det = a * d - b * b;
+  const auto [a, b, d, det] = symmetric_covariance(e);
   return {e.mean[0], e.mean[1], d / det, -b / det, a / det, -kLog2Pi - 0.5 * std::log(det)};
 }
 
@@ -87,6 +99,13 @@ std::string short_number(double v) {
   return text;
 }
 
+// A number for a message where the difference is in the last digits: every digit a double has.
+std::string precise_number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.17g", v);
+  return text;
+}
+
 // Longest string field the loader accepts (metadata, class names): keeps a corrupt length from
 // asking for gigabytes.
 constexpr uint32_t kMaxString = 65536;
@@ -146,20 +165,25 @@ void check_stochastic(const double* p, int n, const std::string& source, const s
   }
 }
 
-// Covariance [[a b][c d]]: symmetric (|b - c| <= 1e-12 max(|a|,|d|)) and positive definite,
-// i.e. a > 0 and det = a d - b^2 > 0 (Sylvester's criterion for 2x2), with det relative to a d
-// above 1e-12 so the inverse the filter precomputes is meaningful; and det a normal double and
-// that inverse (emission_terms) finite, so that it can be computed at all.
+// Covariance [[a b][c d]]: symmetric (|b - c| <= 1e-12 sqrt(|a| |d|): the scale of the
+// off-diagonal itself, |b| < sqrt(a d) when positive definite; max(|a|, |d|) let an asymmetry
+// larger than any valid off-diagonal through when a and d differ by orders of magnitude), and
+// positive definite as the filter sees it, [[a m][m d]] with m = (b + c) / 2 (symmetric_covariance):
+// a > 0 and det = a d - m^2 > 0 (Sylvester's criterion for 2x2), with det relative to a d above
+// 1e-12 so the inverse the filter precomputes is meaningful; and det a normal double and that
+// inverse (emission_terms) finite, so that it can be computed at all.
 void check_covariance(const GaussianEmission& e, const std::string& source, const std::string& what) {
   for (int r = 0; r < kFeatures; ++r) {
     check_finite(e.mean[r], source, what + " mean[" + std::to_string(r) + "]");
     for (int k = 0; k < kFeatures; ++k)
       check_finite(e.cov[r][k], source, what + " cov[" + std::to_string(r) + "][" + std::to_string(k) + "]");
   }
-  const double a = e.cov[0][0], b = e.cov[0][1], c = e.cov[1][0], d = e.cov[1][1];
-  if (std::fabs(b - c) > 1e-12 * std::max(std::fabs(a), std::fabs(d)))
-    fail(source, what + " covariance is not symmetric");
-  const double det = a * d - b * b;
+  const double b = e.cov[0][1], c = e.cov[1][0];
+  const auto [a, m, d, det] = symmetric_covariance(e);
+  // sqrt of each, not of the product: a d may overflow (or sink to 0) where the bound does not.
+  if (std::fabs(b - c) > 1e-12 * std::sqrt(std::fabs(a)) * std::sqrt(std::fabs(d)))
+    fail(source, what + " covariance is not symmetric (cov[0][1] " + precise_number(b) + ", cov[1][0] " +
+                     precise_number(c) + ")");
   const std::string text = short_number(det);  // to_string's %f said "det 0.000000" of 1e-20
   if (!(a > 0.0) || !(d > 0.0) || !(det > 0.0))
     fail(source, what + " covariance is not positive definite (det " + text + ")");

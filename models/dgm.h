@@ -54,7 +54,8 @@ struct GaussianEmission {
 };
 
 // The constants of one emission's log density, computed once per model by the trainer and the
-// online filter alike. For S = [[a b][b d]] and z = x - mean:
+// online filter alike. For S = [[a b][b d]], b the mean of cov[0][1] and cov[1][0] (a valid model
+// holds them within 1e-12 sqrt(a d) of each other), and z = x - mean:
 //     S^-1 = [[ip iq][iq ir]] = [[d -b][-b a]] / det,   det = a d - b^2
 //     log N(x; mean, S) = lconst - (ip z0^2 + 2 iq z0 z1 + ir z1^2) / 2,   lconst = -log(2 pi) - log(det) / 2
 struct EmissionTerms {

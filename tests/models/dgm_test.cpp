@@ -630,6 +630,48 @@ TEST(ModelFileRejects, ClassNamesTheReaderCannotRead) {
   }
 }
 
+// Symmetry is judged against sqrt(cov00 cov11), the scale of the off-diagonal itself (|cov01| <
+// sqrt(cov00 cov11) when positive definite), and positive definiteness on the matrix the filter
+// inverts, whose off-diagonal is the mean of the two (emission_terms). With the larger diagonal
+// as the scale, diagonals 1e10 and 1e-10 let cov01 and cov10 differ by 0.01, far more than any
+// valid off-diagonal (< 1): the pair below passed, and its determinant from cov01 alone (2e-7)
+// hid that the filter's, from their mean 1, is 0. The second pair is symmetric within 1e-12 and
+// positive definite by cov01 alone (det 1.5e-12 > 1e-12 cov00 cov11) but not by their mean
+// (0.6e-12). Each in a file and on encode, named by class and state.
+TEST(ModelFileRejects, CovarianceAsTheFilterSeesIt) {
+  struct Case {
+    double a, d, b, c;
+    const char* want;
+  };
+  const double b2 = std::sqrt(1.0 - 1.5e-12);
+  const Case cases[] = {
+      {1e10, 1e-10, 1.0 - 1e-7, 1.0 - 1e-7 + 2e-7,
+       "class 'good' state 5 covariance is not symmetric (cov[0][1] 0.99999990000000005, cov[1][0] 1.0000001"},
+      {1.0, 1.0, b2, b2 + 0.9e-12, "class 'good' state 5 covariance is not positive definite (det 6."},
+  };
+  // Markers for state 5 of 'good': cov00 and the two off-diagonals, unique in the file.
+  constexpr double kA = 0.4321098765, kB = 0.0123456789, kC = 0.0123456789 + 1e-15;
+  for (const Case& c : cases) {
+    OutcomeModel m = sample_model();
+    GaussianEmission& e = m.classes[0].emission[5];
+    e.cov[0][0] = kA, e.cov[0][1] = kB, e.cov[1][0] = kC;
+    auto b = encode_model(m);
+    replace_double(b, kA, c.a);
+    replace_double(b, 0.6543210987, c.d);
+    replace_double(b, kB, c.b);
+    replace_double(b, kC, c.c);
+    fix_crc(b);
+    expect_rejected(b, c.want);
+    e.cov[0][0] = c.a, e.cov[1][1] = c.d, e.cov[0][1] = c.b, e.cov[1][0] = c.c;
+    try {
+      encode_model(m);
+      ADD_FAILURE() << "encoded a model that should fail with: " << c.want;
+    } catch (const ModelError& err) {
+      EXPECT_NE(std::string(err.what()).find(c.want), std::string::npos) << err.what();
+    }
+  }
+}
+
 TEST(ModelFileRejects, SemanticChecksOnEncode) {
   auto m = sample_model();
   m.classes[1].name = "good";
