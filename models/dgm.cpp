@@ -155,14 +155,11 @@ void check_stochastic(const double* p, int n, const std::string& source, const s
   for (int j = 0; j < n; ++j) {
     check_finite(p[j], source, what + " entry " + std::to_string(j));
     if (p[j] < 0.0 || p[j] > 1.0)
-      fail(source, what + " entry " + std::to_string(j) + " = " + std::to_string(p[j]) + " is not a probability");
+      fail(source, what + " entry " + std::to_string(j) + " = " + precise_number(p[j]) + " is not a probability");
     sum += p[j];
   }
-  if (std::fabs(sum - 1.0) > kStochasticTolerance) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.17g", sum);
-    fail(source, what + " sums to " + buf + ", not 1 (tolerance 1e-9)");
-  }
+  if (std::fabs(sum - 1.0) > kStochasticTolerance)
+    fail(source, what + " sums to " + precise_number(sum) + ", not 1 (tolerance 1e-9)");
 }
 
 // Covariance [[a b][c d]]: symmetric (|b - c| <= 1e-12 sqrt(|a| |d|): the scale of the
@@ -287,7 +284,10 @@ void check_class(const ClassHmm& h, const std::string& source) {
   if (h.initial.size() != n || h.transition.size() != n * n || h.emission.size() != n)
     fail(source, w + " arrays do not match its state count");
   check_finite(h.log_prior, source, w + " log prior");
-  if (h.log_prior > 1e-12) fail(source, w + " log prior is positive");
+  // A prior of 1 is log 0; one normalised in logs (log p - log z) can come out an ulp or so above
+  // 0, which 1e-12 allows (the priors' sum, within 1e-9 of 1, bounds it anyway).
+  if (h.log_prior > 1e-12)
+    fail(source, w + " log prior " + precise_number(h.log_prior) + " is above 0 (a prior above 1; 1e-12 allowed)");
   check_stochastic(h.initial.data(), h.n_states, source, w + " initial distribution");
   for (int i = 0; i < h.n_states; ++i)
     check_stochastic(h.transition.data() + i * n, h.n_states, source, w + " transition row " + std::to_string(i));
@@ -378,7 +378,8 @@ void validate_model(const OutcomeModel& m, const std::string& source) {
     prior_sum += std::exp(h.log_prior);
   }
   // Priors are stored as logs; their exponentials must form a distribution (1e-9 as for rows).
-  if (std::fabs(prior_sum - 1.0) > kStochasticTolerance) fail(source, "class priors sum to " + std::to_string(prior_sum) + ", not 1");
+  if (std::fabs(prior_sum - 1.0) > kStochasticTolerance)
+    fail(source, "class priors sum to " + precise_number(prior_sum) + ", not 1 (tolerance 1e-9)");
   check_finite(m.stop_threshold, source, "stop threshold");
   if (!(m.stop_threshold > 0.0 && m.stop_threshold < 1.0)) fail(source, "stop threshold is not in (0, 1)");
   if (m.stop_consecutive < 1 || m.stop_consecutive > 100000) fail(source, "stop_consecutive is not in 1..100000");

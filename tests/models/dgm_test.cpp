@@ -672,6 +672,38 @@ TEST(ModelFileRejects, CovarianceAsTheFilterSeesIt) {
   }
 }
 
+namespace {
+// What encode_model says of `m`: the ModelError's message, or "encoded".
+std::string encode_error(const OutcomeModel& m) {
+  try {
+    encode_model(m);
+    return "encoded";
+  } catch (const ModelError& e) {
+    return e.what();
+  }
+}
+}  // namespace
+
+// Numbers near 1 are printed with every digit a double has (%.17g): "%f" said "class priors sum
+// to 1.000000, not 1" and "1.000000 is not a probability", hiding the difference. A log prior is
+// at most 1e-12 (a prior of 1 and its rounding), as FORMAT.md now says, and the message says so.
+TEST(ModelFileRejects, NumbersNearTheirBoundShowTheDifference) {
+  auto m = sample_model();
+  m.classes[0].log_prior = std::log(1.0 / 3.0 + 2e-9);
+  EXPECT_EQ(encode_error(m), "model to encode: class priors sum to 1.0000000019999999, not 1 (tolerance 1e-9)");
+  expect_rejected(patched(0.8765432109, 1.0000000001),
+                  "class 'caught' transition row 3 entry 3 = 1.0000000001 is not a probability");
+  expect_rejected(patched(0.8765432109, 0.8765432109 + 1e-6),
+                  "class 'caught' transition row 3 sums to 1.0000010000000001, not 1 (tolerance 1e-9)");
+  OutcomeModel one = sample_model();
+  one.classes.resize(1);
+  one.classes[0].log_prior = 1e-13;  // a prior of 1, give or take rounding
+  EXPECT_EQ(encode_error(one), "encoded");
+  one.classes[0].log_prior = 2e-12;
+  EXPECT_EQ(encode_error(one),
+            "model to encode: class 'good' log prior 2e-12 is above 0 (a prior above 1; 1e-12 allowed)");
+}
+
 TEST(ModelFileRejects, SemanticChecksOnEncode) {
   auto m = sample_model();
   m.classes[1].name = "good";
