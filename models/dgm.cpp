@@ -381,8 +381,10 @@ void validate_model(const OutcomeModel& m, const std::string& source) {
   if (std::fabs(prior_sum - 1.0) > kStochasticTolerance)
     fail(source, "class priors sum to " + precise_number(prior_sum) + ", not 1 (tolerance 1e-9)");
   check_finite(m.stop_threshold, source, "stop threshold");
-  if (!(m.stop_threshold > 0.0 && m.stop_threshold < 1.0)) fail(source, "stop threshold is not in (0, 1)");
-  if (m.stop_consecutive < 1 || m.stop_consecutive > 100000) fail(source, "stop_consecutive is not in 1..100000");
+  if (!(m.stop_threshold > 0.0 && m.stop_threshold < 1.0))
+    fail(source, "stop threshold " + precise_number(m.stop_threshold) + " is not in (0, 1)");
+  if (m.stop_consecutive < 1 || m.stop_consecutive > 100000)
+    fail(source, "stop_consecutive " + std::to_string(m.stop_consecutive) + " is not in 1..100000");
   check_training_period(m.sample_period_s, source);
   check_training_speeds(m.speed_min_m_s, m.speed_max_m_s, source);
   for (const std::string* s : {&m.tool_version, &m.created, &m.source_dataset, &m.training_summary})

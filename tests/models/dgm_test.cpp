@@ -3,13 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <future>
 #include <iterator>
 #include <limits>
@@ -714,6 +715,86 @@ TEST(ModelFileRejects, SemanticChecksOnEncode) {
   m = sample_model();
   m.classes[0].log_prior = 0.0;  // priors then sum to 5/3
   EXPECT_THROW(encode_model(m), ModelError);
+}
+
+namespace {
+void put_u32(std::vector<uint8_t>& b, size_t at, uint32_t v) {
+  for (int i = 0; i < 4; ++i) b[at + i] = static_cast<uint8_t>(v >> (8 * i));
+}
+void put_f64(std::vector<uint8_t>& b, size_t at, double v) { std::memcpy(&b[at], &v, 8); }
+// Where the text `s` starts in `b`; it must occur once.
+size_t text_at(const std::vector<uint8_t>& b, const std::string& s) {
+  const auto at = std::search(b.begin(), b.end(), s.begin(), s.end());
+  EXPECT_NE(at, b.end()) << s;
+  EXPECT_EQ(std::search(at + 1, b.end(), s.begin(), s.end()), b.end()) << s << " is not unique";
+  return static_cast<size_t>(at - b.begin());
+}
+}  // namespace
+
+// Every structural and semantic rule FORMAT.md lists that no test above shows on its own: one
+// small change to the sample model's file each (the size field and the CRC repaired after it, so
+// that the rule under test is what refuses it), refused with a message naming the file and the
+// problem.
+TEST(ModelFileRejects, EachRuleOnItsOwn) {
+  const std::vector<uint8_t> base = encode_model(sample_model());
+  // The layout around the markers (FORMAT.md): feature 0 is axis (i32), sign, offset -2.5, scale
+  // 1.75; the stop threshold 0.9 is followed by the stop count (i32) and, in version 1, the class
+  // count (u32), then class 0's name, 'good', as a str, and its state count.
+  const size_t axis0 = offset_of(base, -2.5) - 12, threshold = offset_of(base, 0.9);
+  const size_t good = text_at(base, "good"), caught = text_at(base, "caught");
+  const size_t class_count = good - 8, state_count = good + 4;
+  ASSERT_EQ(threshold + 12, class_count);
+  using Mutation = std::function<void(std::vector<uint8_t>&)>;
+  const std::string crc_at = std::to_string(base.size() - 4);
+  const std::pair<Mutation, std::string> cases[] = {
+      {[](auto& b) { b.insert(b.end() - 4, 4, uint8_t{0}); }, "4 unexplained bytes before the CRC at byte " + crc_at},
+      {[&](auto& b) { put_u32(b, class_count, 0); }, "0 classes (1..8 allowed)"},
+      {[&](auto& b) { put_u32(b, class_count, 9); }, "9 classes (1..8 allowed)"},
+      {[&](auto& b) { put_u32(b, state_count, 0); }, "class 'good' has 0 states (1..32 allowed)"},
+      {[&](auto& b) { put_u32(b, state_count, 33); }, "class 'good' has 33 states (1..32 allowed)"},
+      {[](auto& b) { put_u32(b, 16, 65537); }, "tool version length 65537 exceeds 65536"},
+      {[&](auto& b) { put_u32(b, good - 4, 70000); }, "class name length 70000 exceeds 65536"},
+      {[&](auto& b) {
+         put_u32(b, good - 4, 0);
+         b.erase(b.begin() + static_cast<std::ptrdiff_t>(good), b.begin() + static_cast<std::ptrdiff_t>(good) + 4);
+       },
+       "class 0 has an empty name"},
+      {[&](auto& b) { std::memcpy(&b[caught], "missed", 6); }, "class name 'missed' appears twice"},
+      {[&](auto& b) { put_u32(b, axis0, 4); }, "feature 0 axis 4 is not 0, 1, 2 or 3 (none)"},
+      {[&](auto& b) { put_u32(b, axis0, 0xFFFFFFFFu); }, "feature 0 axis -1 is not 0, 1, 2 or 3 (none)"},
+      {[&](auto& b) { put_f64(b, axis0 + 4, 0.5); }, "feature 0 sign is not +1 or -1"},
+      {[&](auto& b) { put_f64(b, axis0 + 20, 0.0); }, "feature 0 scale is not positive"},
+      {[&](auto& b) { put_f64(b, threshold, 0.0); }, "stop threshold 0 is not in (0, 1)"},
+      {[&](auto& b) { put_f64(b, threshold, 1.0); }, "stop threshold 1 is not in (0, 1)"},
+      {[&](auto& b) { put_f64(b, threshold, std::numeric_limits<double>::quiet_NaN()); },
+       "stop threshold is not finite"},
+      {[&](auto& b) { put_u32(b, threshold + 8, 0); }, "stop_consecutive 0 is not in 1..100000"},
+      {[&](auto& b) { put_u32(b, threshold + 8, 100001); }, "stop_consecutive 100001 is not in 1..100000"},
+  };
+  for (const auto& [mutate, want] : cases) {
+    SCOPED_TRACE(want);
+    auto b = base;
+    mutate(b);
+    put_u32(b, 12, static_cast<uint32_t>(b.size()));
+    fix_crc(b);
+    expect_rejected(b, want);
+  }
+  // The bounds themselves are inside: 1 and 8 classes, 1 and 32 states, 1 and 100,000 samples.
+  auto edges = sample_model();
+  edges.stop_consecutive = 100000;
+  edges.classes.resize(1);
+  edges.classes[0].log_prior = 0.0;
+  EXPECT_EQ(encode_error(edges), "encoded");
+  edges.stop_consecutive = 1;
+  edges.classes.assign(8, left_right_chain(32, 0.5));
+  for (int c = 0; c < 8; ++c) {
+    edges.classes[c].name = "class" + std::to_string(c);
+    edges.classes[c].emission.assign(32, GaussianEmission{});
+    edges.classes[c].log_prior = std::log(0.125);
+  }
+  EXPECT_EQ(encode_error(edges), "encoded");
+  edges.classes[0].n_states = 1;  // the arrays no longer match: refused on encode
+  EXPECT_EQ(encode_error(edges), "model to encode: class 'class0' arrays do not match its state count");
 }
 
 // The shipped default model: its bytes match the recorded SHA-256 and it loads (CRC and all).
