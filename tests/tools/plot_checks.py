@@ -10,7 +10,10 @@ usage: plot_checks.py CHECK SOURCE_DIR WORK_DIR
   latency     predictor_latency.py draws every log2 bucket between the first and the last
               non-empty one (the empty ones at 0), so a tail stands at its distance
   bad_input   arm_parts.py and sim_forces.py on header-only CSVs exit 1 naming the file (no
-              traceback); calib_eval.py draws an eval.json with null accuracies
+              traceback); calib_eval.py draws an eval.json with null accuracies; the scripts that
+              read through figure_file's load_json / require_columns exit 1 naming the file on
+              one that is not there, not JSON, or lacks a column or key they read, and
+              hmm_sweep.py refuses a sweep without one accuracy (it drew an empty figure, exit 0)
 Drawn in this process with the scripts' own functions; the figure is kept, not saved, where the
 check reads it. Exits 1 naming what failed.
 """
@@ -199,6 +202,40 @@ def check_bad_input(src, work):
     r = run(src, "calib_eval.py", out, ev)
     check(r.returncode == 0 and os.path.exists(out), f"calib_eval.py on null accuracies: exit {r.returncode}, "
           f"stderr {r.stderr.strip()!r}")
+    # Each a KeyError, JSONDecodeError or FileNotFoundError traceback before (session 91's review,
+    # finding F), and the empty sweep an empty figure with exit 0.
+    def text(name, content):
+        path = os.path.join(work, name)
+        with open(path, "w") as f:
+            f.write(content if isinstance(content, str) else json.dumps(content))
+        return path
+    not_json, missing = text("not.json", "{ not json\n"), os.path.join(work, "no-such-file")
+    empty_sweep = text("empty-sweep.csv", "travel_m,accuracy,correct,total\n0.15,,0,0\n")
+    cases = [
+        ("hmm_sweep.py", [text("no-acc.csv", "travel_m,correct,total\n0.1,3,4\n"), png], "no-acc.csv: no accuracy"),
+        ("hmm_sweep.py", [empty_sweep, png], "empty-sweep.csv: no cut with an accuracy"),
+        ("predictor_latency.py", [missing, "--out", png], "no-such-file: cannot read it"),
+        ("predictor_latency.py", [text("zero.txt", "e2e_hist_us [0, 2): 0\n"), "--out", png], "zero.txt: every"),
+        ("sim_scene.py", [text("no-frames.json", {}), png], "no-frames.json: no frames"),
+        ("calib_eval.py", [png, not_json], "not.json: not JSON"),
+        ("calib_eval.py", [png, text("no-rows.json", {"participants": [{"participant": "1"}],
+                                                      "one_nn_accuracy_at_cuts": [1, 1, 1, 1]})],
+         "no-rows.json: no stc_accuracy_whole_and_cuts"),
+        ("calib_overlay.py", ["fit", text("c.curves.csv", "trial_id,height,source,travel\ns4-good-3,high,measured,0.1\n"),
+                              "--out", png], "c.curves.csv: no f_motion"),
+        ("pooled_stc.py", [text("set.json", {"sources": [], "per_height": 3, "force_sets": [{"forces": "F_motion"}]}), png],
+         "set.json: no single"),
+        ("committee_draws.py", [text("no-seed.json", {"force_sets": [{"forces": "F_motion", **{
+            k: [1, 1, 1, 1, 1] for k in ("vote_accuracy_whole_and_cuts", "vote_good_or_missed_accuracy_whole_and_cuts")}}]}),
+                                png], "no-seed.json: no seed"),
+        ("member_weights.py", [not_json, png], "not.json: not JSON"),
+        ("early_cue.py", [text("cue.json", {"early_cue_good_minus_missed": [{"F_motion": [0, 0, 0, 0]}]}), png],
+         "cue.json: no who"),
+    ]
+    for script, args, want in cases:
+        r = run(src, script, *args)
+        check(r.returncode == 1 and want in r.stderr and "Traceback" not in r.stderr,
+              f"{script} {' '.join(os.path.basename(a) for a in args)}: exit {r.returncode}, stderr {r.stderr.strip()!r}")
 
 
 def main(argv):

@@ -9,14 +9,13 @@ EVAL.json is what `bench_calib_pipeline eval` writes (DIR/eval.json); several ru
 participants split over two processes) are merged, a participant appearing twice keeps its last
 row. "whole" is drawn at the right end, after the cuts.
 """
-import json
 import sys
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
-from figure_file import save_figure  # a temporary file, then a rename
+from figure_file import load_json, require_columns, save_figure  # a temporary file, then a rename
 
 CUTS = [0.15, 0.20, 0.25, 0.30]
 ONE_NN_REFERENCE = [71, 83, 94, 100]
@@ -35,9 +34,11 @@ def main(argv):
         return 2
     rows, one_nn = {}, None
     for path in argv[2:]:
-        with open(path) as f:
-            d = json.load(f)
-        for r in d["participants"]:
+        d = load_json(path)
+        require_columns(path, d, ["participants", "one_nn_accuracy_at_cuts"], "its keys")
+        for i, r in enumerate(d["participants"]):
+            require_columns(path, r, ["participant", "stc_accuracy_whole_and_cuts", "bc_accuracy_whole_and_cuts"],
+                            f"the keys of participant row {i}")
             rows[r["participant"]] = r
         one_nn = [percent(v) for v in d["one_nn_accuracy_at_cuts"]]
     if not rows:

@@ -52,11 +52,11 @@ Modes:
             person's trial: 0.09 good, 0.22 missed, 0.26 middle missed) and the paper's own
             simulator on participant 4 (0.22 good, 0.23 missed). Prints the chosen file and its
             L per sequence, one line per participant.
-Reads only what dressguard writes (calibrate's curves file and progress lines; dataset folders).
+Reads only what dressguard writes (calibrate's curves file and progress lines; dataset folders);
+a file that is not there or lacks a column or key the mode reads ends it naming the file.
 """
 import argparse
 import csv
-import json
 import collections
 import os
 import re
@@ -65,7 +65,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-from figure_file import save_figure  # a temporary file, then a rename
+from figure_file import load_json, open_input, require_columns, save_figure  # a temporary file, then a rename
 
 
 CUTS = (0.15, 0.20, 0.25, 0.30)  # issue 4's cuts of the sequences [m]
@@ -82,16 +82,24 @@ def cut_axes(ax, ylabel, up_to=1.0):
     ax.grid(alpha=0.3)
 
 
+def csv_rows(path, columns):
+    """The rows of a CSV dressguard wrote, as dicts; a file that is not there or lacks one of
+    columns ends the script naming it."""
+    with open_input(path) as f:
+        reader = csv.DictReader(f)
+        require_columns(path, reader.fieldnames, columns)
+        return list(reader)
+
+
 def read_curves(path):
     curves = collections.OrderedDict()
-    with open(path, newline="") as f:
-        for row in csv.DictReader(f):
-            key = (row["trial_id"], row["height"])
-            curves.setdefault(key, collections.defaultdict(list))
-            # F_lateral since 2026-11-25 (older curve files: none).
-            lateral = float(row["f_lateral"]) if row.get("f_lateral") not in (None, "") else None
-            curves[key][row["source"]].append(
-                (float(row["travel"]), float(row["f_motion"]), float(row["f_vertical"]), lateral))
+    for row in csv_rows(path, ["trial_id", "height", "source", "travel", "f_motion", "f_vertical"]):
+        key = (row["trial_id"], row["height"])
+        curves.setdefault(key, collections.defaultdict(list))
+        # F_lateral since 2026-11-25 (older curve files: none).
+        lateral = float(row["f_lateral"]) if row.get("f_lateral") not in (None, "") else None
+        curves[key][row["source"]].append(
+            (float(row["travel"]), float(row["f_motion"]), float(row["f_vertical"]), lateral))
     return curves
 
 
@@ -131,14 +139,10 @@ def plot_fit(args):
 
 def read_dataset(folder):
     trials = []
-    with open(os.path.join(folder, "manifest.csv"), newline="") as f:
-        for row in csv.DictReader(f):
-            pts = []
-            with open(os.path.join(folder, row["file"]), newline="") as g:
-                for r in csv.DictReader(g):
-                    pts.append((float(r["travel"]), float(r["f_motion"]), float(r["f_vertical"]),
-                                float(r["f_lateral"])))
-            trials.append((row, pts))
+    for row in csv_rows(os.path.join(folder, "manifest.csv"), ["file", "participant", "label"]):
+        pts = [(float(r["travel"]), float(r["f_motion"]), float(r["f_vertical"]), float(r["f_lateral"]))
+               for r in csv_rows(os.path.join(folder, row["file"]), ["travel", "f_motion", "f_vertical", "f_lateral"])]
+        trials.append((row, pts))
     return trials
 
 
@@ -187,7 +191,7 @@ def simulated_by(prefix):
     """What simulated a `dressguard predict --out PREFIX`'s curves, for the titles: the gown and
     whether its discrepancy term corrected them (PREFIX.csv's gown and discrepancy columns; a file
     written before they were has neither)."""
-    with open(prefix + ".csv", newline="") as f:
+    with open_input(prefix + ".csv") as f:
         first = next(csv.DictReader(f), {})
     parts = []
     if first.get("gown"):
@@ -198,13 +202,11 @@ def simulated_by(prefix):
 
 
 def plot_predict(args):
-    rows = list(csv.DictReader(open(args.prefix + ".csv", newline="")))
+    rows = csv_rows(args.prefix + ".csv", ["trial_id", "height", "real_median", "objective"])
     by = simulated_by(args.prefix)
     curves = collections.defaultdict(lambda: collections.defaultdict(list))
-    with open(args.prefix + ".curves.csv", newline="") as f:
-        for r in csv.DictReader(f):
-            curves[r["trial_id"]][r["source"]].append(
-                (float(r["travel"]), float(r["f_motion"]), float(r["f_vertical"])))
+    for r in csv_rows(args.prefix + ".curves.csv", ["trial_id", "source", "travel", "f_motion", "f_vertical"]):
+        curves[r["trial_id"]][r["source"]].append((float(r["travel"]), float(r["f_motion"]), float(r["f_vertical"])))
     heights = [h for h in ("high", "middle", "low") if any(r["height"] == h for r in rows)]
     fig, axes = plt.subplots(len(heights), 3, figsize=(15, 3.6 * len(heights)), squeeze=False)
     for i, h in enumerate(heights):
@@ -262,10 +264,13 @@ def below_panels(fig, handles):
 
 
 def plot_residual(args):
-    rows = list(csv.DictReader(open(args.prefix + ".residual.csv", newline="")))
+    path = args.prefix + ".residual.csv"
+    rows = csv_rows(path, ["height", "from", "to", "trials"])
+    forces = present_forces(rows)
+    require_columns(path, rows[0] if rows else [], [k + "_" + a for a in forces
+                                                    for k in ("measured", "spread", "simulated", "outside")])
     by = simulated_by(args.prefix)
     heights = [h for h in ("high", "middle", "low") if any(r["height"] == h for r in rows)]
-    forces = present_forces(rows)
     fig, axes = plt.subplots(len(heights), len(forces), figsize=(6 * len(forces), 3.4 * len(heights)), squeeze=False)
     for i, h in enumerate(heights):
         mine = [r for r in rows if r["height"] == h and int(r["trials"]) > 0]
@@ -295,11 +300,14 @@ def plot_residual(args):
 
 
 def plot_contrast(args):
-    rows = list(csv.DictReader(open(args.prefix + ".contrast.csv", newline="")))
+    path = args.prefix + ".contrast.csv"
+    rows = csv_rows(path, ["lower", "from", "to", "trials_high", "trials_lower"])
+    forces = present_forces(rows)
+    require_columns(path, rows[0] if rows else [], [k + "_" + a for a in forces
+                                                    for k in ("measured", "standard_error", "simulated", "verdict")])
     by = simulated_by(args.prefix)
     lowers = [h for h in ("middle", "low") if any(r["lower"] == h for r in rows)]
     shade = {"reverses": ("tab:red", "simulator reverses it"), "misses": ("tab:orange", "simulator misses it")}
-    forces = present_forces(rows)
     fig, axes = plt.subplots(len(lowers), len(forces), figsize=(6 * len(forces), 3.4 * len(lowers)), squeeze=False)
     for i, h in enumerate(lowers):
         mine = [r for r in rows if r["lower"] == h and int(r["trials_high"]) > 0 and int(r["trials_lower"]) > 0]
@@ -326,7 +334,7 @@ def plot_contrast(args):
 
 
 def plot_discrepancy(args):
-    rows = list(csv.DictReader(open(args.table, newline="")))
+    rows = csv_rows(args.table, ["calibration", "height", "travel", "r_motion", "r_vertical", "r_lateral"])
     if not rows:
         raise SystemExit(f"{args.table}: no rows (build-model --discrepancy writes one per grid point)")
     cals = list(dict.fromkeys(r["calibration"] for r in rows))
@@ -355,7 +363,7 @@ PROGRESS = re.compile(r"^generation (\d+)/(\d+)\s+best L ([0-9.eE+-]+|inf)(?: \(
 def read_progress(path):
     """{generation: (best, generation_best, {sequence: L})} from calibrate's progress lines."""
     gens = {}
-    with open(path) as f:
+    with open_input(path) as f:
         for line in f:
             m = PROGRESS.match(line)
             if not m:
@@ -407,11 +415,13 @@ def sequence_kind(seq):
 def plot_standing(args):
     best = {}  # participant -> (worst L, file name, sequences)
     for path in args.calibrations:
-        with open(path) as f:
-            cal = json.load(f)
+        cal = load_json(path)
         seqs = cal.get("sequences") or []
         if not seqs:
             raise SystemExit(f"{path}: no 'sequences' (not a calibration file written by calibrate)")
+        require_columns(path, cal, ["participant"], "its keys")
+        for i, q in enumerate(seqs):
+            require_columns(path, q, ["trial_id", "height", "objective"], f"the keys of sequence {i}")
         worst = max(q["objective"] for q in seqs)
         who = str(cal["participant"])
         if who not in best or worst < best[who][0]:

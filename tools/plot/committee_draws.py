@@ -23,7 +23,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
 from pooled_stc import CUTS, WHOLE_X, cuts_then_whole, read_run  # as the per-run plot
-from figure_file import save_figure  # a temporary file, then a rename
+from figure_file import require_columns, save_figure  # a temporary file, then a rename
 VOTES = [("vote_accuracy_whole_and_cuts", "vote_against_one_nn_at_cuts", "vote (the paper's rule)"),
          ("vote_good_or_missed_accuracy_whole_and_cuts", "vote_good_or_missed_against_one_nn_at_cuts",
           'vote, each STC asked "good or missed?"')]
@@ -65,6 +65,7 @@ def main(argv):
         d = read_run(path)
         if d is None:
             return 1
+        require_columns(path, d, ["seed", "per_height"], "its keys")
         for key, pairing, _ in VOTES:
             for s in d["force_sets"]:
                 if key not in s or len(s[key]) != 5:

@@ -9,14 +9,13 @@ discrepancy term), one panel per force. offline/calib/MEASUREMENTS.md, session 2
 usage: early_cue.py POOLED.json [POOLED2.json ...] OUT.png
 POOLED.json is what `bench_calib_pipeline pooled` writes.
 """
-import json
 import sys
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
-from figure_file import save_figure  # a temporary file, then a rename
+from figure_file import load_json, require_columns, save_figure  # a temporary file, then a rename
 
 FORCES = ["F_motion", "F_lateral", "F_vertical"]
 WINDOWS = ["0.10-0.15 m", "0.15-0.20 m", "0.20-0.25 m", "0.25-0.30 m"]
@@ -48,8 +47,9 @@ def main(argv):
     files, out_png = argv[1:-1], argv[-1]
     fig, axes = plt.subplots(len(files), 3, figsize=(13.5, 4.4 * len(files)), squeeze=False)
     for row, path in zip(axes, files):
-        with open(path) as f:
-            d = json.load(f)
+        d = load_json(path)
+        for i, r in enumerate(d.get("early_cue_good_minus_missed", [])):
+            require_columns(path, r, ["who"] + FORCES, f"the keys of early_cue_good_minus_missed row {i}")
         try:
             people, sims = pairs(d.get("early_cue_good_minus_missed", []))
         except ValueError as e:

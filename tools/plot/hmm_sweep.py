@@ -4,8 +4,8 @@
 usage: hmm_sweep.py SWEEP.csv OUT.png [SWEEP2.csv LABEL2 ...] [--title TEXT]
 --title replaces the title (e.g. to say the trials were in the model's training: in-sample).
 The CSV has columns travel_m,accuracy,correct,total (accuracy empty where no trial was scored:
-left out). Extra CSV/label pairs add curves (e.g. a
-simulation-trained and a measured-data-trained classifier on one plot).
+left out; a file without one accuracy is refused, naming it). Extra CSV/label pairs add curves
+(e.g. a simulation-trained and a measured-data-trained classifier on one plot).
 """
 import csv
 import sys
@@ -14,17 +14,21 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
-from figure_file import save_figure
+from figure_file import open_input, require_columns, save_figure
 
 
 def read(path):
     xs, ys = [], []
-    with open(path, newline="") as f:
-        for row in csv.DictReader(f):
+    with open_input(path) as f:
+        reader = csv.DictReader(f)
+        require_columns(path, reader.fieldnames, ["travel_m", "accuracy"])
+        for row in reader:
             if row["accuracy"] == "":  # a cut that left no trial scored has no accuracy
                 continue
             xs.append(float(row["travel_m"]))
             ys.append(100.0 * float(row["accuracy"]))
+    if not xs:  # an empty curve drew an empty figure and exited 0
+        raise SystemExit(f"{path}: no cut with an accuracy (no rows, or no trial scored at any cut)")
     return xs, ys
 
 

@@ -19,7 +19,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
 from pooled_stc import CUTS, read_run  # the same cuts and reading as the per-run plot
-from figure_file import save_figure  # a temporary file, then a rename
+from figure_file import require_columns, save_figure  # a temporary file, then a rename
 
 COLUMNS = ["whole"] + [f"{c:.2f} m" for c in CUTS]
 
@@ -63,6 +63,12 @@ def main(argv):
             if key not in s:
                 sys.stderr.write(f"{argv[1]}: force set '{s.get('forces')}' has no {key}\n")
                 return 1
+        for i, r in enumerate(s["single_on_other_simulators"]):
+            require_columns(argv[1], r, ["calibration", "good_or_missed_accuracy_whole_and_cuts"],
+                            f"the keys of '{s['forces']}' single_on_other_simulators {i}")
+        for i, r in enumerate(s["single_good_or_missed"]):
+            require_columns(argv[1], r, ["calibration", "accuracy_whole_and_cuts"],
+                            f"the keys of '{s['forces']}' single_good_or_missed {i}")
     rows = [stem(r["calibration"]) for r in sets[0]["single_on_other_simulators"]]
     fig, axes = plt.subplots(2, len(sets), figsize=(4.6 * len(sets), 0.45 * len(rows) * 2 + 2.6), squeeze=False)
     image = None

@@ -13,14 +13,13 @@ set; "whole" is drawn at the right end, after the cuts. Where the file pairs the
 trials only the vote / only the 1-NN got right with McNemar's exact p; above them, in red, the same
 for the vote with each STC asked "good or missed?" (since session 71).
 """
-import json
 import sys
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
-from figure_file import save_figure  # a temporary file, then a rename
+from figure_file import load_json, require_columns, save_figure  # a temporary file, then a rename
 
 CUTS = [0.15, 0.20, 0.25, 0.30]
 WHOLE_X = 0.35  # where "whole sequence" is drawn
@@ -32,12 +31,14 @@ def cuts_then_whole(v):  # the file holds whole first, then the cuts
 
 def read_run(path):
     """A file `bench_calib_pipeline pooled` wrote; None, the reason on stderr, when it has no
-    force sets (every plot of such runs reads them this way)."""
-    with open(path) as f:
-        d = json.load(f)
+    force sets (every plot of such runs reads them this way). One that is not there or not JSON,
+    or a force set without its name, ends the script naming the file."""
+    d = load_json(path)
     if not d.get("force_sets"):
         sys.stderr.write(f"{path}: no force sets\n")
         return None
+    for i, s in enumerate(d["force_sets"]):
+        require_columns(path, s, ["forces"], f"the keys of force set {i}")
     return d
 
 
@@ -48,7 +49,14 @@ def main(argv):
     d = read_run(argv[1])
     if d is None:
         return 1
+    require_columns(argv[1], d, ["sources", "per_height"], "its keys")
     sets = d["force_sets"]
+    for s in sets:
+        require_columns(argv[1], s, ["single", "single_accuracy_whole_and_cuts", "pooled_accuracy_whole_and_cuts",
+                                     "pooled_equal_size_accuracy_whole_and_cuts", "one_nn_accuracy_at_cuts"],
+                        f"the keys of force set '{s['forces']}'")
+        for i, single in enumerate(s["single"]):
+            require_columns(argv[1], single, ["accuracy_whole_and_cuts"], f"the keys of '{s['forces']}' single {i}")
     xs = CUTS + [WHOLE_X]
     fig, axes = plt.subplots(1, len(sets), figsize=(5.2 * len(sets), 4.6), sharey=True, squeeze=False)
     for ax, s in zip(axes[0], sets):

@@ -15,7 +15,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-from figure_file import save_figure  # a temporary file, then a rename
+from figure_file import open_input, save_figure  # a temporary file, then a rename
 
 
 def every_bucket(rows):
@@ -39,7 +39,11 @@ def main():
     ap.add_argument("input", help="bench_predictor output ('-' for stdin)")
     ap.add_argument("--out", default="predictor_latency.png")
     args = ap.parse_args()
-    text = sys.stdin.read() if args.input == "-" else open(args.input).read()
+    if args.input == "-":
+        text = sys.stdin.read()
+    else:
+        with open_input(args.input) as f:
+            text = f.read()
     hists = {}
     for tag, lo, hi, n in re.findall(r"(\w+)_hist_us \[(\d+), (\d+)\): (\d+)", text):
         hists.setdefault(tag, []).append((int(lo), int(hi), int(n)))
@@ -50,6 +54,9 @@ def main():
     for ax, (tag, rows) in zip(axes[0], sorted(hists.items())):
         rows = every_bucket(rows)
         total = sum(n for _, _, n in rows)
+        if total == 0:
+            print(f"predictor_latency.py: {args.input}: every '{tag}_hist_us' bucket is empty", file=sys.stderr)
+            return 1
         ax.bar([f"{lo}-{hi}" for lo, hi, _ in rows], [100.0 * n / total for _, _, n in rows], color="tab:blue")
         ax.set_title(f"{tag} (n={total})")
         ax.set_xlabel("latency [us]")

@@ -5,7 +5,6 @@ the end; three 3-D panels and a side view; and the sleeve opening seen from the 
 start and after contact,
 with the fist at each of the three arm heights (where the rim hangs decides the outcome before
 any force does). Usage: sim_scene.py SCENE.json OUT.png"""
-import json
 import sys
 
 import matplotlib
@@ -14,7 +13,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-from figure_file import save_figure  # a temporary file, then a rename
+from figure_file import load_json, require_columns, save_figure  # a temporary file, then a rename
 
 
 def round_cone_mesh(a, ra, b, rb, n=18, m=10):
@@ -129,10 +128,14 @@ def from_fist(ax, sc, frame, title):
 def main():
     if len(sys.argv) != 3:
         sys.exit(__doc__)
-    sc = json.load(open(sys.argv[1]))
+    sc = load_json(sys.argv[1])
+    require_columns(sys.argv[1], sc, ["frames", "tris", "arm", "opening", "grip", "jaw_half", "samples", "height",
+                                      "arm_offset", "label", "travel", "d_max"], "its keys")
     frames = sc["frames"]
     if not frames:
         sys.exit("sim_scene.py: no frames in " + sys.argv[1])
+    for i, f in enumerate(frames):
+        require_columns(sys.argv[1], f, ["t", "travel", "x"], f"the keys of frame {i}")
     start = min(frames, key=lambda f: abs(f["t"]))
     ct = sc.get("contact_t", -1)
     samples = np.array(sc["samples"]) if sc["samples"] else np.zeros((0, 5))
