@@ -41,13 +41,14 @@ int64_t LatencyHistogram::quantile(double q) const {
   uint64_t acc = 0;
   for (int b = 0; b < kBins; ++b) {
     acc += bins_[static_cast<size_t>(b)];
-    if (acc >= target) return b == kBins - 1 ? max_ : (b + 1) * bin_ns_;
+    if (acc >= target) return (b + 1) * bin_ns_;
   }
-  return max_;
+  return max_;  // among the values beyond the range
 }
 
 void LatencyHistogram::merge(const LatencyHistogram& o) {
   for (int b = 0; b < kBins; ++b) bins_[static_cast<size_t>(b)] += o.bins_[static_cast<size_t>(b)];
+  overflow_ += o.overflow_;
   count_ += o.count_;
   if (o.max_ > max_) max_ = o.max_;
 }

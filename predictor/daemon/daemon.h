@@ -28,22 +28,29 @@ namespace dressguard::predictor {
 
 using EventQueue = SpscQueue<Event, 4096>;
 
-// Fixed-bin histogram (no allocation when adding): bins of `bin_ns`, the last one open-ended.
+// Fixed-bin histogram, added to on the real-time loop (no allocation, no lock: a fixed array and
+// counters): kBins bins of `bin_ns` cover [0, range_ns()); a value at or beyond range_ns() is
+// counted in overflow(), not in a bin (folded into the last bin, a stall read as that bin's
+// latency). count() holds both.
 class LatencyHistogram {
  public:
   static constexpr int kBins = 4096;
   explicit LatencyHistogram(int64_t bin_ns = 100) : bin_ns_(bin_ns) {}  // 100 ns x 4096: up to 410 us
   void add(int64_t ns) noexcept {
-    int64_t b = ns < 0 ? 0 : ns / bin_ns_;
-    if (b >= kBins) b = kBins - 1;
-    ++bins_[static_cast<size_t>(b)];
+    const int64_t b = ns < 0 ? 0 : ns / bin_ns_;
+    if (b < kBins)
+      ++bins_[static_cast<size_t>(b)];
+    else
+      ++overflow_;
     ++count_;
     if (ns > max_) max_ = ns;
   }
   uint64_t count() const { return count_; }
+  uint64_t overflow() const { return overflow_; }  // values >= range_ns()
   int64_t max() const { return max_; }
   int64_t bin_ns() const { return bin_ns_; }
-  // Upper edge of the bin holding quantile q (0..1), in ns.
+  int64_t range_ns() const { return kBins * bin_ns_; }
+  // Upper edge of the bin holding quantile q (0..1), in ns; max() when it lies beyond the range.
   int64_t quantile(double q) const;
   const std::array<uint64_t, kBins>& bins() const { return bins_; }
   void merge(const LatencyHistogram& o);
@@ -51,6 +58,7 @@ class LatencyHistogram {
  private:
   int64_t bin_ns_;
   std::array<uint64_t, kBins> bins_{};
+  uint64_t overflow_ = 0;
   uint64_t count_ = 0;
   int64_t max_ = 0;
 };

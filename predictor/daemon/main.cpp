@@ -272,10 +272,10 @@ int main(int argc, char** argv) {
     if (latency_report) {
       const auto& h = daemon.processing();
       const auto& hs = daemon.processing_with_stop();
-      log->info("processing latency (frame read to decision): n={} median={} ns p99.9={} ns max={} ns", h.count(),
-                h.quantile(0.5), h.quantile(0.999), h.max());
-      log->info("processing latency with the stop frame sent: n={} median={} ns max={} ns", hs.count(),
-                hs.quantile(0.5), hs.max());
+      log->info("processing latency (frame read to decision): n={} median={} ns p99.9={} ns max={} ns, {} at or "
+                "beyond {} ns", h.count(), h.quantile(0.5), h.quantile(0.999), h.max(), h.overflow(), h.range_ns());
+      log->info("processing latency with the stop frame sent: n={} median={} ns max={} ns, {} at or beyond {} ns",
+                hs.count(), hs.quantile(0.5), hs.max(), hs.overflow(), hs.range_ns());
     }
     log->flush();
     return rc;

@@ -386,4 +386,35 @@ TEST(Daemon, WithoutAModelEveryTrialIsRefused) {
   EXPECT_EQ(s.reason, protocol::StopReason::ModelError);
 }
 
+// A latency beyond the histogram's range (kBins x bin_ns) is counted apart, not in the last bin:
+// folded into it, a 1 ms stall read as the bin [409.5, 409.6) us on every picture and report.
+TEST(LatencyHistogram, AValueBeyondTheRangeIsOverflowNotTheLastBin) {
+  LatencyHistogram h(100);  // 100 ns bins: [0, 409.6 us)
+  const int64_t range = LatencyHistogram::kBins * int64_t{100};
+  h.add(range - 1);  // the last bin's own value
+  h.add(range);      // the first beyond
+  h.add(10 * range);
+  EXPECT_EQ(h.bins().back(), 1u) << "a value beyond the range went into the last bin";
+  EXPECT_EQ(h.overflow(), 2u);
+  EXPECT_EQ(h.range_ns(), range);
+  EXPECT_EQ(h.count(), 3u);
+  EXPECT_EQ(h.max(), 10 * range);
+  // The median lies in the last bin (its upper edge); the top quantile beyond it (the maximum).
+  EXPECT_EQ(h.quantile(0.0), range);
+  EXPECT_EQ(h.quantile(1.0), 10 * range);
+  // Merged, the overflow adds up as the bins do; adding allocates nothing (the real-time loop's).
+  LatencyHistogram g(100);
+  {
+    testkit::CountAllocations allocs;
+    g.add(range + 5);
+    g.add(50);
+    EXPECT_EQ(allocs.count(), 0u);
+  }
+  g.merge(h);
+  EXPECT_EQ(g.overflow(), 3u);
+  EXPECT_EQ(g.count(), 5u);
+  EXPECT_EQ(g.bins().front(), 1u);
+  EXPECT_EQ(g.bins().back(), 1u);
+}
+
 }  // namespace

@@ -8,7 +8,9 @@ usage: plot_checks.py CHECK SOURCE_DIR WORK_DIR
   threshold   stop_threshold_curve.py without caught logs draws no catches axis (it plotted every
               threshold at 0 catches) and says so; no label overlaps another or a tick label
   latency     predictor_latency.py draws every log2 bucket between the first and the last
-              non-empty one (the empty ones at 0), so a tail stands at its distance
+              non-empty one (the empty ones at 0), so a tail stands at its distance, and the
+              latencies beyond the histogram's range (bench_predictor's "[range, inf)" line) as a
+              last bar of their own, counted in n
   bad_input   arm_parts.py and sim_forces.py on header-only CSVs exit 1 naming the file (no
               traceback); calib_eval.py draws an eval.json with null accuracies; the scripts that
               read through figure_file's load_json / require_columns exit 1 naming the file on
@@ -170,6 +172,15 @@ def check_latency(src, work):
     check(names == want, f"latency: buckets {names}, expected {want}")
     heights = [p.get_height() for p in ax.patches]
     check(sum(h > 0 for h in heights) == 3 and len(heights) == 14, f"latency: bar heights {heights}")
+    # The overflow line: its own bar after the buckets (the old script dropped it and its count).
+    with open(text, "w") as f:
+        f.write("p_hist_us [16, 32): 90\np_hist_us [256, 512): 5\np_hist_us [409.6, inf): 5\n")
+    check(latency.main() == 0, "latency with overflow: the script failed")
+    ax = latency.figures.pop().axes[0]
+    names = [t.get_text() for t in ax.get_xticklabels()]
+    check(names[-1] == ">= 409.6" and names[-2] == "256-512", f"latency with overflow: buckets {names}")
+    check(abs(ax.patches[-1].get_height() - 5.0) < 1e-9 and "n=100" in ax.get_title(),
+          f"latency with overflow: last bar {ax.patches[-1].get_height()}% in '{ax.get_title()}'")
 
 
 def run(src, script, *args):

@@ -91,7 +91,9 @@ void print_hist(const char* tag, const LatencyHistogram& h) {
   std::printf("%s: n=%llu median=%.1f us p90=%.1f us p99=%.1f us p99.9=%.1f us max=%.1f us\n", tag,
               static_cast<unsigned long long>(h.count()), h.quantile(0.5) / 1e3, h.quantile(0.9) / 1e3,
               h.quantile(0.99) / 1e3, h.quantile(0.999) / 1e3, h.max() / 1e3);
-  // Coarse log-scale histogram: [2^k, 2^(k+1)) microseconds.
+  // Coarse log-scale histogram: [2^k, 2^(k+1)) microseconds, of the values within the histogram's
+  // range; those at or beyond it on a line of their own, "[range, inf)" (they were folded into
+  // the last bin, and so into its bucket).
   uint64_t buckets[24] = {};
   for (int b = 0; b < LatencyHistogram::kBins; ++b) {
     const double us = ((b + 0.5) * h.bin_ns()) / 1e3;  // the bin's middle
@@ -101,6 +103,8 @@ void print_hist(const char* tag, const LatencyHistogram& h) {
   }
   for (int k = 0; k < 24; ++k)
     if (buckets[k]) std::printf("%s_hist_us [%d, %d): %llu\n", tag, k ? 1 << k : 0, 1 << (k + 1), static_cast<unsigned long long>(buckets[k]));
+  if (h.overflow())
+    std::printf("%s_hist_us [%g, inf): %llu\n", tag, h.range_ns() / 1e3, static_cast<unsigned long long>(h.overflow()));
 }
 
 // The probe: TrialStart, one 20 N sample, wait for the stop; repeated. Returns the histogram.

@@ -2,7 +2,9 @@
 """Plots the end-to-end latency histograms that bench_predictor prints (lines
 "<tag>_hist_us [lo, hi): count"), one panel per tag, log-scale bins in microseconds; the
 empty bins between the first and the last non-empty one are drawn (at zero), so a tail's
-distance from the body shows.
+distance from the body shows. The latencies beyond the histogram's range (the line
+"<tag>_hist_us [range, inf): count", since session 91; before, they were in the last bucket)
+are the last bar, ">= range".
 
   bench_predictor > bench.txt            (or the VM test's output: ctest -R robot_vm_socketcan -V)
   tools/plot/predictor_latency.py bench.txt --out predictor_latency.png
@@ -44,26 +46,34 @@ def main():
     else:
         with open_input(args.input) as f:
             text = f.read()
-    hists = {}
+    hists, beyond = {}, {}
     for tag, lo, hi, n in re.findall(r"(\w+)_hist_us \[(\d+), (\d+)\): (\d+)", text):
         hists.setdefault(tag, []).append((int(lo), int(hi), int(n)))
+    for tag, cap, n in re.findall(r"(\w+)_hist_us \[([0-9.]+), inf\): (\d+)", text):
+        beyond[tag] = (float(cap), int(n))
+        hists.setdefault(tag, [])
     if not hists:
         print(f"predictor_latency.py: no '<tag>_hist_us' lines in {args.input}", file=sys.stderr)
         return 2
     fig, axes = plt.subplots(1, len(hists), figsize=(5 * len(hists), 3.5), squeeze=False)
     for ax, (tag, rows) in zip(axes[0], sorted(hists.items())):
-        rows = every_bucket(rows)
-        total = sum(n for _, _, n in rows)
+        rows = every_bucket(rows) if rows else []
+        bars = [(f"{lo}-{hi}", n, "tab:blue") for lo, hi, n in rows]
+        if tag in beyond:  # at or beyond the histogram's range, apart: not a bucket of known width
+            cap, n = beyond[tag]
+            bars.append((f">= {cap:g}", n, "tab:red"))
+        total = sum(n for _, n, _ in bars)
         if total == 0:
             print(f"predictor_latency.py: {args.input}: every '{tag}_hist_us' bucket is empty", file=sys.stderr)
             return 1
-        ax.bar([f"{lo}-{hi}" for lo, hi, _ in rows], [100.0 * n / total for _, _, n in rows], color="tab:blue")
+        ax.bar([name for name, _, _ in bars], [100.0 * n / total for _, n, _ in bars],
+               color=[colour for _, _, colour in bars])
         ax.set_title(f"{tag} (n={total})")
         ax.set_xlabel("latency [us]")
         ax.set_ylabel("share [%]")
         ax.set_yscale("log")
         # Room below the smallest share, so that a one-sample tail is a bar, not a sliver.
-        ax.set_ylim(bottom=min(100.0 * n / total for _, _, n in rows if n) / 3)
+        ax.set_ylim(bottom=min(100.0 * n / total for _, n, _ in bars if n) / 3)
         ax.tick_params(axis="x", rotation=60)
     fig.tight_layout()
     save_figure(fig, args.out, dpi=120)
