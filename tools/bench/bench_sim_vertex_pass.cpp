@@ -361,7 +361,8 @@ int main(int argc, char** argv) {
                 (v.edges.size() * sizeof(EdgeTerm) + v.tris.size() * sizeof(TriTerm) +
                  v.bends.size() * sizeof(BendTerm)) / 1048576.0);
 
-    // 1. Cost per pass, the two alternating, best of `reps`.
+    // 1. Cost per pass, the three alternating (tree with AVX2 kernels, tree scalar, vertex pass),
+    // best of `reps`.
     const int passes = reduced ? 600 : 150;
     double t_tree = 1e30, t_scalar = 1e30, t_vertex = 1e30;
     for (int r = 0; r < reps; ++r) {
