@@ -17,7 +17,10 @@
 //     people's real trials (leave-one-participant-out over the whole study; the reference:
 //     71%, 83%, 94%, 100% at the four cuts). Prints one row per participant and the means, and
 //     writes DIR/eval.json after each participant (plot: tools/plot/calib_eval.py); a rerun with
-//     the same DIR resumes from the calibration checkpoints and synthesized trials.
+//     the same DIR resumes from the calibration checkpoints and synthesized trials. A model that
+//     fails to train (its row's stc_error / bc_error says why) or a cut that scores no trial has
+//     no accuracy: null in the JSON, "-" in the table, and left out of the means, which say over
+//     how many participants they are.
 //     --arm-compliance, --fist-shift, --rim-shift, --density: the person's arm, the grasp and the
 //     gown's weight in the calibration, as `dressguard calibrate` takes them (calibration.h,
 //     kPersonParamInfo): fixed (the paper's, default), fit (one more parameter each) or a value.
@@ -212,10 +215,30 @@ double one_nn_accuracy(const std::vector<const HapticSequence*>& all, double cut
   return static_cast<double>(std::count(right.begin(), right.end(), 1)) / all.size();
 }
 
-// A model's accuracy on `test`, whole and at the four cuts: out[0] whole, out[1..4] kCuts.
+// A model's accuracy on `test`, whole and at the four cuts: out[0] whole, out[1..4] kCuts. NaN
+// (null in the JSON, "-" in the table) where no trial was scored: calib::accuracy's 0 there is no
+// accuracy.
 void accuracies(const model::OutcomeModel& m, const std::vector<const HapticSequence*>& test, double out[5]) {
-  out[0] = accuracy(m, test, std::numeric_limits<double>::infinity());
-  for (int c = 0; c < 4; ++c) out[c + 1] = accuracy(m, test, kCuts[c]);
+  const double cuts[5] = {std::numeric_limits<double>::infinity(), kCuts[0], kCuts[1], kCuts[2], kCuts[3]};
+  for (int c = 0; c < 5; ++c) {
+    int counted = 0;
+    const double a = accuracy(m, test, cuts[c], &counted);
+    out[c] = counted > 0 ? a : std::numeric_limits<double>::quiet_NaN();
+  }
+}
+
+// Five accuracies as the eval table's percentages, "-" for one there is not (NaN).
+std::string percent_cells(const double v[5]) {
+  std::string out;
+  char cell[16];
+  for (int c = 0; c < 5; ++c) {
+    if (std::isfinite(v[c]))
+      std::snprintf(cell, sizeof cell, " %5.0f", 100 * v[c]);
+    else
+      std::snprintf(cell, sizeof cell, " %5s", "-");
+    out += cell;
+  }
+  return out;
 }
 
 int run_baseline() {
@@ -304,7 +327,10 @@ int run_eval(const std::map<std::string, std::string>& a) {
     out.set("sigma0", co.sigma0);
     write_file_atomic(work / "eval.json", out.dump() + "\n");
   };
-  double sum_stc[5] = {}, sum_stc2[5] = {}, sum_bc[5] = {};
+  // The means over the participants whose model trained and scored there (a failed STC or BC,
+  // or a cut that scored no trial, is left out, not counted as 0): per series and column, the
+  // sum and how many.
+  double sum[3][5] = {}, scored[3][5] = {};
   int n = 0;
   for (const auto& p : chosen) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -358,7 +384,11 @@ int run_eval(const std::map<std::string, std::string>& a) {
     // The STC with the forces its calibration supports (stc.h: choose_stc_axes, the default of
     // `dressguard build-model`), and with both forces (the paper's bivariate HMMs) beside it.
     const StcAxes axes = choose_stc_axes(cal.fits, cal.lateral_weight > 0);
-    double stc[5] = {}, stc2[5] = {}, bc[5] = {};
+    // NaN until a model scores them: a model that fails to train has no accuracy (it was 0).
+    double stc[5], stc2[5], bc[5];
+    std::fill_n(stc, 5, std::numeric_limits<double>::quiet_NaN());
+    std::fill_n(stc2, 5, std::numeric_limits<double>::quiet_NaN());
+    std::fill_n(bc, 5, std::numeric_limits<double>::quiet_NaN());
     std::string stc_error, bc_error, stc_classes;
     try {
       StcOptions stc_o;
@@ -393,22 +423,22 @@ int run_eval(const std::map<std::string, std::string>& a) {
         std::snprintf(v, sizeof v, "%s %.4g, ", kPersonParamInfo[i].name, person_value(r.cloth, i));
         person_values += v;
       }
-    std::printf("%-4s %-8.3f %-28s | %5.0f %5.0f %5.0f %5.0f %5.0f   | %5.0f %5.0f %5.0f %5.0f %5.0f   | %5.0f %5.0f %5.0f "
-                "%5.0f %5.0f  (%.0f s) %sSTC classes %s, forces %s%s%s\n",
-                p.c_str(), r.objective, params, 100 * stc[0], 100 * stc[1], 100 * stc[2], 100 * stc[3], 100 * stc[4],
-                100 * stc2[0], 100 * stc2[1], 100 * stc2[2], 100 * stc2[3], 100 * stc2[4],
-                100 * bc[0], 100 * bc[1], 100 * bc[2], 100 * bc[3], 100 * bc[4], seconds_since(t0),
-                person_values.c_str(), stc_classes.c_str(), axes.reason.c_str(), stc_error.empty() ? "" : (" STC failed: " + stc_error).c_str(),
+    std::printf("%-4s %-8.3f %-28s |%s   |%s   |%s  (%.0f s) %sSTC classes %s, forces %s%s%s\n", p.c_str(),
+                r.objective, params, percent_cells(stc).c_str(), percent_cells(stc2).c_str(), percent_cells(bc).c_str(),
+                seconds_since(t0), person_values.c_str(), stc_classes.c_str(), axes.reason.c_str(),
+                stc_error.empty() ? "" : (" STC failed: " + stc_error).c_str(),
                 bc_error.empty() ? "" : (" BC failed: " + bc_error).c_str());
     std::fflush(stdout);
     Json row = calibration_to_json(cal);
     Json js = Json::array(), js2 = Json::array(), jb = Json::array();
-    for (int c = 0; c < 5; ++c) js.push(stc[c]), js2.push(stc2[c]), jb.push(bc[c]);
+    for (int c = 0; c < 5; ++c) js.push(stc[c]), js2.push(stc2[c]), jb.push(bc[c]);  // NaN is written null
     row.set("stc_accuracy_whole_and_cuts", js);
     row.set("stc_forces", stc_forces_name(axes.second_axis));
     row.set("stc_forces_reason", axes.reason);
     row.set("stc_both_forces_accuracy_whole_and_cuts", js2);
     row.set("bc_accuracy_whole_and_cuts", jb);
+    row.set("stc_error", stc_error);  // why the STC has no accuracies (empty when it trained)
+    row.set("bc_error", bc_error);
     row.set("seconds", seconds_since(t0));
     row.set("prediction_of_others", jpred);
     row.set("residual_findings", jres);  // largest first (prediction.h)
@@ -421,15 +451,31 @@ int run_eval(const std::map<std::string, std::string>& a) {
     row.set("synthesized_labels", jl);
     rows.push(row);
     write_eval();
-    for (int c = 0; c < 5; ++c) sum_stc[c] += stc[c], sum_stc2[c] += stc2[c], sum_bc[c] += bc[c];
+    const double* series[3] = {stc, stc2, bc};
+    for (int k = 0; k < 3; ++k)
+      for (int c = 0; c < 5; ++c)
+        if (std::isfinite(series[k][c])) sum[k][c] += series[k][c], scored[k][c] += 1;
     ++n;
   }
-  if (n > 0)
-    std::printf("mean %-37s | %5.0f %5.0f %5.0f %5.0f %5.0f   | %5.0f %5.0f %5.0f %5.0f %5.0f   | %5.0f %5.0f %5.0f %5.0f "
-                "%5.0f\n", "", 100 * sum_stc[0] / n, 100 * sum_stc[1] / n, 100 * sum_stc[2] / n, 100 * sum_stc[3] / n,
-                100 * sum_stc[4] / n, 100 * sum_stc2[0] / n, 100 * sum_stc2[1] / n, 100 * sum_stc2[2] / n,
-                100 * sum_stc2[3] / n, 100 * sum_stc2[4] / n, 100 * sum_bc[0] / n, 100 * sum_bc[1] / n,
-                100 * sum_bc[2] / n, 100 * sum_bc[3] / n, 100 * sum_bc[4] / n);
+  if (n > 0) {
+    double mean[3][5];
+    std::string counts;  // how many participants each series' mean is over
+    const char* names[3] = {"STC", "STC both forces", "BC"};
+    for (int k = 0; k < 3; ++k) {
+      for (int c = 0; c < 5; ++c)
+        mean[k][c] = scored[k][c] > 0 ? sum[k][c] / scored[k][c] : std::numeric_limits<double>::quiet_NaN();
+      const auto [lo, hi] = std::minmax_element(scored[k], scored[k] + 5);
+      char part[96];
+      if (*lo == *hi)
+        std::snprintf(part, sizeof part, "%s%s %.0f", k ? ", " : "", names[k], *lo);
+      else
+        std::snprintf(part, sizeof part, "%s%s %.0f-%.0f", k ? ", " : "", names[k], *lo, *hi);
+      counts += part;
+    }
+    std::printf("mean %-37s |%s   |%s   |%s  (over the participants scored: %s of %d)\n", "",
+                percent_cells(mean[0]).c_str(), percent_cells(mean[1]).c_str(), percent_cells(mean[2]).c_str(),
+                counts.c_str(), n);
+  }
   write_eval();
   return 0;
 }

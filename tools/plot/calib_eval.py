@@ -23,8 +23,9 @@ WHOLE_X = 0.35  # where "whole sequence" is drawn
 
 
 def percent(accuracy):
-    """An accuracy as a percentage; null (an evaluation that scored no trial: bench_calib_pipeline
-    writes null since it stopped writing 0 there) is NaN, which the lines leave out."""
+    """An accuracy as a percentage; null (a model that failed to train, its row's stc_error or
+    bc_error says why, or a cut that scored no trial: bench_calib_pipeline writes null since
+    session 91, 0 before) is NaN, which the lines leave out."""
     return float("nan") if accuracy is None else 100 * accuracy
 
 
@@ -70,9 +71,17 @@ def main(argv):
             last = [(x, y) for x, y in zip(xs, ys) if y == y][-1:]  # the line's right end
             if last:
                 ax.annotate(p, last[0], fontsize=7, color="0.5", xytext=(3, 0), textcoords="offset points")
-        # The mean at each point of the participants scored there (a null is left out, not a 0).
+        # The mean at each point of the participants scored there (a null is left out, not a 0),
+        # and over how many.
         mean = [sum(at) / len(at) if at else float("nan") for at in scored]
-        ax.plot(xs, mean, marker="o", color="tab:blue", lw=2, label=f"mean of {len(rows)} participants")
+        lo, hi = min(map(len, scored)), max(map(len, scored))
+        over = f"{lo}" if lo == hi else f"{lo}-{hi}"
+        ax.plot(xs, mean, marker="o", color="tab:blue", lw=2,
+                label=f"mean of {over} participants" + ("" if lo == hi == len(rows) else f" scored (of {len(rows)})"))
+        failed = sorted((p for p in rows if rows[p].get(key.split("_")[0] + "_error")), key=int)
+        if failed:  # named on the panel, not a line at 0
+            ax.text(0.02, 0.02, f"{key.split('_')[0].upper()} failed for {', '.join(failed)}", transform=ax.transAxes,
+                    fontsize=7, color="tab:red")
         if one_nn:
             ax.plot(CUTS, one_nn, marker="s", color="tab:green", label="1-NN on measured curves (here)")
         ax.plot(CUTS, ONE_NN_REFERENCE, ls="--", color="tab:green", alpha=0.6, label="1-NN, issue's reference")
