@@ -12,10 +12,12 @@ usage: plot_checks.py CHECK SOURCE_DIR WORK_DIR
               latencies beyond the histogram's range (bench_predictor's "[range, inf)" line) as a
               last bar of their own, counted in n
   bad_input   arm_parts.py and sim_forces.py on header-only CSVs exit 1 naming the file (no
-              traceback); calib_eval.py draws an eval.json with null accuracies; the scripts that
-              read through figure_file's load_json / require_columns exit 1 naming the file on
-              one that is not there, not JSON, or lacks a column or key they read, and
-              hmm_sweep.py refuses a sweep without one accuracy (it drew an empty figure, exit 0)
+              traceback); calib_eval.py draws an eval.json with null accuracies and early_cue.py
+              a pooled file with null differences (a window without good or missed trials); the
+              scripts that read through figure_file's load_json / require_columns exit 1 naming
+              the file on one that is not there, not JSON, or lacks a column or key they read,
+              and hmm_sweep.py refuses a sweep without one accuracy (it drew an empty figure,
+              exit 0)
 Drawn in this process with the scripts' own functions; the figure is kept, not saved, where the
 check reads it. Exits 1 naming what failed.
 """
@@ -212,6 +214,18 @@ def check_bad_input(src, work):
     out = os.path.join(work, "eval.png")
     r = run(src, "calib_eval.py", out, ev)
     check(r.returncode == 0 and os.path.exists(out), f"calib_eval.py on null accuracies: exit {r.returncode}, "
+          f"stderr {r.stderr.strip()!r}")
+    # A window where a set has no good or no missed trial: null since session 91 (it was 0); a
+    # TypeError comparing None before early_cue.py skipped them.
+    cue = os.path.join(work, "cue-nulls.json")
+    with open(cue, "w") as f:
+        row = lambda who, v: {"who": who, "F_motion": v, "F_lateral": [0.1, -0.1, 0.2, 0.1], "F_vertical": [0.1] * 4}
+        json.dump({"early_cue_good_minus_missed": [row("the people (measured)", [0.3, 0.2, None, 0.1]),
+                                                   row("p4", [0.2, None, 0.1, 0.1]),
+                                                   row("  participant 4's inputs", [None] * 4)]}, f)
+    out = os.path.join(work, "cue.png")
+    r = run(src, "early_cue.py", cue, out)
+    check(r.returncode == 0 and os.path.exists(out), f"early_cue.py on null differences: exit {r.returncode}, "
           f"stderr {r.stderr.strip()!r}")
     # Each a KeyError, JSONDecodeError or FileNotFoundError traceback before (session 91's review,
     # finding F), and the empty sweep an empty figure with exit 0.

@@ -920,7 +920,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
           const bool weak = cue && std::abs(d) < kFaint;
           reversed += wrong, faint += weak;
           std::printf(" %+5.2f%s", d, wrong ? "*" : weak ? "~" : " ");
-          jf.push(std::isfinite(d) ? d : 0.0);
+          jf.push(d);  // NaN (no good or no missed trial there) is written null, not 0
         }
         j.set(forces[f].first, jf);
       }

@@ -7,7 +7,8 @@ cue a classifier of other people needs. One row per file (e.g. the bench run wit
 discrepancy term), one panel per force. offline/calib/MEASUREMENTS.md, session 27.
 
 usage: early_cue.py POOLED.json [POOLED2.json ...] OUT.png
-POOLED.json is what `bench_calib_pipeline pooled` writes.
+POOLED.json is what `bench_calib_pipeline pooled` writes. A window where a set has no good or no
+missed trial with a sample is null there (since session 91; 0 before) and is left out.
 """
 import sys
 
@@ -60,18 +61,24 @@ def main(argv):
         term += "".join(f", no {what} noise" for key, what in (("arm_noise", "arm-height"), ("gown_noise", "gown"))
                         if d.get(key) is False)
         for ax, force in zip(row, FORCES):
-            lo = min(min(p[force] + s[force]) for s, p in sims + [(people, people)])
-            hi = max(max(p[force] + s[force]) for s, p in sims + [(people, people)])
+            values = [v for s, p in sims + [(people, people)] for v in p[force] + s[force] if v is not None]
+            lo, hi = (min(values), max(values)) if values else (-1.0, 1.0)
             pad = 0.1 * (hi - lo + 1e-9)
             lo, hi = lo - pad, hi + pad
             ax.plot([lo, hi], [lo, hi], color="black", lw=0.8)
+            # (the person's, the simulator's) difference per window where both are there
+            both = [[(p[force][w], s[force][w]) if p[force][w] is not None and s[force][w] is not None else None
+                     for w in range(4)] for s, p in sims]
             for w in range(4):
-                ax.axvspan(people[force][w] - 0.005, people[force][w] + 0.005, color=COLOURS[w], alpha=0.25)
-                ax.scatter([p[force][w] for _, p in sims], [s[force][w] for s, _ in sims], color=COLOURS[w],
-                           s=28, label=WINDOWS[w], zorder=3)
-            for s, p in sims:
+                if people[force][w] is not None:
+                    ax.axvspan(people[force][w] - 0.005, people[force][w] + 0.005, color=COLOURS[w], alpha=0.25)
+                pts = [b[w] for b in both if b[w] is not None]
+                ax.scatter([x for x, _ in pts], [y for _, y in pts], color=COLOURS[w], s=28, label=WINDOWS[w], zorder=3)
+            for (s, p), b in zip(sims, both):
                 name = p["who"].strip().split("'")[0].replace("participant ", "P")
-                ax.annotate(name, (p[force][1], s[force][1]), fontsize=7, xytext=(3, 2), textcoords="offset points")
+                at = b[1] or next((xy for xy in b if xy is not None), None)  # the second window's point, else any
+                if at is not None:
+                    ax.annotate(name, at, fontsize=7, xytext=(3, 2), textcoords="offset points")
             ax.set_xlim(lo, hi)
             ax.set_ylim(lo, hi)
             ax.set_aspect("equal")
