@@ -5,7 +5,9 @@
 #    91/360 x 100 = 25.3 catches per 100 pulls;
 #  - a higher threshold never stops more pulls of any kind (the posterior is the same; only the
 #    bar it must clear rises);
-#  - these logs hold no middle-arm miss, and the tool says so.
+#  - these logs hold no middle-arm miss, and the tool says so;
+#  - without --consecutive every threshold keeps the model's own stop_consecutive (it passed 5
+#    whatever the model said).
 # Plus its error for a model that is not there.
 file(MAKE_DIRECTORY ${WORK})
 execute_process(COMMAND /usr/bin/python3 ${SRC}/tools/plot/stop_threshold_curve.py ${WORK}/curve.png
@@ -19,6 +21,13 @@ if(NOT out MATCHES "no logs of: middle missed")
   message(FATAL_ERROR "the missing middle-arm misses are not flagged: ${out}")
 endif()
 file(READ ${WORK}/curve.json j)
+execute_process(COMMAND ${DG} model show ${MODEL} --json RESULT_VARIABLE rc OUTPUT_VARIABLE model_json)
+string(JSON own GET "${model_json}" stop_consecutive)
+string(JSON used ERROR_VARIABLE json_err GET "${j}" consecutive)
+string(JSON from ERROR_VARIABLE json_err GET "${j}" consecutive_from)
+if(NOT rc EQUAL 0 OR NOT used EQUAL own OR NOT from STREQUAL "model" OR NOT out MATCHES "stop_consecutive ${own} \\(the model's\\)")
+  message(FATAL_ERROR "without --consecutive: ${used} from '${from}', the model's own is ${own} (${rc}): ${out}")
+endif()
 string(JSON n LENGTH "${j}" points)
 if(NOT n EQUAL 4)
   message(FATAL_ERROR "expected 4 points, got ${n}: ${j}")

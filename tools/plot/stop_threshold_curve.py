@@ -16,7 +16,8 @@ trial ids, e.g. s2-middlemiss-7-missed.log) and a low-arm miss otherwise. Logs o
 left out. From a --caught-logs folder only the caught logs count: the study recorded no caught
 pull, so the caught ones are synthetic, and their folder's other trials are no measured mix.
 Without caught logs the catches column is empty; an outcome without logs counts as never
-stopped and is flagged.
+stopped and is flagged. Every threshold is replayed with the model's own stop_consecutive
+(`dressguard model show --json`) unless --consecutive N sets another.
 
 usage: stop_threshold_curve.py OUT.png --model MODEL.dgm --logs DIR [--logs DIR ...]
            [--caught-logs DIR ...] [--dressguard BIN] [--consecutive N] [--thresholds T,T,...]
@@ -49,13 +50,25 @@ def kind_of(file, label):
 
 
 def replay(args, logs, threshold):
-    cmd = [args.dressguard, "replay", "--model", args.model, "--logs", logs, "--set",
-           f"stop_threshold={threshold}", "--set", f"stop_consecutive={args.consecutive}", "--json"]
+    cmd = [args.dressguard, "replay", "--model", args.model, "--logs", logs, "--set", f"stop_threshold={threshold}"]
+    if args.consecutive is not None:  # else the model's own, as the daemon takes it
+        cmd += ["--set", f"stop_consecutive={args.consecutive}"]
+    cmd.append("--json")
     run = subprocess.run(cmd, capture_output=True, text=True)
     if run.returncode != 0:
         sys.exit(f"stop_threshold_curve.py: {' '.join(cmd)} failed ({run.returncode}): "
                  f"{run.stderr.strip() or run.stdout.strip()}")
     return json.loads(run.stdout)["trials"]
+
+
+def model_consecutive(args):
+    """The model's own stop_consecutive (what replay and the daemon use without a setting)."""
+    cmd = [args.dressguard, "model", "show", args.model, "--json"]
+    run = subprocess.run(cmd, capture_output=True, text=True)
+    if run.returncode != 0:
+        sys.exit(f"stop_threshold_curve.py: {' '.join(cmd)} failed ({run.returncode}): "
+                 f"{run.stderr.strip() or run.stdout.strip()}")
+    return json.loads(run.stdout)["stop_consecutive"]
 
 
 def point(args, threshold):
@@ -104,11 +117,12 @@ def place_labels(fig, ax, labels, downwards):
         taken.append(text.get_window_extent(renderer))
 
 
-def draw(points, consecutive, model):
+def draw(points, consecutive, model, own=False):
     """The operating curve: catches stopped against pulls stopped for nothing per 100 pulls, one
     point per threshold, labelled with it (and the caught stops' median lead). Without caught logs
     the catches were not measured: the thresholds lie along the one axis that was, with a note;
-    a catches axis at 0 read as a rule that stops no catch (session 85's tools review, finding 6)."""
+    a catches axis at 0 read as a rule that stops no catch (session 85's tools review, finding 6).
+    own: consecutive is the model's own stop_consecutive (no --consecutive), and the title says so."""
     caught = points[0]["stops"]["caught"][1] > 0
     xs = [q["stopped_for_nothing_per_100"] for q in points]
     top = 100 * PROTOCOL["caught"] / TOTAL
@@ -133,7 +147,8 @@ def draw(points, consecutive, model):
                 "--caught-logs adds synthetic ones)", transform=ax.transAxes, ha="center", va="top", fontsize=8,
                 color="0.3")
     ax.set_xlabel("pulls stopped for nothing per 100 (good, low and middle misses)")
-    ax.set_title(f"stop rule: P(caught) > threshold for {consecutive} samples\n"
+    whose = " (the model's)" if own else ""
+    ax.set_title(f"stop rule: P(caught) > threshold for {consecutive} samples{whose}\n"
                  f"{os.path.basename(model)}, weighted by the study's protocol (360 pulls)", fontsize=10)
     ax.set_xlim(left=0, right=max(xs + [1.0]) * 1.12)
     fig.tight_layout()
@@ -155,7 +170,8 @@ def main():
     p.add_argument("--caught-logs", action="append", default=[])
     p.add_argument("--dressguard", default=os.path.join(os.path.dirname(__file__), "..", "..", "build",
                                                        "release", "offline", "cli", "dressguard"))
-    p.add_argument("--consecutive", type=int, default=5)
+    p.add_argument("--consecutive", type=int, default=None,
+                   help="stop_consecutive at every threshold (default: the model's own)")
     p.add_argument("--thresholds", default=DEFAULT_THRESHOLDS)
     p.add_argument("--json", dest="json_out")
     args = p.parse_args()
@@ -166,12 +182,16 @@ def main():
         thresholds = [float(t) for t in args.thresholds.split(",")]
     except ValueError:
         sys.exit(f"stop_threshold_curve.py: --thresholds '{args.thresholds}' is not a comma-separated list of numbers")
-    if not thresholds or any(not 0.0 < t < 1.0 for t in thresholds) or args.consecutive < 1:
+    if not thresholds or any(not 0.0 < t < 1.0 for t in thresholds) or (args.consecutive is not None
+                                                                          and args.consecutive < 1):
         sys.exit("stop_threshold_curve.py: every threshold must lie in (0, 1) and --consecutive be at least 1")
 
+    own = args.consecutive is None
+    consecutive = model_consecutive(args) if own else args.consecutive
     points = [point(args, t) for t in sorted(thresholds)]
     counts = points[0]["stops"]
     missing = [k for k in ("good", "low missed", "middle missed") if counts[k][1] == 0]
+    print(f"stop_consecutive {consecutive}" + (" (the model's)" if own else " (--consecutive)"))
     print(f"{'threshold':>10}  {'good':>7} {'low miss':>8} {'mid miss':>8} {'caught':>7}   "
           f"stopped for nothing / 100   catches stopped / 100 (of {100 * PROTOCOL['caught'] / TOTAL:.0f})"
           f"   median lead [s]")
@@ -187,12 +207,13 @@ def main():
     if counts["caught"][1] == 0:
         print("no caught logs: no catches column (the study recorded no caught pull; --caught-logs adds synthetic ones)")
 
-    fig = draw(points, args.consecutive, args.model)
+    fig = draw(points, consecutive, args.model, own)
     save_figure(fig, args.out, dpi=120)
     print(f"wrote {args.out}")
     if args.json_out:
         with open(args.json_out + ".tmp", "w") as fh:
-            json.dump({"model": args.model, "consecutive": args.consecutive, "protocol": PROTOCOL,
+            json.dump({"model": args.model, "consecutive": consecutive,
+                       "consecutive_from": "model" if own else "--consecutive", "protocol": PROTOCOL,
                        "points": points}, fh, indent=1)
         os.replace(args.json_out + ".tmp", args.json_out)
 
