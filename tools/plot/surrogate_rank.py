@@ -13,11 +13,16 @@ N(x_file, (s * box)^2), as CMA-ES draws before its covariance has learnt anythin
 scale, in folds of one generation (32 points held out, the rest to fit on), ranks the held-out
 points with each model and prints Kendall's tau against the simulated combined L, how many of the
 true best 16 (CMA-ES's mu) the model's best 16 hold (8 by chance), and tau among the model's best
-16 (the ones lq-CMA-ES evaluates first). Models, all on log L unless named:
+16 (the ones lq-CMA-ES evaluates first). The combined L is the file's L_combined column: what the
+calibration's search minimised (its "combine": sum, worst, bar or count of the sequences' L;
+calibration.h, SequenceCombine). Models, all on log L unless named:
   linear, diagonal quadratic, full quadratic (ridge chosen on the fitting points alone), the full
-  quadratic on L itself (as lq-CMA-ES fits), one full quadratic per sequence summed (the combined
-  L sums sequences whose landscapes differ) and a Gaussian process (squared-exponential kernel,
-  length scale and nugget chosen on the fitting points alone).
+  quadratic on L itself (as lq-CMA-ES fits), one full quadratic per sequence, combined by the
+  file's rule (the sequences' landscapes differ) and a Gaussian process (squared-exponential
+  kernel, length scale and nugget chosen on the fitting points alone). The points file does not
+  name its rule: it is the one of the four whose combination of the L_ columns is L_combined on
+  every row (where two agree on every row, e.g. bar and count with no L over 0.3, the first);
+  where none is, the per-sequence model is left out.
 
 usage: surrogate_rank.py POINTS.csv [OUT.png] [--low-fidelity LOW.csv]
                                                    the table, and with OUT.png a picture;
@@ -26,10 +31,16 @@ usage: surrogate_rank.py POINTS.csv [OUT.png] [--low-fidelity LOW.csv]
                                                    "gown": "coarse"), its L as a model
        surrogate_rank.py --self-test               known objectives: a quadratic must be ranked
                                                    (tau >= 0.9), noise must not (|tau| < 0.3);
+                                                   points files combined by worst and by max:
+                                                   the combined L printed is L_combined's;
                                                    exit 1 if one is not
 """
+import contextlib
+import io
 import itertools
+import os
 import sys
+import tempfile
 
 import numpy as np
 from figure_file import save_figure  # a temporary file, then a rename
@@ -37,6 +48,26 @@ from figure_file import save_figure  # a temporary file, then a rename
 GENERATION = 32  # the paper's population
 MU = 16
 TRUST = 0.85  # lq-CMA-ES's threshold on Kendall's tau
+RHO, BAR = 0.1, 0.3  # calibration.h: kWorstRho, kSequenceBar
+
+
+def combine(Ls, rule):
+    """combined_objective (offline/calib/calibration.cpp) of each row of per-sequence L (n x K)
+    under the rule (calibration.h, SequenceCombine); a row with a non-finite L is infinite."""
+    Ls = np.asarray(Ls, dtype=float)
+    s = Ls.sum(1)
+    excess = np.maximum(0.0, Ls - BAR).sum(1)
+    f = {"sum": lambda: s, "worst": lambda: Ls.max(1) + RHO * s, "bar": lambda: excess + RHO * s,
+         "count": lambda: (Ls > BAR).sum(1) + (excess + RHO * s)}[rule]()
+    return np.where(np.isfinite(Ls).all(1), f, np.inf)
+
+
+RULES = ("sum", "worst", "bar", "count")
+
+
+def combine_rule(Ls, y):
+    """The rules whose combination of the rows' L (n x K) is y, the file's L_combined, on every row."""
+    return [r for r in RULES if np.allclose(combine(Ls, r), y, rtol=1e-12, atol=0)]
 
 
 def kendall_tau(a, b):
@@ -92,31 +123,33 @@ def gaussian_process(Xtr, ytr, Xte):
     return gp_predict(Xtr, ytr, Xte, best[1], best[2])
 
 
-# name -> predict(X_fit, per-sequence L of the fit rows (n x K), X_held) -> predicted combined L
-# (any monotone transform of it: only the ranking counts)
+# name -> predict(X_fit, per-sequence L of the fit rows (n x K), their combined L, X_held, the
+# file's rule) -> predicted combined L (any monotone transform of it: only the ranking counts)
+PER_SEQUENCE = "full quadratic per sequence"
 MODELS = {
-    "linear": lambda X, Ls, Xt: quadratic(X, np.log(Ls.sum(1)), Xt, "lin"),
-    "diagonal quadratic": lambda X, Ls, Xt: quadratic(X, np.log(Ls.sum(1)), Xt, "diag"),
-    "full quadratic": lambda X, Ls, Xt: quadratic(X, np.log(Ls.sum(1)), Xt, "full"),
-    "full quadratic on L": lambda X, Ls, Xt: quadratic(X, Ls.sum(1), Xt, "full"),
-    "full quadratic per sequence": lambda X, Ls, Xt: sum(
-        np.exp(quadratic(X, np.log(Ls[:, k]), Xt, "full")) for k in range(Ls.shape[1])),
-    "Gaussian process": lambda X, Ls, Xt: gaussian_process(X, np.log(Ls.sum(1)), Xt),
+    "linear": lambda X, Ls, y, Xt, rule: quadratic(X, np.log(y), Xt, "lin"),
+    "diagonal quadratic": lambda X, Ls, y, Xt, rule: quadratic(X, np.log(y), Xt, "diag"),
+    "full quadratic": lambda X, Ls, y, Xt, rule: quadratic(X, np.log(y), Xt, "full"),
+    "full quadratic on L": lambda X, Ls, y, Xt, rule: quadratic(X, y, Xt, "full"),
+    PER_SEQUENCE: lambda X, Ls, y, Xt, rule: combine(
+        np.stack([np.exp(quadratic(X, np.log(Ls[:, k]), Xt, "full")) for k in range(Ls.shape[1])], 1), rule),
+    "Gaussian process": lambda X, Ls, y, Xt, rule: gaussian_process(X, np.log(y), Xt),
 }
 
 
 LOW_FIDELITY = "low fidelity (its own L)"
 
 
-def rank_scale(X, Ls, low=None):
+def rank_scale(X, Ls, y, rule, low=None):
     """Per model: (tau per fold, best-16 overlap per fold, tau among the model's best 16 per fold),
-    and the held-out predictions of every fold for the picture. `low`: the combined L of the same
-    points from another simulator (a coarser gown), ranked as it is, with no fitting."""
-    y = Ls.sum(1)
+    and the held-out predictions of every fold for the picture. y: the combined L of each point
+    (the file's L_combined), what every model ranks against; rule: how it combines Ls (None: no
+    rule known, the per-sequence model is left out). `low`: the combined L of the same points from
+    another simulator (a coarser gown), ranked as it is, with no fitting."""
     n = len(y)
     folds = n // GENERATION
     out = {}
-    models = dict(MODELS)
+    models = {name: m for name, m in MODELS.items() if rule is not None or name != PER_SEQUENCE}
     if low is not None:
         models[LOW_FIDELITY] = None
     for name, model in models.items():
@@ -124,7 +157,7 @@ def rank_scale(X, Ls, low=None):
         for f in range(folds):
             held = np.arange(f * GENERATION, (f + 1) * GENERATION)
             fit = np.setdiff1d(np.arange(n), held)
-            p = low[held] if model is None else model(X[fit], Ls[fit], X[held])
+            p = low[held] if model is None else model(X[fit], Ls[fit], y[fit], X[held], rule)
             best = np.argsort(p)[:MU]
             taus.append(kendall_tau(p, y[held]))
             overlaps.append(len(set(best) & set(np.argsort(y[held])[:MU])))
@@ -135,36 +168,45 @@ def rank_scale(X, Ls, low=None):
 
 
 def read_points(path):
+    """{scale: (steps in units of the scale, per-sequence L, combined L)} and the file's combine
+    rule (None when no rule of combined_objective gives its L_combined)."""
     data = np.genfromtxt(path, delimiter=",", names=True)
     names = data.dtype.names
     steps = [c for c in names if c.startswith("d_")]
     seqs = [c for c in names if c.startswith("L_") and c != "L_combined"]
-    if not steps or not seqs or "scale" not in names:
+    if not steps or not seqs or "scale" not in names or "L_combined" not in names:
         raise SystemExit(f"{path}: not a bench_calib_landscape --points file (columns {names})")
+    all_Ls = np.stack([data[c] for c in seqs], 1)
+    rules = combine_rule(all_Ls, data["L_combined"])
     by_scale = {}
     for s in sorted(set(data["scale"]) - {0.0}, reverse=True):
         rows = data[data["scale"] == s]
         if len(rows) < 2 * GENERATION:
             raise SystemExit(f"{path}: scale {s} has {len(rows)} points; need at least {2 * GENERATION}")
         X = np.stack([rows[c] for c in steps], 1) / s  # each step in units of the scale: N(0, 1)
-        by_scale[s] = (X, np.stack([rows[c] for c in seqs], 1))
-    return by_scale
+        by_scale[s] = (X, np.stack([rows[c] for c in seqs], 1), rows["L_combined"])
+    if not rules:
+        print(f"{path}: L_combined is none of {', '.join(RULES)} of the L_ columns: "
+              f"'{PER_SEQUENCE}' is left out")
+    else:
+        print(f"{path}: combined by {' or '.join(rules)} (the rule that gives L_combined"
+              f"{', the same on these points' if len(rules) > 1 else ''})")
+    return by_scale, (rules[0] if rules else None)
 
 
-def report(by_scale, low_by_scale=None):
+def report(by_scale, rule, low_by_scale=None):
     results = {}
     print(f"{'scale':>6}  {'model':28s} {'tau: min / median / max':>24}  {'best 16 held':>12}"
           f"  {'tau in model best 16':>20}")
-    for s, (X, Ls) in by_scale.items():
-        y = Ls.sum(1)
+    for s, (X, Ls, y) in by_scale.items():
         print(f"{s:6g}  {len(y)} points, combined L min {y.min():.3f} median {np.median(y):.3f} max {y.max():.3f}")
         low = None
         if low_by_scale is not None:
             if s not in low_by_scale or not np.array_equal(low_by_scale[s][0], X):
                 raise SystemExit(f"--low-fidelity: its points at scale {s} are not this file's (the same "
                                  "calibration's values, --scales, --samples and --seed draw the same points)")
-            low = low_by_scale[s][1].sum(1)
-        results[s] = rank_scale(X, Ls, low)
+            low = low_by_scale[s][2]  # its own combined L
+        results[s] = rank_scale(X, Ls, y, rule, low)
         for name, (t, o, tb, _) in results[s].items():
             print(f"{'':6}  {name:28s} {t.min():7.3f} / {np.median(t):6.3f} / {t.max():6.3f}"
                   f"  {np.median(o):8.1f} / {MU}  {np.median(tb):20.3f}")
@@ -216,7 +258,7 @@ def self_test():
     minimum is ranked by the quadratic on L (tau >= 0.9); exp of a bowl, by the quadratics on log L
     (tau >= 0.9) and, smooth as it is, by the Gaussian process well above chance (tau >= 0.8);
     independent noise by no model (|median tau| < 0.3). A low fidelity that is a monotone map of
-    the bowl ranks it exactly; one that is noise does not."""
+    the bowl ranks it exactly; one that is noise does not. Then points files (points_file_case)."""
     rng = np.random.default_rng(1)
     P, n = 10, 4 * GENERATION
     X = rng.normal(size=(n, P))
@@ -233,7 +275,7 @@ def self_test():
     ok = True
     lows = {"quadratic bowl": 2 * bowl[:, 0] + 1, "noise": rng.uniform(size=n)}  # a monotone map, noise
     for label, Ls, wants in cases:
-        r = rank_scale(X, Ls, lows.get(label))
+        r = rank_scale(X, Ls, Ls.sum(1), "sum", lows.get(label))
         if label in lows:
             wants = dict(wants, **{LOW_FIDELITY: 0.99 if label == "quadratic bowl" else None})
         for name, floor in wants.items():
@@ -242,7 +284,44 @@ def self_test():
             ok = ok and good
             want = "|tau| < 0.3" if floor is None else f"tau >= {floor}"
             print(f"{label:15s} {name:28s} median tau {t:6.3f} (want {want}) {'ok' if good else 'FAILED'}")
+    # Two sequences, exp of two bowls: a file combined by worst (max + rho sum, as most
+    # calibrations) and one by the max alone (no rule of combined_objective).
+    two = np.exp(0.05 * np.stack([bowl[:, 0], np.einsum("ni,ij,nj->n", X + c, H, X + c) + 0.1], 1))
+    ok = points_file_case("worst", X, two, two.max(1) + RHO * two.sum(1), "worst") and ok
+    ok = points_file_case("max", X, two, two.max(1), None) and ok
     return 0 if ok else 1
+
+
+def points_file_case(label, X, Ls, combined, rule):
+    """A points file whose L_combined is `combined` (not the sum of its L_ columns), read and
+    reported as the bench's: the rule read must be `rule`, the combined L printed must be
+    L_combined's (min and max), and the per-sequence model, where a rule is known, must rank it
+    (tau >= 0.9; left out where none is)."""
+    scale = 0.5
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "points.csv")
+        with open(path, "w") as f:
+            f.write("scale,sample," + ",".join(f"d_p{i}" for i in range(X.shape[1])) +
+                    "".join(f",L_s{k}" for k in range(Ls.shape[1])) + ",L_combined\n")
+            for i in range(len(X)):
+                f.write(f"{scale},{i}," + ",".join(f"{v:.17g}" for v in scale * X[i]) +
+                        "".join(f",{v:.17g}" for v in Ls[i]) + f",{combined[i]:.17g}\n")
+        text = io.StringIO()
+        with contextlib.redirect_stdout(text):
+            by_scale, read_rule = read_points(path)
+            results = report(by_scale, read_rule)[scale]
+    text = text.getvalue()
+    want = f"combined L min {combined.min():.3f} median {np.median(combined):.3f} max {combined.max():.3f}"
+    checks = [(f"the rule read, {read_rule}", read_rule == rule),
+              (f"prints '{want}'", want in text)]
+    if rule is None:
+        checks.append((f"'{PER_SEQUENCE}' left out", PER_SEQUENCE not in results))
+    else:
+        t = np.median(results[PER_SEQUENCE][0]) if PER_SEQUENCE in results else float("nan")
+        checks.append((f"'{PER_SEQUENCE}' median tau {t:.3f} (want >= 0.9)", t >= 0.9))
+    for what, good in checks:
+        print(f"points by {label:6s} {what} {'ok' if good else 'FAILED'}")
+    return all(good for _, good in checks)
 
 
 def main(argv):
@@ -255,12 +334,12 @@ def main(argv):
         if i + 1 >= len(args):
             print("--low-fidelity needs a points file", file=sys.stderr)
             return 2
-        low = read_points(args[i + 1])
+        low = read_points(args[i + 1])[0]
         del args[i:i + 2]
     if len(args) not in (1, 2):
         print(__doc__, file=sys.stderr)
         return 2
-    results = report(read_points(args[0]), low)
+    results = report(*read_points(args[0]), low)
     if len(args) == 2:
         plot(results, args[1])
     return 0
