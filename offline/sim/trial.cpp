@@ -8,8 +8,11 @@
 #include <limits>
 #include <memory>
 #include <random>
+#include <stdexcept>
+#include <string>
 
 #include "arm_spring.h"
+#include "files.h"
 #include "model.h"
 
 namespace dressguard::sim {
@@ -94,6 +97,28 @@ TrialDraws draw(const TrialSpec& spec) {
   if (spec.arm_noise)
     d.arm_offset += spec.height == ArmHeight::Middle ? uniform(rng, -0.06, 0.0) : uniform(rng, -0.015, 0.015);
   return d;
+}
+
+// simulate_trial()'s checks of its spec (trial.h): the values that would pull forever (a speed,
+// acceleration or end of travel of 0, or not finite: the travel never reaches its end and the
+// time limit, max_time_of(), is infinite or NaN), index outside the arm's heights, or sort and
+// size settling's frames by NaN or infinite times.
+void check_spec(const TrialSpec& spec) {
+  auto refuse = [](const char* field, const std::string& what, double value) {
+    throw std::invalid_argument(std::string("simulate_trial: TrialSpec::") + field + " must be " + what + ", not " +
+                                format_number(value));
+  };
+  if (!(spec.speed > 0 && std::isfinite(spec.speed))) refuse("speed", "a positive finite speed [m/s]", spec.speed);
+  if (!(spec.acceleration > 0 && std::isfinite(spec.acceleration)))
+    refuse("acceleration", "a positive finite acceleration [m/s^2]", spec.acceleration);
+  if (!(spec.max_travel > 0 && std::isfinite(spec.max_travel)))
+    refuse("max_travel", "a positive finite travel [m]", spec.max_travel);
+  if (spec.settle_steps < 0) refuse("settle_steps", "0 or more output steps", spec.settle_steps);
+  if (!std::isfinite(spec.arm_offset)) refuse("arm_offset", "a finite offset [m]", spec.arm_offset);
+  const int h = static_cast<int>(spec.height);
+  if (h < 0 || h > 2) refuse("height", "high, middle or low (0, 1 or 2)", h);
+  for (double t : spec.frame_times)
+    if (!std::isfinite(t)) refuse("frame_times", "finite times [s]", t);
 }
 
 double arm_dz_of(const SceneData& sc, const TrialSpec& spec, double arm_offset) {
@@ -481,6 +506,7 @@ double max_time_of(const TrialSpec& spec) {
 }
 
 TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const TrialSpec& spec) {
+  check_spec(spec);
   const SceneData& sc = scene.data();
   const TrialDraws d = draw(spec);
   GownModel m = make_model(sc, params, spec.friction_scheme, spec.self_collision, arm_dz_of(sc, spec, d.arm_offset));
@@ -562,6 +588,7 @@ void pull_together(const std::vector<GownModel>& models, const std::vector<size_
 
 std::vector<TrialResult> simulate_trials(const Scene& scene, const ClothParams& params,
                                          const std::vector<TrialSpec>& specs) {
+  for (const TrialSpec& sp : specs) check_spec(sp);
   const SceneData& sc = scene.data();
   std::vector<TrialResult> out(specs.size());
   std::vector<TrialDraws> draws;

@@ -372,6 +372,10 @@ Scene make_default_scene(GownResolution res = GownResolution::Reduced, bool para
 // One trial: grasp, gravity, settling (with the optional perturbation during output steps
 // 180-330, i.e. 0.5 s) until the gown is at rest, then the pull until max_travel or the force
 // limit. Deterministic: the same inputs give the same bits (single thread, no fast-math).
+// Throws std::invalid_argument naming the TrialSpec field, before simulating anything, for a
+// speed, acceleration or max_travel that is not positive and finite (the pull never reached
+// its end: a speed or acceleration of 0 ran forever), a negative settle_steps, an arm_offset or
+// a frame time that is not finite, or a height that is none of the three.
 TrialResult simulate_trial(const Scene& scene, const ClothParams& params, const TrialSpec& spec);
 // The pull's time limit [s]: past the rig's whole travel by 5 s (a guard; the travel or the
 // force limit ends every pull first).
@@ -402,7 +406,8 @@ double least_max_travel_of(const TrialSpec& spec, const SceneOptions& opt = {});
 // at the same speed, acceleration and force limit are then pulled as one while no arm has
 // touched the gown (the same argument: an arm that corrects no vertex, and so stays at rest,
 // changes no bit), and each goes on alone from the start of the sample in which one touches
-// (TrialResult::pull_shared_travel); where the rig stops one of them, they part before.
+// (TrialResult::pull_shared_travel); where the rig stops one of them, they part before. Every
+// spec is checked first, as simulate_trial() checks its one.
 std::vector<TrialResult> simulate_trials(const Scene& scene, const ClothParams& params,
                                          const std::vector<TrialSpec>& specs);
 

@@ -6,6 +6,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <functional>
+#include <limits>
+#include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -145,6 +149,60 @@ TEST(SimTrial, SamplesFollowTheRig) {
   EXPECT_EQ(r.outcome, Outcome::Missed) << "full (short) travel is labelled missed";
   // The bias is the settled gown's weight: raw F_z = -m g (1%: HangingGownWeightOnTheGripper).
   EXPECT_NEAR(-r.bias[2], r.weight, 0.01 * r.weight);
+}
+
+// simulate_trial() checks its spec before it simulates and names the field: a speed or an
+// acceleration of 0 pulled forever (the travel never reached max_travel, and the time limit,
+// max_time_of(), was infinite), and so did an infinite end of travel; a NaN arm offset or frame
+// time, a negative settling or a height beyond the three were taken too. simulate_trials()
+// checks every spec alike. With the gripper holding the whole patch no force stops a pull.
+TEST(SimTrial, ABadSpecIsRefusedNamingItsField) {
+  ClothMesh mesh = grid_patch({0, 0, 0}, {0.5, 0, 0}, {0, 0.5, 0}, 3, 3);
+  for (int i = 0; i < 9; ++i) mesh.grasp.push_back(i);
+  SceneOptions opt;
+  opt.with_arm = false;
+  opt.jaw_close_steps = 0;
+  const Scene scene = make_scene(mesh, opt);
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  struct Case {
+    const char* field;
+    std::function<void(TrialSpec&)> spoil;
+  };
+  // The ones that ended without the check first, then the ones that ran forever.
+  const std::vector<Case> cases = {
+      {"settle_steps", [](TrialSpec& s) { s.settle_steps = -1; }},
+      {"height", [](TrialSpec& s) { s.height = static_cast<ArmHeight>(7); }},
+      {"arm_offset", [&](TrialSpec& s) { s.arm_offset = nan; }},
+      {"frame_times", [&](TrialSpec& s) { s.frame_times = {0.1, nan}; }},
+      {"max_travel", [](TrialSpec& s) { s.max_travel = 0; }},
+      {"acceleration", [](TrialSpec& s) { s.acceleration = -1; }},
+      {"speed", [](TrialSpec& s) { s.speed = -0.1; }},
+      {"max_travel", [&](TrialSpec& s) { s.max_travel = inf; }},
+      {"acceleration", [](TrialSpec& s) { s.acceleration = 0; }},
+      {"speed", [](TrialSpec& s) { s.speed = 0; }},
+      {"speed", [&](TrialSpec& s) { s.speed = nan; }},
+  };
+  auto refusal = [](const std::function<void()>& run) -> std::string {
+    try {
+      run();
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "(taken)";
+  };
+  for (const Case& c : cases) {
+    TrialSpec spec;
+    spec.max_travel = 0.01;
+    spec.self_collision = false;
+    c.spoil(spec);
+    const std::string field = std::string("TrialSpec::") + c.field + " must be";
+    std::string e = refusal([&] { simulate_trial(scene, ClothParams{}, spec); });
+    EXPECT_NE(e.find(field), std::string::npos) << c.field << ": " << e;
+    TrialSpec fine;
+    fine.max_travel = 0.01;
+    e = refusal([&] { simulate_trials(scene, ClothParams{}, {fine, spec}); });
+    EXPECT_NE(e.find(field), std::string::npos) << c.field << " in simulate_trials: " << e;
+  }
 }
 
 TEST(SimTrial, LabelRule) {
