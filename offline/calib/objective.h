@@ -18,15 +18,18 @@
 // different length (a trial that stops at 10 N too early or too late).
 //
 // Where the pairs begin. Pairing by index assumes both sequences start with the pull. 21 of the
-// study's 22 recordings do, within 1.1 mm of travel (the recorder's start-up, the first 0.05 s of
-// the 1 m/s^2 ramp); s0-middlemiss-10, the one trial at 0.15 m/s, starts 0.0958 m into its pull.
+// study's 22 recordings do, within 1.1 mm of stamped travel (within one 10 ms sample of the
+// stamp's start: the stamp is a constant-speed profile, core/haptic.h, kLateStart);
+// s0-middlemiss-10, the one trial at 0.15 m/s, starts 0.0958 m into its pull.
 // Paired from the simulation's first sample, each of its samples met a simulated one 0.096 m
 // behind it, and the 67 simulated samples left at the end were scored at w = 20 (session 45:
 // 0.53 of participant 0's middle-arm L 1.10). So when one sequence starts more than kLateStart
 // (5 mm, core/haptic.h) further along than the other, the earlier one's samples before that
 // travel are skipped and i = 0 pairs the later start with the first sample at or beyond its
 // travel (paired_start). The 5 mm leave every recording that starts with the pull paired as the
-// paper pairs it.
+// paper pairs it. The two travels are not quite one scale: the simulation's is the ramped
+// profile's, the recording's the constant-speed stamp's, so at 0.15 m/s the simulated sample at
+// 0.0958 m comes 0.075 s (v / 2a) later in the pull than the measured one at the same stamp.
 //
 // PositionWeighted: the variant in the paper's public code (gt-rad/learning-forces,
 // physx_simulation CMAES HapticObjective, evalObj), described here in our own words as we read

@@ -28,11 +28,22 @@ struct HapticSample {
 inline constexpr double kRigAcceleration = 1.0;  // [m/s^2]
 
 // A recording "starts late" when its first sample is more than kLateStart into the pull. 21 of
-// the study's 22 recordings start within 1.1 mm (the recorder's start-up, the first 0.05 s of the
-// ramp); s0-middlemiss-10, the one trial at 0.15 m/s, starts 0.0958 m in. Whatever compares such
-// a recording with one that starts with the pull must begin at the same point of the pull: the
-// objective pairs from the same travel (calib/objective.h, "Where the pairs begin"), the HMMs
-// start their chain that many samples on (hmm/hmm.h, FeatureSequence::unobserved).
+// the study's 22 recordings start within 1.1 mm; s0-middlemiss-10, the one trial at 0.15 m/s,
+// starts 0.0958 m in. Whatever compares such a recording with one that starts with the pull must
+// begin at the same point of the pull: the objective pairs from the same travel
+// (calib/objective.h, "Where the pairs begin"), the HMMs start their chain that many samples on
+// (hmm/hmm.h, FeatureSequence::unobserved).
+//
+// What the recordings' position column is. The study stamped it from the commanded motion
+// profile (data README), and in all 22 recordings it advances at the pull's speed from the first
+// pair on (1.0 mm per 10 ms; 1.5 mm at 0.15 m/s): a parabola fitted to the first 30 samples has
+// an acceleration within +-0.012 m/s^2, where a 1 m/s^2 ramp would advance 0.05 mm in the first
+// 10 ms. So the stamp is a constant-speed profile without the ramp, and the small starting
+// offsets (0.04-1.02 mm, up to about one sample's 1 mm) are where the first sample fell on it,
+// not a ramp's first 0.05 s. If the rig did ramp at kRigAcceleration (data README), the stamp
+// leads the real gripper by v^2 / 2a once the ramp is over: 5 mm at 0.1 m/s, 11 mm at 0.15 m/s.
+// The simulator's travel is the ramped profile (sim/trial.h), so a simulated and a measured
+// curve compared at equal travel are that far apart in the real gripper's position.
 inline constexpr double kLateStart = 0.005;  // [m]
 
 // [s] when a pull from rest reaches `travel` [m]: sqrt(2 x / a) on the ramp (x <= v^2 / 2a), and
@@ -68,6 +79,9 @@ struct HapticSequence {
 // late (kLateStart); then the pull's time at the first sample's travel (pull_time_at, at the
 // trial's speed) over the recording's mean sample period, rounded (0.01 s when it has fewer than
 // two samples). s0-middlemiss-10: 0.0958 m at 0.15 m/s is 0.714 s, 71 samples of 10.0 ms.
+// pull_time_at reads the travel as the ramped profile's. Read as the constant-speed stamp that
+// it is (kLateStart), 0.0958 m is 0.639 s into the pull, 64 samples: the HMMs' chain starts 7
+// samples (v / 2a) later than that reading puts it.
 std::size_t unrecorded_samples(const HapticSequence& trial);
 
 // A recording's mean sample period [s]: (t_last - t_first) / (n - 1); 0 with fewer than 2 samples.
