@@ -10,14 +10,15 @@
 // by default with its sleeve opening held by the jaws and facing the fist (`place_at_opening`,
 // GownPlacement::Opening); the paper's code's own transform is GownPlacement::Paper.
 //
-// How the simulator uses it:
+// How the simulator uses it (sim/gown_scene.h, make_scene):
 //   GownOptions opt;                       // defaults: measured gown if present, its scale 1.679
 //   opt.target_triangles = 5000;           // or 0 for the full 20k-triangle mesh
 //   GownMesh g = load_gown(opt);           // placed in W, loops found, sleeve labelled
-//   auto m = vertex_masses(g);             // lumped (the paper's simulator gives every particle
-//                                          // the same mass, total area * density / n)
 //   auto held = grasp_vertices(g, opt.scene);   // then hold them at z = opt.scene.pinch_z_W()
-//   g.sleeve_lower_half                    // for the outcome label (paper V-A)
+//   g.boundary_loops[g.sleeve_loop]        // the opening: sim::ClothMesh::sleeve_opening
+// vertex_masses(g) lumps the masses as the simulator does (which computes its own, at the
+// trial's ClothParams::areal_density; the paper's simulator gives every particle the same mass,
+// total area * density / n); `dressguard gown` reports them.
 //
 // Data: the measured gown is gt-rad/learning-forces, physx_simulation/Mesh/fullgown.obj (read in
 // place from shared/data/gown/, never copied into the project).
@@ -43,8 +44,12 @@ struct GownMesh {
   std::vector<std::array<int, 3>> triangles;     // vertex indices, 0-based, consistently oriented
   std::vector<std::vector<int>> boundary_loops;  // each ordered around the loop; longest first
   int sleeve_loop = -1;                          // index into boundary_loops: the opening the arm enters
-  std::vector<int> sleeve_lower_half;            // vertices of the lower half of that opening (paper Fig. 3b),
-                                                 // used to label a trial (paper V-A: d_max <= 7 cm is good)
+  // The lower half of that opening as the mesh is placed (its vertices below the loop's
+  // centroid), for looking at: `dressguard gown` reports and writes it, tools/plot/gown.py
+  // draws it. The simulator does not read it: a trial labels its outcome (paper V-A) from the
+  // lower half of the opening as it hangs after settling (the loop's vertices at or below
+  // their mean height then, sim/trial.cpp, settle()), which can differ from this one.
+  std::vector<int> sleeve_lower_half;
   double areal_density = 0.145;                  // [kg/m^2], the paper's simulator value
 };
 
