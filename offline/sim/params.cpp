@@ -34,12 +34,23 @@ double* field(ClothParams& p, const std::string& name) {
   return nullptr;
 }
 
+// `text` as a whole finite number, with an optional leading '+' (from_chars takes none, and
+// '+0.3' is how a signed value is often written); false for anything else.
+bool parse_number(const std::string& text, double* out) {
+  const char* b = text.data();
+  const char* e = b + text.size();
+  if (b != e && *b == '+' && b + 1 != e && b[1] != '-' && b[1] != '+') ++b;
+  auto [ptr, ec] = std::from_chars(b, e, *out);
+  return ec == std::errc() && ptr == e && std::isfinite(*out);
+}
+
 }  // namespace
 
 ClothParams parse_params(const std::string& text, const std::filesystem::path& file) {
   ClothParams p;
   // Turn JSON punctuation into spaces and split records at newlines and commas.
-  std::string t = text;
+  // A UTF-8 byte-order mark (an editor's, on Windows) is no part of the first name.
+  std::string t = text.rfind("\xEF\xBB\xBF", 0) == 0 ? text.substr(3) : text;
   for (char& c : t)
     if (c == '{' || c == '}' || c == '"' || c == ':' || c == '=' || c == '\t' || c == '\r') c = ' ';
   std::istringstream in(t);
@@ -53,11 +64,22 @@ ClothParams parse_params(const std::string& text, const std::filesystem::path& f
     if (auto h = line.find('#'); h != std::string::npos) line.resize(h);
     std::istringstream recs(line);
     std::string rec;
+    std::string before;  // the value of the record before this one on the line, if any
     while (std::getline(recs, rec, ',')) {
       std::istringstream ws(rec);
       std::string name, value, extra;
       if (!(ws >> name)) continue;
-      if (!(ws >> value)) throw_input_error(file, lineno, "parameter '" + name + "' has no value");
+      if (!(ws >> value)) {
+        // 'friction 0,3' is two records, 'friction 0' and '3': a decimal comma.
+        double ignored = 0;
+        if (parse_number(name, &ignored) && !before.empty())
+          throw_input_error(file, lineno,
+                            "'" + before + "," + name + "': a comma separates parameters; use '.' for decimals (" +
+                                before + "." + name + ")");
+        if (parse_number(name, &ignored))
+          throw_input_error(file, lineno, "'" + name + "' is a number where a parameter's name goes");
+        throw_input_error(file, lineno, "parameter '" + name + "' has no value");
+      }
       if (ws >> extra) throw_input_error(file, lineno, "unexpected '" + extra + "' after " + name);
       double* f = field(p, name);
       if (f && line_of.count(name))
@@ -65,11 +87,11 @@ ClothParams parse_params(const std::string& text, const std::filesystem::path& f
                                             std::to_string(line_of[name]) + "); give it once");
       if (!f) throw_input_error(file, lineno, "unknown parameter '" + name + "' (stretch, shear, bend, friction, self_friction, damping, areal_density, arm_compliance, fist_shift, arm_lateral, fist_lateral, hem_width, hem_bend_ratio, support_depth, support_lateral)");
       double v = 0;
-      auto [ptr, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
-      if (ec != std::errc() || ptr != value.data() + value.size() || !std::isfinite(v))
+      if (!parse_number(value, &v))
         throw_input_error(file, lineno, "parameter '" + name + "': '" + value + "' is not a number");
       *f = v;
       line_of[name] = lineno;
+      before = value;
     }
   }
   // The line of a value out of range (0: a default's, which none is).

@@ -2,8 +2,10 @@
 //
 // Params file: one "name value" per line (also "name = value", "name: value", or a flat JSON
 // object {"name": value, ...}); names are the ClothParams fields; '#' starts a comment; fields
-// not given keep their defaults. Unknown names, a name given twice, bad numbers and values out of
-// range are errors naming file and line.
+// not given keep their defaults. Commas separate records as newlines do, so a decimal comma
+// ("friction 0,3") is refused with a word on it; '.' is the decimal point. A value may carry a
+// leading '+'; a UTF-8 byte-order mark at the file's start is skipped. Unknown names, a name
+// given twice, bad numbers and values out of range are errors naming file and line.
 #pragma once
 
 #include <filesystem>

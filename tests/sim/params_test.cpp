@@ -56,3 +56,36 @@ TEST(SimParams, DensityAndComplianceWithinTheCalibrationsLimits) {
   EXPECT_EQ(p.areal_density, 1.0);
   EXPECT_EQ(p.arm_compliance, 1.0);
 }
+
+// What a hand-written file gets wrong, named for what it is: a decimal comma ('friction 0,3' is
+// two records, 'friction 0' and '3', and was refused as "parameter '3' has no value"), a UTF-8
+// byte-order mark (an invisible character made the first name unknown), and a leading '+'
+// (refused as "not a number").
+TEST(SimParams, DecimalCommaByteOrderMarkAndPlusSign) {
+  std::string e = error_of("stretch 0.8\nfriction 0,3\n");
+  EXPECT_NE(e.find("p.txt:2: '0,3': a comma separates parameters; use '.' for decimals (0.3)"), std::string::npos)
+      << e;
+  e = error_of("{\"bend\": 0,5}\n");  // the same in flat JSON
+  EXPECT_NE(e.find("p.txt:1: '0,5': a comma separates parameters; use '.' for decimals (0.5)"), std::string::npos)
+      << e;
+  e = error_of("friction 0.3\n7\n");  // a number alone on its line: no comma to blame
+  EXPECT_NE(e.find("p.txt:2: '7' is a number where a parameter's name goes"), std::string::npos) << e;
+  e = error_of("friction\n");  // a name without a value is still said so
+  EXPECT_NE(e.find("p.txt:1: parameter 'friction' has no value"), std::string::npos) << e;
+  const std::string bom = "\xEF\xBB\xBF" "friction 0.3\nbend 0.4\n";
+  EXPECT_EQ(error_of(bom), "");
+  if (error_of(bom).empty()) {
+    EXPECT_EQ(parse_params(bom, "p.txt").friction, 0.3);
+    EXPECT_EQ(parse_params(bom, "p.txt").bend, 0.4);
+  }
+  const std::string plus = "friction +0.3\narm_lateral +0.05\n";
+  EXPECT_EQ(error_of(plus), "");
+  if (error_of(plus).empty()) {
+    EXPECT_EQ(parse_params(plus, "p.txt").friction, 0.3);
+    EXPECT_EQ(parse_params(plus, "p.txt").arm_lateral, 0.05);
+  }
+  for (const char* bad : {"friction +-0.3\n", "friction ++0.3\n", "friction +\n"}) {
+    e = error_of(bad);
+    EXPECT_NE(e.find("is not a number"), std::string::npos) << bad << ": " << e;
+  }
+}
