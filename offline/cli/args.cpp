@@ -167,6 +167,20 @@ long Args::integer(const std::string& name, long fallback, long lo, long hi) con
   return x;
 }
 
+std::uint64_t Args::unsigned64(const std::string& name, std::uint64_t fallback) const {
+  auto v = get(name);
+  if (!v) return fallback;
+  if (!v->empty() && v->front() == '-')
+    throw UsageError("option --" + name + ": must not be negative, not " + *v + " (0 to 18446744073709551615)");
+  std::uint64_t x = 0;
+  auto [p, ec] = std::from_chars(v->data(), v->data() + v->size(), x);
+  if (ec == std::errc::result_out_of_range && p == v->data() + v->size())
+    throw UsageError("option --" + name + ": " + *v + " is beyond 18446744073709551615 (2^64 - 1)");
+  if (ec != std::errc() || p != v->data() + v->size())
+    throw UsageError("option --" + name + ": not an integer: '" + *v + "'");
+  return x;
+}
+
 void Args::allow_only(const std::set<std::string>& known, std::size_t max_positional) const {
   for (const auto& [k, v] : values_) if (!known.count(k)) throw UsageError("unknown option --" + k);
   for (const auto& k : flags_set_) if (!known.count(k)) throw UsageError("unknown option --" + k);

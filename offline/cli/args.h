@@ -6,6 +6,7 @@
 
 #include <climits>
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <optional>
@@ -78,6 +79,9 @@ class Args {
   double number(const std::string& name, double fallback) const;  // UsageError when not a number
   // UsageError when not a whole number in [lo, hi] (the default range: what an int holds).
   long integer(const std::string& name, long fallback, long lo = -2147483647L - 1, long hi = 2147483647L) const;
+  // UsageError when not a whole number in [0, 2^64 - 1]; a negative one is said to be negative
+  // (a seed is a uint64_t: read as a long, the upper half of its values were "not an integer").
+  std::uint64_t unsigned64(const std::string& name, std::uint64_t fallback) const;
   const std::vector<std::string>& positional() const { return positional_; }
   // UsageError naming the first option that is not in `known` (catches typos like --sped), or
   // the first word that is no option when the command takes fewer than `max_positional` of them

@@ -25,6 +25,8 @@ namespace {
 // --frames: at most this many times (the default keeps 55); each frame costs the scene file a copy
 // of the gown's positions (about 75 kB on the reduced gown: 500 frames made 38 MB).
 constexpr std::size_t kMaxFrames = 100;
+// [m] the largest arm-height offset simulated: --arm-offset plus a calibration's.
+constexpr double kMaxArmOffset = 0.5;
 
 // --frames: times [s] since the start of the pull, each once, from `earliest` (the longest
 // settling before the pull) to `latest` (the pull's time limit): a time outside kept no frame,
@@ -117,14 +119,15 @@ int run_simulate(int argc, char** argv) {
         "  pictures, FILE.scene.json (mesh, arm, frames, contact forces on the arm at the end) read\n"
         "  by tools/plot/sim_scene.py, and FILE.arm.csv: per sample, the cloth's force on each part\n"
         "  of the arm (elbow, fist, [hand,] forearm, upper arm; x y z, N) for tools/plot/arm_parts.py.\n"
-        "  --arm-offset M    [m] added to the height's arm height (default 0)\n"
+        "  --arm-offset M    [m] added to the height's arm height (default 0); within +-%g m,\n"
+        "                    --calibration's offset for the height included\n"
         "  --speed V         [m/s] pull speed within %g-%g: the study's are 0.1 and 0.15 (default 0.1)\n"
         "  --params FILE     cloth parameters ('name value' lines or flat JSON; see offline/sim/params.h)\n"
         "  --calibration CAL a calibration file instead (dressguard calibrate): its cloth and person\n"
         "                    parameters, its offset for this height added to --arm-offset, its gown,\n"
         "                    its end of travel and its grasp (rim_shift) as the defaults of --gown,\n"
         "                    --max-travel and --rim-ahead\n"
-        "  --seed S          seed of the noise models (default 0)\n"
+        "  --seed S          seed of the noise models, 0 to 2^64 - 1 (default 0)\n"
         "  --max-travel M    [m] where the rig stops if the force limit does not stop it first\n"
         "                    (default 0.85; a measured trial's own end: rig_end_of_travel); more than\n"
         "                    the travel of the pull's first sample (0.05 mm), so that it has two\n"
@@ -141,7 +144,7 @@ int run_simulate(int argc, char** argv) {
         "                    positions at, each once, at most %zu, from -%g s (the longest settling)\n"
         "                    to the pull's time limit (%g s at 0.1 m/s); default every 0.25 s from -1.6 s\n"
         "  --json            print the summary as JSON\n",
-        sim::kMinPullSpeed, sim::kMaxPullSpeed, kGripHelp, kMaxFrames, sim::max_settle_time_of({}),
+        kMaxArmOffset, sim::kMinPullSpeed, sim::kMaxPullSpeed, kGripHelp, kMaxFrames, sim::max_settle_time_of({}),
         sim::max_time_of({}));
     return 0;
   }
@@ -152,22 +155,30 @@ int run_simulate(int argc, char** argv) {
   const auto h = parse_arm_height(hs);
   if (!h) throw UsageError("--height must be high, middle or low, not '" + hs + "'");
   spec.height = *h;
-  spec.arm_offset = args.number("arm-offset", 0.0);
-  if (std::abs(spec.arm_offset) > 0.5) throw UsageError("--arm-offset must be within +-0.5 m");
+  const double given_offset = args.number("arm-offset", 0.0);
+  spec.arm_offset = given_offset;
   spec.speed = args.number("speed", 0.1);
   // The pull's time limit grows as 1 / speed (sim/trial.h): a speed near 0 would run for days.
   if (!(spec.speed >= sim::kMinPullSpeed && spec.speed <= sim::kMaxPullSpeed))
     throw UsageError("--speed must be within " + format_number(sim::kMinPullSpeed) + " and " +
                      format_number(sim::kMaxPullSpeed) + " m/s (the study pulls at 0.1 and 0.15), not " +
                      format_number(spec.speed));
-  const long seed = args.integer("seed", 0, LONG_MIN, LONG_MAX);
-  if (seed < 0) throw UsageError("--seed must be non-negative");
-  spec.seed = static_cast<uint64_t>(seed);
+  spec.seed = args.unsigned64("seed", 0);  // the noise models' stream takes any uint64_t
   if (args.has("params") && args.has("calibration")) throw UsageError("give at most one of --params and --calibration");
   std::optional<calib::Calibration> cal;
   if (auto cf = args.get("calibration")) {
     cal = calib::read_calibration(*cf);
     spec.arm_offset += cal->offsets[static_cast<int>(spec.height)];
+  }
+  // The limit holds for the offset simulated, the calibration's included (checked before it was
+  // added, --arm-offset 0.5 with a calibration's +0.1 simulated 0.6 m).
+  if (!(std::abs(spec.arm_offset) <= kMaxArmOffset)) {
+    if (cal)
+      throw UsageError(format_string("--arm-offset %g plus the calibration's %g m for the %s arm is %g m; the sum must "
+                                     "be within +-%g m",
+                                     given_offset, cal->offsets[static_cast<int>(spec.height)], hs.c_str(),
+                                     spec.arm_offset, kMaxArmOffset));
+    throw UsageError(format_string("--arm-offset must be within +-%g m", kMaxArmOffset));
   }
   spec.max_travel = args.number("max-travel", cal ? cal->rig_travel : 0.85);
   if (!(spec.max_travel > 0.0 && spec.max_travel <= 0.85))

@@ -251,3 +251,37 @@ foreach(dir "${TMP}/dg \"quoted\" \\dir" "${TMP}${deep}")
   endif()
 endforeach()
 file(REMOVE_RECURSE "${TMP}/dg \"quoted\" \\dir" "${TMP}/${long}")
+
+# --arm-offset's +-0.5 m holds for the offset simulated, a calibration's included: it was checked
+# before the calibration's was added (participant 4's low arm: +0.011 m), and 0.495 m ran at
+# 0.506 m. Refused naming both parts and the sum, nothing written.
+file(REMOVE ${TMP}/dg_offset_never.csv)
+execute_process(COMMAND ${DG} simulate --gown coarse --height low --arm-offset 0.495 --max-travel 0.01 --frames 0
+                        --calibration ${SRC}/models/participant4-simulator.json --out ${TMP}/dg_offset_never.csv
+                RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+string(CONCAT expect "--arm-offset 0.495 plus the calibration's 0.0110519 m for the low arm is 0.506052 m; "
+                     "the sum must be within \\+-0.5 m")
+if(NOT rc EQUAL 2 OR NOT err MATCHES "${expect}" OR EXISTS ${TMP}/dg_offset_never.csv)
+  message(FATAL_ERROR "--arm-offset 0.495 with a calibration's +0.011: expected exit 2 naming the sum, "
+                      "got rc=${rc}: ${err}")
+endif()
+
+# --seed is the noise models' uint64_t: its upper half was refused as "not an integer" (read as a
+# long). 2^64 - 1 runs and is reported whole; a negative one, or one past 2^64 - 1, is named so.
+execute_process(COMMAND ${DG} simulate --gown coarse --height high --max-travel 0.01 --frames 0 --noise
+                        --seed 18446744073709551615 --out ${TMP}/dg_seed.csv --json
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "\"seed\": 18446744073709551615,")
+  message(FATAL_ERROR "--seed 18446744073709551615: expected a run with that seed, got rc=${rc}: ${out} ${err}")
+endif()
+foreach(case "-1|--seed: must not be negative, not -1" "18446744073709551616|--seed: 18446744073709551616 is beyond"
+             "1e3|--seed: not an integer: '1e3'")
+  string(REPLACE "|" ";" case "${case}")
+  list(GET case 0 seed)
+  list(GET case 1 expect)
+  execute_process(COMMAND ${DG} simulate --gown coarse --height high --max-travel 0.01 --frames 0 --seed ${seed}
+                          --out ${TMP}/dg_seed_never.csv RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+  if(NOT rc EQUAL 2 OR NOT err MATCHES "${expect}" OR EXISTS ${TMP}/dg_seed_never.csv)
+    message(FATAL_ERROR "--seed ${seed}: expected exit 2 saying '${expect}', got rc=${rc}: ${err}")
+  endif()
+endforeach()
