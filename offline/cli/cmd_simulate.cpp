@@ -115,10 +115,12 @@ int run_simulate(int argc, char** argv) {
         "usage: dressguard simulate --height high|middle|low --out FILE.csv [options]\n"
         "  Simulates one sleeve-pulling trial (XPBD cloth, 300 Hz x 20 substeps) and writes its\n"
         "  100 Hz haptic samples as a trial CSV (t,travel,f_motion,f_lateral,f_vertical; the rig's\n"
-        "  signs), a summary FILE.json (label, travel, d_max, final forces, parameters) and, for\n"
-        "  pictures, FILE.scene.json (mesh, arm, frames, contact forces on the arm at the end) read\n"
-        "  by tools/plot/sim_scene.py, and FILE.arm.csv: per sample, the cloth's force on each part\n"
-        "  of the arm (elbow, fist, [hand,] forearm, upper arm; x y z, N) for tools/plot/arm_parts.py.\n"
+        "  signs; then label,height,speed,arm_offset,seed, the same on every row, which readers of\n"
+        "  trial CSVs skip), a summary FILE.json (label, travel, d_max, final forces, parameters)\n"
+        "  and, for pictures, FILE.scene.json (mesh, arm, frames, contact forces on the arm at the\n"
+        "  end) read by tools/plot/sim_scene.py, and FILE.arm.csv: per sample, the cloth's force on\n"
+        "  each part of the arm (elbow, fist, [hand,] forearm, upper arm; x y z, N) for\n"
+        "  tools/plot/arm_parts.py.\n"
         "  --arm-offset M    [m] added to the height's arm height (default 0); within +-%g m,\n"
         "                    --calibration's offset for the height included\n"
         "  --speed V         [m/s] pull speed within %g-%g: the study's are 0.1 and 0.15 (default 0.1)\n"
@@ -130,7 +132,8 @@ int run_simulate(int argc, char** argv) {
         "  --seed S          seed of the noise models, 0 to 2^64 - 1 (default 0)\n"
         "  --max-travel M    [m] where the rig stops if the force limit does not stop it first\n"
         "                    (default 0.85; a measured trial's own end: rig_end_of_travel); more than\n"
-        "                    the travel of the pull's first sample (0.05 mm), so that it has two\n"
+        "                    the travel of the pull's first sample (0.05 mm), so that the trial has\n"
+        "                    at least two samples (a dataset's reader refuses one)\n"
         "  --noise           the paper's gown perturbation (random force up to 6 N for 0.5 s)\n"
         "  --arm-noise       the paper's arm-height noise (+-1.5 cm high/low, -6..0 cm middle)\n"
         "  --gown G          full | reduced | coarse (default reduced): the measured gown at ~20k, 5k,\n"
@@ -251,7 +254,15 @@ int run_simulate(int argc, char** argv) {
   // The CSV last: it is the commit point. A run that stops before it leaves the old CSV (or none),
   // never a new CSV beside old side files; new side files beside an old CSV are rewritten by the
   // next run of the same --out.
-  write_file_atomic(out, format_trial_csv(r.seq.samples));
+  // The label and the trial's conditions on every row, so that the CSV alone says what it is
+  // (issue 5); readers of trial CSVs skip columns after the five (core/dataset.h).
+  const std::vector<ConstantColumn> about = {
+      {"label", std::string(outcome_name(r.outcome))},
+      {"height", std::string(arm_height_name(spec.height))},
+      {"speed", format_string("%.9g", spec.speed)},
+      {"arm_offset", format_string("%.9g", r.arm_offset)},
+      {"seed", std::to_string(spec.seed)}};
+  write_file_atomic(out, format_trial_csv(r.seq.samples, about));
   if (args.has("json")) {
     std::printf("%s\n", b.c_str());
   } else {

@@ -8,6 +8,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 #include "files.h"
 
@@ -130,14 +131,22 @@ std::vector<HapticSample> read_trial_csv(const fs::path& path) {
   const std::string text = read_file(path);
   std::vector<HapticSample> out;
   long first_row = 0;
+  std::size_t columns = 5;  // the header's: the five, then any named ones the reader skips
   for_each_line(text, [&](std::string_view line, long n) {
     if (n == 1) {
-      if (line != kTrialHeader) throw_input_error(path, 1, std::string("expected header '") + kTrialHeader + "'");
+      const std::string_view head(kTrialHeader);
+      const bool more = line.size() > head.size() + 1 && line[head.size()] == ',';
+      if (line.substr(0, head.size()) != head || !(line.size() == head.size() || more))
+        throw_input_error(path, 1, std::string("expected header '") + kTrialHeader + "' (named columns may follow)");
+      columns = split(line, ',').size();
+      for (const std::string_view name : split(line, ','))
+        if (name.empty()) throw_input_error(path, 1, "a column without a name in the header");
       return;
     }
     if (line.empty()) return;
     const auto f = split(line, ',');
-    if (f.size() != 5) throw_input_error(path, n, "expected 5 columns, found " + std::to_string(f.size()));
+    if (f.size() != columns)
+      throw_input_error(path, n, "expected " + std::to_string(columns) + " columns, found " + std::to_string(f.size()));
     static constexpr const char* names[] = {"t", "travel", "f_motion", "f_lateral", "f_vertical"};
     append_sample(f, names, path, n, out);
     if (out.size() == 1) first_row = n;
@@ -146,13 +155,25 @@ std::vector<HapticSample> read_trial_csv(const fs::path& path) {
   return out;
 }
 
-std::string format_trial_csv(const std::vector<HapticSample>& samples) {
-  std::string out = std::string(kTrialHeader) + "\n";
+std::string format_trial_csv(const std::vector<HapticSample>& samples,
+                             const std::vector<ConstantColumn>& constant_columns) {
+  std::string head = kTrialHeader, tail;
+  for (const ConstantColumn& c : constant_columns) {
+    for (const std::string* w : {&c.name, &c.value})
+      if (w->find_first_of(",\"\r\n") != std::string::npos || (w == &c.name && w->empty()))
+        throw std::invalid_argument("format_trial_csv: column '" + c.name + "' = '" + c.value +
+                                    "' is no plain CSV field");
+    head += "," + c.name;
+    tail += "," + c.value;
+  }
+  std::string out = head + "\n";
   char buf[160];
   for (const auto& s : samples) {
     // %.9g keeps sub-micronewton resolution and round-trips the study's 6-decimal values.
-    std::snprintf(buf, sizeof buf, "%.9g,%.9g,%.9g,%.9g,%.9g\n", s.t, s.travel, s.f_motion, s.f_lateral, s.f_vertical);
+    std::snprintf(buf, sizeof buf, "%.9g,%.9g,%.9g,%.9g,%.9g", s.t, s.travel, s.f_motion, s.f_lateral, s.f_vertical);
     out += buf;
+    out += tail;
+    out += '\n';
   }
   return out;
 }

@@ -4,6 +4,9 @@
 //                 height in {high, middle, low}; speed in m/s; label in {good, missed, caught}
 //                 or empty when unknown; file relative to the dataset folder.
 //   <file>.csv    t,travel,f_motion,f_lateral,f_vertical   (see haptic.h for units and signs)
+//                 and, after them, any further named columns, which readers skip: `dressguard
+//                 simulate` adds label,height,speed,arm_offset,seed (one value per trial, on every
+//                 row), so that its CSV alone says what it is; a dataset's trial CSVs have none.
 //
 // Simulated and measured trials share the format, so every command reads both alike.
 //
@@ -47,9 +50,16 @@ struct Dataset {
 // What names `t` (one of ds.trials) in an error: its file where `ds` knows it, else its id.
 std::string trial_file_name(const Dataset& ds, const HapticSequence& t);
 
-// Trial CSV (header then rows). Throws InputError naming file and line on malformed rows.
+// Trial CSV (header then rows). Throws InputError naming file and line on malformed rows, and on
+// a row with another number of fields than the header has names.
 std::vector<HapticSample> read_trial_csv(const std::filesystem::path& path);
-std::string format_trial_csv(const std::vector<HapticSample>& samples);
+// One column after the five, with the same value on every row (`dressguard simulate`'s label and
+// metadata). Neither may hold a comma, a quote or a line end (plain CSV, no quoting).
+struct ConstantColumn {
+  std::string name, value;
+};
+std::string format_trial_csv(const std::vector<HapticSample>& samples,
+                             const std::vector<ConstantColumn>& constant_columns = {});
 
 // Reads manifest.csv and every trial it names.
 Dataset load_dataset(const std::filesystem::path& dir);

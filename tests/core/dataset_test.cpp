@@ -5,6 +5,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
 #include <unistd.h>
 #include <fstream>
 
@@ -188,6 +191,37 @@ TEST(DatasetRejects, EmptyManifestRepeatedFileAndFolders) {
   fs::create_directories(dir / "sub");
   write_text(dir / "manifest.csv", std::string(kManifestHead) + "a,1,high,0.1,good,sub\n");
   EXPECT_TRUE(names(input_error_of([&] { load_dataset(dir); }), "sub: is a folder, not a file"));
+}
+
+// Named columns after the five (dressguard simulate's label and metadata) are written with one
+// value on every row and skipped by the reader, so that simulate's CSV alone says what it is and
+// every reader of trial CSVs still reads it (export-candump --trial refused the extra columns). A
+// row must still have as many fields as the header has names, and the header must begin with
+// the five.
+TEST(Dataset, NamedColumnsAfterTheFiveAreSkipped) {
+  const TempDir tmp("extra");
+  const fs::path csv = tmp.path / "t.csv";
+  const std::vector<HapticSample> samples = {{0.01, 0.00005, -0.1, 0.02, 0.3}, {0.02, 0.0002, -0.2, 0.01, 0.4}};
+  const std::string text = format_trial_csv(samples, {{"label", "missed"}, {"height", "low"}, {"seed", "7"}});
+  EXPECT_EQ(text,
+            "t,travel,f_motion,f_lateral,f_vertical,label,height,seed\n"
+            "0.01,5e-05,-0.1,0.02,0.3,missed,low,7\n0.02,0.0002,-0.2,0.01,0.4,missed,low,7\n");
+  EXPECT_EQ(format_trial_csv(samples), format_trial_csv(samples, {}));  // the dataset's own: five columns
+  EXPECT_EQ(format_trial_csv(samples).substr(0, 39), "t,travel,f_motion,f_lateral,f_vertical\n");
+  write_text(csv, text);
+  const std::vector<HapticSample> back = read_trial_csv(csv);
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_EQ(back[1].f_vertical, 0.4);
+  EXPECT_EQ(back[0].travel, 0.00005);
+  write_text(csv, "t,travel,f_motion,f_lateral,f_vertical,label\n0,0,0,0,0,good\n0.01,0.001,0,0,0\n");
+  EXPECT_TRUE(names(input_error_of([&] { read_trial_csv(csv); }), "t.csv:3: expected 6 columns, found 5"));
+  write_text(csv, std::string(kTrialHead) + "0,0,0,0,0,good\n0.01,0.001,0,0,0\n");
+  EXPECT_TRUE(names(input_error_of([&] { read_trial_csv(csv); }), "t.csv:2: expected 5 columns, found 6"));
+  write_text(csv, "t,travel,f_motion,f_lateral,f_vertical_N\n0,0,0,0,0\n0.01,0.001,0,0,0\n");
+  EXPECT_TRUE(names(input_error_of([&] { read_trial_csv(csv); }), "t.csv:1: expected header"));
+  write_text(csv, "t,travel,f_motion,f_lateral,f_vertical,,seed\n0,0,0,0,0,,1\n0.01,0.001,0,0,0,,1\n");
+  EXPECT_TRUE(names(input_error_of([&] { read_trial_csv(csv); }), "t.csv:1: a column without a name"));
+  EXPECT_THROW(format_trial_csv(samples, {{"label", "a,b"}}), std::invalid_argument);
 }
 
 // A byte-order mark (Excel's "CSV UTF-8") is skipped, in the manifest and in a trial file.

@@ -81,6 +81,23 @@ if(NOT arm_header STREQUAL "t,travel,elbow_fx,elbow_fy,elbow_fz,fist_fx,fist_fy,
    OR arm_n LESS 3)
   message(FATAL_ERROR "short.arm.csv: header '${arm_header}', ${arm_n} lines")
 endif()
+# The trial CSV carries its label and conditions on every row after the rig's five columns
+# (issue 5: "plus label and metadata"; they were only in FILE.json), and a reader of trial CSVs
+# still reads it: export-candump --trial skips the columns after the five.
+file(STRINGS ${TMP}/short.csv csv_rows)
+list(GET csv_rows 0 csv_header)
+list(GET csv_rows 1 csv_first)
+list(GET csv_rows -1 csv_last)
+if(NOT csv_header STREQUAL "t,travel,f_motion,f_lateral,f_vertical,label,height,speed,arm_offset,seed"
+   OR NOT csv_first MATCHES "^0\.01,[-0-9.e]+,[-0-9.e]+,[-0-9.e]+,[-0-9.e]+,missed,low,0\.1,0,0$"
+   OR NOT csv_last MATCHES "^[0-9.]+,0\.05,[-0-9.e]+,[-0-9.e]+,[-0-9.e]+,missed,low,0\.1,0,0$")
+  message(FATAL_ERROR "short.csv: header '${csv_header}', first row '${csv_first}', last row '${csv_last}'")
+endif()
+execute_process(COMMAND ${DG} export-candump --trial ${TMP}/short.csv --out ${TMP}/short.log
+                RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+if(NOT rc EQUAL 0 OR NOT EXISTS ${TMP}/short.log)
+  message(FATAL_ERROR "export-candump --trial on simulate's CSV: rc=${rc}: ${err}")
+endif()
 # A grip the jaws cannot make is named, and nothing is written.
 execute_process(COMMAND ${DG} simulate --height high --gown coarse --grip-depth -0.01 --out ${TMP}/dg_grip_never.csv
                 RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)

@@ -18,6 +18,8 @@ usage: plot_checks.py CHECK SOURCE_DIR WORK_DIR
               the file on one that is not there, not JSON, or lacks a column or key they read,
               and hmm_sweep.py refuses a sweep without one accuracy (it drew an empty figure,
               exit 0)
+  sim_csv     sim_forces.py and arm_parts.py --trial draw `dressguard simulate`'s trial CSV, whose
+              label and metadata columns (words among them) follow the five
 Drawn in this process with the scripts' own functions; the figure is kept, not saved, where the
 check reads it. Exits 1 naming what failed.
 """
@@ -263,9 +265,24 @@ def check_bad_input(src, work):
               f"{script} {' '.join(os.path.basename(a) for a in args)}: exit {r.returncode}, stderr {r.stderr.strip()!r}")
 
 
+def check_sim_csv(src, work):
+    trial = os.path.join(work, "trial.csv")
+    header = ["t", "travel", "f_motion", "f_lateral", "f_vertical", "label", "height", "speed", "arm_offset", "seed"]
+    write_csv(trial, header, [[0.01 * k, 0.001 * k, -0.1 * k, 0.01, 0.05 * k, "missed", "low", 0.1, 0, 7]
+                              for k in range(1, 6)])
+    arm = os.path.join(work, "trial.arm.csv")
+    write_csv(arm, ["t", "travel", "elbow_fx", "elbow_fy", "elbow_fz"],
+              [[0.01 * k, 0.001 * k, 0.1, 0, -0.1] for k in range(1, 6)])
+    forces, loads = os.path.join(work, "forces.png"), os.path.join(work, "arm.png")
+    for what, r, png in [("sim_forces.py", run(src, "sim_forces.py", forces, trial), forces),
+                         ("arm_parts.py --trial", run(src, "arm_parts.py", arm, loads, "--trial", trial), loads)]:
+        check(r.returncode == 0 and os.path.exists(png),
+              f"{what} on simulate's CSV with its label columns: exit {r.returncode}, stderr {r.stderr.strip()!r}")
+
+
 def main(argv):
     checks = {"legends": check_legends, "threshold": check_threshold, "latency": check_latency,
-              "bad_input": check_bad_input}
+              "bad_input": check_bad_input, "sim_csv": check_sim_csv}
     if len(argv) != 4 or argv[1] not in checks:
         sys.exit(__doc__)
     os.makedirs(argv[3], exist_ok=True)

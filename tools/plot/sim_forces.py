@@ -2,7 +2,8 @@
 """Force curves against travel for simulated (and measured) trials.
 
 Usage: sim_forces.py OUT.png TRIAL[=LABEL] ... [--measured STUDY.txt[=LABEL] ...] [--title T]
-  TRIAL: a trial CSV (t,travel,f_motion,f_lateral,f_vertical) as written by dressguard simulate
+  TRIAL: a trial CSV (t,travel,f_motion,f_lateral,f_vertical, then any further columns, such as
+         simulate's label and metadata, which are skipped) as written by dressguard simulate
   --measured: the study's trial files (space separated: t position F_motion F_lateral F_vertical)
 Two panels, F_motion and F_vertical against travel (the paper's X and Y); simulated solid,
 measured dashed; with exactly one simulated and one measured trial, a third panel shows the
@@ -21,12 +22,13 @@ from figure_file import save_figure  # a temporary file, then a rename
 def load(path):
     """Columns t, travel, f_motion, f_lateral, f_vertical of a trial CSV or a study file. A file
     without rows or with fewer columns is an error naming it (a header-only CSV failed with an
-    IndexError far from its name)."""
+    IndexError far from its name). A CSV's columns after the five (simulate's label,height,...,
+    words among them) are not read."""
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UserWarning)  # numpy's "input contained no data"
             try:
-                a = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+                a = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2, usecols=range(5))
             except ValueError:
                 a = np.loadtxt(path, ndmin=2)
     except FileNotFoundError:
