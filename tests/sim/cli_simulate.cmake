@@ -187,15 +187,22 @@ if(NOT rc EQUAL 0 OR NOT out MATCHES "\"rim_ahead\": 0.025}")
   message(FATAL_ERROR "--rim-ahead did not override the calibration's grasp: rc=${rc} ${out} ${err}")
 endif()
 
+# A short coarse-gown simulate with `option value` that must exit 2 saying `expect` and write no
+# file (--speed, --seed and the like: refused before anything is simulated).
+function(expect_simulate_refused option value expect)
+  set(out ${TMP}/dg_refused_never.csv)
+  file(REMOVE ${out})
+  execute_process(COMMAND ${DG} simulate --gown coarse --height high --max-travel 0.01 --frames 0 ${option} ${value}
+                          --out ${out} RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+  if(NOT rc EQUAL 2 OR NOT err MATCHES "${expect}" OR EXISTS ${out})
+    message(FATAL_ERROR "${option} ${value}: expected exit 2 saying '${expect}' and no file, got rc=${rc}: ${err}")
+  endif()
+endfunction()
+
 # --speed within sim::kMinPullSpeed-kMaxPullSpeed (0.05-0.3 m/s, around the study's 0.1 and 0.15):
 # the pull's time limit grows as 1 / speed, and 1e-6 m/s ran for days.
-file(REMOVE ${TMP}/dg_speed_never.csv)
 foreach(speed 0.5 1e-6 0.04)
-  execute_process(COMMAND ${DG} simulate --gown coarse --height high --max-travel 0.01 --frames 0 --speed ${speed}
-                  --out ${TMP}/dg_speed_never.csv RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
-  if(NOT rc EQUAL 2 OR NOT err MATCHES "--speed must be within 0.05 and 0.3 m/s" OR EXISTS ${TMP}/dg_speed_never.csv)
-    message(FATAL_ERROR "--speed ${speed}: expected exit 2 naming it and no file, got rc=${rc}: ${err}")
-  endif()
+  expect_simulate_refused(--speed ${speed} "--speed must be within 0.05 and 0.3 m/s")
 endforeach()
 
 # --frames: each time once, at most 100 of them, from where settling can start (its cap, 10 s
@@ -296,9 +303,5 @@ foreach(case "-1|--seed: must not be negative, not -1" "18446744073709551616|--s
   string(REPLACE "|" ";" case "${case}")
   list(GET case 0 seed)
   list(GET case 1 expect)
-  execute_process(COMMAND ${DG} simulate --gown coarse --height high --max-travel 0.01 --frames 0 --seed ${seed}
-                          --out ${TMP}/dg_seed_never.csv RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
-  if(NOT rc EQUAL 2 OR NOT err MATCHES "${expect}" OR EXISTS ${TMP}/dg_seed_never.csv)
-    message(FATAL_ERROR "--seed ${seed}: expected exit 2 saying '${expect}', got rc=${rc}: ${err}")
-  endif()
+  expect_simulate_refused(--seed ${seed} "${expect}")
 endforeach()
