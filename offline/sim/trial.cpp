@@ -32,7 +32,15 @@ struct Profile {
     const double s = t < ta ? 0.5 * a * t * t : 0.5 * a * ta * ta + v * (t - ta);
     return std::min(s, max_travel);
   }
-  double accel(double t) const { return t < v / a ? a : 0.0; }
+  // The ramp's speed; the stop at max_travel is not in it: the pull ends in the sample that
+  // reaches it, and the rig's braking is not modelled (the travel is clamped there).
+  double speed(double t) const { return std::min(a * t, v); }
+  // The gripper's mean acceleration over [t0, t1], one output step: the change of speed over
+  // the step, so that the grasped vertices' inertia (solver.cpp, substep) adds up to exactly
+  // their mass times the pull's speed however the ramp's end falls on the step grid. Asking
+  // for a at t0 gave a whole step of a to the step in which the ramp ends, or to one after it
+  // when t0 was rounded below v / a.
+  double accel_over(double t0, double t1, double dt) const { return (speed(t1) - speed(t0)) / dt; }
 };
 
 bool all_finite(const GownState& s) {
@@ -287,10 +295,17 @@ struct Pulling {
   ArmSpring arm;                 // a compliant arm (arm_spring.h) moves once per sample
   V3 arm_load0{0, 0, 0};         // its load at the first sample, counted from
   bool first_sample = true;
-  double t = 0;                  // [s] since the start of the pull
+  // Output steps since the start of the pull, and their time [s], step / step_hz. The time is
+  // computed from the count, not summed step by step: 1/300 added 30 times is
+  // 0.09999999999999994, short of a 0.1 s ramp, and the samples' times drifted by ulps.
+  long step = 0;
+  double t = 0;
   size_t next_frame = 0;         // into the sorted non-negative frame times
   bool ended = false, full = false;
 };
+
+// [s] the time of the pull's output step `step` (Pulling::step).
+double pull_time(const GownModel& m, long step) { return static_cast<double>(step) / m.scene->opt.step_hz; }
 
 std::vector<double> pull_frame_times(const TrialSpec& spec) {
   std::vector<double> times;
@@ -339,17 +354,18 @@ void pull_sample(const GownModel& m, Pulling& p, const TrialSpec& spec, const Se
   // this sample's steps; its load is counted from the first sample.
   const V3 arm0 = s.arm_shift_to, arm1 = p.arm.d;
   for (int k = 0; k < 3; ++k) {
-    const double t1 = p.t + m.dt;
+    const double t1 = pull_time(m, p.step + 1);
     const V3 g0{prof.travel(p.t), 0, 0}, g1{prof.travel(t1), 0, 0};
     if (!p.arm.rigid()) {
       s.arm_shift_from = arm0 + (k / 3.0) * (arm1 - arm0);
       s.arm_shift_to = arm0 + ((k + 1) / 3.0) * (arm1 - arm0);
     }
     if (touched && !*touched) watch_arms(m, s, watch_dz);
-    step(m, s, g0, g1, V3{prof.accel(p.t), 0, 0});
+    step(m, s, g0, g1, V3{prof.accel_over(p.t, t1, m.dt), 0, 0});
     if (touched && !*touched) {
       *touched = s.arm_corrected || s.watch_touched;
     }
+    ++p.step;
     p.t = t1;
     maybe_frame(p, spec, frame_times, g1.x);
   }
@@ -551,7 +567,7 @@ void pull_together(const std::vector<GownModel>& models, const std::vector<size_
   bool at_common = false;  // every trial goes on from `common` itself, not from `fork`
   for (;;) {
     // The rig's profile and its stops agree while no trial's end of travel (or time) is near.
-    const double t_next = common.t + 3 * m.dt;
+    const double t_next = pull_time(m, common.step + 3);
     const double travel_next = Profile{lead.acceleration, lead.speed, 1e300}.travel(t_next);
     bool near_end = common.ended;
     for (size_t b : trials)

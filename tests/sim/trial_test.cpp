@@ -205,6 +205,51 @@ TEST(SimTrial, ABadSpecIsRefusedNamingItsField) {
   }
 }
 
+// The gripper's acceleration in each output step is the change of the rig's speed over that
+// step, and the pull's time is counted in steps, not summed. A patch held whole by the gripper
+// (no free vertex, no arm) loads it with nothing but its mass times the gripper's acceleration,
+// so each sample's F_motion is -M times the mean acceleration over its 3 steps. On the rig's
+// 1 m/s^2 ramp exactly 30 steps carry it at 0.1 m/s and 45 at 0.15 m/s; with a ramp that ends
+// inside a step (0.7 m/s^2) the steps' accelerations still add up to the pull's speed. The time
+// summed 1/300 at a time was 0.09999999999999994 after 30 steps, short of v / a = 0.1, so a
+// 31st (46th) step carried the whole 1 m/s^2, and the samples' times were off by ulps.
+TEST(SimTrial, GripperAccelerationAddsUpToThePullSpeed) {
+  ClothMesh mesh = grid_patch({0, 0, 0}, {0.5, 0, 0}, {0, 0.5, 0}, 3, 3);
+  for (int i = 0; i < 9; ++i) mesh.grasp.push_back(i);
+  SceneOptions opt;
+  opt.with_arm = false;
+  opt.jaw_close_steps = 0;
+  const Scene scene = make_scene(mesh, opt);
+  struct Case {
+    double speed, acceleration;
+    int ramp_steps;  // output steps that carry the acceleration; -1: the ramp ends inside one
+  };
+  for (const Case& c : {Case{0.1, 1.0, 30}, Case{0.15, 1.0, 45}, Case{0.1, 0.7, -1}}) {
+    TrialSpec spec;
+    spec.speed = c.speed;
+    spec.acceleration = c.acceleration;
+    spec.max_travel = 0.05;
+    spec.self_collision = false;
+    const TrialResult r = simulate_trial(scene, ClothParams{}, spec);
+    ASSERT_GE(r.seq.samples.size(), 20u);
+    const double mass = r.weight / 9.81;
+    double speed = 0;  // the gripper's, summed from its accelerations
+    double steps = 0;  // output steps at the ramp's acceleration
+    for (std::size_t k = 0; k < r.seq.samples.size(); ++k) {
+      const HapticSample& s = r.seq.samples[k];
+      EXPECT_EQ(s.t, static_cast<double>(3 * (k + 1)) / 300.0) << "sample " << k;
+      EXPECT_LE(std::abs(s.t - 0.01 * static_cast<double>(k + 1)), std::nextafter(s.t, 1e9) - s.t) << "sample " << k;
+      const double a = -s.f_motion / mass;  // the mean over the sample's 3 steps
+      speed += a * 3 / 300.0;
+      steps += 3 * a / c.acceleration;
+    }
+    EXPECT_NEAR(speed, c.speed, 1e-9) << c.speed << " m/s at " << c.acceleration << " m/s^2";
+    if (c.ramp_steps >= 0) {
+      EXPECT_NEAR(steps, c.ramp_steps, 1e-6) << c.speed << " m/s";
+    }
+  }
+}
+
 TEST(SimTrial, LabelRule) {
   EXPECT_EQ(label_outcome(true, 0.0), Outcome::Missed);
   EXPECT_EQ(label_outcome(false, 0.07), Outcome::Good);
