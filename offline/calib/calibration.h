@@ -160,7 +160,8 @@ struct TrialRequest {
 
 struct SimulatedTrial {
   std::vector<HapticSample> samples;
-  Outcome outcome = Outcome::Missed;  // the automatic label of paper V-A
+  // The automatic label of paper V-A; none when the simulation blew up (sim::TrialResult::outcome).
+  std::optional<Outcome> outcome = Outcome::Missed;
   bool finite = true;                 // false: the simulation blew up (ranked worst)
   // false: the gown was still moving when its settling gave up (sim::TrialResult::settled,
   // sim::TrialSpec::settle_max_steps) and the pull began from it; the paper's robot waits.

@@ -171,7 +171,7 @@ Prediction predict_others(const Calibration& cal, const Dataset& ds, const Trial
                                 : std::numeric_limits<double>::infinity();
       b[kSign] = vertical_sign_agreement(st.samples, target.samples);
       b[kSimEnd] = st.samples.back().travel;
-      b[kOutcome] = static_cast<double>(static_cast<int>(st.outcome));
+      b[kOutcome] = st.outcome ? static_cast<double>(static_cast<int>(*st.outcome)) : -1.0;  // -1: none
       b[kCount] = static_cast<double>(st.samples.size());
       double* col = b + kColumns;
       for (std::size_t i = 0; i < st.samples.size(); ++i) {
@@ -210,7 +210,7 @@ Prediction predict_others(const Calibration& cal, const Dataset& ds, const Trial
     t.vertical_sign = b[kSign];
     t.simulated_end = b[kSimEnd];
     t.measured_end = target.samples.back().travel;
-    t.simulated_outcome = static_cast<Outcome>(static_cast<int>(b[kOutcome]));
+    if (b[kOutcome] >= 0) t.simulated_outcome = static_cast<Outcome>(static_cast<int>(b[kOutcome]));
     const double* col = b + kColumns;
     for (int i = 0; i < static_cast<int>(b[kCount]); ++i)
       t.simulated.push_back(
@@ -250,8 +250,8 @@ std::string prediction_csv(const Prediction& p) {
   for (const auto& t : p.trials)
     o << t.trial_id << ',' << t.participant << ',' << arm_height_name(t.height) << ',' << t.speed << ',' << t.objective
       << ',' << t.real_median << ',' << t.real_count << ',' << t.vertical_sign << ',' << t.simulated_end << ','
-      << t.measured_end << ',' << outcome_name(t.simulated_outcome) << ',' << p.gown << ',' << (p.discrepancy ? 1 : 0)
-      << '\n';
+      << t.measured_end << ',' << (t.simulated_outcome ? outcome_name(*t.simulated_outcome) : "") << ',' << p.gown
+      << ',' << (p.discrepancy ? 1 : 0) << '\n';
   return o.str();
 }
 

@@ -17,6 +17,7 @@
 
 #include <cmath>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -36,7 +37,8 @@ struct PredictedTrial {
   double vertical_sign = 0;   // vertical_sign_agreement(simulated, measured); NaN: none to agree on
   double simulated_end = 0;   // [m] travel where the simulated pull stopped
   double measured_end = 0;    // [m] and the measured one
-  Outcome simulated_outcome = Outcome::Missed;  // the simulator's own label (paper V-A)
+  // The simulator's own label (paper V-A); none when its simulation did not stay finite.
+  std::optional<Outcome> simulated_outcome;
   std::vector<HapticSample> simulated;          // the simulated curve, for the overlay plots
 };
 
@@ -124,8 +126,9 @@ std::pair<double, int> real_person_median(const Dataset& ds, const HapticSequenc
 std::vector<PredictionSummary> summarize(const Prediction& p);
 
 // Per-trial table (CSV: trial_id,participant,height,speed,objective,real_median,real_count,
-// vertical_sign,simulated_end,measured_end,simulated_outcome,gown,discrepancy; the last two the
-// same on every row, discrepancy 0 or 1, for the plots' titles) and the curves for the overlay
+// vertical_sign,simulated_end,measured_end,simulated_outcome,gown,discrepancy; simulated_outcome
+// empty for a simulation that did not stay finite; the last two the same on every row,
+// discrepancy 0 or 1, for the plots' titles) and the curves for the overlay
 // plot (CSV: trial_id,source,travel,f_motion,f_vertical; source "measured" or
 // simulated_source(p)).
 std::string prediction_csv(const Prediction& p);

@@ -77,7 +77,7 @@ MiddleEdge locate_middle_edge(const Calibration& cal, const TrialSimulator& sim,
       q.max_travel = cal.rig_travel;
       const SimulatedTrial st = sim(cal.cloth, q);
       if (!st.finite) throw std::runtime_error("locate_middle_edge: the simulation did not stay finite");
-      r[0] = static_cast<double>(st.outcome);
+      r[0] = static_cast<double>(st.outcome.value());
     });
     e.trials += 2;
     return std::array<Outcome, 2>{static_cast<Outcome>(static_cast<int>(res[0])),
@@ -133,8 +133,8 @@ ArmBand locate_repeat_band(const Calibration& cal, const TrialSimulator& sim, Ar
     throw std::runtime_error(std::string("locate_repeat_band: the calibrated ") + name +
                              " arm's trial did not stay finite");
   ArmBand b;
-  b.at_calibrated = reference.outcome;
-  b.tolerance = reference.outcome == Outcome::Missed ? kRepeatDistanceMissed : kRepeatDistanceGood;
+  b.at_calibrated = reference.outcome.value();
+  b.tolerance = b.at_calibrated == Outcome::Missed ? kRepeatDistanceMissed : kRepeatDistanceGood;
   for (int k = -k_max; k <= k_max; ++k)
     if (k != 0) b.offsets.push_back(k * step);
   const int n = static_cast<int>(b.offsets.size());
@@ -206,8 +206,8 @@ constexpr double kNotFiniteCode = -1.0;  // its label code in the results
 // label alone (their evidence reads as NaN, unknown) or no third line (taken as settled).
 std::string marker_text(const SimulatedTrial& st) {
   char buf[160];
-  std::snprintf(buf, sizeof buf, "%s\n%.17g %.17g\n%s", std::string(outcome_name(st.outcome)).c_str(), st.d_behind,
-                st.d_ahead, st.settled ? "" : "unsettled\n");
+  std::snprintf(buf, sizeof buf, "%s\n%.17g %.17g\n%s", std::string(outcome_name(st.outcome.value())).c_str(),
+                st.d_behind, st.d_ahead, st.settled ? "" : "unsettled\n");
   return buf;
 }
 struct Marker {
@@ -419,7 +419,7 @@ SynthesisSummary synthesize(const Calibration& cal, const TrialSimulator& sim, c
           } else {
             write_file_atomic(csv, format_trial_csv(st.samples));
             write_file_atomic(marker, marker_text(st));
-            r[0] = static_cast<double>(st.outcome);
+            r[0] = static_cast<double>(st.outcome.value());
             r[2] = st.d_behind;
             r[3] = st.d_ahead;
             r[4] = st.settled ? 1.0 : 0.0;

@@ -178,7 +178,7 @@ int run_predict(int argc, char** argv) {
     std::printf("  %-18s %-6s %8.3f %8.3f (%2d) %9.0f%% %8.3f m %8.3f m  %s\n", t.trial_id.c_str(),
                 std::string(arm_height_name(t.height)).c_str(), t.objective, t.real_median, t.real_count,
                 100 * t.vertical_sign, t.simulated_end, t.measured_end,
-                std::string(outcome_name(t.simulated_outcome)).c_str());
+                t.simulated_outcome ? std::string(outcome_name(*t.simulated_outcome)).c_str() : "none");
   for (const auto& s : sum)
     if (s.trials > 0)
       std::printf("%-6s median L %.3f against %.3f between real people; no worse on %d of %d; Fv sign %.0f%%\n",

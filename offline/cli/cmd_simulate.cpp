@@ -240,7 +240,7 @@ int run_simulate(int argc, char** argv) {
                 "\"opening\": {\"depth\": %.4f, \"height\": %.4f, \"width\": %.4f, \"centre_y\": %.4f, "
                 "\"perimeter_ratio\": %.4f, \"rim_low_above_fist\": %.4f}, "
                 "\"grip\": {\"depth\": %.6g, \"rim_ahead\": %.6g}, \"out\": ",
-                std::string(outcome_name(r.outcome)).c_str(), hs.c_str(), r.arm_offset, spec.speed,
+                std::string(sim::label_name(r)).c_str(), hs.c_str(), r.arm_offset, spec.speed,
                 static_cast<unsigned long long>(spec.seed), spec.gown_noise ? "true" : "false", gs.c_str(), fr.c_str(),
                 r.travel, r.d_max, r.d_behind, r.d_ahead, r.stopped_by_force ? "true" : "false", r.contact_travel, r.seq.samples.size(),
                 last.f_motion, last.f_lateral, last.f_vertical, r.weight, r.support_load, r.area_ratio, r.settle_time,
@@ -257,7 +257,7 @@ int run_simulate(int argc, char** argv) {
   // The label and the trial's conditions on every row, so that the CSV alone says what it is
   // (issue 5); readers of trial CSVs skip columns after the five (core/dataset.h).
   const std::vector<ConstantColumn> about = {
-      {"label", std::string(outcome_name(r.outcome))},
+      {"label", std::string(sim::label_name(r))},
       {"height", std::string(arm_height_name(spec.height))},
       {"speed", format_string("%.9g", spec.speed)},
       {"arm_offset", format_string("%.9g", r.arm_offset)},
@@ -267,7 +267,7 @@ int run_simulate(int argc, char** argv) {
     std::printf("%s\n", b.c_str());
   } else {
     std::printf("%s at %s arm (offset %+.3f m): travel %.3f m, d_max %.3f m, final F motion %.2f N vertical %.2f N -> %s\n",
-                std::string(outcome_name(r.outcome)).c_str(), hs.c_str(), r.arm_offset, r.travel, r.d_max,
+                std::string(sim::label_name(r)).c_str(), hs.c_str(), r.arm_offset, r.travel, r.d_max,
                 last.f_motion, last.f_vertical, out.c_str());
     std::printf("  opening at the start of the pull: %.1f cm below the jaws, %.1f cm tall, %.1f cm wide, centre y %+.1f cm,"
                 " rim %.0f %% of its rest length; its lowest point %+.1f cm from the fist's centre\n",

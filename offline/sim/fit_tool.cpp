@@ -171,8 +171,8 @@ int main(int argc, char** argv) {
             char buf[256];
             std::snprintf(buf, sizeof buf, "%s,%.5f,%.5f,%s,%.4f,%s,%.4f,%.4f", p.key().c_str(),
                           calib::area_objective(rg.seq.samples, good), calib::area_objective(rm.seq.samples, miss),
-                          std::string(outcome_name(rg.outcome)).c_str(), rg.travel,
-                          std::string(outcome_name(rm.outcome)).c_str(), rm.travel,
+                          std::string(sim::label_name(rg)).c_str(), rg.travel,
+                          std::string(sim::label_name(rm)).c_str(), rm.travel,
                           rm.seq.samples.empty() ? 0.0 : rm.seq.samples.back().f_motion);
             line = buf;
             csv += line + "\n";
@@ -201,8 +201,8 @@ int main(int argc, char** argv) {
   std::printf("best: friction %.3f stretch %.3f bend %.3f offset %.3f grip %.3f: L_good %.3f (%s, travel %.3f vs measured %.3f), "
               "L_miss %.3f (%s, final drag %.2f vs measured %.2f N)\n",
               best_p.friction, best_p.stretch, best_p.bend, best_p.offset, best_p.grip, calib::area_objective(rg.seq.samples, good),
-              std::string(outcome_name(rg.outcome)).c_str(), rg.travel, good.back().travel,
-              calib::area_objective(rm.seq.samples, miss), std::string(outcome_name(rm.outcome)).c_str(),
+              std::string(sim::label_name(rg)).c_str(), rg.travel, good.back().travel,
+              calib::area_objective(rm.seq.samples, miss), std::string(sim::label_name(rm)).c_str(),
               rm.seq.samples.empty() ? 0.0 : rm.seq.samples.back().f_motion, miss.back().f_motion);
   return 0;
 }

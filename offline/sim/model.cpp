@@ -252,6 +252,12 @@ Scene make_scene(const ClothMesh& mesh, const SceneOptions& opt) {
   if (d->grasp_list.empty() && opt.require_grasp) throw std::invalid_argument("make_scene: no vertex of '" + mesh.name + "' is inside the jaw box");
   for (int v : mesh.sleeve_opening)
     if (v < 0 || v >= n) throw std::invalid_argument("make_scene: sleeve opening vertex " + std::to_string(v) + " out of range");
+  // The label of a trial that the force limit stops is the opening's lower half against the
+  // elbow (paper V-A): an arm without an opening labelled every such trial good (d_max 0).
+  if (opt.with_arm && mesh.sleeve_opening.empty())
+    throw std::invalid_argument("make_scene: '" + mesh.name + "' has no sleeve opening (ClothMesh::sleeve_opening), "
+                                "which a scene with the arm needs to label its trials; give one, or build the scene "
+                                "without the arm (SceneOptions::with_arm false)");
   d->opening = std::vector<int32_t>(mesh.sleeve_opening.begin(), mesh.sleeve_opening.end());
   d->rim_distance.assign(n, std::numeric_limits<double>::infinity());
   for (int i = 0; i < n; ++i)

@@ -197,7 +197,7 @@ std::string scene_json(const Scene& scene, const ClothParams& params, const Tria
   for (size_t k = 0; k < sc.grasp_list.size(); ++k) o << (k ? "," : "") << sc.grasp_list[k];
   o << "], \"opening\": [";
   for (size_t k = 0; k < sc.opening.size(); ++k) o << (k ? "," : "") << sc.opening[k];
-  o << "],\n\"label\": \"" << outcome_name(r.outcome) << "\", \"travel\": " << r.travel << ", \"d_max\": " << r.d_max << ", \"contact_travel\": " << r.contact_travel
+  o << "],\n\"label\": \"" << label_name(r) << "\", \"travel\": " << r.travel << ", \"d_max\": " << r.d_max << ", \"contact_travel\": " << r.contact_travel
     << ", \"height\": \"" << arm_height_name(spec.height) << "\", \"arm_offset\": " << r.arm_offset << ",\n\"frames\": [";
   for (size_t f = 0; f < r.frames.size(); ++f) {
     const Frame& fr = r.frames[f];

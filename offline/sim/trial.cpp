@@ -69,6 +69,8 @@ Outcome label_outcome(bool full_travel, double d_max) {
   return d_max <= kGoodLabelDistance ? Outcome::Good : Outcome::Caught;
 }
 
+std::string_view label_name(const TrialResult& r) { return r.outcome ? outcome_name(*r.outcome) : "none"; }
+
 namespace {
 
 // Settling (settle()): the gown perturbation's output steps, and the rest check's window and
@@ -423,7 +425,7 @@ TrialResult finish_pull(const GownModel& m, Pulling& p, const TrialSpec& spec, c
   r.travel = Profile{spec.acceleration, spec.speed, spec.max_travel}.travel(p.t);
   r.self_pairs_dropped = s.pairs_dropped;
   r.d_max = r.d_behind = r.d_ahead = 0;
-  if (!p.full) {
+  if (!p.full && r.finite) {
     // The elbow where the (compliant) arm has it now.
     for (int v : at_rest.lower) {
       const double dx = s.x[v].x - (m.elbow.x + s.arm_shift.x);
@@ -432,7 +434,8 @@ TrialResult finish_pull(const GownModel& m, Pulling& p, const TrialSpec& spec, c
     }
     r.d_max = std::max(r.d_behind, r.d_ahead);  // the paper's unsigned distance
   }
-  r.outcome = label_outcome(p.full, r.d_max);
+  // A gown that blew up has no opening to measure (its NaN distances left d_max at 0): no label.
+  r.outcome = r.finite ? std::optional<Outcome>(label_outcome(p.full, r.d_max)) : std::nullopt;
   r.seq.label = r.outcome;
   r.area_ratio = current_area(m, s) / m.scene->rest_area;
   r.arm_shift = {s.arm_shift.x, s.arm_shift.y, s.arm_shift.z};

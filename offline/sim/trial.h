@@ -26,7 +26,9 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "haptic.h"
@@ -244,9 +246,12 @@ struct PausedPull;
 
 struct TrialResult {
   double arm_offset = 0;            // [m] the arm offset used (spec.arm_offset plus the arm noise)
-  HapticSequence seq;               // samples from the start of the pull; label set
-  Outcome outcome = Outcome::Missed;
-  double d_max = 0;                 // [m] paper V-A label distance (NaN-free; 0 when missed)
+  HapticSequence seq;               // samples from the start of the pull; label as `outcome`
+  // The label of paper V-A; none when the trial did not stay finite (`finite` false). A gown
+  // that blew up has no opening to measure: its d_max stayed 0, so a trial that diverged while
+  // settling (no pull sample) or before the end of travel was labelled good.
+  std::optional<Outcome> outcome;
+  double d_max = 0;                 // [m] paper V-A label distance (NaN-free; 0 when missed or not finite)
   // d_max's two sides, 0 when missed: the most a lower-half vertex of the opening lags behind the
   // elbow centre (on the forearm's side, x below it) and the most one has gone past it (x above;
   // the pull runs along +x). d_max = max(d_behind, d_ahead): the paper's distance has no sign.
@@ -351,7 +356,9 @@ class Scene {
 
 // Builds the constant model: topology, constraint lists (stretch edges, shear triangles,
 // bending stencils), rest lengths, bending matrices, the arm, the grasp set. Throws
-// std::invalid_argument naming the problem (empty mesh, bad index, no grasped vertex...).
+// std::invalid_argument naming the problem (empty mesh, bad index, no grasped vertex, an arm
+// without a sleeve opening: the outcome is labelled from the opening's lower half, and without
+// one every trial that the force limit stopped was labelled good).
 // Masses are derived from ClothParams::areal_density at trial time.
 Scene make_scene(const ClothMesh& mesh, const SceneOptions& opt = {});
 
@@ -420,5 +427,7 @@ TrialResult resume_trial(const PausedPull& paused);
 
 // The label rule of paper V-A from the final state; exposed for tests.
 Outcome label_outcome(bool full_travel, double d_max);
+// The trial's label by name (outcome_name), "none" for a trial without one (not finite).
+std::string_view label_name(const TrialResult& r);
 
 }  // namespace dressguard::sim

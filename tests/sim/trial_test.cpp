@@ -250,6 +250,67 @@ TEST(SimTrial, GripperAccelerationAddsUpToThePullSpeed) {
   }
 }
 
+namespace {
+
+// A tube held at one end by its top vertices, the free end's ring its opening: a small mesh with
+// everything a labelled trial needs.
+ClothMesh held_tube() {
+  ClothMesh mesh = tube(0.075, -0.4, 0.0, 16, 20);
+  const int top = 19 * 16 + 4;
+  mesh.grasp = {top - 1, top, top + 1};
+  for (int iu = 0; iu < 16; ++iu) mesh.sleeve_opening.push_back(iu);
+  return mesh;
+}
+
+}  // namespace
+
+// A trial whose gown did not stay finite has no label (paper V-A's label needs the opening
+// where it is): here the masses are NaN (a NaN areal density), so the gown blows up while it
+// settles and the pull gives no sample. Its d_max stayed 0, and it was labelled good.
+TEST(SimTrial, ATrialThatBlewUpHasNoLabel) {
+  SceneOptions opt;
+  opt.jaw_close_steps = 0;
+  opt.arm.fist_x = 0.0;
+  const Scene scene = make_scene(held_tube(), opt);
+  ClothParams blows_up;
+  blows_up.areal_density = std::numeric_limits<double>::quiet_NaN();
+  TrialSpec spec;
+  spec.max_travel = 0.05;
+  spec.settle_speed = 0;  // the fixed 500 steps: a NaN gown never comes to rest
+  const TrialResult r = simulate_trial(scene, blows_up, spec);
+  ASSERT_FALSE(r.finite);
+  EXPECT_TRUE(r.seq.samples.empty());
+  EXPECT_FALSE(r.outcome.has_value()) << "labelled " << label_name(r);
+  EXPECT_FALSE(r.seq.label.has_value());
+  EXPECT_EQ(label_name(r), std::string_view("none"));
+  EXPECT_EQ(r.d_max, 0.0);
+  const std::vector<TrialResult> both = simulate_trials(scene, blows_up, {spec, spec});
+  for (const TrialResult& b : both) EXPECT_FALSE(b.outcome.has_value()) << "simulate_trials: " << label_name(b);
+  // The same scene with a finite gown is labelled.
+  const TrialResult fine = simulate_trial(scene, ClothParams{}, spec);
+  EXPECT_TRUE(fine.finite);
+  EXPECT_TRUE(fine.outcome.has_value());
+  EXPECT_EQ(fine.seq.label, fine.outcome);
+}
+
+// A scene with the arm needs a sleeve opening: the label of a trial that the force limit stops
+// is the opening's lower half against the elbow, and without one d_max stayed 0, so every such
+// trial was labelled good. make_scene says so; a scene without the arm needs none.
+TEST(SimTrial, AnArmWithoutASleeveOpeningIsRefused) {
+  ClothMesh mesh = held_tube();
+  mesh.sleeve_opening.clear();
+  try {
+    make_scene(mesh, SceneOptions{});
+    ADD_FAILURE() << "a scene with the arm and no opening was built";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("'tube' has no sleeve opening"), std::string::npos) << e.what();
+  }
+  SceneOptions no_arm;
+  no_arm.with_arm = false;
+  EXPECT_NO_THROW(make_scene(mesh, no_arm));
+  EXPECT_NO_THROW(make_scene(held_tube(), SceneOptions{}));
+}
+
 TEST(SimTrial, LabelRule) {
   EXPECT_EQ(label_outcome(true, 0.0), Outcome::Missed);
   EXPECT_EQ(label_outcome(false, 0.07), Outcome::Good);
@@ -321,14 +382,15 @@ TEST(SimTrial, ThreeOutcomesFromArmHeightAlone) {
   for (size_t k = 0; k < offsets.size(); ++k) {
     const TrialResult& r = results[k];
     std::printf("arm offset %+.2f m: %-7s travel %.3f m, d_max %.3f m (behind the elbow %.3f, past it %.3f)\n", offsets[k],
-                std::string(outcome_name(r.outcome)).c_str(), r.travel, r.d_max, r.d_behind, r.d_ahead);
+                std::string(label_name(r)).c_str(), r.travel, r.d_max, r.d_behind, r.d_ahead);
     // The label's two sides make up its unsigned distance; a missed trial has neither.
     EXPECT_EQ(r.d_max, std::max(r.d_behind, r.d_ahead)) << offsets[k];
     if (r.outcome == Outcome::Missed) {
       EXPECT_EQ(r.d_behind, 0.0);
       EXPECT_EQ(r.d_ahead, 0.0);
     }
-    if (seen.empty() || seen.back() != r.outcome) seen.push_back(r.outcome);
+    ASSERT_TRUE(r.outcome.has_value()) << offsets[k];
+    if (seen.empty() || seen.back() != *r.outcome) seen.push_back(*r.outcome);
   }
   const std::vector<Outcome> want = {Outcome::Good, Outcome::Caught, Outcome::Missed};
   EXPECT_EQ(seen, want);
@@ -387,7 +449,7 @@ TEST(SimTrial, PlausibleAgainstMeasuredParticipant4) {
   for (const Point& q : grid) {
     const double l = calib::area_objective(q.g.seq.samples, good) + calib::area_objective(q.m.seq.samples, miss);
     std::printf("friction %.2f stretch %.2f: L %.3f (high: %s %.3f m, low: %s %.3f m, %.2f N)\n", q.friction, q.stretch, l,
-                std::string(outcome_name(q.g.outcome)).c_str(), q.g.travel, std::string(outcome_name(q.m.outcome)).c_str(),
+                std::string(label_name(q.g)).c_str(), q.g.travel, std::string(label_name(q.m)).c_str(),
                 q.m.travel, q.m.seq.samples.back().f_motion);
     if (q.m.outcome == Outcome::Missed && l < best) best = l, chosen = &q;
   }
@@ -665,6 +727,7 @@ TEST(SimTrial, NoSharedSettlingWhereAnArmTouchesTheGown) {
   ClothMesh mesh = tube(0.075, -0.4, 0.0, 16, 20);
   const int top = 19 * 16 + 4;
   mesh.grasp = {top - 1, top, top + 1};
+  for (int iu = 0; iu < 16; ++iu) mesh.sleeve_opening.push_back(iu);  // the free end's ring (labels)
   SceneOptions opt;
   opt.jaw_close_steps = 0;
   opt.arm.fist_x = 0.0;                    // the fist right under the grasp
@@ -706,6 +769,7 @@ TEST(SimTrial, SharedSettlingWhereAnArmCameNearButDidNotTouch) {
   ClothMesh mesh = tube(0.075, -0.4, 0.0, 16, 20);
   const int top = 19 * 16 + 4;
   mesh.grasp = {top - 1, top, top + 1};
+  for (int iu = 0; iu < 16; ++iu) mesh.sleeve_opening.push_back(iu);  // the free end's ring (labels)
   int near_shared = 0, touched = 0;
   for (int mm = 310; mm <= 350; mm += 5) {
     SceneOptions opt;

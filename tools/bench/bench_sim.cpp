@@ -108,7 +108,7 @@ Figures run(GownResolution res, double max_travel) {
   f.settle_sim = settled.settle_time;  // until the gown is at rest (TrialSpec::settle_speed)
   f.pull_wall = f.trial_cpu - settle_cpu;
   f.pull_sim = r.seq.samples.empty() ? 0 : r.seq.samples.back().t;
-  std::snprintf(f.label, sizeof f.label, "%s", std::string(outcome_name(r.outcome)).c_str());
+  std::snprintf(f.label, sizeof f.label, "%s", std::string(label_name(r)).c_str());
   f.travel = r.travel;
   return f;
 }
