@@ -413,7 +413,7 @@ TEST(SimCalibration, Participant4sTrialsShareTheirSettlingAndPullPrefix) {
 // selected by the run's seed 1) fit at L <= 0.3 each, near the floor of two repeats of one
 // person's trial (issue 4: 0.09 good, 0.22 missed), and give the objectives the search recorded,
 // to the bit: the file holds everything the simulation needs, and the simulator has not changed
-// since the search.
+// since the search or the file's last `calibrate --rescore` (its provenance's "rescored").
 // Each sequence at L <= at_most (the issue's 0.3 unless said), and a contrast term, where the
 // file records one, to the bit too.
 // `fits`, when given, receives each sequence's L (empty when the test was skipped).
