@@ -151,18 +151,28 @@ TEST(SimTrial, SamplesFollowTheRig) {
   EXPECT_NEAR(-r.bias[2], r.weight, 0.01 * r.weight);
 }
 
+namespace {
+
+// A 3 x 3 patch held whole by the gripper, no arm: nothing but the gripper moves it, and no force
+// stops its pull.
+Scene held_patch_scene() {
+  ClothMesh mesh = grid_patch({0, 0, 0}, {0.5, 0, 0}, {0, 0.5, 0}, 3, 3);
+  for (int i = 0; i < 9; ++i) mesh.grasp.push_back(i);
+  SceneOptions opt;
+  opt.with_arm = false;
+  opt.jaw_close_steps = 0;
+  return make_scene(mesh, opt);
+}
+
+}  // namespace
+
 // simulate_trial() checks its spec before it simulates and names the field: a speed or an
 // acceleration of 0 pulled forever (the travel never reached max_travel, and the time limit,
 // max_time_of(), was infinite), and so did an infinite end of travel; a NaN arm offset or frame
 // time, a negative settling or a height beyond the three were taken too. simulate_trials()
 // checks every spec alike. With the gripper holding the whole patch no force stops a pull.
 TEST(SimTrial, ABadSpecIsRefusedNamingItsField) {
-  ClothMesh mesh = grid_patch({0, 0, 0}, {0.5, 0, 0}, {0, 0.5, 0}, 3, 3);
-  for (int i = 0; i < 9; ++i) mesh.grasp.push_back(i);
-  SceneOptions opt;
-  opt.with_arm = false;
-  opt.jaw_close_steps = 0;
-  const Scene scene = make_scene(mesh, opt);
+  const Scene scene = held_patch_scene();
   const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
   struct Case {
     const char* field;
@@ -214,12 +224,7 @@ TEST(SimTrial, ABadSpecIsRefusedNamingItsField) {
 // summed 1/300 at a time was 0.09999999999999994 after 30 steps, short of v / a = 0.1, so a
 // 31st (46th) step carried the whole 1 m/s^2, and the samples' times were off by ulps.
 TEST(SimTrial, GripperAccelerationAddsUpToThePullSpeed) {
-  ClothMesh mesh = grid_patch({0, 0, 0}, {0.5, 0, 0}, {0, 0.5, 0}, 3, 3);
-  for (int i = 0; i < 9; ++i) mesh.grasp.push_back(i);
-  SceneOptions opt;
-  opt.with_arm = false;
-  opt.jaw_close_steps = 0;
-  const Scene scene = make_scene(mesh, opt);
+  const Scene scene = held_patch_scene();
   struct Case {
     double speed, acceleration;
     int ramp_steps;  // output steps that carry the acceleration; -1: the ramp ends inside one
