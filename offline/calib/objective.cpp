@@ -59,14 +59,40 @@ std::size_t first_at_or_beyond(const std::vector<HapticSample>& seq, double x) {
   return std::min(static_cast<std::size_t>(it - seq.begin()), seq.size() - 1);
 }
 
+// The speed of a recording's stamp [m/s]: (x_last - x_first) / (t_last - t_first). The stamp is a
+// constant-speed profile (core/haptic.h), so this is the pull's speed; 0 when the sequence has no
+// span of time or travel to tell it by.
+double stamp_speed(const std::vector<HapticSample>& seq) {
+  const double dt = seq.back().t - seq.front().t, dx = seq.back().travel - seq.front().travel;
+  const double v = dt > 0.0 ? dx / dt : 0.0;
+  return std::isfinite(v) && v > 0.0 ? v : 0.0;
+}
+
+// The index of `seq` whose time is nearest to t (the later one of a tie; its ends beyond them).
+std::size_t nearest_in_time(const std::vector<HapticSample>& seq, double t) {
+  const auto it = std::lower_bound(seq.begin(), seq.end(), t, [](const HapticSample& s, double v) { return s.t < v; });
+  if (it == seq.begin()) return 0;
+  if (it == seq.end()) return seq.size() - 1;
+  const std::size_t k = static_cast<std::size_t>(it - seq.begin());
+  return t - seq[k - 1].t < seq[k].t - t ? k - 1 : k;
+}
+
 }  // namespace
 
 PairedStart paired_start(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured) {
   require_samples(sim, measured);
   const double xs = sim.front().travel, xm = measured.front().travel;
-  if (xm - xs > kLateStart) return {first_at_or_beyond(sim, xm), 0};
-  if (xs - xm > kLateStart) return {0, first_at_or_beyond(measured, xs)};
-  return {};
+  if (std::abs(xm - xs) <= kLateStart) return {};
+  const double v = stamp_speed(measured);
+  if (xm - xs > kLateStart) {
+    // The recording starts late: its first sample is x_m / v into the pull by the stamp, and the
+    // simulation's clock is the pull's.
+    if (v > 0.0) return {nearest_in_time(sim, xm / v), 0};
+    return {first_at_or_beyond(sim, xm), 0};
+  }
+  // The simulation starts late (a pull simulated from further along): the measured sample whose
+  // stamp is where the pull is at the simulation's first time.
+  return {0, first_at_or_beyond(measured, v > 0.0 ? v * sim.front().t : xs)};
 }
 
 namespace {

@@ -23,13 +23,18 @@
 // s0-middlemiss-10, the one trial at 0.15 m/s, starts 0.0958 m into its pull.
 // Paired from the simulation's first sample, each of its samples met a simulated one 0.096 m
 // behind it, and the 67 simulated samples left at the end were scored at w = 20 (session 45:
-// 0.53 of participant 0's middle-arm L 1.10). So when one sequence starts more than kLateStart
-// (5 mm, core/haptic.h) further along than the other, the earlier one's samples before that
-// travel are skipped and i = 0 pairs the later start with the first sample at or beyond its
-// travel (paired_start). The 5 mm leave every recording that starts with the pull paired as the
-// paper pairs it. The two travels are not quite one scale: the simulation's is the ramped
-// profile's, the recording's the constant-speed stamp's, so at 0.15 m/s the simulated sample at
-// 0.0958 m comes 0.075 s (v / 2a) later in the pull than the measured one at the same stamp.
+// 0.53 of participant 0's middle-arm L 1.10). So when the recording starts more than kLateStart
+// (5 mm, core/haptic.h) further along than the simulation, i = 0 pairs its first sample with the
+// simulated sample at the same time of the pull (paired_start), as eq. 3's index does for the
+// pulls recorded from their start. That time is the stamp's: x_m / v, v the stamp's own speed
+// (0.0958 m at 0.15 m/s is 0.639 s, the simulated sample at 0.64 s). Not the same travel: the
+// simulation's travel is the ramped profile's and the stamp leads it by v^2 / 2a once the ramp is
+// over (11 mm at 0.15 m/s), so pairing equal travels (sessions 45-91) paired the recording's
+// first sample with the simulated one 0.075 s (v / 2a) later in the pull, at 0.714 s. A
+// simulation that starts late (none does: the simulator records from the pull's start) pairs
+// its first sample with the measured one stamped where the pull is at its time, v t. The 5 mm
+// leave every recording that starts with the pull paired as the paper pairs it. The first
+// argument is the simulation: its t is the pull's time, the recording's t its own clock.
 //
 // PositionWeighted: the variant in the paper's public code (gt-rad/learning-forces,
 // physx_simulation CMAES HapticObjective, evalObj), described here in our own words as we read
@@ -61,8 +66,9 @@ enum class ForceAxis { Motion, Vertical, Lateral };
 inline constexpr double kLengthPenaltyWeight = 20.0;  // w of eq. 4
 
 // The first index of each sequence that eq. 3 pairs (i = 0): both 0 unless one starts more than
-// kLateStart further along; then the other's first sample at or beyond that travel (its last
-// sample if it never gets there).
+// kLateStart further along; then the other's sample at the same time of the pull ("Where the
+// pairs begin"; its last sample if it never gets there). A recording whose stamp does not
+// advance (no speed to read its time by) is paired from the same travel.
 struct PairedStart {
   std::size_t sim = 0;
   std::size_t measured = 0;

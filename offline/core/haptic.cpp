@@ -47,7 +47,8 @@ std::size_t unrecorded_samples(const HapticSequence& trial) {
   if (trial.samples.empty() || trial.samples.front().travel <= kLateStart) return 0;
   const double period = trial.samples.size() >= 2 ? mean_sample_period(trial) : 0.01;
   if (!(period > 0.0)) return 0;  // a recording without time: nothing to say where it began
-  return static_cast<std::size_t>(std::lround(pull_time_at(trial.samples.front().travel, trial.speed) / period));
+  if (!(trial.speed > 0.0)) return 0;  // no speed to read the stamp's time by
+  return static_cast<std::size_t>(std::lround(trial.samples.front().travel / trial.speed / period));
 }
 
 double mean_sample_period(const HapticSequence& trial) {

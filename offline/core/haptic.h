@@ -30,9 +30,9 @@ inline constexpr double kRigAcceleration = 1.0;  // [m/s^2]
 // A recording "starts late" when its first sample is more than kLateStart into the pull. 21 of
 // the study's 22 recordings start within 1.1 mm; s0-middlemiss-10, the one trial at 0.15 m/s,
 // starts 0.0958 m in. Whatever compares such a recording with one that starts with the pull must
-// begin at the same point of the pull: the objective pairs from the same travel
-// (calib/objective.h, "Where the pairs begin"), the HMMs start their chain that many samples on
-// (hmm/hmm.h, FeatureSequence::unobserved).
+// begin at the same point of the pull, read by the stamp as x / v: the objective pairs it with
+// the simulated sample of that time (calib/objective.h, "Where the pairs begin"), the HMMs start
+// their chain that many samples on (hmm/hmm.h, FeatureSequence::unobserved).
 //
 // What the recordings' position column is. The study stamped it from the commanded motion
 // profile (data README), and in all 22 recordings it advances at the pull's speed from the first
@@ -76,12 +76,11 @@ struct HapticSequence {
 };
 
 // How many samples of `trial`'s pull went unrecorded before its first one: 0 unless it starts
-// late (kLateStart); then the pull's time at the first sample's travel (pull_time_at, at the
-// trial's speed) over the recording's mean sample period, rounded (0.01 s when it has fewer than
-// two samples). s0-middlemiss-10: 0.0958 m at 0.15 m/s is 0.714 s, 71 samples of 10.0 ms.
-// pull_time_at reads the travel as the ramped profile's. Read as the constant-speed stamp that
-// it is (kLateStart), 0.0958 m is 0.639 s into the pull, 64 samples: the HMMs' chain starts 7
-// samples (v / 2a) later than that reading puts it.
+// late (kLateStart); then the pull's time at the first sample, read from the constant-speed
+// stamp as travel / speed (the trial's commanded speed), over the recording's mean sample period,
+// rounded (0.01 s when it has fewer than two samples). s0-middlemiss-10: 0.0958 m at 0.15 m/s is
+// 0.639 s, 64 samples of 10.0 ms. Until session 92 the travel was read as the ramped profile's
+// (pull_time_at: 0.714 s, 71 samples), which put the HMMs' chain 7 samples (v / 2a) too far on.
 std::size_t unrecorded_samples(const HapticSequence& trial);
 
 // A recording's mean sample period [s]: (t_last - t_first) / (n - 1); 0 with fewer than 2 samples.

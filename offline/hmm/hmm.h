@@ -64,7 +64,7 @@ using model::kFeatures;
 //
 // A sequence that starts late. The HMMs are trained on pulls recorded from their start, so their
 // chain's time is the pull's time. A recording that begins `unobserved` samples into its pull
-// (core/haptic.h, unrecorded_samples; one study trial begins 71 samples in) is scored from the
+// (core/haptic.h, unrecorded_samples; one study trial begins 64 samples in) is scored from the
 // state distribution the chain has reached by then with nothing observed, pi A^k: the forward
 // recursion over k samples whose emission densities are all 1, i.e. the missing start
 // marginalised out. Scored from pi instead, the late recording's first forces (a pull 0.1 m in)

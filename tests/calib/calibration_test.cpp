@@ -417,7 +417,7 @@ TEST(Calibration, FileOfASearchRecordsItsChoices) {
 // its values kept, and what each figure was in provenance "rescored", one entry per rescoring.
 // The curves are the inputs with F_motion 0.1 N and 0.2 N lower, so each L is that offset times
 // the travel the pairs cover (eq. 3 in closed form); the second input is recorded from its 100th
-// sample on, as s0-middlemiss-10 is, and is paired from the same travel (objective.h).
+// sample on, as s0-middlemiss-10 is, and is paired from the same time of the pull (objective.h).
 TEST(Calibration, RescoreScoresTheFileAgainAndKeepsWhatItReplaced) {
   auto inputs = fake_inputs(Truth{});
   ASSERT_EQ(inputs.size(), 2u);

@@ -126,22 +126,26 @@ TEST(Objective, ContrastErrorClosedForm) {
 }
 
 // A recording that starts late (objective.h, "Where the pairs begin"). The measured curve is the
-// simulated one from 0.096 m on, sample for sample (the forces a function of travel only): paired
-// from the simulation's first sample its L would be the area between the curve and itself
-// shifted by 0.096 m plus the w = 20 tail; paired from the same travel it is 0, exactly, both ways
-// round. A start within kLateStart pairs as the paper pairs (index 0 with 0).
-TEST(Objective, LateStartPairsFromTheSameTravel) {
+// simulated one from 0.96 s on, sample for sample (a pull at 0.1 m/s from the start, forces a
+// function of travel only; the recording's clock its own, from 0): paired from the simulation's
+// first sample its L would be the area between the curve and itself shifted by 0.096 m plus the
+// w = 20 tail; paired from the same time of the pull, 0.096 m / 0.1 m/s, it is 0, exactly. A
+// simulation that starts late (its clock the pull's) pairs the same way round. A start within
+// kLateStart pairs as the paper pairs (index 0 with 0).
+TEST(Objective, LateStartPairsFromTheSameTimeOfThePull) {
   const double h = 0.001;
   auto f = [](int k) { return -0.01 * k; };  // F_motion -10 N/m of travel, sample k at k mm
-  std::vector<HapticSample> sim, late;
+  std::vector<HapticSample> sim, late, late_sim;
   for (int k = 0; k <= 850; ++k) sim.push_back({k * 0.01, k * h, f(k), 0.0, 0.5 * f(k)});
   for (int k = 96; k <= 850; ++k) late.push_back({(k - 96) * 0.01, k * h, f(k), 0.0, 0.5 * f(k)});
+  for (int k = 96; k <= 850; ++k) late_sim.push_back({k * 0.01, k * h, f(k), 0.0, 0.5 * f(k)});
   const PairedStart p = paired_start(sim, late);
   EXPECT_EQ(p.sim, 96u);
   EXPECT_EQ(p.measured, 0u);
   EXPECT_EQ(area_objective(sim, late), 0.0);
-  EXPECT_EQ(area_objective(late, sim), 0.0);
-  EXPECT_EQ(paired_start(late, sim).measured, 96u);
+  EXPECT_EQ(paired_start(late_sim, sim).sim, 0u);
+  EXPECT_EQ(paired_start(late_sim, sim).measured, 96u);
+  EXPECT_EQ(area_objective(late_sim, sim), 0.0);
   // Shifted back to start with the pull, the same samples are 0.096 m off: 0.96 N (and 0.48 N)
   // over 0.754 m, plus the simulation's 96 extra samples at w = 20, all in closed form.
   auto early = late;
@@ -160,6 +164,41 @@ TEST(Objective, LateStartPairsFromTheSameTravel) {
   double longer = 0;
   for (int k = 97; k <= 850; ++k) longer += kLengthPenaltyWeight * h * 1.5 * std::abs(f(50) - f(k));
   EXPECT_NEAR(area_objective(short_sim, late), longer, 1e-9);
+  // A recording whose stamp does not advance has no speed to read its time by: paired from the
+  // same travel.
+  std::vector<HapticSample> still = late;
+  for (auto& x : still) x.travel = late.front().travel;
+  EXPECT_EQ(paired_start(sim, still).sim, 96u);
+}
+
+// The simulation's travel is the ramped profile's (from rest at 1 m/s^2 to 0.15 m/s), the
+// recording's the constant-speed stamp's (core/haptic.h): v t. A recording that starts 0.64 s
+// into a pull, stamped at 0.096 m, of forces that are the same function of the pull's time as the
+// simulation's (the gripper where the simulated one is at that time), pairs with the simulated
+// sample at 0.64 s, and the two curves are one: L = 0 up to rounding. The simulated sample at the
+// same travel, 0.096 m, is 0.075 s (v / 2a) later (0.715 s, the sample at 0.72 s): paired there
+// (sessions 45-91) every pair was 8 samples apart.
+TEST(Objective, ALateRecordingPairsAtItsStampsTimeOnTheRampedPull) {
+  const double v = 0.15, a = kRigAcceleration, ramp_end = v / a;
+  auto ramped = [&](double t) { return t < ramp_end ? 0.5 * a * t * t : v * (t - 0.5 * ramp_end); };
+  auto g = [](double t) { return -2.0 * t; };  // F_motion [N] against the pull's time [s]
+  std::vector<HapticSample> sim, late;
+  for (int k = 0; k < 500; ++k) {
+    const double t = (k + 1) * 0.01;  // the simulator's first sample is one step into the pull
+    sim.push_back({t, ramped(t), g(t), 0.0, 0.5 * g(t)});
+  }
+  for (int j = 0; j < 437; ++j) {  // 0.64 s to 5.0 s of the pull: both end at its sample at 5.0 s
+    const double t = 0.64 + j * 0.01;
+    late.push_back({j * 0.01, v * t, g(t), 0.0, 0.5 * g(t)});
+  }
+  const PairedStart p = paired_start(sim, late);
+  EXPECT_EQ(p.sim, 63u) << "the simulated sample at 0.64 s";
+  EXPECT_EQ(p.measured, 0u);
+  EXPECT_NEAR(area_objective(sim, late), 0.0, 1e-12);
+  // The same travel is later in the ramped pull.
+  std::size_t same_travel = 0;
+  while (sim[same_travel].travel < late.front().travel) ++same_travel;
+  EXPECT_EQ(same_travel, 71u) << "0.096 m is reached at 0.715 s: the sample at 0.72 s";
 }
 
 TEST(Objective, ParseNames) {
@@ -212,7 +251,7 @@ TEST(Objective, YardstickOnMeasuredRepeats) {
 
 // The study's starts, which kLateStart rests on: every recording but one starts within 1.1 mm of its
 // pull's start; s0-middlemiss-10 (0.15 m/s) starts 0.0958 m in, and only it pairs from a later
-// simulated sample against a pull from 0.
+// simulated sample against a pull from 0 (here one at 0.1 m/s, its sample k at k * 10 ms).
 TEST(Objective, OneStudyRecordingStartsLate) {
   const auto dir = study_dir();
   if (dir.empty()) GTEST_SKIP() << "shared/data/kapusta2016-calibration-trials not present";
@@ -222,10 +261,12 @@ TEST(Objective, OneStudyRecordingStartsLate) {
     const PairedStart p = paired_start(pull, t.samples);
     if (t.id == "s0-middlemiss-10") {
       EXPECT_NEAR(t.samples.front().travel, 0.0958, 5e-5);
-      EXPECT_EQ(p.sim, 96u) << "the simulated sample at 0.096 m";
-      // 0.0958 / 0.15 + 0.15 / 2 = 0.714 s into the pull at its 10.0 ms period: the HMMs start
-      // their chain 71 samples on (hmm.h, FeatureSequence::unobserved).
-      EXPECT_EQ(unrecorded_samples(t), 71u);
+      // By its stamp 0.0958 / 0.15 = 0.639 s into the pull: paired with the simulated sample at
+      // 0.64 s, and at its 10.0 ms period the HMMs start their chain 64 samples on (hmm.h,
+      // FeatureSequence::unobserved). Read as the ramped profile's travel (until session 92),
+      // 0.714 s: the sample at 0.096 m of this pull and 71 samples.
+      EXPECT_EQ(p.sim, 64u) << "the simulated sample at 0.64 s";
+      EXPECT_EQ(unrecorded_samples(t), 64u);
     } else {
       EXPECT_LT(t.samples.front().travel, 0.0011) << t.id;
       EXPECT_EQ(p.sim, 0u) << t.id;
@@ -236,7 +277,7 @@ TEST(Objective, OneStudyRecordingStartsLate) {
 }
 
 // The bound on the study's own trials, each prefix of one trial scored against another trial of
-// the same person (the late-starting s0-middlemiss-10 among them, paired from its travel): never
+// the same person (the late-starting s0-middlemiss-10 among them): never
 // above the whole L, never decreasing, equal to it at the end when the first runs at least as
 // long as the second.
 TEST(Objective, SoFarBoundsTheWholeLOnMeasuredTrials) {

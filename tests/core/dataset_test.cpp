@@ -409,7 +409,8 @@ TEST(Study, RigEndOfTravel) {
 }
 
 // The rig's pull (haptic.h): on the ramp x = a t^2 / 2, after it x = v (t - v / 2a); the two
-// meet at x = v^2 / 2a, t = v / a. A recording counts its unrecorded start in its own periods.
+// meet at x = v^2 / 2a, t = v / a. A recording counts its unrecorded start in its own periods,
+// the time read from its stamp, a constant-speed profile (haptic.h): x / v, not pull_time_at.
 TEST(Pull, TimeAtTravelAndUnrecordedStart) {
   EXPECT_NEAR(pull_time_at(0.005, 0.15), 0.1, 1e-15);                 // sqrt(2 * 0.005 / 1)
   EXPECT_NEAR(pull_time_at(0.01125, 0.15), 0.15, 1e-15);              // the ramp's end, both forms
@@ -421,10 +422,12 @@ TEST(Pull, TimeAtTravelAndUnrecordedStart) {
   s.speed = 0.1;
   for (int i = 0; i < 50; ++i) s.samples.push_back({0.01 * i, 0.004 + 0.001 * i, 0, 0, 0});
   EXPECT_EQ(unrecorded_samples(s), 0u) << "4 mm in is within kLateStart: recorded from the start";
-  for (auto& smp : s.samples) smp.travel += 0.1;  // 0.104 m in: 0.104 / 0.1 + 0.05 = 1.09 s
-  EXPECT_EQ(unrecorded_samples(s), 109u);
+  for (auto& smp : s.samples) smp.travel += 0.1;  // 0.104 m in by the stamp: 0.104 / 0.1 = 1.04 s
+  EXPECT_EQ(unrecorded_samples(s), 104u) << "the ramped reading, 1.09 s, would be 109";
   for (auto& smp : s.samples) smp.t *= 3.0;       // the same start at a 30 ms period
-  EXPECT_EQ(unrecorded_samples(s), 36u);          // 1.09 / 0.03 = 36.3
+  EXPECT_EQ(unrecorded_samples(s), 35u);          // 1.04 / 0.03 = 34.7
+  s.speed = 0.0;                                  // no speed to read the stamp's time by
+  EXPECT_EQ(unrecorded_samples(s), 0u);
   EXPECT_EQ(unrecorded_samples(HapticSequence{}), 0u);
 }
 

@@ -121,7 +121,7 @@ int main(int argc, char** argv) {
       if (!tr.label || outcome_name(*tr.label) != study_label) continue;
       auto f = hmm::features_of(tr, fc);
       // GHMM has no unobserved start (hmm.h, FeatureSequence::unobserved; one study trial begins
-      // 71 samples into its pull): both libraries get each recording as it begins, so that the
+      // 64 samples into its pull): both libraries get each recording as it begins, so that the
       // comparison is of the two algorithms on the same sequences.
       f.unobserved = 0;
       if (tr.participant == held_participant) {
