@@ -82,7 +82,6 @@ std::size_t nearest_in_time(const std::vector<HapticSample>& seq, double t) {
 PairedStart paired_start(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured) {
   require_samples(sim, measured);
   const double xs = sim.front().travel, xm = measured.front().travel;
-  if (std::abs(xm - xs) <= kLateStart) return {};
   const double v = stamp_speed(measured);
   if (xm - xs > kLateStart) {
     // The recording starts late: its first sample is x_m / v into the pull by the stamp, and the
@@ -90,9 +89,12 @@ PairedStart paired_start(const std::vector<HapticSample>& sim, const std::vector
     if (v > 0.0) return {nearest_in_time(sim, xm / v), 0};
     return {first_at_or_beyond(sim, xm), 0};
   }
-  // The simulation starts late (a pull simulated from further along): the measured sample whose
-  // stamp is where the pull is at the simulation's first time.
-  return {0, first_at_or_beyond(measured, v > 0.0 ? v * sim.front().t : xs)};
+  if (xs - xm > kLateStart) {
+    // The simulation starts late (a pull simulated from further along): the measured sample
+    // whose stamp is where the pull is at the simulation's first time.
+    return {0, first_at_or_beyond(measured, v > 0.0 ? v * sim.front().t : xs)};
+  }
+  return {};  // within kLateStart, or a travel that is not a number: paired by index
 }
 
 namespace {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include "dataset.h"
@@ -169,6 +170,12 @@ TEST(Objective, LateStartPairsFromTheSameTimeOfThePull) {
   std::vector<HapticSample> still = late;
   for (auto& x : still) x.travel = late.front().travel;
   EXPECT_EQ(paired_start(sim, still).sim, 96u);
+  // A first travel that is not a number (a simulation that blew up) starts nowhere: paired by
+  // index, not taken for a late start.
+  std::vector<HapticSample> blown = late_sim;
+  blown.front().travel = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(paired_start(blown, sim).sim, 0u);
+  EXPECT_EQ(paired_start(blown, sim).measured, 0u);
 }
 
 // The simulation's travel is the ramped profile's (from rest at 1 m/s^2 to 0.15 m/s), the
