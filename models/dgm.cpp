@@ -1,5 +1,6 @@
 // The .dgm model file: encoding, decoding and validation. The byte layout is FORMAT.md's.
 #include "dgm.h"
+#include "utf8.h"
 
 #include <algorithm>
 #include <array>
@@ -233,32 +234,6 @@ void check_training_speeds(double min_m_s, double max_m_s, const std::string& so
   if (!(min_m_s > 0.0)) fail(source, "speed_min_m_s is not positive" + range);
   if (!(max_m_s <= 2.0)) fail(source, "speed_max_m_s is above 2 m/s" + range);
   if (!(min_m_s <= max_m_s)) fail(source, "speed_min_m_s is above speed_max_m_s" + range);
-}
-
-// Where `s` stops being well-formed UTF-8 (RFC 3629: no overlong forms, no surrogates, nothing
-// above U+10FFFF): the offset of the first byte that begins no valid sequence, or npos.
-size_t invalid_utf8_at(std::string_view s) {
-  size_t i = 0;
-  while (i < s.size()) {
-    const auto c = static_cast<unsigned char>(s[i]);
-    if (c < 0x80) {
-      ++i;
-      continue;
-    }
-    if (c < 0xC0 || c > 0xF7) return i;  // a continuation byte with no lead, or no lead at all
-    const size_t len = c >= 0xF0 ? 4 : c >= 0xE0 ? 3 : 2;
-    const uint32_t least = len == 4 ? 0x10000 : len == 3 ? 0x800 : 0x80;  // below: overlong
-    uint32_t cp = c & (0x7Fu >> len);
-    if (len > s.size() - i) return i;
-    for (size_t k = 1; k < len; ++k) {
-      const auto t = static_cast<unsigned char>(s[i + k]);
-      if ((t & 0xC0u) != 0x80u) return i;
-      cp = (cp << 6) | (t & 0x3Fu);
-    }
-    if (cp < least || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return i;
-    i += len;
-  }
-  return std::string_view::npos;
 }
 
 // A class name is what messages, `model show`, the predictor's logs and JSON print and what

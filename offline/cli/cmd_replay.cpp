@@ -12,6 +12,7 @@
 #include "candump_log.h"
 #include "dgm.h"
 #include "files.h"
+#include "json.h"
 #include "replay.h"
 
 namespace dressguard::cli {
@@ -39,15 +40,6 @@ const char* kHelp =
     "  --json             {stopped, stop_time, travel, reason, posteriors at the stop, ...}\n"
     "  Times are logical: stop_time = the deciding sample's index x the sample period; travel is\n"
     "  the commanded travel at that time (TrialStart's speed, the configured acceleration).";
-
-std::string json_escape(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    if (c == '"' || c == '\\') o += '\\';
-    o += c;
-  }
-  return o;
-}
 
 std::vector<protocol::LoggedFrame> load_log(const std::string& path) {
   try {
@@ -132,8 +124,8 @@ int replay_folder(const std::string& dir,
                     "\"max_p_caught\": %.6f}",
                     t.trial, t.stopped ? "true" : "false", t.stopped ? protocol::stop_reason_name(t.reason) : "none",
                     t.stopped ? t.travel : 0.0, t.stopped ? lead : 0.0, t.max_p_caught);
-      json_logs += std::string(json_logs.empty() ? "" : ", ") + "{\"file\": \"" + json_escape(log.filename().string()) +
-                   "\", \"label\": \"" + label + "\", " + jb;
+      json_logs += std::string(json_logs.empty() ? "" : ", ") + "{\"file\": " + json_string(log.filename().string()) +
+                   ", \"label\": \"" + label + "\", " + jb;
     }
     if (!json) std::printf("%s\n", line.c_str());
   }
@@ -255,16 +247,21 @@ int run_replay(int argc, char** argv) {
     return s + "}";
   };
   auto trial_json = [&](const predictor::ReplayTrial& t) {
-    char buf[1024];
+    // The class names are the model's (up to 65,536 bytes each, models/FORMAT.md): appended, not
+    // printed into the fixed buffer, which holds only the numbers.
+    char buf[512];
     std::snprintf(buf, sizeof buf,
                   "{\"trial_id\": %u, \"stopped\": %s, \"reason\": \"%s\", \"stop_sample\": %u, \"stop_time\": %.3f, "
                   "\"travel\": %.4f, \"log_time\": %.6f, \"f_motion\": %.3f, \"f_vertical\": %.3f, \"samples\": %u, "
-                  "\"max_p_caught\": %.6f, \"posteriors\": {\"%s\": %.6f, \"%s\": %.6f, \"%s\": %.6f}}",
+                  "\"max_p_caught\": %.6f, \"posteriors\": {",
                   t.trial, t.stopped ? "true" : "false", t.stopped ? protocol::stop_reason_name(t.reason) : "none",
-                  t.stop_sample, t.stop_time, t.travel, t.log_time, t.f_motion, t.f_vertical, t.samples, t.max_p_caught,
-                  json_escape(names[0]).c_str(), t.p[0], json_escape(names[1]).c_str(), t.p[1],
-                  json_escape(names[2]).c_str(), t.p[2]);
-    return std::string(buf);
+                  t.stop_sample, t.stop_time, t.travel, t.log_time, t.f_motion, t.f_vertical, t.samples, t.max_p_caught);
+    std::string s = buf;
+    for (size_t c = 0; c < 3; ++c) {
+      std::snprintf(buf, sizeof buf, ": %.6f", t.p[c]);
+      s += (c ? ", " : "") + json_string(names[c]) + buf;
+    }
+    return s + "}}";
   };
   if (args.has("json")) {
     std::string s = "{";
@@ -277,7 +274,7 @@ int run_replay(int argc, char** argv) {
     s += "\"trials\": [";
     for (size_t i = 0; i < r.trials.size(); ++i) s += (i ? ", " : "") + trial_json(r.trials[i]);
     s += "], \"frames\": " + std::to_string(r.frames) + ", \"counters\": " + counters_json();
-    if (!model_error.empty()) s += ", \"model_error\": \"" + json_escape(model_error) + "\"";
+    if (!model_error.empty()) s += ", \"model_error\": " + json_string(model_error);
     std::printf("%s}\n", s.c_str());
     return 0;
   }

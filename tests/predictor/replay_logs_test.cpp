@@ -15,6 +15,7 @@
 
 #include "candump_log.h"
 #include "dgm.h"
+#include "utf8.h"
 #include "replay.h"
 #include "test_model.h"
 
@@ -306,6 +307,42 @@ TEST(ReplayCli, JsonReportsTheStop) {
   EXPECT_EQ(WEXITSTATUS(rc), 2);
   EXPECT_NE(bad3.find("/nonexistent/t.csv"), std::string::npos) << bad3;
   EXPECT_FALSE(fs::exists("/tmp/dg_never.log"));
+}
+
+// `replay --json` is JSON whatever the names it carries hold. A log's file name may be any bytes
+// but NUL: a tab was printed raw (a JSON reader refuses a control character in a string) and a
+// byte that is no UTF-8 passed through (JSON is UTF-8). A model's class names may be 65,536 bytes
+// long: printed into a 1,024-byte buffer, a long one cut the report short, braces and all.
+TEST(ReplayCli, JsonIsJsonWhateverTheNamesHold) {
+  const fs::path dir = fs::temp_directory_path() / ("dg_replay_names_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string odd = "a\tb\xff-caught.log";
+  fs::copy_file(kLogs / "syn2-caught-0-caught.log", dir / odd);
+  auto m = load_model();
+  const std::string long_name = std::string(1500, 'g');
+  ASSERT_NE(m.classes[0].name, "caught");
+  m.classes[0].name = long_name;
+  model::write_model((dir / "m.dgm").string(), m);
+  for (const std::string& what : {std::string(" --logs ") + dir.string(), " --log '" + (dir / odd).string() + "'"}) {
+    int rc = 0;
+    const std::string out = run(std::string(DG_CLI) + " replay --model " + (dir / "m.dgm").string() + what + " --json", rc);
+    ASSERT_EQ(rc, 0) << what << ": " << out;
+    EXPECT_EQ(model::invalid_utf8_at(out), std::string::npos) << what << ": not UTF-8: " << out;
+    // No raw control character but the line's end.
+    EXPECT_EQ(std::count_if(out.begin(), out.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20; }), 1) << out;
+    EXPECT_EQ(out.back(), '\n');
+    if (what.find("--logs") != std::string::npos) {
+      // The file's name as JSON: the tab escaped, the stray byte as U+FFFD.
+      EXPECT_NE(out.find("{\"file\": \"a\\u0009b\xEF\xBF\xBD-caught.log\""), std::string::npos) << out;
+    } else {
+      // The long name whole, with its posterior after it, and the report closed.
+      EXPECT_NE(out.find("\"posteriors\": {\"" + long_name + "\": "), std::string::npos) << out;
+      EXPECT_NE(out.find("\"caught\": "), std::string::npos) << out;
+      EXPECT_EQ(out.substr(out.size() - 2), "}\n");
+    }
+  }
+  fs::remove_all(dir);
 }
 
 // export-candump wrote logs that its own reader refuses: an interface name with a space or of
