@@ -6,29 +6,13 @@
 #include <stdexcept>
 
 #include "files.h"
+#include "objective.h"
 
 namespace dressguard::calib {
 namespace {
 
 // The three forces of a sample in Discrepancy's order.
 std::array<double, 3> forces(const HapticSample& s) { return {s.f_motion, s.f_lateral, s.f_vertical}; }
-
-// Mean force over the samples with travel in [lo, hi); false when there are none.
-bool window_mean(const std::vector<HapticSample>& samples, double lo, double hi, std::array<double, 3>& mean) {
-  std::array<double, 3> sum{};
-  int n = 0;
-  for (const auto& s : samples) {
-    if (s.travel < lo || s.travel >= hi) continue;
-    const auto f = forces(s);
-    for (int k = 0; k < 3; ++k) sum[k] += f[k];
-    ++n;
-  }
-  if (n == 0) return false;
-  for (int k = 0; k < 3; ++k) mean[k] = sum[k] / n;
-  return true;
-}
-
-double last_travel(const std::vector<HapticSample>& s) { return s.empty() ? 0.0 : s.back().travel; }
 
 // r at x on one height's grid (non-empty) that the curves covered up to `end`.
 std::array<double, 3> on_grid(const std::vector<std::array<double, 3>>& r, double end, const DiscrepancyOptions& o,
@@ -64,21 +48,30 @@ Discrepancy measure_discrepancy(const std::vector<HapticSequence>& inputs,
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     const auto& measured = inputs[i].samples;
     const auto& sim = simulated[i].samples;
-    const double end = std::min(last_travel(measured), last_travel(sim));
+    if (measured.empty() || sim.empty()) continue;
+    // Pair k: sim[ps.sim + k] and measured[ps.measured + k], one moment of the pull.
+    const PairedStart ps = paired_start(sim, measured);
+    const std::size_t pairs = std::min(sim.size() - ps.sim, measured.size() - ps.measured);
+    const double end = sim[ps.sim + pairs - 1].travel;
     const int h = static_cast<int>(inputs[i].height);
     std::vector<std::array<double, 3>> r;
     for (int j = 0; j * o.step <= end; ++j) {
-      const double x = j * o.step;
-      std::array<double, 3> m{}, s{};
-      // Near x = 0 the window holds the rig's first samples; a window with no sample on either
-      // side, or one that begins before a late-starting recording does (its mean would hold only
-      // the window's end against the simulator's whole window: records_from), keeps the previous
-      // grid point's value (the curves are continuous).
-      if (records_from(measured, x - o.window / 2) && window_mean(measured, x - o.window / 2, x + o.window / 2, m) &&
-          window_mean(sim, x - o.window / 2, x + o.window / 2, s)) {
-        r.push_back({m[0] - s[0], m[1] - s[1], m[2] - s[2]});
-      } else {
+      const double x = j * o.step, lo = x - o.window / 2, hi = x + o.window / 2;
+      std::array<double, 3> sum{};
+      int n = 0;
+      for (std::size_t k = 0; k < pairs; ++k) {
+        const HapticSample& s = sim[ps.sim + k];
+        if (s.travel < lo || s.travel >= hi) continue;
+        const auto fm = forces(measured[ps.measured + k]), fs = forces(s);
+        for (int a = 0; a < 3; ++a) sum[a] += fm[a] - fs[a];
+        ++n;
+      }
+      // A window without a pair (before a late-starting recording's first one) keeps the
+      // previous grid point's value (the curves are continuous; 0 before the first).
+      if (n == 0) {
         r.push_back(r.empty() ? std::array<double, 3>{} : r.back());
+      } else {
+        r.push_back({sum[0] / n, sum[1] / n, sum[2] / n});
       }
     }
     if (r.empty()) continue;

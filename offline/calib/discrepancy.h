@@ -8,11 +8,17 @@
 // classifier trained on them (the STC) learns the outcomes' differences as the sensor shows
 // them rather than as the simulator makes them.
 //
-//   r_h(x) = mean of measured F over [x - w/2, x + w/2)  -  the same mean of the simulated F
+//   r_h(x) = mean of (R_i - S_i) over the pairs i whose simulated travel x_i is in [x - w/2, x + w/2)
 //
-// per arm height h with an input, per force (motion, lateral, vertical), on a grid of travel x.
-// A grid point whose window begins before a late-starting input's recording does (haptic.h,
-// records_from) keeps the previous point's value (0 before the first), as a window without samples.
+// per arm height h with an input, per force (motion, lateral, vertical), on a grid of travel x,
+// the pairs those of eq. 3: one moment of the pull (objective.h, paired_start), so the term is
+// the calibration's own residual, smoothed over the simulator's travel, which is the travel of
+// the trials it is added to. Until session 94 it was the difference of two window means at equal
+// travel, the measured one by the recording's stamp: the stamp is a constant-speed profile and
+// leads the ramped pull by v^2 / 2a (5 mm at 0.1 m/s; core/haptic.h), which moved the term by a
+// median of 0.006-0.017 N and up to 0.55 N (calib/MEASUREMENTS.md, session 93), and a
+// late-starting recording needed its own rule (records_from). A window without a pair (before a
+// late-starting recording's first) keeps the previous point's value (0 before the first).
 // It uses only the calibrating person's inputs: a classifier tested on other people never sees
 // their data through it.
 #pragma once
@@ -41,13 +47,15 @@ struct Discrepancy {
   // Per ArmHeight: r_h at x = 0, step, 2 step, ... up to the travel both curves cover; empty when
   // the height had no input.
   std::array<std::vector<std::array<double, 3>>, 3> by_height;  // (motion, lateral, vertical) [N]
-  // Per ArmHeight, the travel both curves reached [m]: r_h keeps its last grid value up to it and
-  // fades only beyond (0: from the last grid point).
+  // Per ArmHeight, the simulated travel of the last pair (the shorter curve's end) [m]: r_h keeps
+  // its last grid value up to it and fades only beyond (0: from the last grid point).
   std::array<double, 3> end{};
 };
 
 // r_h of each input against its simulated curve (simulate_inputs: the calibrated cloth and
-// offsets), inputs and curves in the same order. Two inputs of one height are averaged (never
+// offsets), inputs and curves in the same order, both at the simulator's rate (calibration_inputs
+// requires it: pairs by index are pairs in time only then). An input or curve without samples
+// adds nothing. Two inputs of one height are averaged (never
 // the case with select_inputs, one per height). Throws std::invalid_argument when the counts
 // differ or the options are not positive.
 Discrepancy measure_discrepancy(const std::vector<HapticSequence>& inputs,

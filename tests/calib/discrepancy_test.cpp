@@ -57,11 +57,11 @@ TEST(Discrepancy, GivesBackTheDifferenceItWasMadeWith) {
 }
 
 // An input whose recording starts 0.0958 m into the pull (s0-middlemiss-10), made as the
-// simulated curve plus 1 N of F_motion: a grid point whose window begins before that start would
-// set the recording's last few samples against the simulator's whole window (here the high arm's
-// drag, steep in travel); it keeps the previous point's value (0: none before) instead. From
-// x = 0.11 m (window [0.10, 0.12)) both curves cover the window: 1 N.
-TEST(Discrepancy, AWindowBeforeALateStartIsNotMeasured) {
+// simulated curve plus 1 N of F_motion. Its pairs begin at the simulated sample of its first
+// sample's time (objective.h, paired_start), so a window holding the start holds only pairs of one
+// moment: 1 N, where the means of the recording's few samples and of the simulator's whole window
+// would differ by the high arm's drag, steep in travel. Windows without a pair keep 0.
+TEST(Discrepancy, ALateStartIsMeasuredFromItsFirstPair) {
   const auto sim = simulated_curve(ArmHeight::High);
   HapticSequence late = measured_from(sim, ArmHeight::High, [](double) { return std::array<double, 3>{1.0, 0, 0}; });
   late.samples.erase(late.samples.begin(), std::find_if(late.samples.begin(), late.samples.end(),
@@ -69,8 +69,29 @@ TEST(Discrepancy, AWindowBeforeALateStartIsNotMeasured) {
   const auto d = measure_discrepancy({late}, {sim});
   const auto& r = d.by_height[static_cast<int>(ArmHeight::High)];
   ASSERT_GE(r.size(), 12u);
-  for (int j : {8, 9, 10}) EXPECT_EQ(r[static_cast<std::size_t>(j)][0], 0.0) << "grid point " << j;
-  EXPECT_NEAR(r[11][0], 1.0, 1e-9);
+  for (int j = 0; j <= 8; ++j) EXPECT_EQ(r[static_cast<std::size_t>(j)][0], 0.0) << "grid point " << j;  // to 0.09 m
+  for (int j : {9, 10, 11}) EXPECT_NEAR(r[static_cast<std::size_t>(j)][0], 1.0, 1e-12) << "grid point " << j;
+}
+
+// The pairs are those of time, not of travel: a recording stamped as the study's are, with the
+// constant-speed profile's travel (v t, 5 mm ahead of the ramped pull at 0.1 m/s once the ramp is
+// over: core/haptic.h), made as the ramped simulated curve plus 0.2 N, gives 0.2 N at every grid
+// point. Windows of equal travel would set each simulated mean against the measured one 5 mm
+// further on, and the drag's slope would show in the term.
+TEST(Discrepancy, PairsAreMomentsOfThePullNotEqualTravels) {
+  // The stand-in's curve with its travel put on the rig's ramp (pull_time_at's inverse).
+  SimulatedTrial sim = simulated_curve(ArmHeight::High);
+  HapticSequence measured = measured_from(sim, ArmHeight::High, [](double) { return std::array<double, 3>{0.2, 0.2, 0.2}; });
+  for (std::size_t i = 0; i < sim.samples.size(); ++i) {
+    const double t = sim.samples[i].t, v = 0.1, ramp = v / kRigAcceleration;
+    sim.samples[i].travel = t <= ramp ? 0.5 * kRigAcceleration * t * t : v * t - v * v / (2 * kRigAcceleration);
+    measured.samples[i].travel = v * t;
+  }
+  const auto d = measure_discrepancy({measured}, {sim});
+  const auto& r = d.by_height[static_cast<int>(ArmHeight::High)];
+  ASSERT_GE(r.size(), 40u);
+  for (std::size_t j = 0; j < r.size(); ++j)
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(r[j][k], 0.2, 1e-12) << "grid point " << j << ", force " << k;
 }
 
 TEST(Discrepancy, AddedToTheSimulatedCurveGivesTheMeasuredOne) {

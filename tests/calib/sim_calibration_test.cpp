@@ -789,7 +789,9 @@ TEST(SimCalibration, DiscrepancyBringsParticipant4sSimulatorOntoHisSequences) {
     std::printf("  %s: area part of L %.4f -> %.4f with the discrepancy\n", inputs[k].id.c_str(), raw, fixed);
     // Below the floor of the study's own repeats (two good trials of one person: 0.09; issue 4).
     EXPECT_LT(fixed, 0.09) << inputs[k].id;
-    EXPECT_LT(fixed, 0.5 * raw) << inputs[k].id;
+    // Paired as eq. 3 pairs (moments of the pull) the term leaves 0.12 and 0.14 of the area;
+    // with windows of equal travel, the recording's by its stamp (until session 94), 0.21 and 0.18.
+    EXPECT_LT(fixed, 0.2 * raw) << inputs[k].id;
   }
   const double windows[3][2] = {{0.10, 0.15}, {0.15, 0.20}, {0.20, 0.30}};
   for (const auto& w : windows) {
@@ -800,7 +802,18 @@ TEST(SimCalibration, DiscrepancyBringsParticipant4sSimulatorOntoHisSequences) {
         if (x.travel >= w[0] && x.travel < w[1]) sum += x.f_motion, ++n;
       return sum / n;
     };
-    const double measured = mean(inputs[0]) - mean(inputs[1]);
+    // The recordings on the simulator's travel: each measured sample at its pair's (the term
+    // pairs moments of the pull, as eq. 3: objective.h, paired_start).
+    auto on_simulated_travel = [&](std::size_t k) {
+      HapticSequence m = inputs[k];
+      const PairedStart ps = paired_start(sts[k].samples, m.samples);
+      const std::size_t n = std::min(sts[k].samples.size() - ps.sim, m.samples.size() - ps.measured);
+      m.samples.erase(m.samples.begin(), m.samples.begin() + static_cast<std::ptrdiff_t>(ps.measured));
+      m.samples.resize(n);
+      for (std::size_t i = 0; i < n; ++i) m.samples[i].travel = sts[k].samples[ps.sim + i].travel;
+      return m;
+    };
+    const double measured = mean(on_simulated_travel(0)) - mean(on_simulated_travel(1));
     const double simulated = mean(HapticSequence{"", "", ArmHeight::High, 0.1, {}, sts[0].samples}) -
                              mean(HapticSequence{"", "", ArmHeight::Low, 0.1, {}, sts[1].samples});
     const double fixed = mean(corrected[0]) - mean(corrected[1]);
