@@ -97,6 +97,17 @@ PairedStart paired_start(const std::vector<HapticSample>& sim, const std::vector
   return {};  // within kLateStart, or a travel that is not a number: paired by index
 }
 
+std::vector<HapticSample> measured_on_simulated_travel(const std::vector<HapticSample>& sim,
+                                                       const std::vector<HapticSample>& measured) {
+  if (sim.empty() || measured.empty()) return {};
+  const PairedStart p = paired_start(sim, measured);
+  const std::size_t n = std::min(sim.size() - p.sim, measured.size() - p.measured);
+  std::vector<HapticSample> out(measured.begin() + static_cast<std::ptrdiff_t>(p.measured),
+                                measured.begin() + static_cast<std::ptrdiff_t>(p.measured + n));
+  for (std::size_t k = 0; k < n; ++k) out[k].travel = sim[p.sim + k].travel;
+  return out;
+}
+
 namespace {
 
 // eq. 3-4; `sim_goes_on`: the simulation may have samples still to come, so the terms that its
@@ -174,12 +185,14 @@ double position_weighted_objective(const std::vector<HapticSample>& sim, const s
 double vertical_sign_agreement(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured,
                                double threshold) {
   require_samples(sim, measured);
+  const PairedStart p = paired_start(sim, measured);
+  const std::size_t n = std::min(sim.size() - p.sim, measured.size() - p.measured);
   double asked = 0.0, agreed = 0.0;
-  for (std::size_t i = 1; i < measured.size(); ++i) {
-    const HapticSample& r = measured[i];
-    if (std::abs(r.f_vertical) <= threshold || r.travel > sim.back().travel) continue;
-    const double dx = step(measured, i);
-    const double s = force_at(sim, r.travel, ForceAxis::Vertical);
+  for (std::size_t k = 1; k < n; ++k) {
+    const HapticSample& r = measured[p.measured + k];
+    if (std::abs(r.f_vertical) <= threshold) continue;
+    const double dx = step(measured, p.measured + k);
+    const double s = sim[p.sim + k].f_vertical;
     asked += dx;
     if ((s > 0) == (r.f_vertical > 0) && s != 0) agreed += dx;
   }

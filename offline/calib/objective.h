@@ -75,6 +75,15 @@ struct PairedStart {
 };
 PairedStart paired_start(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured);
 
+// The measured samples of eq. 3's pairs (from paired_start to the shorter sequence's end), each
+// with its simulated partner's travel: the recording on the simulator's travel. What compares a
+// recording with a simulation over travel (a window's mean, prediction.h residual_windows) reads
+// it there. By its own stamp, a constant-speed profile that leads the simulator's ramped travel
+// by v^2 / 2a once the ramp is over (core/haptic.h), each measured force would stand beside the
+// simulated one of 5 mm (0.1 m/s) or 11 mm (0.15 m/s) earlier in the pull. Empty when either is.
+std::vector<HapticSample> measured_on_simulated_travel(const std::vector<HapticSample>& sim,
+                                                       const std::vector<HapticSample>& measured);
+
 // eq. 3-4 for one axis, paired from paired_start(). `sim` and `measured` need at least one sample each.
 double area_error(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured, ForceAxis axis,
                   double w = kLengthPenaltyWeight);
@@ -98,10 +107,12 @@ double area_objective_so_far(const std::vector<HapticSample>& sim, const std::ve
 double position_weighted_objective(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured);
 
 // The vertical force's sign (issue 5: the paper's simulator "often has the opposite sign"): the
-// share of the measured travel, over the travel both sequences cover, where the measured
-// |F_vertical| exceeds `threshold` and the simulated F_vertical, interpolated at the same travel,
-// has the same sign. Each measured sample counts with its travel step (a sample at 0.1 m/s and
-// one at 0.15 m/s weigh by the distance they stand for). NaN when no such travel exists. The
+// share of the measured travel, over eq. 3's pairs, where the measured |F_vertical| exceeds
+// `threshold` and its simulated partner's F_vertical (the same moment of the pull) has the same
+// sign. Each measured sample after the first pair counts with its travel step (a sample at
+// 0.1 m/s and one at 0.15 m/s weigh by the distance they stand for). Until session 94 the
+// simulated force was interpolated at the recording's stamped travel, which leads the simulated
+// pull by v^2 / 2a (measured_on_simulated_travel). NaN when no such travel exists. The
 // 0.2 N default is ten times the sensor's high-frequency noise (shared/data: 0.017 N), so a sign
 // is only asked of where the measurement has one.
 double vertical_sign_agreement(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured,

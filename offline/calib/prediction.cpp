@@ -302,7 +302,7 @@ std::vector<ResidualWindow> residual_windows(const Prediction& p, const Dataset&
   struct Pair {
     ArmHeight height;
     const std::string* participant;
-    const std::vector<HapticSample>* measured;
+    std::vector<HapticSample> measured;  // on the simulator's travel (objective.h)
     const std::vector<HapticSample>* simulated;
   };
   std::vector<Pair> pairs;
@@ -310,7 +310,7 @@ std::vector<ResidualWindow> residual_windows(const Prediction& p, const Dataset&
   for (const auto& t : p.trials) {
     const HapticSequence* m = find_trial(ds, t.trial_id);
     if (m == nullptr || m->samples.empty() || t.simulated.empty()) continue;
-    pairs.push_back({t.height, &t.participant, &m->samples, &t.simulated});
+    pairs.push_back({t.height, &t.participant, measured_on_simulated_travel(t.simulated, m->samples), &t.simulated});
     longest = std::max(longest, m->samples.back().travel);
   }
   // Window k is [k w, (k + 1) w): computed from k, not accumulated, so the edges are exact
@@ -333,11 +333,11 @@ std::vector<ResidualWindow> residual_windows(const Prediction& p, const Dataset&
       for (const Pair& q : pairs) {
         // Both curves through the whole window: a recording that starts late (haptic.h) covers
         // it only from its start, which its mean would pair with the simulator's whole window.
-        if (q.height != h || !records_from(*q.measured, w.from) || q.measured->back().travel < w.to ||
+        if (q.height != h || !records_from(q.measured, w.from) || q.measured.back().travel < w.to ||
             q.simulated->back().travel < w.to)
           continue;
         double a[kForces], b[kForces];
-        if (!window_mean(*q.measured, w.from, w.to, a) || !window_mean(*q.simulated, w.from, w.to, b)) continue;
+        if (!window_mean(q.measured, w.from, w.to, a) || !window_mean(*q.simulated, w.from, w.to, b)) continue;
         Person& person = people[*q.participant];
         for (int ax = 0; ax < kForces; ++ax) {
           person.measured[ax] += a[ax];

@@ -139,7 +139,9 @@ std::string prediction_curves_csv(const Prediction& p, const Dataset& ds);
 // L says how far a prediction is off; the residual says where and which way. Per height and
 // travel window [from, to), over the predicted trials whose measured and simulated curves both
 // cover it (the measured one recorded from `from` on, records_from, and both reaching `to`): each
-// trial's mean force over the window (samples with from <= travel < to), then each person's
+// trial's mean force over the window (samples with from <= travel < to; the recording's samples
+// at their simulated partners' travel, as eq. 3 pairs them: objective.h,
+// measured_on_simulated_travel; by its stamp until session 94), then each person's
 // mean over their trials there, then over those people the measured mean, the people's spread
 // (the sample standard deviation of the people's means: how much the real people differ from
 // each other there) and the simulated mean (of the people's simulated means). Per person first,

@@ -582,6 +582,50 @@ TEST(Prediction, ResidualWindowsLeaveOutARecordingThatStartsInsideTheWindow) {
   EXPECT_NEAR(w[2].measured[0], -5.0 / 3, 1e-12);
 }
 
+// A pull at 0.1 m/s on the rig's 1 m/s^2 ramp, sampled at 100 Hz for `seconds`, as the simulator
+// records it (travel: the ramped pull's) and as the study's recordings stamp it (travel v t, a
+// constant-speed profile, 5 mm ahead of the ramp once it is over: core/haptic.h); the same forces
+// at each moment, f(x) of the ramped travel x. (t, travel, F_motion, F_lateral, F_vertical.)
+template <class F>
+std::pair<std::vector<HapticSample>, std::vector<HapticSample>> ramped_and_stamped(double seconds, F f) {
+  std::vector<HapticSample> ramped, stamped;
+  const double v = 0.1, a = kRigAcceleration;
+  for (int k = 0; k * 0.01 <= seconds + 1e-12; ++k) {
+    const double t = k * 0.01, x = t <= v / a ? 0.5 * a * t * t : v * t - v * v / (2 * a);
+    const auto [fm, fv] = f(x);
+    ramped.push_back({t, x, fm, 0.0, fv});
+    stamped.push_back({t, v * t, fm, 0.0, fv});
+  }
+  return {ramped, stamped};
+}
+
+// The residual sets each recording beside the simulation at the same moment of the pull (eq. 3's
+// pairs: objective.h, measured_on_simulated_travel): three people whose recordings are the
+// simulated curves themselves, stamped as the study stamps, have no residual in any window.
+// Where the drag climbs 40 N/m, windows of the stamped travel set each measured mean 5 mm beside
+// the simulated one: 0.2 N, twice kResidualFloor.
+TEST(Prediction, ResidualWindowsCompareTheSameMomentsOfThePull) {
+  Dataset ds;
+  Prediction p;
+  p.participant = "1";
+  for (int k = 0; k < 3; ++k) {
+    auto [ramped, stamped] = ramped_and_stamped(3.0, [](double x) { return std::pair{-40.0 * x, 4.0 * x}; });
+    add_high_pair(ds, p, "p" + std::to_string(k + 2) + "-high", std::to_string(k + 2), stamped, ramped);
+  }
+  const std::vector<ResidualWindow> w = residual_windows(p, ds, 0.05);
+  int covered = 0;
+  for (const auto& win : w) {
+    if (win.trials == 0) continue;
+    ++covered;
+    EXPECT_EQ(win.trials, 3) << win.from;
+    for (int ax = 0; ax < kForces; ++ax) {
+      EXPECT_NEAR(win.residual(ax), 0.0, 1e-12) << force_name(ax) << " at " << win.from;
+      EXPECT_FALSE(win.outside(ax));
+    }
+  }
+  EXPECT_EQ(covered, 5) << "0 to 0.25 m: the simulated pull's 0.295 m, whole windows only";
+}
+
 // The people's spread is over people: person 2 has two trials (F_motion -1 and -1 N), persons 3
 // and 4 one each (-3 and -2 N). Per person the means are -1, -3, -2: mean -2, spread 1, n 3 (over
 // the four trials it was mean -1.75 and spread 0.957). The simulated mean is weighed alike:
@@ -642,6 +686,40 @@ TEST(Objective, VerticalSignAgreementClosedForm) {
   EXPECT_EQ(vertical_sign_agreement(curve(0.8, [](double) { return 0.0; }), measured), 0.0);
   // The threshold: a measurement within +-0.2 N has no sign to agree with.
   EXPECT_TRUE(std::isnan(vertical_sign_agreement(measured, curve(0.8, [](double) { return 0.15; }))));
+}
+
+// The recording on the simulator's travel: each sample of eq. 3's pairs with its simulated
+// partner's travel, for a recording stamped from the pull's start and for one that starts late
+// (0.0958 m in by its stamp, s0-middlemiss-10's start, paired from the simulated sample of its
+// time, 0.958 s: objective.h, paired_start).
+TEST(Objective, MeasuredOnSimulatedTravelIsThePairsTravel) {
+  auto [ramped, stamped] = ramped_and_stamped(2.0, [](double x) { return std::pair{-x, 0.0}; });
+  const auto on = measured_on_simulated_travel(ramped, stamped);
+  ASSERT_EQ(on.size(), ramped.size());
+  for (std::size_t k = 0; k < on.size(); ++k) {
+    EXPECT_EQ(on[k].travel, ramped[k].travel) << k;
+    EXPECT_EQ(on[k].t, stamped[k].t);
+    EXPECT_EQ(on[k].f_motion, stamped[k].f_motion);
+  }
+  EXPECT_NEAR(stamped[150].travel - on[150].travel, 0.005, 1e-12);  // v^2 / 2a after the ramp
+  std::vector<HapticSample> late(stamped.begin() + 96, stamped.begin() + 120);  // 0.096 m on
+  for (auto& x : late) x.t -= 0.96;  // its own clock starts at its first sample
+  const auto on_late = measured_on_simulated_travel(ramped, late);
+  ASSERT_EQ(on_late.size(), late.size());
+  EXPECT_EQ(on_late.front().travel, ramped[96].travel);
+  EXPECT_EQ(on_late.back().travel, ramped[119].travel);
+  // The shorter sequence ends the pairs.
+  EXPECT_EQ(measured_on_simulated_travel(std::vector<HapticSample>(ramped.begin(), ramped.begin() + 50), stamped).size(),
+            50u);
+  EXPECT_TRUE(measured_on_simulated_travel({}, stamped).empty());
+}
+
+// The vertical sign is asked of the pairs: a simulation whose F_vertical turns down at the same
+// moment as the recording's (0.3 m of the ramped pull, where the stamp reads 0.305 m) agrees
+// everywhere. Interpolated at the stamped travel it disagreed over those 5 mm: 0.5 cm of 0.4 m.
+TEST(Objective, VerticalSignComparesTheSameMomentsOfThePull) {
+  auto [ramped, stamped] = ramped_and_stamped(4.0, [](double x) { return std::pair{-1.0, x < 0.3 ? 1.0 : -1.0}; });
+  EXPECT_EQ(vertical_sign_agreement(ramped, stamped), 1.0);
 }
 
 // On the study's data the yardstick per target is the median over third persons' trials of the
