@@ -24,7 +24,7 @@
 #   DRESSGUARD  the binary, in both modes (the second argument wins)
 #   PER_HEIGHT (default 40), STATES (default 10, the paper's), THREADS (default: all cores; the
 #   bits do not depend on it), CREATED (creation time to record; the shipped model used
-#   CREATED=2026-12-07T19:30:00Z, so the same data and binary give the same bytes),
+#   CREATED=2026-12-07T22:45:00Z, so the same data and binary give the same bytes),
 #   DRESSGUARD_SHARED_DIR (where shared/data is; default ../shared).
 # The same bytes need the same build and a CPU of the same kind: training runs the AVX2+FMA
 # E-step where the CPU has it and the portable one elsewhere, whose exps differ in the last bit,
