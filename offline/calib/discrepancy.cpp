@@ -51,15 +51,14 @@ Discrepancy measure_discrepancy(const std::vector<HapticSequence>& inputs,
     if (measured.empty() || sim.empty()) continue;
     // Pair k: sim[ps.sim + k] and measured[ps.measured + k], one moment of the pull.
     const PairedStart ps = paired_start(sim, measured);
-    const std::size_t pairs = std::min(sim.size() - ps.sim, measured.size() - ps.measured);
-    const double end = sim[ps.sim + pairs - 1].travel;
+    const double end = sim[ps.sim + ps.count - 1].travel;
     const int h = static_cast<int>(inputs[i].height);
     std::vector<std::array<double, 3>> r;
     for (int j = 0; j * o.step <= end; ++j) {
       const double x = j * o.step, lo = x - o.window / 2, hi = x + o.window / 2;
       std::array<double, 3> sum{};
       int n = 0;
-      for (std::size_t k = 0; k < pairs; ++k) {
+      for (std::size_t k = 0; k < ps.count; ++k) {
         const HapticSample& s = sim[ps.sim + k];
         if (s.travel < lo || s.travel >= hi) continue;
         const auto fm = forces(measured[ps.measured + k]), fs = forces(s);

@@ -77,34 +77,40 @@ std::size_t nearest_in_time(const std::vector<HapticSample>& seq, double t) {
   return t - seq[k - 1].t < seq[k].t - t ? k - 1 : k;
 }
 
-}  // namespace
-
-PairedStart paired_start(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured) {
-  require_samples(sim, measured);
+// paired_start's first indices (its count left 0).
+PairedStart first_pair(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured) {
   const double xs = sim.front().travel, xm = measured.front().travel;
   const double v = stamp_speed(measured);
   if (xm - xs > kLateStart) {
     // The recording starts late: its first sample is x_m / v into the pull by the stamp, and the
     // simulation's clock is the pull's.
-    if (v > 0.0) return {nearest_in_time(sim, xm / v), 0};
-    return {first_at_or_beyond(sim, xm), 0};
+    if (v > 0.0) return {nearest_in_time(sim, xm / v), 0, 0};
+    return {first_at_or_beyond(sim, xm), 0, 0};
   }
   if (xs - xm > kLateStart) {
     // The simulation starts late (a pull simulated from further along): the measured sample
     // whose stamp is where the pull is at the simulation's first time.
-    return {0, first_at_or_beyond(measured, v > 0.0 ? v * sim.front().t : xs)};
+    return {0, first_at_or_beyond(measured, v > 0.0 ? v * sim.front().t : xs), 0};
   }
   return {};  // within kLateStart, or a travel that is not a number: paired by index
+}
+
+}  // namespace
+
+PairedStart paired_start(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured) {
+  require_samples(sim, measured);
+  PairedStart p = first_pair(sim, measured);
+  p.count = std::min(sim.size() - p.sim, measured.size() - p.measured);
+  return p;
 }
 
 std::vector<HapticSample> measured_on_simulated_travel(const std::vector<HapticSample>& sim,
                                                        const std::vector<HapticSample>& measured) {
   if (sim.empty() || measured.empty()) return {};
   const PairedStart p = paired_start(sim, measured);
-  const std::size_t n = std::min(sim.size() - p.sim, measured.size() - p.measured);
   std::vector<HapticSample> out(measured.begin() + static_cast<std::ptrdiff_t>(p.measured),
-                                measured.begin() + static_cast<std::ptrdiff_t>(p.measured + n));
-  for (std::size_t k = 0; k < n; ++k) out[k].travel = sim[p.sim + k].travel;
+                                measured.begin() + static_cast<std::ptrdiff_t>(p.measured + p.count));
+  for (std::size_t k = 0; k < p.count; ++k) out[k].travel = sim[p.sim + k].travel;
   return out;
 }
 
@@ -186,9 +192,8 @@ double vertical_sign_agreement(const std::vector<HapticSample>& sim, const std::
                                double threshold) {
   require_samples(sim, measured);
   const PairedStart p = paired_start(sim, measured);
-  const std::size_t n = std::min(sim.size() - p.sim, measured.size() - p.measured);
   double asked = 0.0, agreed = 0.0;
-  for (std::size_t k = 1; k < n; ++k) {
+  for (std::size_t k = 1; k < p.count; ++k) {
     const HapticSample& r = measured[p.measured + k];
     if (std::abs(r.f_vertical) <= threshold) continue;
     const double dx = step(measured, p.measured + k);

@@ -67,11 +67,12 @@ inline constexpr double kLengthPenaltyWeight = 20.0;  // w of eq. 4
 
 // The first index of each sequence that eq. 3 pairs (i = 0): both 0 unless one starts more than
 // kLateStart further along; then the other's sample at the same time of the pull ("Where the
-// pairs begin"; its last sample if it never gets there). A recording whose stamp does not
+// pairs begin"; its last sample if it never gets there); and how many pairs follow from there. A recording whose stamp does not
 // advance (no speed to read its time by) is paired from the same travel.
 struct PairedStart {
   std::size_t sim = 0;
   std::size_t measured = 0;
+  std::size_t count = 0;  // the pairs: from these indices to the shorter sequence's end (>= 1)
 };
 PairedStart paired_start(const std::vector<HapticSample>& sim, const std::vector<HapticSample>& measured);
 

@@ -143,6 +143,7 @@ TEST(Objective, LateStartPairsFromTheSameTimeOfThePull) {
   const PairedStart p = paired_start(sim, late);
   EXPECT_EQ(p.sim, 96u);
   EXPECT_EQ(p.measured, 0u);
+  EXPECT_EQ(p.count, 755u);  // both to the end: samples 96-850 of the simulation
   EXPECT_EQ(area_objective(sim, late), 0.0);
   EXPECT_EQ(paired_start(late_sim, sim).sim, 0u);
   EXPECT_EQ(paired_start(late_sim, sim).measured, 96u);
@@ -162,6 +163,7 @@ TEST(Objective, LateStartPairsFromTheSameTimeOfThePull) {
   // one; the rest is the measurement running longer (eq. 4's third case).
   const std::vector<HapticSample> short_sim(sim.begin(), sim.begin() + 51);
   EXPECT_EQ(paired_start(short_sim, late).sim, 50u);
+  EXPECT_EQ(paired_start(short_sim, late).count, 1u);  // its last sample, the one pair
   double longer = 0;
   for (int k = 97; k <= 850; ++k) longer += kLengthPenaltyWeight * h * 1.5 * std::abs(f(50) - f(k));
   EXPECT_NEAR(area_objective(short_sim, late), longer, 1e-9);

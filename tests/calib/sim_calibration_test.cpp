@@ -807,10 +807,9 @@ TEST(SimCalibration, DiscrepancyBringsParticipant4sSimulatorOntoHisSequences) {
     auto on_simulated_travel = [&](std::size_t k) {
       HapticSequence m = inputs[k];
       const PairedStart ps = paired_start(sts[k].samples, m.samples);
-      const std::size_t n = std::min(sts[k].samples.size() - ps.sim, m.samples.size() - ps.measured);
       m.samples.erase(m.samples.begin(), m.samples.begin() + static_cast<std::ptrdiff_t>(ps.measured));
-      m.samples.resize(n);
-      for (std::size_t i = 0; i < n; ++i) m.samples[i].travel = sts[k].samples[ps.sim + i].travel;
+      m.samples.resize(ps.count);
+      for (std::size_t i = 0; i < ps.count; ++i) m.samples[i].travel = sts[k].samples[ps.sim + i].travel;
       return m;
     };
     const double measured = mean(on_simulated_travel(0)) - mean(on_simulated_travel(1));
