@@ -79,13 +79,13 @@ TEST(Discrepancy, ALateStartIsMeasuredFromItsFirstPair) {
 // point. Windows of equal travel would set each simulated mean against the measured one 5 mm
 // further on, and the drag's slope would show in the term.
 TEST(Discrepancy, PairsAreMomentsOfThePullNotEqualTravels) {
-  // The stand-in's curve with its travel put on the rig's ramp (pull_time_at's inverse).
+  // The stand-in's curve with its travel put on the rig's ramp.
   SimulatedTrial sim = simulated_curve(ArmHeight::High);
   HapticSequence measured = measured_from(sim, ArmHeight::High, [](double) { return std::array<double, 3>{0.2, 0.2, 0.2}; });
   for (std::size_t i = 0; i < sim.samples.size(); ++i) {
-    const double t = sim.samples[i].t, v = 0.1, ramp = v / kRigAcceleration;
-    sim.samples[i].travel = t <= ramp ? 0.5 * kRigAcceleration * t * t : v * t - v * v / (2 * kRigAcceleration);
-    measured.samples[i].travel = v * t;
+    const double t = sim.samples[i].t;
+    sim.samples[i].travel = testing::rig_travel_at(t, 0.1);
+    measured.samples[i].travel = 0.1 * t;
   }
   const auto d = measure_discrepancy({measured}, {sim});
   const auto& r = d.by_height[static_cast<int>(ArmHeight::High)];

@@ -75,4 +75,12 @@ inline SimulatedTrial fake_simulate(const ClothValues& c, const TrialRequest& r)
   return out;
 }
 
+// [m] where the rig's gripper is `t` [s] into a pull from rest at `v` [m/s] (core/haptic.h):
+// a t^2 / 2 on the 1 m/s^2 ramp, v t - v^2 / 2a after it (pull_time_at's inverse). The simulator's
+// travel; the study's recordings stamp v t instead.
+inline double rig_travel_at(double t, double v) {
+  const double a = kRigAcceleration;
+  return t <= v / a ? 0.5 * a * t * t : v * t - v * v / (2 * a);
+}
+
 }  // namespace dressguard::calib::testing

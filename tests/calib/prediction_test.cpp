@@ -589,9 +589,9 @@ TEST(Prediction, ResidualWindowsLeaveOutARecordingThatStartsInsideTheWindow) {
 template <class F>
 std::pair<std::vector<HapticSample>, std::vector<HapticSample>> ramped_and_stamped(double seconds, F f) {
   std::vector<HapticSample> ramped, stamped;
-  const double v = 0.1, a = kRigAcceleration;
+  const double v = 0.1;
   for (int k = 0; k * 0.01 <= seconds + 1e-12; ++k) {
-    const double t = k * 0.01, x = t <= v / a ? 0.5 * a * t * t : v * t - v * v / (2 * a);
+    const double t = k * 0.01, x = testing::rig_travel_at(t, v);
     const auto [fm, fv] = f(x);
     ramped.push_back({t, x, fm, 0.0, fv});
     stamped.push_back({t, v * t, fm, 0.0, fv});
