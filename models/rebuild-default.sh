@@ -8,8 +8,10 @@
 # repeat band (--high-low repeat-band: only the heights whose noise-free trial stays within one
 # measured repeat's distance of the calibrated one); what each simulator gets wrong on its own
 # person's measured sequences is added to every trial it synthesized (--discrepancy, Kennedy and
-# O'Hagan's discrepancy term); one 10-state HMM per outcome on F_motion and F_lateral; equal
-# priors and the predictor's default stop policy (P(caught) > 0.9 for 5 samples).
+# O'Hagan's discrepancy term); one 10-state HMM per outcome on F_motion and F_lateral, Baum-Welch
+# run to its tolerance (--max-iter 1000, a cap it does not reach: at build-model's default of 100
+# the missed class stopped short, and needs 109); equal priors and the predictor's default stop
+# policy (P(caught) > 0.9 for 5 samples).
 #
 # usage: models/rebuild-default.sh [DATASET [DRESSGUARD]]
 #   DATASET     a labelled dataset to train on instead (plain `build-model --data`)
@@ -71,7 +73,8 @@ keyed() {
 }
 if [ -n "$dataset" ]; then
   [ -f "$dataset/manifest.csv" ] || { echo "rebuild-default.sh: $dataset/manifest.csv not found" >&2; exit 2; }
-  "$dg" build-model --data "$dataset" --out "$out/default.dgm" --states "${STATES:-10}" --created "$created"
+  "$dg" build-model --data "$dataset" --out "$out/default.dgm" --states "${STATES:-10}" --max-iter 1000 \
+    --created "$created"
 else
   [ -f "$shared/data/gown/fullgown.obj" ] || {
     echo "rebuild-default.sh: $shared/data/gown/fullgown.obj not found: the default model is synthesized on the measured gown and corrected by the measured trials (set DRESSGUARD_SHARED_DIR)" >&2
@@ -89,7 +92,7 @@ else
   DRESSGUARD_SHARED_DIR=$shared "$dg" build-model --calibration "$committee" \
     --synth-dir build/default-model-data --per-height "${PER_HEIGHT:-40}" --seed 1 --gown reduced \
     --high-low repeat-band --discrepancy "$study" --forces lateral ${THREADS:+--threads $THREADS} \
-    --out "$out/default.dgm" --states "${STATES:-10}" --created "$created"
+    --out "$out/default.dgm" --states "${STATES:-10}" --max-iter 1000 --created "$created"
   rm -f "$out/default.dgm.discrepancy.csv"
 fi
 # The hash through a temporary and a rename: an interrupted run leaves the old .sha256 or the new

@@ -9,7 +9,7 @@ namespace dressguard::calib {
 
 model::OutcomeModel build_outcome_model(const std::vector<const HapticSequence*>& trials, const StcOptions& o) {
   hmm::ModelOptions mo;
-  mo.hmm.n_states = o.states;
+  mo.hmm = o.hmm;
   mo.uniform_priors = o.uniform_priors;
   mo.features.axis[1] = o.second_axis;
   mo.source_dataset = o.source;

@@ -15,7 +15,7 @@
 namespace dressguard::calib {
 
 struct StcOptions {
-  int states = 10;             // paper VI: bivariate HMMs with 10 hidden states
+  hmm::TrainOptions hmm;       // Baum-Welch's; its defaults are paper VI's 10 hidden states
   bool uniform_priors = true;  // paper V-B: the class whose HMM has the highest likelihood
   // The second feature beside F_motion: model::kAxisVertical (the paper's), kAxisLateral, or
   // kAxisNone (F_motion alone).

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <iterator>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -15,6 +16,7 @@
 #include "dataset.h"
 #include "discrepancy.h"
 #include "files.h"
+#include "hmm_options.h"
 #include "json.h"
 #include "synthesis.h"
 #ifdef DRESSGUARD_HAVE_SIM
@@ -38,7 +40,7 @@ constexpr const char* kTrainingOutMark = "training-set.txt";
 int run_build_model(int argc, char** argv) {
   Args args(argc - 1, argv + 1, {"help", "json", "no-gown-noise", "no-arm-noise"});
   if (args.has("help")) {
-    std::puts(
+    std::printf(
         "usage: dressguard build-model (--calibration CAL.json[,CAL...] | --data DATASET[,DATASET...])\n"
         "                              --out MODEL.dgm [options]\n"
         "  With --calibration: synthesizes the training data first (into --synth-dir, default\n"
@@ -48,7 +50,6 @@ int run_build_model(int argc, char** argv) {
         "  own set, into SYNTH-DIR/<calibration file's name>/, and the HMMs learn from all of them.\n"
         "  With --data: trains on the labelled trials of existing datasets (several are pooled,\n"
         "  each folder once).\n"
-        "  --states N   hidden states per HMM (default 10, paper VI)\n"
         "  --forces F   auto | both | lateral | motion: the second force beside F_motion\n"
         "               (F_vertical, F_lateral or none). Default auto: with --calibration,\n"
         "               F_lateral when the calibration fitted it (--lateral-weight), else\n"
@@ -78,16 +79,19 @@ int run_build_model(int argc, char** argv) {
         "               class's share of the training trials (the Bayes decision for trials\n"
         "               drawn like the synthesized ones: the protocol's three heights alike)\n"
         "  --created T  creation time to record (default now, UTC); fixes the model's bytes\n"
-        "  --json       machine-readable summary");
+        "  --json       machine-readable summary\n"
+        " Baum-Welch (dressguard train's):\n%s",
+        kHmmHelp);
     return 0;
   }
-  args.allow_only({"help", "json", "no-gown-noise", "no-arm-noise", "calibration", "data", "out", "synth-dir",
-                   "states", "per-height", "seed", "gown", "threads", "forces", "middle", "high-low", "created", "discrepancy", "label-margin",
-                   "priors", "training-out"});
+  std::set<std::string> known{"help", "json", "no-gown-noise", "no-arm-noise", "calibration", "data", "out",
+                              "synth-dir", "per-height", "seed", "gown", "threads", "forces", "middle", "high-low",
+                              "created", "discrepancy", "label-margin", "priors", "training-out"};
+  known.insert(std::begin(kHmmOptionNames), std::end(kHmmOptionNames));
+  args.allow_only(known);
   const std::string out = args.require_output_file("out");
   if (args.has("calibration") == args.has("data")) throw UsageError("give exactly one of --calibration and --data");
-  const int states = static_cast<int>(args.integer("states", 10));
-  if (states < 1 || states > 32) throw UsageError("--states must be in 1..32");
+  const hmm::TrainOptions baum_welch = hmm_options(args);  // before the synthesis: a bad value fails at once
   const std::string priors = args.get("priors").value_or("uniform");
   if (priors != "uniform" && priors != "training") throw UsageError("--priors must be uniform or training");
   const std::string forces = args.get("forces").value_or("auto");
@@ -218,7 +222,7 @@ int run_build_model(int argc, char** argv) {
                                   "calibration's own sequences)"};
   else if (calibration_fits) axes = choose_stc_axes(*calibration_fits, lateral_fitted);
   StcOptions so;
-  so.states = states;
+  so.hmm = baum_welch;
   so.source = data + "; forces: " + axes.reason + (priors == "training" ? "; priors: the training shares" : "");
   so.second_axis = axes.second_axis;
   so.uniform_priors = priors == "uniform";

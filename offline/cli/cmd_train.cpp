@@ -1,6 +1,7 @@
 // dressguard train: a labelled dataset -> an outcome model file (one left-right HMM per outcome).
 #include <cstdio>
 #include <ctime>
+#include <iterator>
 #include <set>
 #include <sstream>
 
@@ -10,6 +11,7 @@
 #include "files.h"
 #include "dgm.h"
 #include "hmm.h"
+#include "hmm_options.h"
 #include "report.h"
 
 namespace dressguard::cli {
@@ -17,46 +19,31 @@ namespace dressguard::cli {
 int run_train(int argc, char** argv) {
   Args args(argc - 1, argv + 1, {"help", "json", "uniform-priors"});
   if (args.has("help")) {
-    std::puts(
+    std::printf(
         "usage: dressguard train --data DATASET[,DATASET...] --out MODEL.dgm [options] [--json]\n"
         "  Trains one left-right HMM per labelled outcome (good, missed, caught) on F_motion and\n"
         "  F_vertical (paper V-B): equal-segment initialisation, Baum-Welch to convergence.\n"
         "  Several datasets (comma-separated, each folder once) are pooled, their trials in the\n"
         "  order given.\n"
-        "  --states N              states per HMM (default 10, the paper; the study's code used 5)\n"
-        "  --band W                left-right width: state i may go to i..i+W (default 1)\n"
-        "  --cov-floor V           minimum covariance eigenvalue in scaled feature units squared,\n"
-        "                          at least 1e-9: below it a 2x2 determinant is lost to rounding\n"
-        "                          (default 0.05)\n"
-        "  --max-iter N            Baum-Welch iterations at most (default 100)\n"
-        "  --tolerance T           stop when the gain per sample is below T nats (default 1e-6)\n"
+        "%s"
         "  --uniform-priors        equal class priors instead of the training counts\n"
         "  --exclude-participant P[,Q...]  leave these participants out (leave-one-participant-out)\n"
         "  --stop-threshold X      predictor default: stop when P(caught) > X ... (default 0.9)\n"
         "  --stop-consecutive K    ... for K consecutive samples (default 5)\n"
         "  --created TIME          creation time to record (default now, UTC); fixes the bytes\n"
-        "  --json                  print a machine-readable summary");
+        "  --json                  print a machine-readable summary\n",
+        kHmmHelp);
     return 0;
   }
-  args.allow_only({"help", "json", "uniform-priors", "data", "out", "states", "band", "cov-floor", "max-iter",
-                   "tolerance", "exclude-participant", "stop-threshold", "stop-consecutive", "created"});
+  std::set<std::string> known{"help", "json", "uniform-priors", "data", "out", "exclude-participant",
+                              "stop-threshold", "stop-consecutive", "created"};
+  known.insert(std::begin(kHmmOptionNames), std::end(kHmmOptionNames));
+  args.allow_only(known);
   const std::string data = args.require("data"), out = args.require_output_file("out");
   hmm::ModelOptions opt;
-  opt.hmm.n_states = static_cast<int>(args.integer("states", 10));
-  opt.hmm.band = static_cast<int>(args.integer("band", 1));
-  opt.hmm.cov_floor = args.number("cov-floor", opt.hmm.cov_floor);
-  opt.hmm.max_iterations = static_cast<int>(args.integer("max-iter", 100));
-  opt.hmm.tolerance = args.number("tolerance", 1e-6);
+  opt.hmm = hmm_options(args);
   opt.uniform_priors = args.has("uniform-priors");
   opt.source_dataset = data;
-  if (opt.hmm.n_states < 1 || opt.hmm.n_states > model::kMaxStates)
-    throw UsageError("--states must be 1.." + std::to_string(model::kMaxStates));
-  if (opt.hmm.band < 1 || opt.hmm.band > model::kMaxStates) throw UsageError("--band must be 1..32");
-  if (!(opt.hmm.cov_floor >= hmm::kMinCovFloor))
-    throw UsageError("--cov-floor must be at least 1e-9 (scaled feature units squared): below it a state's "
-                     "covariance determinant is lost to rounding and its log-likelihood is -inf");
-  if (opt.hmm.max_iterations < 1) throw UsageError("--max-iter must be >= 1");
-  if (!(opt.hmm.tolerance >= 0)) throw UsageError("--tolerance must be >= 0");
   const double stop_threshold = args.number("stop-threshold", 0.9);
   const long stop_consecutive = args.integer("stop-consecutive", 5);
   if (!(stop_threshold > 0 && stop_threshold < 1)) throw UsageError("--stop-threshold must be in (0, 1)");

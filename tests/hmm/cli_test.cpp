@@ -552,6 +552,44 @@ TEST_F(CliTest, ACovarianceFloorBelowTheBoundIsRefused) {
   EXPECT_EQ(r.err.find("inf"), std::string::npos) << r.err;
 }
 
+// build-model takes train's Baum-Welch settings (--states, --band, --cov-floor, --max-iter,
+// --tolerance), which it had not: its HMMs stopped at train's default of 100 iterations, whatever
+// their gain. Given the same settings, the two commands train the same numbers; 3 iterations
+// with tolerance 0 stop at the cap, and the summary says so. A value out of range is refused
+// before anything is synthesized: with --calibration naming no file, the option is what fails.
+TEST_F(CliTest, BuildModelTakesTrainsBaumWelchSettings) {
+  save_dataset(fx::synthetic_dataset(4, 200, 260, 58, 5), dir / "d");
+  const std::string data = " --data " + (dir / "d").string();
+  const std::string settings = " --states 4 --band 2 --cov-floor 0.1 --max-iter 3 --tolerance 0";
+  ASSERT_EQ(run("train" + data + settings + " --uniform-priors --out " + (dir / "t.dgm").string()).code, 0);
+  const auto b = run("build-model" + data + settings + " --out " + (dir / "b.dgm").string());
+  ASSERT_EQ(b.code, 0) << b.err;
+  const auto t = model::read_model(dir / "t.dgm"), m = model::read_model(dir / "b.dgm");
+  ASSERT_EQ(m.classes.size(), 3u);
+  ASSERT_EQ(t.classes.size(), 3u);
+  for (size_t c = 0; c < 3; ++c) {
+    SCOPED_TRACE(m.classes[c].name);
+    EXPECT_EQ(m.classes[c].n_states, 4);
+    EXPECT_EQ(m.classes[c].transition, t.classes[c].transition);
+    EXPECT_GT(m.classes[c].transition[0 * 4 + 2], 0.0) << "--band 2: state 0 may skip to state 2";
+    for (int i = 0; i < 4; ++i) {
+      const auto &x = m.classes[c].emission[i], &y = t.classes[c].emission[i];
+      for (int k = 0; k < model::kFeatures; ++k) {
+        EXPECT_EQ(x.mean[k], y.mean[k]);
+        for (int l = 0; l < model::kFeatures; ++l) EXPECT_EQ(x.cov[k][l], y.cov[k][l]);
+      }
+    }
+  }
+  EXPECT_NE(m.training_summary.find("4 states, 3 iterations (not converged)"), std::string::npos)
+      << m.training_summary;
+  for (const std::string bad : {"--max-iter 0", "--tolerance -1", "--band 0", "--states 33", "--cov-floor 0"}) {
+    const auto r = run("build-model --calibration " + (dir / "none.json").string() + " --out " +
+                       (dir / "x.dgm").string() + " " + bad);
+    EXPECT_EQ(r.code, 2) << bad;
+    EXPECT_NE(r.err.find(bad.substr(0, bad.find(' ')) + " must be"), std::string::npos) << r.err;
+  }
+}
+
 // A folder that --data names twice, as itself or by another path, is refused, naming it: train
 // pooled study,study as 44 trials, each counted twice. train and build-model read the list alike.
 TEST_F(CliTest, ADatasetPooledTwiceIsRefused) {

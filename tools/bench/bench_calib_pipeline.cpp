@@ -838,7 +838,7 @@ int run_pooled(const std::map<std::string, std::string>& a) {
   };
   auto train = [&](const std::vector<const HapticSequence*>& trials, int second_axis, const std::string& what) {
     StcOptions o;
-    o.states = states;
+    o.hmm.n_states = states;
     o.second_axis = second_axis;
     o.source = what;
     return build_outcome_model(trials, o);
